@@ -1,0 +1,5 @@
+//! The `trilux` command.
+
+fn main() {
+    println!("trilux: under construction");
+}
