@@ -1,0 +1,116 @@
+//! Geometric throughput of an element pair, T_ij = A_i F_{i→j} V_ij, cached.
+//!
+//! T is symmetric (reciprocity A_i F_ij = A_j F_ji), so one number serves
+//! both directions: a link i→j transports flux π T_ij δL_i and gives j the
+//! radiance ρ (T_ij / A_j) δL_i. The paper stores "a form factor multiplied
+//! by a visibility term" in each interaction (§4.6); the solver keeps it on
+//! stored interaction nodes and, for the transient pairs of Lambertian
+//! senders, in this bounded cache so that later shots between the same
+//! elements do not trace the same shadow rays again.
+
+use std::collections::HashMap;
+use std::sync::RwLock;
+
+use trilux_geometry::{ElementId, FormFactorOptions, SceneGeometry};
+
+/// One element seen from one of its sides.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub(crate) struct SidedElement {
+    /// The element.
+    pub element: ElementId,
+    /// Its back face rather than its front.
+    pub back: bool,
+}
+
+impl SidedElement {
+    fn key(self) -> u64 {
+        (u64::from(self.element.0) << 1) | u64::from(self.back)
+    }
+}
+
+/// A throughput with the visible fraction it was made with.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct Throughput {
+    /// T = A_i F_{i→j} V (m²).
+    pub t: f64,
+    /// The visible fraction V in [0, 1].
+    pub v: f64,
+}
+
+const SHARDS: usize = 64;
+
+/// A bounded, thread-safe cache of throughputs keyed by unordered sided pairs.
+pub(crate) struct ThroughputCache {
+    shards: Vec<RwLock<HashMap<u64, Throughput>>>,
+    per_shard_cap: usize,
+}
+
+impl ThroughputCache {
+    /// A cache holding at most about `capacity` pairs.
+    pub fn new(capacity: usize) -> Self {
+        ThroughputCache {
+            shards: (0..SHARDS).map(|_| RwLock::new(HashMap::new())).collect(),
+            per_shard_cap: (capacity / SHARDS).max(16),
+        }
+    }
+
+    fn key(a: SidedElement, b: SidedElement) -> u64 {
+        let (x, y) = (a.key(), b.key());
+        let (lo, hi) = if x <= y { (x, y) } else { (y, x) };
+        (hi << 32) | lo
+    }
+
+    fn shard(key: u64) -> usize {
+        // Fibonacci hashing spreads neighbouring ids over the shards.
+        (key.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 58) as usize % SHARDS
+    }
+
+    /// The cached throughput of a pair, if any.
+    pub fn get(&self, a: SidedElement, b: SidedElement) -> Option<Throughput> {
+        let key = Self::key(a, b);
+        let shard = self.shards[Self::shard(key)].read().ok()?;
+        shard.get(&key).copied()
+    }
+
+    /// Stores a throughput; clears the shard when it is full (a simple bound
+    /// that keeps memory O(capacity) whatever the scene).
+    pub fn insert(&self, a: SidedElement, b: SidedElement, t: Throughput) {
+        let key = Self::key(a, b);
+        if let Ok(mut shard) = self.shards[Self::shard(key)].write() {
+            if shard.len() >= self.per_shard_cap {
+                shard.clear();
+            }
+            shard.insert(key, t);
+        }
+    }
+
+    /// Number of cached pairs.
+    pub fn len(&self) -> usize {
+        self.shards
+            .iter()
+            .map(|s| s.read().map(|s| s.len()).unwrap_or(0))
+            .sum()
+    }
+}
+
+/// Computes T_ij = A_i F_{i→j} V_ij for the given sides, without the cache.
+pub(crate) fn compute_throughput(
+    geom: &SceneGeometry,
+    i: SidedElement,
+    j: SidedElement,
+    visibility_samples: u32,
+    ff_options: &FormFactorOptions,
+) -> Throughput {
+    let ff = geom.form_factor_sided(i.element, i.back, j.element, j.back, ff_options);
+    if !(ff.value.is_finite() && ff.value > 0.0) {
+        return Throughput::default();
+    }
+    let v = geom.visibility_sided(i.element, i.back, j.element, j.back, visibility_samples);
+    let area = geom.element(i.element).area;
+    let t = area * ff.value * v;
+    if t.is_finite() && t > 0.0 {
+        Throughput { t, v }
+    } else {
+        Throughput { t: 0.0, v }
+    }
+}
