@@ -4,7 +4,7 @@
 //!
 //! Run: `cargo run -p trilux-geometry --release --example two_squares`
 
-use glam::{DMat4, DVec3, DVec4};
+use glam::{DMat4, DVec4};
 use trilux_geometry::{SceneGeometry, Shape, ShapeKind};
 
 /// The rectangle [-1,1]² scaled by `half`, at height `z`, facing down if
