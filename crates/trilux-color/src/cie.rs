@@ -170,7 +170,12 @@ impl SampledSpectrum {
             b.push(k);
             k += 1.0;
         }
-        b.extend(self.wavelengths.iter().copied().filter(|&l| l > lo && l < hi));
+        b.extend(
+            self.wavelengths
+                .iter()
+                .copied()
+                .filter(|&l| l > lo && l < hi),
+        );
         b.push(hi);
         b.sort_by(f64::total_cmp);
         b.dedup();
@@ -225,7 +230,11 @@ impl SampledSpectrum {
     pub fn observer_weighted_average(&self, lo: f64, hi: f64) -> f64 {
         let num: f64 = self.cmf_integral_range(lo, hi).iter().sum();
         let den: f64 = table_integral(lo, hi).iter().sum();
-        if den > 0.0 { num / den } else { self.average(lo, hi) }
+        if den > 0.0 {
+            num / den
+        } else {
+            self.average(lo, hi)
+        }
     }
 
     /// CIE XYZ, normalised so that the equal-energy spectrum of value 1 has
@@ -274,7 +283,10 @@ pub mod mitsuba {
     /// reflectance seen under D65; `bounded` clamps to [0, 1], otherwise
     /// negative channels clamp to 0.
     pub fn spectrum_to_srgb(s: &SampledSpectrum, bounded: bool, d65: bool) -> [f64; 3] {
-        let (lo, hi) = (s.wavelengths()[0], s.wavelengths()[s.wavelengths().len() - 1]);
+        let (lo, hi) = (
+            s.wavelengths()[0],
+            s.wavelengths()[s.wavelengths().len() - 1],
+        );
         let mut xyz = [0.0; 3];
         const STEPS: usize = 1000;
         for i in 0..STEPS {

@@ -94,13 +94,11 @@ impl ColorParam {
                     _ => Spectrum::splat(*v),
                 },
                 ColorParam::Constant(v) => Spectrum::splat(*v),
-                ColorParam::Rgb(c) => {
-                    match role {
-                        Role::Reflectance => smooth_reflectance::<N>(*c).clamp(0.0, 1.0),
-                        Role::Unbounded => smooth_reflectance::<N>(*c).max(Spectrum::zero()),
-                        Role::Emission => smooth_emission::<N>(*c),
-                    }
-                }
+                ColorParam::Rgb(c) => match role {
+                    Role::Reflectance => smooth_reflectance::<N>(*c).clamp(0.0, 1.0),
+                    Role::Unbounded => smooth_reflectance::<N>(*c).max(Spectrum::zero()),
+                    Role::Emission => smooth_emission::<N>(*c),
+                },
                 ColorParam::Sampled(s) => {
                     let s = SampledSpectrum::new(s)?;
                     let mut a = [0.0; N];
@@ -167,7 +165,10 @@ mod tests {
 
     fn close(a: [f64; 3], b: [f64; 3], rel: f64) {
         for k in 0..3 {
-            assert!((a[k] - b[k]).abs() <= rel * b[k].abs().max(1e-3), "{a:?} vs {b:?}");
+            assert!(
+                (a[k] - b[k]).abs() <= rel * b[k].abs().max(1e-3),
+                "{a:?} vs {b:?}"
+            );
         }
     }
 
@@ -177,7 +178,9 @@ mod tests {
     fn rgb_mode_matches_mitsuba() {
         let w: Spectrum<3> = parse(CORNELL_WHITE).reflectance().unwrap();
         close(w.0, [0.735013, 0.735625, 0.736264], 2e-6);
-        let l: Spectrum<3> = parse("400:0, 500:8, 600:15.6, 700:18.4").emission().unwrap();
+        let l: Spectrum<3> = parse("400:0, 500:8, 600:15.6, 700:18.4")
+            .emission()
+            .unwrap();
         close(l.0, [20.7108, 10.8546, 2.77115], 5e-6);
         let e: Spectrum<3> = ColorParam::Constant(1.0).emission().unwrap();
         close(e.0, [1.20479, 0.948291, 0.908916], 5e-6);
@@ -191,7 +194,9 @@ mod tests {
         close(flat.0, [0.998985, 0.998874, 0.998802], 2e-6);
         let sat: Spectrum<3> = parse("400:1, 500:0, 700:0").reflectance().unwrap();
         close(sat.0, [0.0284337, 0.0, 0.515323], 2e-5);
-        let eta: Spectrum<3> = parse("400:1.5, 500:0.5, 600:2.5, 700:3.0").unbounded().unwrap();
+        let eta: Spectrum<3> = parse("400:1.5, 500:0.5, 600:2.5, 700:3.0")
+            .unbounded()
+            .unwrap();
         close(eta.0, [3.10261, 1.2672, 0.873268], 5e-6);
         let k: Spectrum<3> = parse("400:3, 700:4").unbounded().unwrap();
         close(k.0, [3.79017, 3.47572, 3.12077], 5e-6);
@@ -211,7 +216,15 @@ mod tests {
         let r: Spectrum<10> = ColorParam::Rgb([0.5, 0.4, 0.3]).emission().unwrap();
         close(r.to_linear_srgb(), [0.5, 0.4, 0.3], 1e-9);
         assert!(ColorParam::Float(-1.0).reflectance::<10>().is_err());
-        assert!(ColorParam::Rgb([f64::NAN, 0.0, 0.0]).reflectance::<3>().is_err());
-        assert!(ColorParam::Sampled(vec![(400.0, 1.0)]).emission::<3>().is_err());
+        assert!(
+            ColorParam::Rgb([f64::NAN, 0.0, 0.0])
+                .reflectance::<3>()
+                .is_err()
+        );
+        assert!(
+            ColorParam::Sampled(vec![(400.0, 1.0)])
+                .emission::<3>()
+                .is_err()
+        );
     }
 }

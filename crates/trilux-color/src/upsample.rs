@@ -121,7 +121,13 @@ fn solve(mut a: Vec<Vec<f64>>) -> Vec<f64> {
         }
     }
     (0..n)
-        .map(|i| if a[i][i] != 0.0 { a[i][n] / a[i][i] } else { 0.0 })
+        .map(|i| {
+            if a[i][i] != 0.0 {
+                a[i][n] / a[i][i]
+            } else {
+                0.0
+            }
+        })
         .collect()
 }
 
@@ -150,11 +156,19 @@ mod tests {
 
     #[test]
     fn exact_round_trip_before_clamping() {
-        for rgb in [[0.5, 0.5, 0.5], [0.2, 0.6, 0.3], [0.9, 0.1, 0.4], [1.0, 1.0, 1.0]] {
+        for rgb in [
+            [0.5, 0.5, 0.5],
+            [0.2, 0.6, 0.3],
+            [0.9, 0.1, 0.4],
+            [1.0, 1.0, 1.0],
+        ] {
             let s = smooth_reflectance::<10>(rgb);
             let back = reflectance_to_srgb(&s);
             for c in 0..3 {
-                assert!((back[c] - rgb[c]).abs() < 1e-10, "{rgb:?} → {s:?} → {back:?}");
+                assert!(
+                    (back[c] - rgb[c]).abs() < 1e-10,
+                    "{rgb:?} → {s:?} → {back:?}"
+                );
             }
         }
     }
@@ -173,7 +187,10 @@ mod tests {
             let e = smooth_emission::<10>(rgb);
             let back = e.to_linear_srgb();
             for c in 0..3 {
-                assert!((back[c] - rgb[c]).abs() < 1e-9 * rgb[c].max(1.0), "{back:?}");
+                assert!(
+                    (back[c] - rgb[c]).abs() < 1e-9 * rgb[c].max(1.0),
+                    "{back:?}"
+                );
             }
         }
         // A saturated green needs the clamp at zero: 1.3% error in red (measured).
