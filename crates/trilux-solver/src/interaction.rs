@@ -218,7 +218,12 @@ impl<const N: usize> Hierarchy<N> {
     /// Radiance leaving the point `x` of the sender side towards the point
     /// `y` of the receiver side: the leaf (deepest node) whose elements
     /// contain both (paper §4.5, Fig. 11c).
-    pub fn radiance_at(&self, geom: &SceneGeometry, x: SurfaceCoord, y: SurfaceCoord) -> Spectrum<N> {
+    pub fn radiance_at(
+        &self,
+        geom: &SceneGeometry,
+        x: SurfaceCoord,
+        y: SurfaceCoord,
+    ) -> Spectrum<N> {
         let mut n = 0u32;
         loop {
             let node = &self.nodes[n as usize];

@@ -53,8 +53,10 @@ pub struct SolverSettings {
     /// MinArea as a fraction of the scene's bounding-box diagonal squared:
     /// elements smaller than this are never split.
     pub min_area_fraction: f64,
-    /// FFErr: a link is accurate enough when the point-to-disc form-factor
-    /// estimates between its elements are below this (HSA91).
+    /// FFErr: a pair link is accurate enough when the point form factor to
+    /// the sender varies by less than this over the receiver (so that the
+    /// gathered radiance can be pushed down unchanged); three-point links
+    /// compare the point-to-disc estimates of (j, k) against it (HSA91).
     pub ff_eps: f64,
     /// FrErr: bound on π F (fr_max − fr_min) over the three elements.
     pub fr_eps: f64,
@@ -77,9 +79,9 @@ impl SolverSettings {
                 max_shots: 20_000,
                 max_depth: 4,
                 min_area_fraction: 1e-5,
-                ff_eps: 0.04,
+                ff_eps: 0.02,
                 fr_eps: 0.5,
-                flux_eps: 1e-3,
+                flux_eps: 1e-4,
                 visibility_samples: 9,
                 transport: Transport::TwoPoint,
             },
@@ -88,9 +90,9 @@ impl SolverSettings {
                 max_shots: 100_000,
                 max_depth: 5,
                 min_area_fraction: 1e-6,
-                ff_eps: 0.01,
+                ff_eps: 0.005,
                 fr_eps: 0.25,
-                flux_eps: 1e-4,
+                flux_eps: 1e-5,
                 visibility_samples: 16,
                 transport: Transport::TwoPoint,
             },
@@ -99,9 +101,9 @@ impl SolverSettings {
                 max_shots: 500_000,
                 max_depth: 6,
                 min_area_fraction: 1e-7,
-                ff_eps: 0.004,
+                ff_eps: 0.001,
                 fr_eps: 0.1,
-                flux_eps: 2e-5,
+                flux_eps: 1e-6,
                 visibility_samples: 25,
                 transport: Transport::TwoPoint,
             },

@@ -78,7 +78,11 @@ pub(crate) fn build_sides<const N: usize>(
         let shape = surface.shape as usize;
         let bsdf = &materials[shape];
         for back in [false, true] {
-            let side = if back { BsdfSide::Back } else { BsdfSide::Front };
+            let side = if back {
+                BsdfSide::Back
+            } else {
+                BsdfSide::Front
+            };
             let rho = bsdf.diffuse_albedo(side);
             let glossy = bsdf.has_glossy(side);
             let (rho_d, stored) = match transport {
@@ -137,7 +141,7 @@ pub(crate) fn eligible_pairs<const N: usize>(
         .par_iter()
         .map(|s| probe_points(geom, s.surface, s.sign()))
         .collect();
-    let scale = geom.bounds().diagonal().max(1e-300);
+    let scale = geom.bounds().diagonal().length().max(1e-300);
     let eps = 1e-9 * scale;
     (0..sides.len())
         .into_par_iter()
