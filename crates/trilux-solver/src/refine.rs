@@ -283,16 +283,6 @@ impl<const N: usize> RefineContext<'_, N> {
             Transport::TwoPoint => bsdf.eval_glossy(wi, wo),
             Transport::Uniform => bsdf.eval(wi, wo),
         };
-        // Mean of the centre value and the sampled extremes: a cheap
-        // estimate of the discretised fr over the three elements.
-        let fr = if variation.evaluations > 0 {
-            (fr * 2.0
-                + variation.fr_min.max(Spectrum::zero())
-                + variation.fr_max.max(Spectrum::zero()))
-                * 0.25
-        } else {
-            fr
-        };
         let spread = (variation.fr_max - variation.fr_min).max_value().max(0.0);
         (fr, spread, variation.driver())
     }

@@ -109,6 +109,53 @@ impl<const N: usize> Solution<N> {
         self.radiance[usize::from(from.back)][leaf.index()]
     }
 
+    /// Flux π Σ T L carried by the stored interaction from one face to
+    /// another (flux-weighted over its hierarchy, so it is the root's
+    /// π T L), if that interaction exists.
+    pub fn interaction_flux(
+        &self,
+        from: (SurfaceId, bool),
+        to: (SurfaceId, bool),
+    ) -> Option<Spectrum<N>> {
+        let key = (
+            from.0.0 * 2 + u32::from(from.1),
+            to.0.0 * 2 + u32::from(to.1),
+        );
+        let h = &self.hierarchies[*self.by_sides.get(&key)? as usize];
+        let root = &h.nodes[0];
+        Some(root.radiance * (std::f64::consts::PI * root.t))
+    }
+
+    /// The smallest radiance value (any band, any element or node) of the
+    /// solution; NaN if any value is not finite.
+    pub fn min_radiance(&self) -> f64 {
+        let mut min = f64::INFINITY;
+        let mut visit = |s: &Spectrum<N>| {
+            for b in 0..N {
+                if !s[b].is_finite() {
+                    min = f64::NAN;
+                } else if !min.is_nan() {
+                    min = min.min(s[b]);
+                }
+            }
+        };
+        for side in &self.radiance {
+            side.iter().for_each(&mut visit);
+        }
+        for h in &self.hierarchies {
+            h.nodes.iter().for_each(|n| visit(&n.radiance));
+        }
+        min
+    }
+
+    /// Number of stored interaction hierarchies and of their nodes.
+    pub fn interaction_counts(&self) -> (usize, usize) {
+        (
+            self.hierarchies.len(),
+            self.hierarchies.iter().map(|h| h.nodes.len()).sum(),
+        )
+    }
+
     /// Whether the solution has stored (direction-dependent) radiance from
     /// `from`'s face towards `to`'s face.
     pub fn has_stored(&self, from: &SurfaceSite, to: &SurfaceSite) -> bool {

@@ -578,6 +578,8 @@ impl<const N: usize> Solver<N> {
         stats.escaped_flux = self.ledger.escaped.clone();
         stats.residual_flux = residual.to_array().to_vec();
         stats.solve_seconds = seconds;
+        stats.min_shot_escaped = self.ledger.min_shot_escaped;
+        stats.min_element_absorbed = self.ledger.min_element_absorbed;
         Solution::from_solver(self)
     }
 

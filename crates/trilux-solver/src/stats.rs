@@ -41,6 +41,13 @@ pub struct SolveStats {
     pub bands: usize,
     /// Band edges in nm (`None` in RGB mode).
     pub wavelengths_nm: Option<Vec<f64>>,
+    /// The smallest escaped flux of any shot, as a fraction of that shot's
+    /// flux (band minimum). Negative would mean a shot created energy.
+    pub min_shot_escaped: f64,
+    /// The smallest absorbed flux of any receiving element in any shot, as
+    /// a fraction of what arrived there (band minimum). Negative would mean
+    /// an element reflected more than it received.
+    pub min_element_absorbed: f64,
     /// Warnings (e.g. self-exchange of concave surfaces left out).
     pub warnings: Vec<String>,
 }
