@@ -243,12 +243,23 @@ impl<const N: usize> Solver<N> {
             if uniform {
                 // The emission is stored per receiver; what no receiver
                 // takes leaves the scene at once.
+                let t_sum: f64 = hierarchies_from[s]
+                    .iter()
+                    .map(|&h| hierarchies[h as usize].nodes[0].t)
+                    .sum();
+                // Sampled root throughputs may over-count slightly: never
+                // store more than was emitted.
+                let scale = if PI * t_sum > PI * surface.area() {
+                    surface.area() / t_sum
+                } else {
+                    1.0
+                };
                 let mut taken = Spectrum::zero();
                 for &h in &hierarchies_from[s] {
                     let hier = &mut hierarchies[h as usize];
                     let t = hier.nodes[0].t;
-                    hier.nodes[0].unshot = side.emission;
-                    hier.unshot_flux = side.emission * (PI * t);
+                    hier.nodes[0].unshot = side.emission * scale;
+                    hier.unshot_flux = side.emission * (PI * t * scale);
                     taken += hier.unshot_flux;
                 }
                 escaped_at_start += (flux - taken).max(Spectrum::zero());
