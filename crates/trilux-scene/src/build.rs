@@ -82,15 +82,7 @@ pub(crate) fn build(resolved: Resolved, path: &Path) -> Result<Scene> {
             }
         }
     }
-    let camera = match camera {
-        Some((c, _)) => c,
-        None => {
-            return Err(SceneError::at(
-                &scene_el.loc,
-                "the scene has no <sensor type=\"perspective\">",
-            ));
-        }
-    };
+    let camera = camera.map(|(c, _)| c);
     let spectral = shapes.iter().any(|s| {
         bsdf_is_sampled(&s.bsdf)
             || s.emitter

@@ -46,8 +46,9 @@ pub struct Scene {
     pub path: PathBuf,
     /// The shapes, in file order (index i is shape i of the geometry layer).
     pub shapes: Vec<SceneShape>,
-    /// The camera.
-    pub camera: Camera,
+    /// The camera, when the file has a `<sensor>` (Mitsuba 3 loads scenes
+    /// without one too; solving needs none, rendering does).
+    pub camera: Option<Camera>,
     /// The integrator's `max_depth`, when the file gives one (noted in
     /// stats; trilux's solver has its own stopping rule).
     pub max_depth: Option<i64>,

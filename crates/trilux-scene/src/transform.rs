@@ -70,10 +70,18 @@ pub(crate) fn parse(e: &Element) -> Result<TransformValue> {
                 let axis = parse_xyz(op, 0.0)?;
                 let angle = op.required("angle")?;
                 let degrees = parse_f64(&angle.value, &angle.loc)?;
-                if axis.length_squared() == 0.0 {
-                    return Err(SceneError::at(&op.loc, "<rotate> needs a non-zero axis"));
+                // Mitsuba uses the axis as written, without normalising it:
+                // refuse what it would turn into a scale instead.
+                if (axis.length() - 1.0).abs() > 1e-3 {
+                    return Err(SceneError::at(
+                        &op.loc,
+                        format!(
+                            "the <rotate> axis must be a unit vector, found length {} (Mitsuba does not normalise it)",
+                            axis.length()
+                        ),
+                    ));
                 }
-                DMat4::from_axis_angle(axis.normalize(), degrees.to_radians())
+                rotation(axis, degrees)
             }
             "matrix" => {
                 op.check_attrs(&["value"])?;
@@ -113,6 +121,21 @@ pub(crate) fn parse(e: &Element) -> Result<TransformValue> {
         _ => None,
     };
     Ok(TransformValue { matrix, lookat })
+}
+
+/// Rotation by `degrees` about `axis` (right-handed), with Dr.Jit's formula
+/// (used by Mitsuba) so that nearly-unit axes give bit-compatible matrices.
+fn rotation(axis: DVec3, degrees: f64) -> DMat4 {
+    let (s, c) = degrees.to_radians().sin_cos();
+    let cm = 1.0 - c;
+    let DVec3 { x, y, z } = axis;
+    // Rows of the matrix, transposed into glam's columns.
+    DMat4::from_cols(
+        DVec4::new(c + x * x * cm, x * y * cm + z * s, x * z * cm - y * s, 0.0),
+        DVec4::new(x * y * cm - z * s, c + y * y * cm, y * z * cm + x * s, 0.0),
+        DVec4::new(x * z * cm + y * s, y * z * cm - x * s, c + z * z * cm, 0.0),
+        DVec4::W,
+    )
 }
 
 fn vec3_attr(op: &Element, name: &str) -> Result<Option<DVec3>> {

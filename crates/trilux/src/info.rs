@@ -36,7 +36,8 @@ struct InfoJson {
     bsdfs: BTreeMap<String, usize>,
     emitted_power: Vec<f64>,
     mode: &'static str,
-    camera: CameraJson,
+    /// `null` when the scene has no sensor.
+    camera: Option<CameraJson>,
 }
 
 #[derive(Debug, Serialize)]
@@ -58,7 +59,6 @@ pub fn run(args: &InfoArgs) -> Result<()> {
     } else {
         ModeArg::Rgb
     });
-    let c = &scene.camera;
     let info = InfoJson {
         shapes: scene.shapes.len(),
         input_surfaces: input_surfaces_provisional(&scene),
@@ -69,7 +69,7 @@ pub fn run(args: &InfoArgs) -> Result<()> {
             ModeArg::Rgb => "rgb",
             ModeArg::Spectral => "spectral",
         },
-        camera: CameraJson {
+        camera: scene.camera.as_ref().map(|c| CameraJson {
             origin: c.origin.to_array(),
             target: c.target.to_array(),
             up: c.up.to_array(),
@@ -77,7 +77,7 @@ pub fn run(args: &InfoArgs) -> Result<()> {
             fov_axis: c.fov_axis.name(),
             width: c.width,
             height: c.height,
-        },
+        }),
     };
     if args.json {
         println!("{}", serde_json::to_string_pretty(&info)?);
@@ -108,15 +108,19 @@ fn print_text(scene: &Scene, info: &InfoJson) {
     if let Some(d) = scene.max_depth {
         println!("max_depth      {d}");
     }
-    let c = &info.camera;
-    println!(
-        "camera         origin {:?} target {:?} up {:?}",
-        c.origin, c.target, c.up
-    );
-    println!(
-        "               fov {} ({}), {}x{} px, {} spp, {:?} filter",
-        c.fov, c.fov_axis, c.width, c.height, scene.camera.sample_count, scene.camera.rfilter
-    );
+    match (&info.camera, &scene.camera) {
+        (Some(c), Some(cam)) => {
+            println!(
+                "camera         origin {:?} target {:?} up {:?}",
+                c.origin, c.target, c.up
+            );
+            println!(
+                "               fov {} ({}), {}x{} px, {} spp, {:?} filter",
+                c.fov, c.fov_axis, c.width, c.height, cam.sample_count, cam.rfilter
+            );
+        }
+        _ => println!("camera         none (the scene has no <sensor>)"),
+    }
     for (i, s) in scene.shapes.iter().enumerate() {
         let kind = match &s.shape.kind {
             ShapeKind::Rectangle => "rectangle".to_string(),
