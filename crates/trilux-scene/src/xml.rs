@@ -96,7 +96,11 @@ pub(crate) fn parse(text: &str, file: &Arc<Path>, params: &[(String, String)]) -
             line: pos.row,
             col: pos.col,
         };
-        SceneError::at(&loc, format!("malformed XML: {e}"))
+        // roxmltree repeats the position inside its message: drop it there.
+        let message = e
+            .to_string()
+            .replace(&format!(" at {}:{}", pos.row, pos.col), "");
+        SceneError::at(&loc, format!("malformed XML: {message}"))
     })?;
     let mut ctx = Context {
         doc: &doc,
