@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use serde::Serialize;
 use trilux_brdf::BsdfParams;
-use trilux_color::ColorParam;
+use trilux_color::{ColorParam, Mode};
 use trilux_geometry::Shape;
 
 use crate::camera::Camera;
@@ -61,6 +61,16 @@ pub struct Scene {
 }
 
 impl Scene {
+    /// The mode this scene solves in unless overridden (`--mode`): spectral
+    /// when [`Scene::spectral`], else RGB.
+    pub fn mode(&self) -> Mode {
+        if self.spectral {
+            Mode::Spectral
+        } else {
+            Mode::Rgb
+        }
+    }
+
     /// The shapes as the geometry layer takes them (`SceneGeometry::build`).
     pub fn geometry_shapes(&self) -> Vec<Shape> {
         self.shapes.iter().map(|s| s.shape.clone()).collect()

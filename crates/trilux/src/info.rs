@@ -6,6 +6,7 @@ use std::path::PathBuf;
 use anyhow::Result;
 use clap::Args;
 use serde::Serialize;
+use trilux_color::Mode;
 use trilux_geometry::ShapeKind;
 use trilux_scene::Scene;
 
@@ -54,21 +55,18 @@ struct CameraJson {
 /// Runs `trilux info`.
 pub fn run(args: &InfoArgs) -> Result<()> {
     let scene = trilux_scene::load(&args.scene)?;
-    let mode = args.mode.unwrap_or(if scene.spectral {
-        ModeArg::Spectral
-    } else {
-        ModeArg::Rgb
-    });
+    let mode = match args.mode {
+        Some(ModeArg::Rgb) => Mode::Rgb,
+        Some(ModeArg::Spectral) => Mode::Spectral,
+        None => scene.mode(),
+    };
     let info = InfoJson {
         shapes: scene.shapes.len(),
         input_surfaces: input_surfaces_provisional(&scene),
         emitters: scene.emitters().count(),
         bsdfs: scene.bsdf_counts.clone(),
-        emitted_power: emitted_power(&scene, mode),
-        mode: match mode {
-            ModeArg::Rgb => "rgb",
-            ModeArg::Spectral => "spectral",
-        },
+        emitted_power: emitted_power(&scene, mode)?,
+        mode: mode.name(),
         camera: scene.camera.as_ref().map(|c| CameraJson {
             origin: c.origin.to_array(),
             target: c.target.to_array(),

@@ -304,13 +304,12 @@ fn info_json_for_the_cornell_box() {
     );
     // π · A · L: the light is 0.46 × 0.38 (Mitsuba's area 0.1748) and the
     // classic light spectrum is linear sRGB (20.7108, 10.8546, 2.77115)
-    // (design.md §3). 3% tolerance while the colour conversion is the
-    // provisional CMF fit (crates/trilux/src/power.rs).
+    // (design.md §3, Mitsuba 3.9). 1e-4 relative: the check value's digits.
     let power = v["emitted_power"].as_array().expect("array");
     for (p, l) in power.iter().zip([20.7108, 10.8546, 2.77115]) {
         let want = std::f64::consts::PI * 0.1748 * l;
         let got = p.as_f64().expect("number");
-        assert!((got - want).abs() <= 0.03 * want, "{got} vs {want}");
+        assert!((got - want).abs() <= 1e-4 * want, "{got} vs {want}");
     }
 }
 
