@@ -380,9 +380,9 @@ fn shared_edges_of_a_triangulated_cube_do_not_leak() {
     let g = SceneGeometry::build(&[mesh(p.clone(), t, m)]).expect("valid mesh");
     let o = m.transform_point3(DVec3::new(0.1, -0.2, 0.05));
     let mut rays = 0;
-    for a in 0..8 {
+    for a in 0..8usize {
         for b in 0..8 {
-            if (a ^ b as usize).count_ones() > 2 {
+            if (a ^ b).count_ones() > 2 {
                 continue;
             }
             for k in 0..=100 {
