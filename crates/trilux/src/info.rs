@@ -12,7 +12,6 @@ use trilux_scene::Scene;
 
 use crate::ModeArg;
 use crate::power::emitted_power;
-use crate::surfaces::input_surfaces_provisional;
 
 /// Arguments of `trilux info`.
 #[derive(Debug, Args)]
@@ -62,7 +61,7 @@ pub fn run(args: &InfoArgs) -> Result<()> {
     };
     let info = InfoJson {
         shapes: scene.shapes.len(),
-        input_surfaces: input_surfaces_provisional(&scene),
+        input_surfaces: scene.build_geometry()?.surfaces().len(),
         emitters: scene.emitters().count(),
         bsdfs: scene.bsdf_counts.clone(),
         emitted_power: emitted_power(&scene, mode)?,

@@ -6,7 +6,6 @@
 
 mod info;
 mod power;
-mod surfaces;
 
 use std::path::PathBuf;
 use std::process::ExitCode;

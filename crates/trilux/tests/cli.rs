@@ -287,6 +287,8 @@ fn info_json_has_exactly_the_design_keys() {
 fn info_json_for_the_cornell_box() {
     let v = info_json(&scenes_dir().join("cornell-box.xml"), &["--mode", "rgb"]);
     assert_eq!(v["shapes"], 8);
+    // One input surface per rectangle, one per cube face (design.md §2).
+    assert_eq!(v["input_surfaces"], 6 + 2 * 6);
     assert_eq!(v["emitters"], 1);
     assert_eq!(v["bsdfs"], serde_json::json!({ "diffuse": 3 }));
     assert_eq!(v["mode"], "rgb");
@@ -317,6 +319,7 @@ fn info_json_for_the_cornell_box() {
 fn info_json_for_the_furnace() {
     let v = info_json(&scenes_dir().join("furnace.xml"), &[]);
     assert_eq!(v["shapes"], 1);
+    assert_eq!(v["input_surfaces"], 6);
     assert_eq!(v["emitters"], 1);
     assert_eq!(v["mode"], "rgb");
     // Six inner faces of 2 × 2, radiance 1: π · 24 W per band.
