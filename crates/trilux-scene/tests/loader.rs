@@ -288,6 +288,10 @@ fn sensor_errors() {
     assert!(err(r#"<sensor type="perspective"><transform name="to_world"><scale value="2"/></transform></sensor>"#).contains("must not scale"));
     assert!(err(r#"<sensor type="thinlens"/>"#).contains("unknown sensor plugin"));
     assert!(
+        err(r#"<sensor type="perspective"><string name="fov_axis" value="y"/></sensor>"#)
+            .contains("fov_axis needs a fov")
+    );
+    assert!(
         err(r#"<sensor type="perspective"><float name="near_clip" value="0.1"/></sensor>"#)
             .contains("unknown parameter \"near_clip\"")
     );

@@ -21,7 +21,7 @@ pub struct InfoArgs {
     /// Print a JSON object instead of text.
     #[arg(long)]
     pub json: bool,
-    /// Override the scene's colour mode (spectral when some <spectrum> has
+    /// Override the scene's colour mode (spectral when some `<spectrum>` has
     /// wavelength:value pairs).
     #[arg(long, value_enum)]
     pub mode: Option<ModeArg>,
