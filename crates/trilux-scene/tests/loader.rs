@@ -244,6 +244,12 @@ fn sensor_parameters() {
     assert_eq!(c.origin, DVec3::new(1.0, 2.0, 3.0));
     assert_eq!(c.target, DVec3::new(1.0, 2.0, 0.0));
     assert_eq!(c.up, DVec3::Y);
+    // fov without fov_axis: Mitsuba's default axis is x.
+    let x = load(r#"<sensor type="perspective"><float name="fov" value="40"/></sensor>"#)
+        .camera
+        .expect("camera");
+    assert_eq!((x.fov, x.fov_axis), (40.0, FovAxis::X));
+    assert_eq!(x.x_fov(), 40.0);
     for (name, axis) in [
         ("x", FovAxis::X),
         ("y", FovAxis::Y),
