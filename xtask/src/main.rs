@@ -1,8 +1,11 @@
-//! Project automation: `cargo xtask ci` runs everything the tests need.
+//! Project automation: `cargo xtask ci` runs everything the tests need;
+//! `cargo xtask color` checks trilux's colorimetry against colour-science.
 
 use std::process::Command;
 
 use anyhow::{Context, Result, bail};
+
+mod color;
 
 fn run(program: &str, args: &[&str]) -> Result<()> {
     eprintln!("xtask: {program} {}", args.join(" "));
@@ -30,6 +33,7 @@ fn ci() -> Result<()> {
         ],
     )?;
     run("cargo", &["test", "--workspace", "--release"])?;
+    color::color()?;
     Ok(())
 }
 
@@ -37,8 +41,9 @@ fn main() -> Result<()> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     match args.first().map(String::as_str) {
         Some("ci") => ci(),
+        Some("color") => color::color(),
         _ => {
-            eprintln!("usage: cargo xtask ci");
+            eprintln!("usage: cargo xtask ci | color");
             std::process::exit(2);
         }
     }

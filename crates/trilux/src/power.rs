@@ -1,0 +1,62 @@
+//! Emitted power per band, P = π · L · A for each one-sided Lambertian area
+//! emitter (radiance L in each band, area A), summed over the emitters.
+//!
+//! L comes from trilux-color's emission conversion
+//! ([`ColorParam::emission`](trilux_color::ColorParam::emission)), exactly as
+//! the solver will see it: in RGB mode Mitsuba 3's conversions (a sampled
+//! spectrum through CIE 1931 XYZ to linear sRGB; a constant `<spectrum>` as
+//! the equal-energy spectrum), in spectral mode the band values of
+//! trilux-color's bands. A is the shape's exact world-space area
+//! ([`trilux_scene::surface_area`]).
+
+use anyhow::{Result, anyhow};
+use trilux_color::{ColorParam, Mode, Spectrum};
+use trilux_scene::{Scene, surface_area};
+
+/// Bands of the spectral mode (trilux-color's default for the paper: 10).
+pub const SPECTRAL_BANDS: usize = 10;
+
+/// Total emitted power per band (W): Σ π · L · A over the area emitters.
+pub fn emitted_power(scene: &Scene, mode: Mode) -> Result<Vec<f64>> {
+    match mode {
+        Mode::Rgb => power::<3>(scene),
+        Mode::Spectral => power::<SPECTRAL_BANDS>(scene),
+    }
+}
+
+fn power<const N: usize>(scene: &Scene) -> Result<Vec<f64>> {
+    let mut total = Spectrum::<N>::zero();
+    for (_, s) in scene.emitters() {
+        let Some(emitter) = &s.emitter else { continue };
+        let radiance = radiance::<N>(&emitter.radiance)
+            .map_err(|e| anyhow!("{}: emitted radiance: {e}", emitter.location))?;
+        total += radiance * (std::f64::consts::PI * surface_area(&s.shape));
+    }
+    Ok(total.0.to_vec())
+}
+
+fn radiance<const N: usize>(c: &ColorParam) -> Result<Spectrum<N>> {
+    Ok(c.emission::<N>()?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// design.md §3's check value (Mitsuba 3.9): the classic Cornell light
+    /// in RGB mode is linear sRGB (20.7108, 10.8546, 2.77115). 1e-4 relative:
+    /// the check value's six digits.
+    #[test]
+    fn cornell_light_in_rgb_matches_mitsuba() {
+        let light = ColorParam::Sampled(vec![
+            (400.0, 0.0),
+            (500.0, 8.0),
+            (600.0, 15.6),
+            (700.0, 18.4),
+        ]);
+        let rgb = radiance::<3>(&light).expect("valid");
+        for (got, want) in rgb.0.iter().zip([20.7108, 10.8546, 2.77115]) {
+            assert!((got - want).abs() <= 1e-4 * want, "{rgb:?}");
+        }
+    }
+}
