@@ -21,6 +21,8 @@
 //! - [`solution`]: the radiance query for final gathering and the file format.
 //! - [`stats`]: what `--stats` writes.
 #![forbid(unsafe_code)]
+// Band loops index several per-band arrays in step.
+#![allow(clippy::needless_range_loop)]
 
 pub mod error;
 pub mod input;
