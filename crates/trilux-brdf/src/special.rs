@@ -6,6 +6,22 @@
 
 use std::f64::consts::PI;
 
+/// Taylor coefficients of erf(x)/x in x²: 2/√π · (−1)ⁿ/(n! (2n + 1)).
+const ERF_SERIES: [f64; 44] = {
+    let mut c = [0.0; 44];
+    let mut fact = 1.0;
+    let mut n = 0;
+    while n < 44 {
+        if n > 0 {
+            fact *= n as f64;
+        }
+        let sign = if n % 2 == 0 { 1.0 } else { -1.0 };
+        c[n] = std::f64::consts::FRAC_2_SQRT_PI * sign / (fact * (2 * n + 1) as f64);
+        n += 1;
+    }
+    c
+};
+
 /// The error function.
 pub fn erf(x: f64) -> f64 {
     if x.is_nan() {
@@ -13,17 +29,13 @@ pub fn erf(x: f64) -> f64 {
     }
     let z = x.abs();
     if z < 2.5 {
+        // Horner on the series coefficients (the last term is < 1e-17 at 2.5).
         let x2 = x * x;
-        let (mut sum, mut term) = (0.0, x);
-        for n in 0..80 {
-            let t = term / (2 * n + 1) as f64;
-            sum += t;
-            if t.abs() < 1e-17 * sum.abs() {
-                break;
-            }
-            term *= -x2 / (n + 1) as f64;
+        let mut acc = 0.0;
+        for c in ERF_SERIES.iter().rev() {
+            acc = acc * x2 + c;
         }
-        2.0 / PI.sqrt() * sum
+        x * acc
     } else {
         // erfc(z) = exp(−z²)/√π · 1/(z + ½/(z + 1/(z + 3⁄2/(z + …)))).
         let mut k = z;
@@ -35,8 +47,22 @@ pub fn erf(x: f64) -> f64 {
     }
 }
 
-/// The inverse of [`erf`] on (−1, 1) (clamped just inside).
+/// The inverse of [`erf`] on (−1, 1) (clamped just inside), to ~1e-12.
 pub fn erf_inv(x: f64) -> f64 {
+    let mut y = erf_inv_fast(x);
+    for _ in 0..2 {
+        let d = 2.0 / PI.sqrt() * (-y * y).exp();
+        if d > 0.0 {
+            y -= (erf(y) - x) / d;
+        }
+    }
+    y
+}
+
+/// Giles' (2010) approximation of the inverse error function alone (no
+/// refinement): |erf(erf_inv_fast(x)) − x| < 1e-6 (tested), ~20× cheaper than
+/// [`erf_inv`].
+pub fn erf_inv_fast(x: f64) -> f64 {
     let x = x.clamp(-1.0 + 1e-15, 1.0 - 1e-15);
     let mut w = -((1.0 - x) * (1.0 + x)).ln();
     let mut p;
@@ -63,14 +89,7 @@ pub fn erf_inv(x: f64) -> f64 {
         p = 1.001_674_06 + p * w;
         p = 2.832_976_82 + p * w;
     }
-    let mut y = p * x;
-    for _ in 0..2 {
-        let d = 2.0 / PI.sqrt() * (-y * y).exp();
-        if d > 0.0 {
-            y -= (erf(y) - x) / d;
-        }
-    }
-    y
+    p * x
 }
 
 #[cfg(test)]
@@ -89,6 +108,7 @@ mod tests {
         for i in 1..200 {
             let x = -0.995 + i as f64 * 0.00995;
             assert!((erf(erf_inv(x)) - x).abs() < 1e-12, "{x}");
+            assert!((erf(erf_inv_fast(x)) - x).abs() < 1e-6, "{x}");
         }
     }
 }
