@@ -1,5 +1,8 @@
 //! Project automation: `cargo xtask ci` runs everything the tests need.
 
+mod golden;
+mod sweep;
+
 use std::process::Command;
 
 use anyhow::{Context, Result, bail};
@@ -20,7 +23,14 @@ fn ci() -> Result<()> {
     run("cargo", &["fmt", "--all", "--", "--check"])?;
     run(
         "cargo",
-        &["clippy", "--workspace", "--all-targets", "--", "-D", "warnings"],
+        &[
+            "clippy",
+            "--workspace",
+            "--all-targets",
+            "--",
+            "-D",
+            "warnings",
+        ],
     )?;
     run("cargo", &["test", "--workspace", "--release"])?;
     Ok(())
@@ -30,8 +40,10 @@ fn main() -> Result<()> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     match args.first().map(String::as_str) {
         Some("ci") => ci(),
+        Some("golden") => golden::main(&args[1..]),
+        Some("sweep") => sweep::main(&args[1..]),
         _ => {
-            eprintln!("usage: cargo xtask ci");
+            eprintln!("usage: cargo xtask ci | golden | sweep");
             std::process::exit(2);
         }
     }

@@ -1,0 +1,288 @@
+//! Golden images: trilux renders against Mitsuba 3 references.
+//!
+//! References live in `tests/golden/` (made by
+//! `tests/golden/make_references.py`): `NAME.exr` (linear sRGB),
+//! `NAME.mask.exr` (1 where an emitter is directly visible, dilated by 1 px)
+//! and `NAME.json` (how it was made, its size and its own noise).
+//!
+//! Metrics (pixels where the mask is set are left out unless said):
+//! - relative RMSE: `sqrt(Σ (a − r)² / Σ r²)` over unmasked pixels and the
+//!   three channels, i.e. the RMS error normalised by the RMS of the
+//!   reference (robust against dark pixels, unlike a per-pixel ratio);
+//! - mean ratio: mean(a) / mean(r) over unmasked pixels and channels (the
+//!   energy bias); also over all pixels.
+//!
+//! Commands:
+//! - `cargo xtask golden compare IMAGE.exr REFERENCE.exr [--mask MASK.exr]`
+//!   prints the metrics of any two EXRs of the same size;
+//! - `cargo xtask golden [--spp N] [--only NAME]...` renders every scene that
+//!   has a reference with `target/release/trilux render` at the reference's
+//!   size and compares, failing above [`MAX_REL_RMSE`] or outside
+//!   [`MAX_MEAN_BIAS`].
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use anyhow::{Context, Result, bail};
+use trilux_render::Image;
+
+/// Largest accepted relative RMSE (unmasked) of a trilux render at the
+/// golden sample count against its reference. Provisional until the solver
+/// lands and the measured values are in docs/results.md.
+pub const MAX_REL_RMSE: f64 = 0.10;
+/// Largest accepted |mean ratio − 1| (unmasked): issue 5 asks for 1 %.
+pub const MAX_MEAN_BIAS: f64 = 0.01;
+
+/// The metrics of one image against its reference.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Comparison {
+    /// Relative RMSE over unmasked pixels.
+    pub rel_rmse: f64,
+    /// Relative RMSE over all pixels.
+    pub rel_rmse_all: f64,
+    /// mean(image) / mean(reference) over unmasked pixels.
+    pub mean_ratio: f64,
+    /// mean(image) / mean(reference) over all pixels.
+    pub mean_ratio_all: f64,
+    /// Number of masked pixels.
+    pub masked: usize,
+}
+
+/// Compares `image` with `reference`; `mask` (same size, > 0.5 = masked)
+/// leaves pixels out.
+pub fn compare(image: &Image, reference: &Image, mask: Option<&Image>) -> Result<Comparison> {
+    let size = |i: &Image| (i.width(), i.height());
+    if size(image) != size(reference) {
+        bail!(
+            "image is {:?} but the reference is {:?}",
+            size(image),
+            size(reference)
+        );
+    }
+    if let Some(m) = mask
+        && size(m) != size(reference)
+    {
+        bail!(
+            "mask is {:?} but the reference is {:?}",
+            size(m),
+            size(reference)
+        );
+    }
+    let mut acc = [[0.0f64; 4]; 2]; // [unmasked, all] × [Σd², Σr², Σa, Σr]
+    let mut masked = 0;
+    for (k, (a, r)) in image.pixels().iter().zip(reference.pixels()).enumerate() {
+        let is_masked = mask.is_some_and(|m| m.pixels()[k][0] > 0.5);
+        masked += usize::from(is_masked);
+        for c in 0..3 {
+            let (a, r) = (a[c] as f64, r[c] as f64);
+            let terms = [(a - r) * (a - r), r * r, a, r];
+            for (set, acc) in acc.iter_mut().enumerate() {
+                if set == 1 || !is_masked {
+                    for (s, t) in acc.iter_mut().zip(terms) {
+                        *s += t;
+                    }
+                }
+            }
+        }
+    }
+    let rmse = |a: &[f64; 4]| (a[0] / a[1]).sqrt();
+    let ratio = |a: &[f64; 4]| a[2] / a[3];
+    Ok(Comparison {
+        rel_rmse: rmse(&acc[0]),
+        rel_rmse_all: rmse(&acc[1]),
+        mean_ratio: ratio(&acc[0]),
+        mean_ratio_all: ratio(&acc[1]),
+        masked,
+    })
+}
+
+/// The repository root (xtask lives one level below it).
+pub fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .map(Path::to_path_buf)
+        .unwrap_or_else(|| PathBuf::from("."))
+}
+
+/// One stored reference.
+#[derive(Clone, Debug)]
+pub struct Reference {
+    /// Scene name (file stem in scenes/).
+    pub name: String,
+    /// The reference image.
+    pub image: Image,
+    /// Its emitter mask, if stored.
+    pub mask: Option<Image>,
+    /// Its own estimated relative RMSE (from the sidecar JSON).
+    pub noise: Option<f64>,
+}
+
+/// Every reference in tests/golden/ (optionally only those named).
+pub fn references(only: &[String]) -> Result<Vec<Reference>> {
+    let dir = root().join("tests/golden");
+    let mut names: Vec<String> = std::fs::read_dir(&dir)
+        .with_context(|| format!("reading {}", dir.display()))?
+        .filter_map(|e| e.ok())
+        .filter_map(|e| {
+            let n = e.file_name().to_string_lossy().into_owned();
+            n.strip_suffix(".json").map(str::to_owned)
+        })
+        .filter(|n| only.is_empty() || only.contains(n))
+        .collect();
+    names.sort();
+    let mut out = Vec::new();
+    for name in names {
+        let image = Image::read_exr(&dir.join(format!("{name}.exr")))?;
+        let mask_path = dir.join(format!("{name}.mask.exr"));
+        let mask = if mask_path.exists() {
+            Some(Image::read_exr(&mask_path)?)
+        } else {
+            None
+        };
+        let json: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.join(format!("{name}.json")))?)
+                .with_context(|| format!("parsing tests/golden/{name}.json"))?;
+        let noise = json.get("noise_rel_rmse_unmasked").and_then(|v| v.as_f64());
+        out.push(Reference {
+            name,
+            image,
+            mask,
+            noise,
+        });
+    }
+    Ok(out)
+}
+
+/// Renders `scenes/NAME.xml` with the trilux binary into `out`; returns the
+/// wall-clock seconds.
+pub fn render_trilux(
+    name: &str,
+    width: u32,
+    height: u32,
+    extra: &[String],
+    out: &Path,
+) -> Result<f64> {
+    let root = root();
+    let bin = root.join("target/release/trilux");
+    if !bin.exists() {
+        bail!(
+            "{} is missing: run `cargo build --release -p trilux` first",
+            bin.display()
+        );
+    }
+    let scene = root.join(format!("scenes/{name}.xml"));
+    let start = std::time::Instant::now();
+    let status = Command::new(&bin)
+        .arg("render")
+        .arg(&scene)
+        .args([
+            "--width",
+            &width.to_string(),
+            "--height",
+            &height.to_string(),
+        ])
+        .args(extra)
+        .arg("-o")
+        .arg(out)
+        .status()
+        .with_context(|| format!("starting {}", bin.display()))?;
+    if !status.success() {
+        bail!("trilux render {} failed ({status})", scene.display());
+    }
+    Ok(start.elapsed().as_secs_f64())
+}
+
+fn print(name: &str, c: &Comparison) {
+    println!(
+        "{name:<20} relRMSE {:.4} (all pixels {:.4})  mean ratio {:.4} (all pixels {:.4})  masked {}",
+        c.rel_rmse, c.rel_rmse_all, c.mean_ratio, c.mean_ratio_all, c.masked
+    );
+}
+
+/// `cargo xtask golden ...`
+pub fn main(args: &[String]) -> Result<()> {
+    if args.first().map(String::as_str) == Some("compare") {
+        let [image, reference, rest @ ..] = &args[1..] else {
+            bail!("usage: cargo xtask golden compare IMAGE.exr REFERENCE.exr [--mask MASK.exr]");
+        };
+        let mask = match rest {
+            [flag, m] if flag == "--mask" => Some(Image::read_exr(Path::new(m))?),
+            [] => None,
+            _ => {
+                bail!("usage: cargo xtask golden compare IMAGE.exr REFERENCE.exr [--mask MASK.exr]")
+            }
+        };
+        let c = compare(
+            &Image::read_exr(Path::new(image))?,
+            &Image::read_exr(Path::new(reference))?,
+            mask.as_ref(),
+        )?;
+        print(image, &c);
+        return Ok(());
+    }
+    let mut spp = 256u32;
+    let mut only = Vec::new();
+    let mut it = args.iter();
+    while let Some(a) = it.next() {
+        match a.as_str() {
+            "--spp" => spp = it.next().context("--spp needs a value")?.parse()?,
+            "--only" => only.push(it.next().context("--only needs a scene name")?.clone()),
+            other => bail!("unknown argument {other}"),
+        }
+    }
+    let tmp = std::env::temp_dir().join(format!("trilux-golden-{}", std::process::id()));
+    std::fs::create_dir_all(&tmp)?;
+    let mut failed = Vec::new();
+    for r in references(&only)? {
+        let out = tmp.join(format!("{}.exr", r.name));
+        let seconds = render_trilux(
+            &r.name,
+            r.image.width(),
+            r.image.height(),
+            &["--spp".into(), spp.to_string(), "--seed".into(), "0".into()],
+            &out,
+        )?;
+        let c = compare(&Image::read_exr(&out)?, &r.image, r.mask.as_ref())?;
+        print(&r.name, &c);
+        println!("{:<20} {seconds:.2} s, reference noise {:?}", "", r.noise);
+        if c.rel_rmse > MAX_REL_RMSE || (c.mean_ratio - 1.0).abs() > MAX_MEAN_BIAS {
+            failed.push(r.name.clone());
+        }
+    }
+    let _ = std::fs::remove_dir_all(&tmp);
+    if !failed.is_empty() {
+        bail!(
+            "golden images differ beyond relRMSE {MAX_REL_RMSE} or mean bias {MAX_MEAN_BIAS}: {}",
+            failed.join(", ")
+        );
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn img(v: &[f32]) -> Image {
+        Image::from_pixels(v.len() as u32, 1, v.iter().map(|&x| [x, x, x]).collect()).unwrap()
+    }
+
+    #[test]
+    fn metrics_follow_their_definitions() {
+        let r = img(&[1.0, 2.0, 3.0, 100.0]);
+        let same = compare(&r, &r, None).unwrap();
+        assert_eq!((same.rel_rmse, same.mean_ratio), (0.0, 1.0));
+        // 10 % brighter everywhere: relRMSE 0.1, ratio 1.1.
+        let a = img(&[1.1, 2.2, 3.3, 110.0]);
+        let c = compare(&a, &r, None).unwrap();
+        assert!((c.rel_rmse - 0.1).abs() < 1e-6 && (c.mean_ratio - 1.1).abs() < 1e-6);
+        // Masking the bright pixel leaves sqrt(Σ d² / Σ r²) over the rest.
+        let b = img(&[1.0, 2.0, 4.0, 0.0]);
+        let m = img(&[0.0, 0.0, 0.0, 1.0]);
+        let c = compare(&b, &r, Some(&m)).unwrap();
+        assert!((c.rel_rmse - (1.0f64 / 14.0).sqrt()).abs() < 1e-9);
+        assert!((c.mean_ratio - 7.0 / 6.0).abs() < 1e-9);
+        assert_eq!(c.masked, 1);
+        assert!(compare(&img(&[1.0]), &r, None).is_err());
+    }
+}
