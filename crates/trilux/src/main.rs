@@ -1,5 +1,74 @@
-//! The `trilux` command.
+//! The `trilux` command: solve, render and inspect scenes (design.md §3).
+//!
+//! Runtime errors print one line `error: ...` on stderr and exit with status
+//! 1; command-line usage errors keep clap's message and exit with status 2.
+//! Subcommands live one per module; `render` and `solve` join `info` here.
 
-fn main() {
-    println!("trilux: under construction");
+mod info;
+mod power;
+mod surfaces;
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand, ValueEnum};
+
+/// Progressive hierarchical three-point light transport.
+#[derive(Debug, Parser)]
+#[command(name = "trilux", version, about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Print what a scene file loads to: shapes, input surfaces, materials,
+    /// emitters, camera.
+    Info(info::InfoArgs),
+}
+
+/// How light is carried: 3 RGB bands or spectral bands.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum ModeArg {
+    /// Linear sRGB, 3 bands.
+    Rgb,
+    /// Spectral bands (10 by default).
+    Spectral,
+}
+
+/// The bundled default scene (the Cornell box): `scenes/cornell-box.xml`
+/// below the current folder, else in the source tree this binary was built
+/// from.
+pub fn default_scene() -> PathBuf {
+    let local = PathBuf::from("scenes/cornell-box.xml");
+    if local.exists() {
+        return local;
+    }
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/cornell-box.xml")
+}
+
+fn run(cli: Cli) -> anyhow::Result<()> {
+    match cli.command {
+        Some(Command::Info(args)) => info::run(&args),
+        // Until the renderer lands, the main job describes the default scene.
+        None => info::run(&info::InfoArgs {
+            scene: default_scene(),
+            json: false,
+            mode: None,
+        }),
+    }
+}
+
+fn main() -> ExitCode {
+    // Usage errors exit here with clap's message and status 2.
+    let cli = Cli::parse();
+    match run(cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            let message = e.to_string().replace(['\n', '\r'], " ");
+            eprintln!("error: {message}");
+            ExitCode::FAILURE
+        }
+    }
 }

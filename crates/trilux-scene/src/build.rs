@@ -1,0 +1,368 @@
+//! Stage 4 of loading: the resolved tree → the [`Scene`] model.
+//!
+//! Top level: `<shape>`, `<sensor>` (one), `<integrator>` (at most one,
+//! ignored except `max_depth`), `<bsdf>` definitions. Anything else is
+//! refused with its location.
+
+use std::path::Path;
+
+use glam::{DMat4, DVec3};
+use trilux_brdf::BsdfParams;
+use trilux_color::ColorParam;
+
+use crate::camera::{Camera, FovAxis, ReconstructionFilter, default_fov};
+use crate::error::{Result, SceneError};
+use crate::material::{build_bsdf, check_color};
+use crate::props::Props;
+use crate::resolve::Resolved;
+use crate::scene::{AreaEmitter, Scene, SceneShape};
+use crate::shape::build_shape;
+use crate::xml::Element;
+
+/// Builds the scene from the resolved tree. `path` is the scene file.
+pub(crate) fn build(resolved: Resolved, path: &Path) -> Result<Scene> {
+    let scene_el = &resolved.scene;
+    scene_el.check_attrs(&["version"])?;
+    let folder = path.parent().unwrap_or(Path::new("."));
+    let mut shapes = Vec::new();
+    let mut camera: Option<(Camera, &Element)> = None;
+    let mut integrator: Option<&Element> = None;
+    let mut max_depth = None;
+    for e in &scene_el.children {
+        match e.tag.as_str() {
+            "shape" => shapes.push(scene_shape(e, folder)?),
+            "bsdf" => {
+                // A definition: built once here so that errors in unused
+                // definitions are reported too.
+                build_bsdf(e)?;
+            }
+            "sensor" => {
+                if let Some((_, first)) = &camera {
+                    return Err(SceneError::at(
+                        &e.loc,
+                        format!(
+                            "only one <sensor> is supported (the first is at line {})",
+                            first.loc.line
+                        ),
+                    ));
+                }
+                camera = Some((sensor(e)?, e));
+            }
+            "integrator" => {
+                if let Some(first) = integrator {
+                    return Err(SceneError::at(
+                        &e.loc,
+                        format!(
+                            "only one <integrator> is allowed (the first is at line {})",
+                            first.loc.line
+                        ),
+                    ));
+                }
+                integrator = Some(e);
+                max_depth = integrator_max_depth(e)?;
+            }
+            "emitter" => {
+                let t = e.plugin_type()?;
+                let message = if t == "area" {
+                    "an area <emitter> must be placed inside a <shape>".to_string()
+                } else {
+                    format!(
+                        "unknown emitter plugin \"{t}\" (only area emitters inside shapes are supported)"
+                    )
+                };
+                return Err(SceneError::at(&e.loc, message));
+            }
+            other => {
+                return Err(SceneError::at(
+                    &e.loc,
+                    format!(
+                        "unsupported element <{other}> in <scene> (supported: shape, bsdf, sensor, integrator, default)"
+                    ),
+                ));
+            }
+        }
+    }
+    let camera = camera.map(|(c, _)| c);
+    let spectral = shapes.iter().any(|s| {
+        bsdf_is_sampled(&s.bsdf)
+            || s.emitter
+                .as_ref()
+                .is_some_and(|em| em.radiance.is_sampled())
+    });
+    Ok(Scene {
+        path: path.to_path_buf(),
+        shapes,
+        camera,
+        max_depth,
+        spectral,
+        bsdf_counts: resolved.bsdf_counts,
+    })
+}
+
+/// True when some colour of the BSDF is a sampled spectrum.
+fn bsdf_is_sampled(b: &BsdfParams) -> bool {
+    match b {
+        BsdfParams::Diffuse { reflectance } => reflectance.is_sampled(),
+        BsdfParams::RoughConductor(rc) => {
+            rc.specular_reflectance.is_sampled()
+                || rc
+                    .eta_k
+                    .as_ref()
+                    .is_some_and(|(eta, k)| eta.is_sampled() || k.is_sampled())
+        }
+        BsdfParams::Blend { first, second, .. } => {
+            bsdf_is_sampled(first) || bsdf_is_sampled(second)
+        }
+        BsdfParams::TwoSided { front, back } => {
+            bsdf_is_sampled(front) || back.as_deref().is_some_and(bsdf_is_sampled)
+        }
+    }
+}
+
+fn scene_shape(e: &Element, folder: &Path) -> Result<SceneShape> {
+    e.check_attrs(&["type", "id", "name"])?;
+    let props = Props::new(e)?;
+    let mut bsdf = None;
+    let mut emitter = None;
+    for o in &props.objects {
+        match o.tag.as_str() {
+            "bsdf" => {
+                if bsdf.is_some() {
+                    return Err(SceneError::at(&o.loc, "a <shape> takes at most one <bsdf>"));
+                }
+                bsdf = Some(build_bsdf(o)?);
+            }
+            "emitter" => {
+                if emitter.is_some() {
+                    return Err(SceneError::at(
+                        &o.loc,
+                        "a <shape> takes at most one <emitter>",
+                    ));
+                }
+                emitter = Some(area_emitter(o)?);
+            }
+            _ => {
+                return Err(SceneError::at(
+                    &o.loc,
+                    format!("a <shape> cannot contain {}", o.describe()),
+                ));
+            }
+        }
+    }
+    let shape = build_shape(&props, folder)?;
+    props.finish()?;
+    Ok(SceneShape {
+        id: e.attr("id").map(|a| a.value.clone()),
+        shape,
+        bsdf: bsdf.unwrap_or_default(),
+        emitter,
+        location: e.loc.clone(),
+    })
+}
+
+fn area_emitter(e: &Element) -> Result<AreaEmitter> {
+    e.check_attrs(&["type", "id", "name"])?;
+    let t = e.plugin_type()?;
+    if t != "area" {
+        return Err(SceneError::at(
+            &e.required("type")?.loc,
+            format!("unknown emitter plugin \"{t}\" (only \"area\" inside a shape)"),
+        ));
+    }
+    let props = Props::new(e)?;
+    props.no_objects()?;
+    // Mitsuba's default radiance is 1.
+    let radiance = props.color("radiance")?.unwrap_or(ColorParam::Float(1.0));
+    check_color(&radiance, &props.loc("radiance"), "radiance", None)?;
+    props.finish()?;
+    Ok(AreaEmitter {
+        radiance,
+        location: e.loc.clone(),
+    })
+}
+
+fn integrator_max_depth(e: &Element) -> Result<Option<i64>> {
+    e.check_attrs(&["type", "id", "name"])?;
+    e.plugin_type()?;
+    // Only max_depth is read; everything else is accepted and ignored.
+    match e
+        .children
+        .iter()
+        .find(|c| c.attr("name").is_some_and(|n| n.value == "max_depth"))
+    {
+        None => Ok(None),
+        Some(c) if c.tag == "integer" => {
+            let v = c.required("value")?;
+            let d: i64 = v.value.trim().parse().map_err(|_| {
+                SceneError::at(&v.loc, format!("\"{}\" is not an integer", v.value))
+            })?;
+            if d < -1 {
+                return Err(SceneError::at(
+                    &v.loc,
+                    format!("max_depth must be -1 (unlimited) or at least 0, found {d}"),
+                ));
+            }
+            Ok(Some(d))
+        }
+        Some(c) => Err(SceneError::at(
+            &c.loc,
+            format!("max_depth must be an <integer>, found <{}>", c.tag),
+        )),
+    }
+}
+
+fn sensor(e: &Element) -> Result<Camera> {
+    e.check_attrs(&["type", "id", "name"])?;
+    let t = e.plugin_type()?;
+    if t != "perspective" {
+        return Err(SceneError::at(
+            &e.required("type")?.loc,
+            format!("unknown sensor plugin \"{t}\" (only \"perspective\")"),
+        ));
+    }
+    let props = Props::new(e)?;
+    let (fov, fov_axis) = match props.float("fov")? {
+        Some(fov) => {
+            if !(fov > 0.0 && fov < 180.0) {
+                return Err(SceneError::at(
+                    &props.loc("fov"),
+                    format!("fov must lie strictly between 0 and 180 degrees, found {fov}"),
+                ));
+            }
+            let axis = match props.string("fov_axis")? {
+                None => FovAxis::X,
+                Some(name) => FovAxis::from_name(&name).ok_or_else(|| {
+                    SceneError::at(
+                        &props.loc("fov_axis"),
+                        format!("unknown fov_axis \"{name}\" (x, y, smaller, larger or diagonal)"),
+                    )
+                })?,
+            };
+            (fov, axis)
+        }
+        // Mitsuba's default: a 50 mm lens, fov along the diagonal.
+        None => (default_fov(), FovAxis::Diagonal),
+    };
+    let transform = props.transform("to_world")?;
+    let world_from_camera = transform.as_ref().map_or(DMat4::IDENTITY, |t| t.matrix);
+    let l = crate::transform::linear_part(&world_from_camera);
+    for axis in [l.x_axis, l.y_axis, l.z_axis] {
+        if (axis.length() - 1.0).abs() > 1e-3 {
+            return Err(SceneError::at(
+                &props.loc("to_world"),
+                "the sensor's to_world must not scale (Mitsuba refuses scale factors in a camera transform)",
+            ));
+        }
+    }
+    let origin = world_from_camera.transform_point3(DVec3::ZERO);
+    let (target, up) = match transform.as_ref().and_then(|t| t.lookat) {
+        Some(la) => (la.target, la.up),
+        None => (
+            origin + world_from_camera.transform_vector3(DVec3::Z),
+            world_from_camera.transform_vector3(DVec3::Y),
+        ),
+    };
+    let mut width = 768;
+    let mut height = 576;
+    let mut rfilter = ReconstructionFilter::Gaussian;
+    let mut sample_count = 4;
+    let mut seen_film = false;
+    let mut seen_sampler = false;
+    for o in &props.objects {
+        match o.tag.as_str() {
+            "film" if !seen_film => {
+                seen_film = true;
+                (width, height, rfilter) = film(o)?;
+            }
+            "sampler" if !seen_sampler => {
+                seen_sampler = true;
+                sample_count = sampler(o)?;
+            }
+            _ => {
+                return Err(SceneError::at(
+                    &o.loc,
+                    format!(
+                        "a <sensor> takes one <film> and one <sampler>; unexpected {}",
+                        o.describe()
+                    ),
+                ));
+            }
+        }
+    }
+    props.finish()?;
+    Ok(Camera {
+        origin,
+        target,
+        up,
+        world_from_camera,
+        fov,
+        fov_axis,
+        width,
+        height,
+        rfilter,
+        sample_count,
+    })
+}
+
+fn positive_u32(props: &Props<'_>, name: &str, default: u32) -> Result<u32> {
+    match props.integer(name)? {
+        None => Ok(default),
+        Some(v) => u32::try_from(v).ok().filter(|&v| v > 0).ok_or_else(|| {
+            SceneError::at(
+                &props.loc(name),
+                format!("{name} must be a positive integer, found {v}"),
+            )
+        }),
+    }
+}
+
+fn film(e: &Element) -> Result<(u32, u32, ReconstructionFilter)> {
+    e.check_attrs(&["type", "id", "name"])?;
+    let t = e.plugin_type()?;
+    if t != "hdrfilm" {
+        return Err(SceneError::at(
+            &e.required("type")?.loc,
+            format!("unknown film plugin \"{t}\" (only \"hdrfilm\")"),
+        ));
+    }
+    let props = Props::new(e)?;
+    let width = positive_u32(&props, "width", 768)?;
+    let height = positive_u32(&props, "height", 576)?;
+    props.ignore(&["pixel_format", "component_format"]);
+    let mut rfilter = ReconstructionFilter::Gaussian;
+    for (i, o) in props.objects.iter().enumerate() {
+        if o.tag != "rfilter" || i > 0 {
+            return Err(SceneError::at(
+                &o.loc,
+                format!("a <film> takes one <rfilter>; unexpected {}", o.describe()),
+            ));
+        }
+        o.check_attrs(&["type", "id", "name"])?;
+        let fp = Props::new(o)?;
+        fp.no_objects()?;
+        rfilter = match o.plugin_type()? {
+            "gaussian" => ReconstructionFilter::Gaussian,
+            "box" => ReconstructionFilter::Box,
+            other => {
+                return Err(SceneError::at(
+                    &o.required("type")?.loc,
+                    format!("unknown rfilter plugin \"{other}\" (gaussian or box)"),
+                ));
+            }
+        };
+        fp.finish()?;
+    }
+    props.finish()?;
+    Ok((width, height, rfilter))
+}
+
+fn sampler(e: &Element) -> Result<u32> {
+    e.check_attrs(&["type", "id", "name"])?;
+    // Any Mitsuba sampler type: trilux uses its own low-discrepancy sampler.
+    e.plugin_type()?;
+    let props = Props::new(e)?;
+    props.no_objects()?;
+    let n = positive_u32(&props, "sample_count", 4)?;
+    props.finish()?;
+    Ok(n)
+}

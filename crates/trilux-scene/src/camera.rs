@@ -1,0 +1,122 @@
+//! The camera (`<sensor type="perspective">`), its film and its sampler.
+//!
+//! Mitsuba 3 conventions: the camera looks down its local +z axis, +x points
+//! to the left of the image and +y up (see [`crate::transform`] for
+//! `lookat`). `fov` is in degrees along `fov_axis`; without `fov`, Mitsuba's
+//! default 50 mm lens on a 36 × 24 mm film gives 2·atan(√(36² + 24²)/100) ≈
+//! 46.79° along the diagonal. The film defaults to 768 × 576 with a Gaussian
+//! reconstruction filter; the sampler to 4 samples per pixel.
+
+use glam::{DMat4, DVec3};
+use serde::Serialize;
+
+/// The image axis along which `fov` is measured.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum FovAxis {
+    /// The horizontal axis (Mitsuba's default).
+    X,
+    /// The vertical axis.
+    Y,
+    /// Whichever of x and y is shorter.
+    Smaller,
+    /// Whichever of x and y is longer.
+    Larger,
+    /// The image diagonal.
+    Diagonal,
+}
+
+impl FovAxis {
+    /// The name used in scene files.
+    pub fn name(self) -> &'static str {
+        match self {
+            FovAxis::X => "x",
+            FovAxis::Y => "y",
+            FovAxis::Smaller => "smaller",
+            FovAxis::Larger => "larger",
+            FovAxis::Diagonal => "diagonal",
+        }
+    }
+
+    /// Parses a scene-file name.
+    pub fn from_name(name: &str) -> Option<Self> {
+        Some(match name {
+            "x" => FovAxis::X,
+            "y" => FovAxis::Y,
+            "smaller" => FovAxis::Smaller,
+            "larger" => FovAxis::Larger,
+            "diagonal" => FovAxis::Diagonal,
+            _ => return None,
+        })
+    }
+}
+
+/// The film's reconstruction filter (`<rfilter>`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ReconstructionFilter {
+    /// Mitsuba's default: Gaussian, standard deviation 0.5 px, radius 2 px.
+    Gaussian,
+    /// One pixel box.
+    Box,
+}
+
+/// A perspective camera with its film and sample count.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Camera {
+    /// Eye position (world space).
+    pub origin: DVec3,
+    /// A point the camera looks at: the `lookat` target when `to_world` is
+    /// one `<lookat>`, else one unit along the viewing direction.
+    pub target: DVec3,
+    /// Up direction: as written in `<lookat>`, else the camera's +y axis in
+    /// world space.
+    pub up: DVec3,
+    /// Mitsuba's sensor `to_world` (camera space: looking down +z, +x left).
+    pub world_from_camera: DMat4,
+    /// Field of view in degrees, along `fov_axis`.
+    pub fov: f64,
+    /// Axis along which `fov` is measured.
+    pub fov_axis: FovAxis,
+    /// Film width in pixels.
+    pub width: u32,
+    /// Film height in pixels.
+    pub height: u32,
+    /// Film reconstruction filter.
+    pub rfilter: ReconstructionFilter,
+    /// Samples per pixel (the sampler's `sample_count`).
+    pub sample_count: u32,
+}
+
+impl Camera {
+    /// The horizontal field of view in degrees, converted from `fov` along
+    /// `fov_axis` with the film's aspect ratio as Mitsuba's `parse_fov` does.
+    pub fn x_fov(&self) -> f64 {
+        let aspect = self.width as f64 / self.height as f64;
+        let half_tan = (0.5 * self.fov.to_radians()).tan();
+        let from_y = || (2.0 * (half_tan * aspect).atan()).to_degrees();
+        match self.fov_axis {
+            FovAxis::X => self.fov,
+            FovAxis::Y => from_y(),
+            FovAxis::Diagonal => {
+                (2.0 * (half_tan / (1.0 + 1.0 / (aspect * aspect)).sqrt()).atan()).to_degrees()
+            }
+            FovAxis::Smaller if aspect > 1.0 => from_y(),
+            FovAxis::Smaller => self.fov,
+            FovAxis::Larger if aspect > 1.0 => self.fov,
+            FovAxis::Larger => from_y(),
+        }
+    }
+
+    /// The vertical field of view in degrees.
+    pub fn y_fov(&self) -> f64 {
+        let aspect = self.width as f64 / self.height as f64;
+        (2.0 * ((0.5 * self.x_fov().to_radians()).tan() / aspect).atan()).to_degrees()
+    }
+}
+
+/// Mitsuba's default field of view (50 mm lens, 36 × 24 mm film), along the
+/// diagonal, in degrees.
+pub fn default_fov() -> f64 {
+    (2.0 * ((36f64 * 36.0 + 24.0 * 24.0).sqrt() / 100.0).atan()).to_degrees()
+}

@@ -1,0 +1,71 @@
+//! Errors of scene loading, each carrying the place in the file that caused it.
+//!
+//! Every error displays as `FILE:LINE:COL: what is wrong` (design.md §3), like a
+//! compiler's, so that the command line can print it on one line. Lines and
+//! columns count from 1 and point at the element or attribute value at fault.
+
+use std::fmt;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+/// A place in a scene file: the file, and a 1-based line and column.
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+pub struct SourceLocation {
+    /// The scene file (as it was named when loading).
+    pub file: Arc<Path>,
+    /// Line, counting from 1.
+    pub line: u32,
+    /// Column in characters, counting from 1.
+    pub col: u32,
+}
+
+impl fmt::Display for SourceLocation {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}:{}:{}", self.file.display(), self.line, self.col)
+    }
+}
+
+/// Why a scene could not be loaded.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    /// Something is wrong at a known place of the scene file.
+    #[error("{location}: {message}")]
+    At {
+        /// Where.
+        location: SourceLocation,
+        /// What is wrong (one line).
+        message: String,
+    },
+    /// The scene file itself could not be read.
+    #[error("{}: cannot read the scene file: {source}", path.display())]
+    Read {
+        /// The scene file.
+        path: PathBuf,
+        /// The operating system's reason.
+        #[source]
+        source: std::io::Error,
+    },
+}
+
+impl SceneError {
+    /// An error at `location`.
+    pub fn at(location: &SourceLocation, message: impl Into<String>) -> Self {
+        // One line, whatever the message (the command prints one line).
+        let message: String = message.into();
+        SceneError::At {
+            location: location.clone(),
+            message: message.replace(['\n', '\r'], " "),
+        }
+    }
+
+    /// Where the error is, when it is at a place in the file.
+    pub fn location(&self) -> Option<&SourceLocation> {
+        match self {
+            SceneError::At { location, .. } => Some(location),
+            SceneError::Read { .. } => None,
+        }
+    }
+}
+
+/// Shorthand for results of the loader.
+pub type Result<T, E = SceneError> = std::result::Result<T, E>;

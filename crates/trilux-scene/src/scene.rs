@@ -1,0 +1,76 @@
+//! The scene model: what the solver and the renderer consume. It knows
+//! nothing of XML (the loader's stages live in `xml`, `resolve` and `build`).
+
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+use serde::Serialize;
+use trilux_brdf::BsdfParams;
+use trilux_color::ColorParam;
+use trilux_geometry::Shape;
+
+use crate::camera::Camera;
+use crate::error::SourceLocation;
+
+/// An area light (`<emitter type="area">` inside a shape): one-sided
+/// Lambertian emission from the front side of its shape.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct AreaEmitter {
+    /// Emitted radiance as written (`radiance`; Mitsuba's default is 1).
+    pub radiance: ColorParam,
+    /// Where the `<emitter>` is written.
+    #[serde(skip)]
+    pub location: SourceLocation,
+}
+
+/// One `<shape>` with its material and optional area light.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SceneShape {
+    /// The shape's `id` attribute, if any.
+    pub id: Option<String>,
+    /// Geometry in Mitsuba's object-space conventions, with `to_world`.
+    pub shape: Shape,
+    /// Its BSDF (Mitsuba's default `diffuse` 0.5 when none is given).
+    pub bsdf: BsdfParams,
+    /// The area light on it, if any.
+    pub emitter: Option<AreaEmitter>,
+    /// Where the `<shape>` is written.
+    #[serde(skip)]
+    pub location: SourceLocation,
+}
+
+/// A loaded scene.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Scene {
+    /// The scene file.
+    pub path: PathBuf,
+    /// The shapes, in file order (index i is shape i of the geometry layer).
+    pub shapes: Vec<SceneShape>,
+    /// The camera, when the file has a `<sensor>` (Mitsuba 3 loads scenes
+    /// without one too; solving needs none, rendering does).
+    pub camera: Option<Camera>,
+    /// The integrator's `max_depth`, when the file gives one (noted in
+    /// stats; trilux's solver has its own stopping rule).
+    pub max_depth: Option<i64>,
+    /// True when some `<spectrum>` in use gives wavelength:value pairs: the
+    /// scene then solves in spectral bands by default (design.md §2).
+    pub spectral: bool,
+    /// Number of `<bsdf>` elements of each type written in the file (nested
+    /// ones included; a referenced BSDF counts once).
+    pub bsdf_counts: BTreeMap<String, usize>,
+}
+
+impl Scene {
+    /// The shapes as the geometry layer takes them (`SceneGeometry::build`).
+    pub fn geometry_shapes(&self) -> Vec<Shape> {
+        self.shapes.iter().map(|s| s.shape.clone()).collect()
+    }
+
+    /// Indices and shapes of the emitting shapes.
+    pub fn emitters(&self) -> impl Iterator<Item = (usize, &SceneShape)> {
+        self.shapes
+            .iter()
+            .enumerate()
+            .filter(|(_, s)| s.emitter.is_some())
+    }
+}

@@ -1,0 +1,176 @@
+//! `<shape>` elements → [`Shape`], and the surface area of a shape.
+//!
+//! Object-space conventions are Mitsuba 3's (see [`ShapeKind`]). A sphere's
+//! `center`/`radius` and a cylinder's `p0`/`p1`/`radius` are kept in object
+//! space and combined with `to_world` by the geometry layer, as Mitsuba
+//! combines them (`to_world · translate(center) · scale(radius)`).
+//!
+//! Refused, each at the place that causes it: a singular `to_world` (a zero
+//! scale), zero radius or length, a sphere scaled non-uniformly, a cylinder
+//! whose cross-section is not a circle after `to_world` (Mitsuba only warns;
+//! the exact analytic intersection needs a circle), a zero total area, and a
+//! missing or malformed OBJ file.
+
+use std::path::Path;
+
+use glam::{DMat3, DVec3};
+use trilux_geometry::{Shape, ShapeKind};
+
+use crate::error::{Result, SceneError};
+use crate::obj::load_obj;
+use crate::props::Props;
+use crate::transform::{coordinate_system, linear_part};
+
+/// Surface area of a shape in world space (one side).
+///
+/// Exact for every kind: parallelograms for rectangles and cube faces, an
+/// ellipse for a disk under any affine map, 4πr² for a uniformly scaled
+/// sphere, 2πrh for a cylinder whose cross-section stays circular, and the
+/// sum of the transformed triangles for a mesh.
+pub fn surface_area(shape: &Shape) -> f64 {
+    let l = linear_part(&shape.world_from_object);
+    let (x, y, z) = (l.x_axis, l.y_axis, l.z_axis);
+    match &shape.kind {
+        ShapeKind::Rectangle => 4.0 * x.cross(y).length(),
+        ShapeKind::Cube => 8.0 * (y.cross(z).length() + x.cross(z).length() + x.cross(y).length()),
+        ShapeKind::Disk => std::f64::consts::PI * x.cross(y).length(),
+        ShapeKind::Sphere { radius, .. } => {
+            let s = x.length() * radius;
+            4.0 * std::f64::consts::PI * s * s
+        }
+        ShapeKind::Cylinder { p0, p1, radius } => {
+            let (s, _, _) = cylinder_frame(*p0, *p1);
+            2.0 * std::f64::consts::PI * (l * s).length() * radius * (l * (*p1 - *p0)).length()
+        }
+        ShapeKind::Mesh(mesh) => mesh
+            .triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|i| l * mesh.positions[i as usize]);
+                0.5 * (b - a).cross(c - a).length()
+            })
+            .sum(),
+    }
+}
+
+/// Mitsuba's cylinder frame: (s, t, n) with n along p1 − p0 (zero vectors
+/// when p0 = p1).
+fn cylinder_frame(p0: DVec3, p1: DVec3) -> (DVec3, DVec3, DVec3) {
+    let d = p1 - p0;
+    if d.length_squared() == 0.0 {
+        return (DVec3::ZERO, DVec3::ZERO, DVec3::ZERO);
+    }
+    let n = d.normalize();
+    let (s, t) = coordinate_system(n);
+    (s, t, n)
+}
+
+/// True when `a` and `b` have the same length and are orthogonal (relative
+/// tolerance 1e-6, far below anything a scene author means).
+fn same_length_orthogonal(a: DVec3, b: DVec3) -> bool {
+    let (la, lb) = (a.length(), b.length());
+    (la - lb).abs() <= 1e-6 * la.max(lb) && a.dot(b).abs() <= 1e-6 * la * lb
+}
+
+/// Builds the shape of a `<shape>` element. `props` are its parameters;
+/// `folder` is the scene file's folder (OBJ file names are relative to it).
+pub(crate) fn build_shape(props: &Props<'_>, folder: &Path) -> Result<Shape> {
+    let e = props.owner();
+    let to_world = props
+        .transform("to_world")?
+        .map(|t| t.matrix)
+        .unwrap_or_default();
+    let flip_normals = props.boolean("flip_normals")?.unwrap_or(false);
+    let l: DMat3 = linear_part(&to_world);
+    let scale = l.x_axis.length() * l.y_axis.length() * l.z_axis.length();
+    if l.determinant().abs() <= 1e-12 * scale || !scale.is_finite() {
+        return Err(SceneError::at(
+            &props.loc("to_world"),
+            "to_world is singular (a zero scale?): the shape would have no area or no normal",
+        ));
+    }
+    let positive = |name: &str, default: f64| -> Result<f64> {
+        let v = props.float(name)?.unwrap_or(default);
+        if v <= 0.0 {
+            return Err(SceneError::at(
+                &props.loc(name),
+                format!("{name} must be positive, found {v}"),
+            ));
+        }
+        Ok(v)
+    };
+    let kind = match e.plugin_type()? {
+        "rectangle" => ShapeKind::Rectangle,
+        "cube" => ShapeKind::Cube,
+        "disk" => ShapeKind::Disk,
+        "sphere" => {
+            let center = props.vec3("center")?.unwrap_or(DVec3::ZERO);
+            let radius = positive("radius", 1.0)?;
+            if !(same_length_orthogonal(l.x_axis, l.y_axis)
+                && same_length_orthogonal(l.y_axis, l.z_axis)
+                && same_length_orthogonal(l.x_axis, l.z_axis))
+            {
+                return Err(SceneError::at(
+                    &props.loc("to_world"),
+                    "a sphere's to_world must scale uniformly (no non-uniform scale or shear)",
+                ));
+            }
+            ShapeKind::Sphere { center, radius }
+        }
+        "cylinder" => {
+            let p0 = props.vec3("p0")?.unwrap_or(DVec3::ZERO);
+            let p1 = props.vec3("p1")?.unwrap_or(DVec3::Z);
+            let radius = positive("radius", 1.0)?;
+            let (s, t, n) = cylinder_frame(p0, p1);
+            if n == DVec3::ZERO {
+                return Err(SceneError::at(
+                    &props.loc("p1"),
+                    "cylinder p0 and p1 are the same point (zero length)",
+                ));
+            }
+            let (ws, wt, wn) = (l * s, l * t, l * n);
+            let tol = 1e-6 * ws.length() * wn.length();
+            if !same_length_orthogonal(ws, wt) || ws.dot(wn).abs() > tol || wt.dot(wn).abs() > tol {
+                return Err(SceneError::at(
+                    &props.loc("to_world"),
+                    "a cylinder's to_world must keep its cross-section circular and its axis perpendicular to it",
+                ));
+            }
+            ShapeKind::Cylinder { p0, p1, radius }
+        }
+        "obj" => {
+            let name = props.string("filename")?.ok_or_else(|| {
+                SceneError::at(
+                    &e.loc,
+                    "<shape type=\"obj\"> needs <string name=\"filename\">",
+                )
+            })?;
+            let face_normals = props.boolean("face_normals")?.unwrap_or(false);
+            let path = folder.join(&name);
+            let mesh = load_obj(&path, face_normals)
+                .map_err(|err| SceneError::at(&props.loc("filename"), err.to_string()))?;
+            ShapeKind::Mesh(mesh)
+        }
+        other => {
+            return Err(SceneError::at(
+                &e.required("type")?.loc,
+                format!(
+                    "unknown shape plugin \"{other}\" (supported: rectangle, cube, disk, sphere, cylinder, obj)"
+                ),
+            ));
+        }
+    };
+    let shape = Shape {
+        kind,
+        world_from_object: to_world,
+        flip_normals,
+    };
+    let area = surface_area(&shape);
+    if !(area > 0.0 && area.is_finite()) {
+        return Err(SceneError::at(
+            &e.loc,
+            format!("{} has zero area", e.describe()),
+        ));
+    }
+    Ok(shape)
+}

@@ -1,0 +1,245 @@
+//! Typed parameter values: `<float>`, `<integer>`, `<boolean>`, `<string>`,
+//! `<point>`, `<vector>`, `<rgb>`, `<spectrum>` and `<transform>`.
+//!
+//! Numbers are lists separated by commas and/or spaces, as Mitsuba reads
+//! them. Every number must be finite: `nan` and `inf` are refused here, once,
+//! so that nothing downstream sees them.
+
+use glam::DVec3;
+use trilux_color::ColorParam;
+
+use crate::error::{Result, SceneError, SourceLocation};
+use crate::transform::{self, TransformValue};
+use crate::xml::Element;
+
+/// A parameter value as written.
+#[derive(Clone, Debug)]
+pub(crate) enum Value {
+    /// `<float>`.
+    Float(f64),
+    /// `<integer>`.
+    Integer(i64),
+    /// `<boolean>`.
+    Boolean(bool),
+    /// `<string>`.
+    String(String),
+    /// `<point>` or `<vector>` (Mitsuba 3 stores both as a 3-array).
+    Vec3(DVec3),
+    /// `<rgb>`, or `<spectrum>`.
+    Color(ColorParam),
+    /// `<transform>`.
+    Transform(TransformValue),
+}
+
+impl Value {
+    /// The XML tag that writes this kind of value, for messages.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Value::Float(_) => "float",
+            Value::Integer(_) => "integer",
+            Value::Boolean(_) => "boolean",
+            Value::String(_) => "string",
+            Value::Vec3(_) => "point/vector",
+            Value::Color(ColorParam::Rgb(_)) => "rgb",
+            Value::Color(_) => "spectrum",
+            Value::Transform(_) => "transform",
+        }
+    }
+}
+
+/// The tags that write a parameter value (as opposed to a nested object).
+pub(crate) const VALUE_TAGS: &[&str] = &[
+    "float",
+    "integer",
+    "boolean",
+    "string",
+    "point",
+    "vector",
+    "rgb",
+    "spectrum",
+    "transform",
+];
+
+/// Parses one finite number.
+pub(crate) fn parse_f64(text: &str, loc: &SourceLocation) -> Result<f64> {
+    let t = text.trim();
+    let v: f64 = t
+        .parse()
+        .map_err(|_| SceneError::at(loc, format!("\"{t}\" is not a number")))?;
+    if v.is_nan() {
+        return Err(SceneError::at(loc, "NaN is not allowed here"));
+    }
+    if !v.is_finite() {
+        return Err(SceneError::at(
+            loc,
+            format!("\"{t}\" is not a finite number"),
+        ));
+    }
+    Ok(v)
+}
+
+/// Parses a list of finite numbers separated by commas and/or whitespace.
+pub(crate) fn parse_list(text: &str, loc: &SourceLocation) -> Result<Vec<f64>> {
+    text.split(|c: char| c == ',' || c.is_whitespace())
+        .filter(|t| !t.is_empty())
+        .map(|t| parse_f64(t, loc))
+        .collect()
+}
+
+/// Parses exactly `n` numbers.
+pub(crate) fn parse_n(text: &str, n: usize, loc: &SourceLocation) -> Result<Vec<f64>> {
+    let v = parse_list(text, loc)?;
+    if v.len() != n {
+        return Err(SceneError::at(
+            loc,
+            format!("expected {n} numbers, found {} in \"{text}\"", v.len()),
+        ));
+    }
+    Ok(v)
+}
+
+/// A 3-vector written as `value="x, y, z"` or with `x`, `y`, `z` attributes
+/// (each defaulting to `default`).
+pub(crate) fn parse_xyz(e: &Element, default: f64) -> Result<DVec3> {
+    if let Some(v) = e.attr("value") {
+        if ["x", "y", "z"].iter().any(|n| e.attr(n).is_some()) {
+            return Err(SceneError::at(
+                &v.loc,
+                format!("<{}> takes either value or x/y/z, not both", e.tag),
+            ));
+        }
+        let n = parse_n(&v.value, 3, &v.loc)?;
+        return Ok(DVec3::new(n[0], n[1], n[2]));
+    }
+    let mut out = [default; 3];
+    for (i, name) in ["x", "y", "z"].iter().enumerate() {
+        if let Some(a) = e.attr(name) {
+            out[i] = parse_f64(&a.value, &a.loc)?;
+        }
+    }
+    Ok(DVec3::from_array(out))
+}
+
+/// Parses a value element (one of [`VALUE_TAGS`]) into its name and value.
+pub(crate) fn parse_value(e: &Element) -> Result<(String, Value)> {
+    let name = e.required("name")?.value.clone();
+    let value = match e.tag.as_str() {
+        "transform" => {
+            e.check_attrs(&["name"])?;
+            Value::Transform(transform::parse(e)?)
+        }
+        tag => {
+            if let Some(c) = e.children.first() {
+                return Err(SceneError::at(
+                    &c.loc,
+                    format!("<{tag}> has no child elements"),
+                ));
+            }
+            match tag {
+                "float" | "integer" | "boolean" | "string" | "rgb" => {
+                    e.check_attrs(&["name", "value"])?;
+                    let a = e.required("value")?;
+                    scalar_value(tag, &a.value, &a.loc)?
+                }
+                "spectrum" => {
+                    e.check_attrs(&["name", "value"])?;
+                    let a = e.required("value")?;
+                    Value::Color(parse_spectrum(&a.value, &a.loc)?)
+                }
+                "point" | "vector" => {
+                    e.check_attrs(&["name", "value", "x", "y", "z"])?;
+                    Value::Vec3(parse_xyz(e, 0.0)?)
+                }
+                _ => {
+                    return Err(SceneError::at(
+                        &e.loc,
+                        format!("<{tag}> is not a parameter value"),
+                    ));
+                }
+            }
+        }
+    };
+    Ok((name, value))
+}
+
+fn scalar_value(tag: &str, text: &str, loc: &SourceLocation) -> Result<Value> {
+    Ok(match tag {
+        "float" => Value::Float(parse_f64(text, loc)?),
+        "integer" => {
+            let t = text.trim();
+            Value::Integer(
+                t.parse()
+                    .map_err(|_| SceneError::at(loc, format!("\"{t}\" is not an integer")))?,
+            )
+        }
+        "boolean" => match text.trim().to_ascii_lowercase().as_str() {
+            "true" => Value::Boolean(true),
+            "false" => Value::Boolean(false),
+            other => {
+                return Err(SceneError::at(
+                    loc,
+                    format!("\"{other}\" is not a boolean (true or false)"),
+                ));
+            }
+        },
+        "string" => Value::String(text.to_string()),
+        _ => {
+            // rgb: one value (grey) or three.
+            let v = parse_list(text, loc)?;
+            match v.as_slice() {
+                [g] => Value::Color(ColorParam::Rgb([*g; 3])),
+                [r, g, b] => Value::Color(ColorParam::Rgb([*r, *g, *b])),
+                _ => {
+                    return Err(SceneError::at(
+                        loc,
+                        format!("<rgb> takes 1 or 3 numbers, found {}", v.len()),
+                    ));
+                }
+            }
+        }
+    })
+}
+
+/// Parses a `<spectrum value>`: one number (a constant spectrum) or
+/// `λ:v` pairs in nm, strictly ascending in wavelength.
+pub(crate) fn parse_spectrum(text: &str, loc: &SourceLocation) -> Result<ColorParam> {
+    if !text.contains(':') {
+        let v = parse_list(text, loc)?;
+        return match v.as_slice() {
+            [c] => Ok(ColorParam::Constant(*c)),
+            _ => Err(SceneError::at(
+                loc,
+                "<spectrum> takes one number or wavelength:value pairs (\"400:0.5, 500:0.6\")",
+            )),
+        };
+    }
+    let mut samples: Vec<(f64, f64)> = Vec::new();
+    for pair in text.split(',').map(str::trim).filter(|p| !p.is_empty()) {
+        let (l, v) = pair.split_once(':').ok_or_else(|| {
+            SceneError::at(loc, format!("\"{pair}\" is not a wavelength:value pair"))
+        })?;
+        let (l, v) = (parse_f64(l, loc)?, parse_f64(v, loc)?);
+        if l <= 0.0 {
+            return Err(SceneError::at(
+                loc,
+                format!("wavelength {l} nm is not positive"),
+            ));
+        }
+        if let Some(&(prev, _)) = samples.last()
+            && l <= prev
+        {
+            return Err(SceneError::at(
+                loc,
+                format!("wavelengths must increase ({l} nm follows {prev} nm)"),
+            ));
+        }
+        samples.push((l, v));
+    }
+    if samples.len() < 2 {
+        return Err(SceneError::at(
+            loc,
+            "a sampled <spectrum> needs at least two wavelength:value pairs",
+        ));
+    }
+    Ok(ColorParam::Sampled(samples))
+}

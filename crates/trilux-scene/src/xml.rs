@@ -1,0 +1,251 @@
+//! Stages 1 and 2 of loading: XML text → an intermediate tree with source
+//! locations, `<default>` and `$name` substitution done.
+//!
+//! As in Mitsuba 3's parser, the tree knows nothing about plugins: it is just
+//! elements and attributes, each with the line and column it came from. A
+//! `<default name="n" value="v"/>` defines `$n` for the elements that follow it
+//! (in document order), unless the caller already set `n`; every attribute
+//! value has its `$name` references replaced. An undefined `$name` is an error,
+//! as in Mitsuba.
+
+use std::path::Path;
+use std::sync::Arc;
+
+use crate::error::{Result, SceneError, SourceLocation};
+
+/// One attribute of an element, after substitution.
+#[derive(Clone, Debug)]
+pub(crate) struct Attribute {
+    /// Attribute name.
+    pub name: String,
+    /// Value after `$name` substitution.
+    pub value: String,
+    /// Where the value starts.
+    pub loc: SourceLocation,
+}
+
+/// One element of the intermediate tree.
+#[derive(Clone, Debug)]
+pub(crate) struct Element {
+    /// Tag name (`shape`, `float`, ...).
+    pub tag: String,
+    /// Attributes in document order.
+    pub attrs: Vec<Attribute>,
+    /// Child elements (comments and whitespace dropped).
+    pub children: Vec<Element>,
+    /// Where the element starts.
+    pub loc: SourceLocation,
+}
+
+impl Element {
+    /// The attribute called `name`, if present.
+    pub fn attr(&self, name: &str) -> Option<&Attribute> {
+        self.attrs.iter().find(|a| a.name == name)
+    }
+
+    /// The attribute called `name`, or an error naming the element.
+    pub fn required(&self, name: &str) -> Result<&Attribute> {
+        self.attr(name).ok_or_else(|| {
+            SceneError::at(
+                &self.loc,
+                format!("<{}> needs the attribute \"{name}\"", self.tag),
+            )
+        })
+    }
+
+    /// Refuses attributes outside `allowed`.
+    pub fn check_attrs(&self, allowed: &[&str]) -> Result<()> {
+        for a in &self.attrs {
+            if !allowed.contains(&a.name.as_str()) {
+                return Err(SceneError::at(
+                    &a.loc,
+                    format!("unexpected attribute \"{}\" in <{}>", a.name, self.tag),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// `type="..."` of a plugin element, or an error.
+    pub fn plugin_type(&self) -> Result<&str> {
+        Ok(self.required("type")?.value.as_str())
+    }
+
+    /// Description for messages: `<shape type="cube">`.
+    pub fn describe(&self) -> String {
+        match self.attr("type") {
+            Some(t) => format!("<{} type=\"{}\">", self.tag, t.value),
+            None => format!("<{}>", self.tag),
+        }
+    }
+}
+
+/// Parses scene text into the intermediate tree rooted at `<scene>`.
+///
+/// `params` are caller-given values for `$name` (they take precedence over
+/// `<default>`s, as Mitsuba's `load_file(path, name=value)` does).
+pub(crate) fn parse(text: &str, file: &Arc<Path>, params: &[(String, String)]) -> Result<Element> {
+    let options = roxmltree::ParsingOptions {
+        allow_dtd: false,
+        ..Default::default()
+    };
+    let doc = roxmltree::Document::parse_with_options(text, options).map_err(|e| {
+        let pos = e.pos();
+        let loc = SourceLocation {
+            file: file.clone(),
+            line: pos.row,
+            col: pos.col,
+        };
+        SceneError::at(&loc, format!("malformed XML: {e}"))
+    })?;
+    let mut ctx = Context {
+        doc: &doc,
+        file: file.clone(),
+        params: params.to_vec(),
+    };
+    let root = doc.root_element();
+    let root_loc = ctx.loc(root.range().start);
+    if root.tag_name().name() != "scene" {
+        return Err(SceneError::at(
+            &root_loc,
+            format!(
+                "the root element must be <scene>, found <{}>",
+                root.tag_name().name()
+            ),
+        ));
+    }
+    let tree = ctx
+        .element(root)?
+        .ok_or_else(|| SceneError::at(&root_loc, "the root element must be <scene>"))?;
+    check_version(&tree)?;
+    Ok(tree)
+}
+
+/// Mitsuba requires `version` on `<scene>`; files older than 2.0 use other
+/// parameter names, which this loader does not translate.
+fn check_version(scene: &Element) -> Result<()> {
+    let v = scene.attr("version").ok_or_else(|| {
+        SceneError::at(
+            &scene.loc,
+            "<scene> needs a version attribute (version=\"3.0.0\")",
+        )
+    })?;
+    let major = v
+        .value
+        .split('.')
+        .next()
+        .and_then(|m| m.trim().parse::<u32>().ok());
+    match major {
+        Some(2 | 3) => Ok(()),
+        _ => Err(SceneError::at(
+            &v.loc,
+            format!(
+                "unsupported scene version \"{}\" (this loader reads Mitsuba 2 and 3 scenes)",
+                v.value
+            ),
+        )),
+    }
+}
+
+struct Context<'a, 'input> {
+    doc: &'a roxmltree::Document<'input>,
+    file: Arc<Path>,
+    params: Vec<(String, String)>,
+}
+
+impl Context<'_, '_> {
+    fn loc(&self, byte: usize) -> SourceLocation {
+        let pos = self.doc.text_pos_at(byte);
+        SourceLocation {
+            file: self.file.clone(),
+            line: pos.row,
+            col: pos.col,
+        }
+    }
+
+    /// Converts one element; `None` for a `<default>`, which only defines a
+    /// parameter.
+    fn element(&mut self, node: roxmltree::Node<'_, '_>) -> Result<Option<Element>> {
+        let loc = self.loc(node.range().start);
+        let tag = node.tag_name().name().to_string();
+        let mut attrs = Vec::new();
+        for a in node.attributes() {
+            let aloc = self.loc(a.range_value().start);
+            let value = self.substitute(a.value(), &aloc)?;
+            attrs.push(Attribute {
+                name: a.name().to_string(),
+                value,
+                loc: aloc,
+            });
+        }
+        let element = Element {
+            tag,
+            attrs,
+            children: Vec::new(),
+            loc,
+        };
+        if element.tag == "default" {
+            element.check_attrs(&["name", "value"])?;
+            let name = element.required("name")?.value.clone();
+            let value = element.required("value")?.value.clone();
+            if node.children().any(|c| c.is_element()) {
+                return Err(SceneError::at(&element.loc, "<default> has no children"));
+            }
+            if !self.params.iter().any(|(n, _)| *n == name) {
+                self.params.push((name, value));
+            }
+            return Ok(None);
+        }
+        let mut element = element;
+        for child in node.children() {
+            if child.is_element() {
+                if let Some(e) = self.element(child)? {
+                    element.children.push(e);
+                }
+            } else if child.is_text() {
+                let text = child.text().unwrap_or("");
+                if !text.trim().is_empty() {
+                    return Err(SceneError::at(
+                        &self.loc(child.range().start),
+                        format!("unexpected text inside <{}>", element.tag),
+                    ));
+                }
+            }
+        }
+        Ok(Some(element))
+    }
+
+    /// Replaces every `$name` in `value` by its parameter value.
+    fn substitute(&self, value: &str, loc: &SourceLocation) -> Result<String> {
+        if !value.contains('$') {
+            return Ok(value.to_string());
+        }
+        let mut out = String::with_capacity(value.len());
+        let mut rest = value;
+        while let Some(i) = rest.find('$') {
+            out.push_str(&rest[..i]);
+            let after = &rest[i + 1..];
+            let len = after
+                .find(|c: char| !(c.is_ascii_alphanumeric() || c == '_'))
+                .unwrap_or(after.len());
+            let name = &after[..len];
+            if name.is_empty() {
+                return Err(SceneError::at(loc, "a lone '$' in an attribute value"));
+            }
+            match self.params.iter().find(|(n, _)| n == name) {
+                Some((_, v)) => out.push_str(v),
+                None => {
+                    return Err(SceneError::at(
+                        loc,
+                        format!(
+                            "undefined parameter ${name} (define it with <default name=\"{name}\" value=\"...\"/>)"
+                        ),
+                    ));
+                }
+            }
+            rest = &after[len..];
+        }
+        out.push_str(rest);
+        Ok(out)
+    }
+}

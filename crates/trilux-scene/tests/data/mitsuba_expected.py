@@ -1,0 +1,124 @@
+#!/usr/bin/env python3
+"""Expected values for trilux-scene's tests, computed by Mitsuba 3.
+
+Run from this folder:  python3 mitsuba_expected.py > mitsuba_expected.json
+
+Each case is an XML fragment; the test (tests/mitsuba.rs) wraps it the same
+way, loads it with trilux-scene and compares with what Mitsuba 3 (variant
+scalar_rgb, single precision) built from the same text:
+- "transforms": the `to_world` of a rectangle with that <transform>;
+- "sensors": the sensor's to_world matrix and its horizontal fov (x_fov);
+- "areas": the surface area of a shape;
+- "meshes": positions and vertex normals of an OBJ mesh without `vn`.
+"""
+import json
+
+import mitsuba as mi
+
+mi.set_variant("scalar_rgb")
+
+HEAD = '<scene version="3.0.0">'
+
+
+def matrix(t):
+    m = t.matrix
+    return [[float(m[i][j]) for j in range(4)] for i in range(4)]
+
+
+TRANSFORMS = [
+    '<translate x="1" y="-2" z="3"/>',
+    '<translate value="1, -2, 3"/>',
+    '<scale value="2"/>',
+    '<scale value="2, 3, 4"/>',
+    '<scale x="2" z="-1"/>',
+    '<rotate x="1" angle="90"/>',
+    '<rotate y="1" angle="-17"/>',
+    '<rotate value="0.6, 0, 0.8" angle="33"/>',
+    '<rotate x="0.48" y="0.6" z="0.64" angle="-120"/>',
+    '<matrix value="1 2 3 4  0 1 0 -5  0 0 2 6  0 0 0 1"/>',
+    '<lookat origin="1, 2, 3" target="0, 0, 0" up="0, 1, 0"/>',
+    '<lookat origin="0, 0, 5" target="0, 0, 0"/>',
+    '<lookat origin="1, -2, 0.5" target="3, 1, 1"/>',
+    '<scale x="0.3" y="0.61" z="0.3"/><rotate y="1" angle="18.25"/><translate x="-0.33" y="-0.4" z="-0.28"/>',
+    '<translate x="1"/><rotate z="1" angle="90"/><scale value="2"/>',
+]
+
+SENSORS = [
+    '<float name="fov" value="45"/>',
+    '<float name="fov" value="45"/><string name="fov_axis" value="x"/>',
+    '<float name="fov" value="45"/><string name="fov_axis" value="y"/>',
+    '<float name="fov" value="45"/><string name="fov_axis" value="smaller"/>',
+    '<float name="fov" value="45"/><string name="fov_axis" value="larger"/>',
+    '<float name="fov" value="45"/><string name="fov_axis" value="diagonal"/>',
+    '<float name="fov" value="45"/><string name="fov_axis" value="smaller"/>'
+    '<film type="hdrfilm"><integer name="width" value="300"/><integer name="height" value="400"/></film>',
+    '<float name="fov" value="45"/><string name="fov_axis" value="larger"/>'
+    '<film type="hdrfilm"><integer name="width" value="300"/><integer name="height" value="400"/></film>',
+    '<float name="fov" value="45"/><string name="fov_axis" value="diagonal"/>'
+    '<film type="hdrfilm"><integer name="width" value="300"/><integer name="height" value="400"/></film>',
+    '<float name="fov" value="30"/><string name="fov_axis" value="y"/>'
+    '<film type="hdrfilm"><integer name="width" value="300"/><integer name="height" value="400"/></film>',
+    '',  # no fov: Mitsuba's 50 mm default
+    '<transform name="to_world"><lookat origin="0, 0, 3.9" target="0, 0, 0" up="0, 1, 0"/></transform>',
+    '<transform name="to_world"><lookat origin="1, 2, 3" target="0, 0.5, 0" up="0, 0, 1"/></transform>',
+    '<transform name="to_world"><rotate y="1" angle="30"/><translate x="1" y="2" z="3"/></transform>',
+    '<transform name="to_world"><scale x="-1"/><lookat origin="0, 1, 4" target="0, 0, 0" up="0, 1, 0"/></transform>',
+]
+
+AREAS = [
+    '<shape type="rectangle"/>',
+    '<shape type="rectangle"><transform name="to_world"><scale x="0.23" y="0.19" z="0.19"/>'
+    '<rotate x="1" angle="90"/><translate y="0.99" z="0.01"/></transform></shape>',
+    '<shape type="rectangle"><transform name="to_world"><matrix value="1 0.5 0 0  0 2 0 0  0 0 1 0  0 0 0 1"/></transform></shape>',
+    '<shape type="cube"/>',
+    '<shape type="cube"><transform name="to_world"><scale x="0.3" y="0.61" z="0.3"/><rotate y="1" angle="18.25"/></transform></shape>',
+    '<shape type="disk"/>',
+    '<shape type="disk"><transform name="to_world"><scale x="2" y="0.5"/><rotate x="1" angle="40"/></transform></shape>',
+    '<shape type="sphere"/>',
+    '<shape type="sphere"><float name="radius" value="0.25"/><point name="center" x="1" y="2" z="3"/></shape>',
+    '<shape type="sphere"><float name="radius" value="0.5"/><transform name="to_world"><scale value="3"/><translate x="1"/></transform></shape>',
+    '<shape type="cylinder"/>',
+    '<shape type="cylinder"><point name="p0" value="0, 0, 0"/><point name="p1" value="1, 2, 2"/><float name="radius" value="0.3"/></shape>',
+    '<shape type="cylinder"><float name="radius" value="0.5"/><transform name="to_world"><scale x="2" y="2" z="5"/></transform></shape>',
+    '<shape type="obj"><string name="filename" value="quad.obj"/></shape>',
+    '<shape type="obj"><string name="filename" value="pyramid.obj"/>'
+    '<transform name="to_world"><scale x="2"/><rotate x="1" angle="10"/></transform></shape>',
+]
+
+# Vertex normals Mitsuba computes for an OBJ without `vn` (by position).
+MESHES = [
+    '<shape type="obj"><string name="filename" value="pyramid.obj"/></shape>',
+]
+
+
+def load(xml):
+    return mi.load_string(HEAD + xml + "</scene>")
+
+
+out = {"mitsuba_version": mi.__version__, "transforms": [], "sensors": [], "areas": []}
+for t in TRANSFORMS:
+    scene = load(f'<shape type="rectangle"><transform name="to_world">{t}</transform></shape>')
+    m = mi.traverse(scene.shapes()[0])["to_world"]
+    out["transforms"].append({"xml": t, "matrix": matrix(m)})
+for s in SENSORS:
+    scene = load(f'<sensor type="perspective">{s}</sensor>')
+    sensor = scene.sensors()[0]
+    out["sensors"].append({
+        "xml": s,
+        "to_world": matrix(sensor.world_transform()),
+        "x_fov": float(mi.traverse(sensor)["x_fov"]),
+    })
+for a in AREAS:
+    scene = load(a)
+    out["areas"].append({"xml": a, "area": float(scene.shapes()[0].surface_area())})
+out["meshes"] = []
+for m in MESHES:
+    params = mi.traverse(load(m).shapes()[0])
+    p = list(params["vertex_positions"])
+    n = list(params["vertex_normals"])
+    out["meshes"].append({
+        "xml": m,
+        "positions": [p[i:i + 3] for i in range(0, len(p), 3)],
+        "normals": [n[i:i + 3] for i in range(0, len(n), 3)],
+    })
+print(json.dumps(out, indent=1))

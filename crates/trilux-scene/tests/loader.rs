@@ -1,0 +1,713 @@
+//! One test (at least) per element of the supported subset (design.md §3),
+//! with expected values from Mitsuba 3's documented defaults and semantics.
+
+use std::path::PathBuf;
+
+use glam::{DMat4, DVec3};
+use trilux_brdf::{BsdfParams, Distribution};
+use trilux_color::ColorParam;
+use trilux_geometry::ShapeKind;
+use trilux_scene::{
+    FovAxis, ReconstructionFilter, Scene, SceneError, load_str, load_str_with_params,
+};
+
+fn data_dir() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data")
+}
+
+fn try_load(body: &str) -> Result<Scene, SceneError> {
+    load_str(
+        &format!("<scene version=\"3.0.0\">{body}</scene>"),
+        data_dir().join("inline.xml"),
+    )
+}
+
+fn load(body: &str) -> Scene {
+    try_load(body).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// The first shape's BSDF with `bsdf` as its only child.
+fn bsdf(bsdf: &str) -> BsdfParams {
+    load(&format!("<shape type=\"rectangle\">{bsdf}</shape>")).shapes[0]
+        .bsdf
+        .clone()
+}
+
+fn diffuse_reflectance(value: &str) -> ColorParam {
+    match bsdf(&format!("<bsdf type=\"diffuse\">{value}</bsdf>")) {
+        BsdfParams::Diffuse { reflectance } => reflectance,
+        other => panic!("{other:?}"),
+    }
+}
+
+fn err(body: &str) -> String {
+    match try_load(body) {
+        Ok(_) => panic!("{body} should be refused"),
+        Err(e) => e.to_string(),
+    }
+}
+
+// ---- values -------------------------------------------------------------
+
+#[test]
+fn float_rgb_and_spectrum_values() {
+    let r = diffuse_reflectance;
+    assert_eq!(
+        r(r#"<float name="reflectance" value="0.25"/>"#),
+        ColorParam::Float(0.25)
+    );
+    assert_eq!(
+        r(r#"<rgb name="reflectance" value="0.1, 0.2, 0.3"/>"#),
+        ColorParam::Rgb([0.1, 0.2, 0.3])
+    );
+    assert_eq!(
+        r(r#"<rgb name="reflectance" value="0.4"/>"#),
+        ColorParam::Rgb([0.4; 3])
+    );
+    assert_eq!(
+        r(r#"<spectrum name="reflectance" value="0.3"/>"#),
+        ColorParam::Constant(0.3)
+    );
+    assert_eq!(
+        r(r#"<spectrum name="reflectance" value="400:0.1, 500:0.2,600:0.3"/>"#),
+        ColorParam::Sampled(vec![(400.0, 0.1), (500.0, 0.2), (600.0, 0.3)])
+    );
+}
+
+#[test]
+fn integer_and_boolean_and_string_values() {
+    let s = load(
+        r#"<integrator type="path"><integer name="max_depth" value="5"/></integrator>
+           <shape type="rectangle"><boolean name="flip_normals" value="true"/>
+             <bsdf type="roughconductor"><string name="distribution" value="ggx"/></bsdf></shape>"#,
+    );
+    assert_eq!(s.max_depth, Some(5));
+    assert!(s.shapes[0].shape.flip_normals);
+    let BsdfParams::RoughConductor(rc) = &s.shapes[0].bsdf else {
+        panic!()
+    };
+    assert_eq!(rc.distribution, Distribution::Ggx);
+}
+
+#[test]
+fn point_and_vector_values() {
+    let s = load(
+        r#"<shape type="sphere"><point name="center" value="1, 2, 3"/></shape>
+           <shape type="sphere"><point name="center" x="1" z="-3"/></shape>
+           <shape type="cylinder"><vector name="p1" value="0 0 2"/></shape>"#,
+    );
+    let center = |i: usize| match s.shapes[i].shape.kind {
+        ShapeKind::Sphere { center, .. } => center,
+        _ => panic!(),
+    };
+    assert_eq!(center(0), DVec3::new(1.0, 2.0, 3.0));
+    assert_eq!(center(1), DVec3::new(1.0, 0.0, -3.0));
+    assert!(
+        matches!(s.shapes[2].shape.kind, ShapeKind::Cylinder { p1, .. } if p1 == DVec3::new(0.0, 0.0, 2.0))
+    );
+}
+
+#[test]
+fn wrong_value_types_are_refused() {
+    let e = err(
+        r#"<shape type="rectangle"><bsdf type="diffuse"><string name="reflectance" value="red"/></bsdf></shape>"#,
+    );
+    assert!(
+        e.contains("must be a <rgb, spectrum or float>, found <string>"),
+        "{e}"
+    );
+    let e = err(r#"<shape type="rectangle"><float name="flip_normals" value="1"/></shape>"#);
+    assert!(e.contains("must be a <boolean>"), "{e}");
+    let e = err(r#"<shape type="sphere"><float name="radius" value="abc"/></shape>"#);
+    assert!(e.contains("\"abc\" is not a number"), "{e}");
+    let e = err(r#"<shape type="rectangle"><boolean name="flip_normals" value="yes"/></shape>"#);
+    assert!(e.contains("not a boolean"), "{e}");
+    let e = err(
+        r#"<sensor type="perspective"><sampler type="independent"><integer name="sample_count" value="1.5"/></sampler></sensor>"#,
+    );
+    assert!(e.contains("not an integer"), "{e}");
+}
+
+#[test]
+fn spectra_must_be_well_formed() {
+    let sp = |v: &str| {
+        err(&format!(
+            r#"<shape type="rectangle"><bsdf type="diffuse"><spectrum name="reflectance" value="{v}"/></bsdf></shape>"#
+        ))
+    };
+    assert!(sp("500:0.1, 400:0.2").contains("wavelengths must increase"));
+    assert!(sp("500:0.1").contains("at least two"));
+    assert!(sp("0.1, 0.2").contains("one number or wavelength:value pairs"));
+    assert!(sp("400:0.1, 500:nan").contains("NaN"));
+}
+
+// ---- <default>, $name, <ref>, top-level <bsdf id> ---------------------
+
+#[test]
+fn defaults_and_substitution() {
+    let body = r#"<default name="r" value="0.125"/><default name="kind" value="diffuse"/>
+        <shape type="rectangle"><bsdf type="$kind"><float name="reflectance" value="$r"/></bsdf></shape>"#;
+    let BsdfParams::Diffuse { reflectance } = &load(body).shapes[0].bsdf else {
+        panic!()
+    };
+    assert_eq!(*reflectance, ColorParam::Float(0.125));
+    // A caller's value overrides the <default> (Mitsuba's load_file(path, r=...)).
+    let s = load_str_with_params(
+        &format!("<scene version=\"3.0.0\">{body}</scene>"),
+        "inline.xml",
+        &[("r".into(), "0.75".into())],
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    let BsdfParams::Diffuse { reflectance } = &s.shapes[0].bsdf else {
+        panic!()
+    };
+    assert_eq!(*reflectance, ColorParam::Float(0.75));
+    // Substitution inside a longer value.
+    let s = load(
+        r#"<default name="y" value="2"/><shape type="sphere"><point name="center" value="1, $y, 3"/></shape>"#,
+    );
+    assert!(matches!(s.shapes[0].shape.kind, ShapeKind::Sphere { center, .. } if center.y == 2.0));
+    let e = err(r#"<shape type="sphere"><float name="radius" value="$nope"/></shape>"#);
+    assert!(e.contains("undefined parameter $nope"), "{e}");
+}
+
+#[test]
+fn references_to_top_level_bsdfs() {
+    let s = load(
+        r#"<bsdf type="diffuse" id="grey"><float name="reflectance" value="0.3"/></bsdf>
+           <shape type="rectangle"><ref id="grey"/></shape>
+           <shape type="cube"><ref name="bsdf" id="grey"/></shape>"#,
+    );
+    for shape in &s.shapes {
+        assert_eq!(
+            shape.bsdf,
+            BsdfParams::Diffuse {
+                reflectance: ColorParam::Float(0.3)
+            }
+        );
+    }
+    // The definition counts once, however often it is referenced.
+    assert_eq!(s.bsdf_counts.get("diffuse"), Some(&1));
+    assert!(
+        err(r#"<shape type="rectangle"><ref id="missing"/></shape>"#)
+            .contains("unknown id \"missing\"")
+    );
+    assert!(
+        err(r#"<shape type="rectangle" id="a"/><shape type="cube"><ref id="a"/></shape>"#)
+            .contains("only <bsdf> elements can be referenced")
+    );
+    assert!(
+        err(r#"<bsdf type="diffuse" id="a"/><bsdf type="diffuse" id="a"/>"#)
+            .contains("already used")
+    );
+}
+
+// ---- sensor, film, sampler, integrator ---------------------------------
+
+#[test]
+fn sensor_defaults_follow_mitsuba() {
+    let c = load(r#"<sensor type="perspective"/>"#)
+        .camera
+        .expect("camera");
+    assert_eq!((c.width, c.height), (768, 576));
+    assert_eq!(c.rfilter, ReconstructionFilter::Gaussian);
+    assert_eq!(c.sample_count, 4);
+    assert_eq!(c.fov_axis, FovAxis::Diagonal);
+    // 50 mm lens on 36 x 24 mm: 2 atan(43.2666 / 100) = 46.7930° (the
+    // x_fov Mitsuba derives from it is checked in tests/mitsuba.rs).
+    assert!((c.fov - 46.7930).abs() < 1e-4, "{}", c.fov);
+    assert_eq!(c.world_from_camera, DMat4::IDENTITY);
+    assert_eq!(c.origin, DVec3::ZERO);
+    assert_eq!(c.target, DVec3::Z);
+    assert_eq!(c.up, DVec3::Y);
+    assert!(load("").camera.is_none());
+}
+
+#[test]
+fn sensor_parameters() {
+    let c = load(
+        r#"<sensor type="perspective">
+             <float name="fov" value="30"/><string name="fov_axis" value="larger"/>
+             <transform name="to_world"><lookat origin="1, 2, 3" target="1, 2, 0" up="0, 1, 0"/></transform>
+             <sampler type="stratified"><integer name="sample_count" value="16"/></sampler>
+             <film type="hdrfilm"><integer name="width" value="320"/><integer name="height" value="240"/>
+               <rfilter type="box"/><string name="pixel_format" value="rgba"/>
+               <string name="component_format" value="float16"/></film>
+           </sensor>"#,
+    )
+    .camera
+    .expect("camera");
+    assert_eq!(c.fov, 30.0);
+    assert_eq!(c.fov_axis, FovAxis::Larger);
+    assert_eq!((c.width, c.height, c.sample_count), (320, 240, 16));
+    assert_eq!(c.rfilter, ReconstructionFilter::Box);
+    assert_eq!(c.origin, DVec3::new(1.0, 2.0, 3.0));
+    assert_eq!(c.target, DVec3::new(1.0, 2.0, 0.0));
+    assert_eq!(c.up, DVec3::Y);
+    for (name, axis) in [
+        ("x", FovAxis::X),
+        ("y", FovAxis::Y),
+        ("smaller", FovAxis::Smaller),
+        ("larger", FovAxis::Larger),
+        ("diagonal", FovAxis::Diagonal),
+    ] {
+        let c = load(&format!(r#"<sensor type="perspective"><float name="fov" value="40"/><string name="fov_axis" value="{name}"/></sensor>"#)).camera.expect("camera");
+        assert_eq!(c.fov_axis, axis);
+    }
+    for sampler in ["independent", "multijitter", "ldsampler", "orthogonal"] {
+        let c = load(&format!(r#"<sensor type="perspective"><sampler type="{sampler}"><integer name="sample_count" value="8"/></sampler></sensor>"#)).camera.expect("camera");
+        assert_eq!(c.sample_count, 8);
+    }
+}
+
+#[test]
+fn sensor_to_world_may_be_any_transform() {
+    let c = load(
+        r#"<sensor type="perspective"><transform name="to_world">
+             <rotate y="1" angle="90"/><translate x="1" y="2" z="3"/></transform></sensor>"#,
+    )
+    .camera
+    .expect("camera");
+    assert!(c.origin.distance(DVec3::new(1.0, 2.0, 3.0)) < 1e-12);
+    // Camera +z (forward) rotated 90° about +y is world +x.
+    assert!(
+        c.target.distance(DVec3::new(2.0, 2.0, 3.0)) < 1e-12,
+        "{}",
+        c.target
+    );
+    assert!(c.up.distance(DVec3::Y) < 1e-12);
+}
+
+#[test]
+fn sensor_errors() {
+    assert!(
+        err(r#"<sensor type="perspective"><float name="fov" value="180"/></sensor>"#)
+            .contains("fov must lie")
+    );
+    assert!(err(r#"<sensor type="perspective"><float name="fov" value="40"/><string name="fov_axis" value="z"/></sensor>"#).contains("unknown fov_axis"));
+    assert!(err(r#"<sensor type="perspective"><transform name="to_world"><scale value="2"/></transform></sensor>"#).contains("must not scale"));
+    assert!(err(r#"<sensor type="thinlens"/>"#).contains("unknown sensor plugin"));
+    assert!(
+        err(r#"<sensor type="perspective"><float name="near_clip" value="0.1"/></sensor>"#)
+            .contains("unknown parameter \"near_clip\"")
+    );
+    assert!(err(r#"<sensor type="perspective"><film type="hdrfilm"><integer name="width" value="0"/></film></sensor>"#).contains("width must be a positive integer"));
+    assert!(err(r#"<sensor type="perspective"><film type="hdrfilm"><rfilter type="tent"/></film></sensor>"#).contains("unknown rfilter plugin"));
+    assert!(
+        err(r#"<sensor type="perspective"><film type="specfilm"/></sensor>"#)
+            .contains("unknown film plugin")
+    );
+    assert!(
+        err(r#"<sensor type="perspective"/><sensor type="perspective"/>"#)
+            .contains("only one <sensor>")
+    );
+    assert!(err(r#"<sensor type="perspective"><transform name="to_world"><lookat origin="0,0,0" target="0,1,0" up="0,1,0"/></transform></sensor>"#).contains("parallel"));
+}
+
+#[test]
+fn integrator_is_ignored_except_max_depth() {
+    let s = load(
+        r#"<integrator type="volpath"><integer name="max_depth" value="-1"/><boolean name="hide_emitters" value="true"/><integer name="rr_depth" value="3"/></integrator>"#,
+    );
+    assert_eq!(s.max_depth, Some(-1));
+    assert_eq!(load(r#"<integrator type="direct"/>"#).max_depth, None);
+}
+
+// ---- BSDFs -------------------------------------------------------------
+
+#[test]
+fn shape_without_bsdf_is_diffuse_half() {
+    let s = load(r#"<shape type="rectangle"/>"#);
+    assert_eq!(
+        s.shapes[0].bsdf,
+        BsdfParams::Diffuse {
+            reflectance: ColorParam::Float(0.5)
+        }
+    );
+    assert!(s.bsdf_counts.is_empty());
+}
+
+#[test]
+fn diffuse() {
+    assert_eq!(
+        bsdf(r#"<bsdf type="diffuse"/>"#),
+        BsdfParams::Diffuse {
+            reflectance: ColorParam::Float(0.5)
+        }
+    );
+    let e = err(
+        r#"<shape type="rectangle"><bsdf type="diffuse"><rgb name="reflectance" value="0.5, -0.1, 0.5"/></bsdf></shape>"#,
+    );
+    assert!(e.contains("reflectance must not be negative"), "{e}");
+    let e = err(
+        r#"<shape type="rectangle"><bsdf type="diffuse"><float name="reflectance" value="1.5"/></bsdf></shape>"#,
+    );
+    assert!(e.contains("must not exceed 1"), "{e}");
+}
+
+#[test]
+fn roughconductor_defaults_and_parameters() {
+    let rc = |body: &str| match bsdf(&format!(r#"<bsdf type="roughconductor">{body}</bsdf>"#)) {
+        BsdfParams::RoughConductor(rc) => rc,
+        other => panic!("{other:?}"),
+    };
+    let d = rc("");
+    assert_eq!(d.distribution, Distribution::Beckmann);
+    assert_eq!(d.alpha, 0.1);
+    assert_eq!(d.eta_k, None);
+    assert_eq!(d.specular_reflectance, ColorParam::Float(1.0));
+    let g = rc(
+        r#"<string name="distribution" value="ggx"/><float name="alpha" value="0.3"/>
+                <string name="material" value="none"/><boolean name="sample_visible" value="false"/>
+                <rgb name="specular_reflectance" value="0.9, 0.8, 0.7"/>"#,
+    );
+    assert_eq!((g.distribution, g.alpha), (Distribution::Ggx, 0.3));
+    assert_eq!(g.specular_reflectance, ColorParam::Rgb([0.9, 0.8, 0.7]));
+    assert_eq!(
+        rc(r#"<float name="alpha_u" value="0.2"/><float name="alpha_v" value="0.2"/>"#).alpha,
+        0.2
+    );
+    let m = rc(r#"<rgb name="eta" value="0.2, 0.9, 1.1"/><float name="k" value="3"/>"#);
+    assert_eq!(
+        m.eta_k,
+        Some((ColorParam::Rgb([0.2, 0.9, 1.1]), ColorParam::Float(3.0)))
+    );
+    // Mitsuba's defaults for the missing half: eta 0, k 1.
+    assert_eq!(
+        rc(r#"<float name="k" value="2"/>"#).eta_k,
+        Some((ColorParam::Float(0.0), ColorParam::Float(2.0)))
+    );
+}
+
+#[test]
+fn roughconductor_refusals() {
+    let e = |body: &str| {
+        err(&format!(
+            r#"<shape type="rectangle"><bsdf type="roughconductor">{body}</bsdf></shape>"#
+        ))
+    };
+    assert!(
+        e(r#"<float name="alpha_u" value="0.1"/><float name="alpha_v" value="0.2"/>"#)
+            .contains("anisotropic")
+    );
+    assert!(e(r#"<float name="alpha_u" value="0.1"/>"#).contains("both alpha_u and alpha_v"));
+    assert!(e(r#"<float name="alpha" value="0"/>"#).contains("alpha must be positive"));
+    assert!(e(r#"<float name="alpha" value="-0.1"/>"#).contains("alpha must be positive"));
+    assert!(e(r#"<string name="material" value="Au"/>"#).contains("named conductor materials"));
+    assert!(
+        e(r#"<string name="distribution" value="phong"/>"#)
+            .contains("unknown microfacet distribution")
+    );
+    assert!(e(r#"<float name="eta" value="-1"/>"#).contains("eta must not be negative"));
+}
+
+#[test]
+fn blendbsdf_and_twosided() {
+    let b = bsdf(
+        r#"<bsdf type="blendbsdf"><float name="weight" value="0.25"/>
+                     <bsdf type="diffuse"/><bsdf type="roughconductor"/></bsdf>"#,
+    );
+    let BsdfParams::Blend {
+        weight,
+        first,
+        second,
+    } = b
+    else {
+        panic!()
+    };
+    assert_eq!(weight, 0.25);
+    assert!(matches!(*first, BsdfParams::Diffuse { .. }));
+    assert!(matches!(*second, BsdfParams::RoughConductor(_)));
+
+    let one = bsdf(r#"<bsdf type="twosided"><bsdf type="diffuse"/></bsdf>"#);
+    assert!(matches!(one, BsdfParams::TwoSided { back: None, .. }));
+    let two =
+        bsdf(r#"<bsdf type="twosided"><bsdf type="diffuse"/><bsdf type="roughconductor"/></bsdf>"#);
+    let BsdfParams::TwoSided {
+        front,
+        back: Some(back),
+    } = two
+    else {
+        panic!()
+    };
+    assert!(matches!(*front, BsdfParams::Diffuse { .. }));
+    assert!(matches!(*back, BsdfParams::RoughConductor(_)));
+
+    let e = |b: &str| err(&format!(r#"<shape type="rectangle">{b}</shape>"#));
+    assert!(
+        e(r#"<bsdf type="blendbsdf"><bsdf type="diffuse"/><bsdf type="diffuse"/></bsdf>"#)
+            .contains("weight")
+    );
+    assert!(e(r#"<bsdf type="blendbsdf"><float name="weight" value="1.5"/><bsdf type="diffuse"/><bsdf type="diffuse"/></bsdf>"#).contains("[0, 1]"));
+    assert!(e(r#"<bsdf type="blendbsdf"><float name="weight" value="0.5"/><bsdf type="diffuse"/></bsdf>"#).contains("exactly two"));
+    assert!(e(r#"<bsdf type="twosided"/>"#).contains("one or two"));
+    assert!(e(r#"<bsdf type="plastic"/>"#).contains("unknown bsdf plugin \"plastic\""));
+}
+
+#[test]
+fn bsdf_counts_include_nested_ones() {
+    let s = load(
+        r#"<bsdf type="diffuse" id="w"/>
+           <shape type="rectangle"><bsdf type="twosided"><bsdf type="blendbsdf"><float name="weight" value="0.5"/>
+             <bsdf type="diffuse"/><bsdf type="roughconductor"/></bsdf></bsdf></shape>
+           <shape type="rectangle"><ref id="w"/></shape>"#,
+    );
+    let counts: Vec<(&str, usize)> = s
+        .bsdf_counts
+        .iter()
+        .map(|(k, v)| (k.as_str(), *v))
+        .collect();
+    assert_eq!(
+        counts,
+        [
+            ("blendbsdf", 1),
+            ("diffuse", 2),
+            ("roughconductor", 1),
+            ("twosided", 1)
+        ]
+    );
+}
+
+// ---- emitters -----------------------------------------------------------
+
+#[test]
+fn area_emitters() {
+    let s = load(
+        r#"<shape type="rectangle"><emitter type="area"><rgb name="radiance" value="1, 2, 3"/></emitter></shape>
+           <shape type="rectangle"><emitter type="area"/></shape>
+           <shape type="rectangle"/>"#,
+    );
+    assert_eq!(s.emitters().count(), 2);
+    assert_eq!(
+        s.shapes[0].emitter.as_ref().map(|e| e.radiance.clone()),
+        Some(ColorParam::Rgb([1.0, 2.0, 3.0]))
+    );
+    // Mitsuba's default radiance is 1.
+    assert_eq!(
+        s.shapes[1].emitter.as_ref().map(|e| e.radiance.clone()),
+        Some(ColorParam::Float(1.0))
+    );
+    assert!(err(r#"<emitter type="point"/>"#).contains("unknown emitter plugin \"point\""));
+    assert!(err(r#"<emitter type="area"/>"#).contains("inside a <shape>"));
+    assert!(
+        err(r#"<shape type="rectangle"><emitter type="spot"/></shape>"#)
+            .contains("unknown emitter plugin")
+    );
+    assert!(err(r#"<shape type="rectangle"><emitter type="area"><float name="radiance" value="-1"/></emitter></shape>"#).contains("radiance must not be negative"));
+}
+
+#[test]
+fn spectral_decision() {
+    assert!(!load(r#"<shape type="rectangle"><emitter type="area"><spectrum name="radiance" value="2"/></emitter></shape>"#).spectral);
+    assert!(load(r#"<shape type="rectangle"><emitter type="area"><spectrum name="radiance" value="400:1, 700:2"/></emitter></shape>"#).spectral);
+    assert!(load(r#"<shape type="rectangle"><bsdf type="twosided"><bsdf type="diffuse"><spectrum name="reflectance" value="400:0.1, 700:0.2"/></bsdf></bsdf></shape>"#).spectral);
+}
+
+// ---- shapes and transforms ----------------------------------------------
+
+#[test]
+fn every_shape_kind() {
+    let s = load(
+        r#"<shape type="rectangle"/><shape type="cube"/><shape type="disk"/>
+           <shape type="sphere"><float name="radius" value="2"/></shape>
+           <shape type="cylinder"><point name="p0" value="0,0,-1"/><point name="p1" value="0,0,1"/><float name="radius" value="0.5"/></shape>
+           <shape type="obj"><string name="filename" value="quad.obj"/></shape>"#,
+    );
+    assert!(matches!(s.shapes[0].shape.kind, ShapeKind::Rectangle));
+    assert!(matches!(s.shapes[1].shape.kind, ShapeKind::Cube));
+    assert!(matches!(s.shapes[2].shape.kind, ShapeKind::Disk));
+    assert!(
+        matches!(s.shapes[3].shape.kind, ShapeKind::Sphere { radius, center } if radius == 2.0 && center == DVec3::ZERO)
+    );
+    assert!(matches!(s.shapes[4].shape.kind, ShapeKind::Cylinder { radius, .. } if radius == 0.5));
+    assert!(matches!(s.shapes[5].shape.kind, ShapeKind::Mesh(_)));
+    // Mitsuba's cylinder defaults: p0 = 0, p1 = (0, 0, 1), radius 1.
+    let c = load(r#"<shape type="cylinder"/>"#);
+    assert!(
+        matches!(c.shapes[0].shape.kind, ShapeKind::Cylinder { p0, p1, radius } if p0 == DVec3::ZERO && p1 == DVec3::Z && radius == 1.0)
+    );
+}
+
+#[test]
+fn shape_ids_locations_and_flip_normals() {
+    let s = load(
+        "<shape type=\"rectangle\" id=\"floor\">\n<boolean name=\"flip_normals\" value=\"true\"/></shape>\n  <shape type=\"disk\"/>",
+    );
+    assert_eq!(s.shapes[0].id.as_deref(), Some("floor"));
+    assert_eq!(s.shapes[1].id, None);
+    assert!(s.shapes[0].shape.flip_normals);
+    assert!(!s.shapes[1].shape.flip_normals);
+    assert_eq!(
+        (s.shapes[1].location.line, s.shapes[1].location.col),
+        (3, 3)
+    );
+}
+
+#[test]
+fn obj_meshes() {
+    let s = load(
+        r#"<shape type="obj"><string name="filename" value="quad.obj"/></shape>
+                    <shape type="obj"><string name="filename" value="quad.obj"/><boolean name="face_normals" value="true"/></shape>"#,
+    );
+    let mesh = |i: usize| match &s.shapes[i].shape.kind {
+        ShapeKind::Mesh(m) => m.clone(),
+        _ => panic!(),
+    };
+    let with_vn = mesh(0);
+    assert_eq!(with_vn.triangles.len(), 2);
+    assert!(!with_vn.face_normals);
+    // The file's vn, not the face normal.
+    for n in with_vn.normals.as_ref().expect("vn") {
+        assert!(n.distance(DVec3::new(0.0, 0.6, 0.8)) < 1e-6);
+    }
+    // Counter-clockwise seen from +z: the face normal is +z.
+    let t = with_vn.triangles[0].map(|i| with_vn.positions[i as usize]);
+    assert!((t[1] - t[0]).cross(t[2] - t[0]).z > 0.0);
+    let flat = mesh(1);
+    assert!(flat.face_normals);
+    assert!(flat.normals.is_none());
+    // Relative file names resolve against the scene file's folder, not the
+    // working directory.
+    let e = load_str(
+        r#"<scene version="3.0.0"><shape type="obj"><string name="filename" value="quad.obj"/></shape></scene>"#,
+        "/nonexistent/scene.xml",
+    )
+    .expect_err("no quad.obj there");
+    assert!(e.to_string().contains("/nonexistent/quad.obj"), "{e}");
+    let e = err(r#"<shape type="obj"><string name="filename" value="broken.obj"/></shape>"#);
+    assert!(e.contains("malformed OBJ file"), "{e}");
+    let e = err(r#"<shape type="obj"><string name="filename" value="missing.obj"/></shape>"#);
+    assert!(e.contains("cannot read OBJ file"), "{e}");
+    let e = err(r#"<shape type="obj"/>"#);
+    assert!(e.contains("needs <string name=\"filename\">"), "{e}");
+}
+
+#[test]
+fn transform_operations_compose_first_listed_first() {
+    let m = |t: &str| {
+        load(&format!(
+            r#"<shape type="rectangle"><transform name="to_world">{t}</transform></shape>"#
+        ))
+        .shapes[0]
+            .shape
+            .world_from_object
+    };
+    let p = DVec3::new(1.0, 0.0, 0.0);
+    // Scale, then translate: (1,0,0) → (2,0,0) → (2,5,0).
+    assert!(
+        m(r#"<scale value="2"/><translate y="5"/>"#)
+            .transform_point3(p)
+            .distance(DVec3::new(2.0, 5.0, 0.0))
+            < 1e-12
+    );
+    // Translate, then scale: (1,0,0) → (1,5,0) → (2,10,0).
+    assert!(
+        m(r#"<translate y="5"/><scale value="2"/>"#)
+            .transform_point3(p)
+            .distance(DVec3::new(2.0, 10.0, 0.0))
+            < 1e-12
+    );
+    // Rotate +90° about z maps x to y (right-handed).
+    assert!(
+        m(r#"<rotate z="1" angle="90"/>"#)
+            .transform_point3(p)
+            .distance(DVec3::Y)
+            < 1e-12
+    );
+    assert_eq!(
+        m(r#"<scale x="2" y="3" z="4"/>"#),
+        DMat4::from_scale(DVec3::new(2.0, 3.0, 4.0))
+    );
+    assert_eq!(
+        m(r#"<scale value="2, 3, 4"/>"#),
+        DMat4::from_scale(DVec3::new(2.0, 3.0, 4.0))
+    );
+    assert_eq!(
+        m(r#"<translate value="1 2 3"/>"#),
+        DMat4::from_translation(DVec3::new(1.0, 2.0, 3.0))
+    );
+    // matrix is written row by row.
+    let mm = m(r#"<matrix value="1 0 0 7  0 1 0 8  0 0 1 9  0 0 0 1"/>"#);
+    assert_eq!(mm.transform_point3(DVec3::ZERO), DVec3::new(7.0, 8.0, 9.0));
+    // A lookat in a shape's to_world places +z towards the target.
+    let l = m(r#"<lookat origin="0, 0, 5" target="0, 0, 0" up="0, 1, 0"/>"#);
+    assert!(l.transform_vector3(DVec3::Z).distance(-DVec3::Z) < 1e-12);
+    assert!(
+        l.transform_point3(DVec3::ZERO)
+            .distance(DVec3::new(0.0, 0.0, 5.0))
+            < 1e-12
+    );
+}
+
+#[test]
+fn transform_refusals() {
+    let e = |t: &str| {
+        err(&format!(
+            r#"<shape type="rectangle"><transform name="to_world">{t}</transform></shape>"#
+        ))
+    };
+    assert!(e(r#"<rotate value="1, 1, 0" angle="30"/>"#).contains("unit vector"));
+    assert!(e(r#"<rotate x="1"/>"#).contains("needs the attribute \"angle\""));
+    assert!(e(r#"<rotate axis="1, 0, 0" angle="30"/>"#).contains("unexpected attribute \"axis\""));
+    assert!(e(r#"<matrix value="1 0 0 0"/>"#).contains("expected 16 numbers"));
+    assert!(e(r#"<shear value="1"/>"#).contains("unknown transform operation <shear>"));
+    assert!(e(r#"<scale value="0"/>"#).contains("singular"));
+    assert!(e(r#"<scale x="1" y="0"/>"#).contains("singular"));
+    assert!(e(r#"<translate x="inf"/>"#).contains("not a finite number"));
+}
+
+#[test]
+fn zero_and_degenerate_shapes_are_refused() {
+    assert!(
+        err(r#"<shape type="sphere"><float name="radius" value="0"/></shape>"#)
+            .contains("radius must be positive")
+    );
+    assert!(
+        err(r#"<shape type="cylinder"><float name="radius" value="-1"/></shape>"#)
+            .contains("radius must be positive")
+    );
+    assert!(
+        err(r#"<shape type="cylinder"><point name="p1" value="0, 0, 0"/></shape>"#)
+            .contains("zero length")
+    );
+    assert!(
+        err(
+            r#"<shape type="sphere"><transform name="to_world"><scale x="2"/></transform></shape>"#
+        )
+        .contains("uniformly")
+    );
+    assert!(err(r#"<shape type="cylinder"><transform name="to_world"><scale x="2"/></transform></shape>"#).contains("circular"));
+    assert!(err(r#"<shape type="rectangle"><transform name="to_world"><matrix value="1 1 0 0  1 1 0 0  0 0 1 0  0 0 0 1"/></transform></shape>"#).contains("singular"));
+}
+
+#[test]
+fn unknown_things_are_refused() {
+    assert!(err(r#"<shape type="ply"/>"#).contains("unknown shape plugin \"ply\""));
+    assert!(
+        err(r#"<shape type="rectangle"><float name="size" value="2"/></shape>"#)
+            .contains("unknown parameter \"size\" for <shape type=\"rectangle\">")
+    );
+    assert!(err(r#"<texture type="bitmap"/>"#).contains("unsupported element <texture>"));
+    assert!(
+        err(r#"<shape type="rectangle"><bsdf type="diffuse"/><bsdf type="diffuse"/></shape>"#)
+            .contains("at most one <bsdf>")
+    );
+    assert!(err(r#"<shape type="rectangle"><float name="x" value="1"/><float name="x" value="2"/></shape>"#).contains("given twice"));
+    assert!(err(r#"<shape type="rectangle" foo="1"/>"#).contains("unexpected attribute \"foo\""));
+    assert!(err(r#"<shape type="rectangle">hello</shape>"#).contains("unexpected text"));
+}
+
+#[test]
+fn scene_root_and_version() {
+    let e =
+        load_str("<scene><shape type=\"rectangle\"/></scene>", "a.xml").expect_err("no version");
+    assert!(e.to_string().starts_with("a.xml:1:1: "), "{e}");
+    let e = load_str("<scene version=\"0.6.0\"/>", "a.xml").expect_err("old version");
+    assert!(e.to_string().contains("unsupported scene version"), "{e}");
+    let e = load_str("<shape type=\"rectangle\"/>", "a.xml").expect_err("no scene root");
+    assert!(
+        e.to_string().contains("the root element must be <scene>"),
+        "{e}"
+    );
+    assert!(load_str("<scene version=\"2.1.0\"/>", "a.xml").is_ok());
+}

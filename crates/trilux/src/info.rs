@@ -1,0 +1,141 @@
+//! `trilux info SCENE [--json] [--mode rgb|spectral]`: what a scene loads to.
+
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+use anyhow::Result;
+use clap::Args;
+use serde::Serialize;
+use trilux_geometry::ShapeKind;
+use trilux_scene::Scene;
+
+use crate::ModeArg;
+use crate::power::emitted_power;
+use crate::surfaces::input_surfaces_provisional;
+
+/// Arguments of `trilux info`.
+#[derive(Debug, Args)]
+pub struct InfoArgs {
+    /// The scene file (Mitsuba 3 XML subset).
+    pub scene: PathBuf,
+    /// Print a JSON object instead of text.
+    #[arg(long)]
+    pub json: bool,
+    /// Override the scene's colour mode (spectral when some <spectrum> has
+    /// wavelength:value pairs).
+    #[arg(long, value_enum)]
+    pub mode: Option<ModeArg>,
+}
+
+/// The JSON of `info --json` (design.md §3), exactly these keys.
+#[derive(Debug, Serialize)]
+struct InfoJson {
+    shapes: usize,
+    input_surfaces: usize,
+    emitters: usize,
+    bsdfs: BTreeMap<String, usize>,
+    emitted_power: Vec<f64>,
+    mode: &'static str,
+    /// `null` when the scene has no sensor.
+    camera: Option<CameraJson>,
+}
+
+#[derive(Debug, Serialize)]
+struct CameraJson {
+    origin: [f64; 3],
+    target: [f64; 3],
+    up: [f64; 3],
+    fov: f64,
+    fov_axis: &'static str,
+    width: u32,
+    height: u32,
+}
+
+/// Runs `trilux info`.
+pub fn run(args: &InfoArgs) -> Result<()> {
+    let scene = trilux_scene::load(&args.scene)?;
+    let mode = args.mode.unwrap_or(if scene.spectral {
+        ModeArg::Spectral
+    } else {
+        ModeArg::Rgb
+    });
+    let info = InfoJson {
+        shapes: scene.shapes.len(),
+        input_surfaces: input_surfaces_provisional(&scene),
+        emitters: scene.emitters().count(),
+        bsdfs: scene.bsdf_counts.clone(),
+        emitted_power: emitted_power(&scene, mode),
+        mode: match mode {
+            ModeArg::Rgb => "rgb",
+            ModeArg::Spectral => "spectral",
+        },
+        camera: scene.camera.as_ref().map(|c| CameraJson {
+            origin: c.origin.to_array(),
+            target: c.target.to_array(),
+            up: c.up.to_array(),
+            fov: c.fov,
+            fov_axis: c.fov_axis.name(),
+            width: c.width,
+            height: c.height,
+        }),
+    };
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&info)?);
+    } else {
+        print_text(&scene, &info);
+    }
+    Ok(())
+}
+
+fn print_text(scene: &Scene, info: &InfoJson) {
+    println!("scene          {}", scene.path.display());
+    println!(
+        "mode           {} (the file is {})",
+        info.mode,
+        if scene.spectral { "spectral" } else { "rgb" }
+    );
+    println!("shapes         {}", info.shapes);
+    println!("input surfaces {}", info.input_surfaces);
+    println!("emitters       {}", info.emitters);
+    let bsdfs: Vec<String> = info.bsdfs.iter().map(|(k, v)| format!("{k} {v}")).collect();
+    println!("bsdfs          {}", bsdfs.join(", "));
+    let power: Vec<String> = info
+        .emitted_power
+        .iter()
+        .map(|p| format!("{p:.6}"))
+        .collect();
+    println!("emitted power  [{}] W", power.join(", "));
+    if let Some(d) = scene.max_depth {
+        println!("max_depth      {d}");
+    }
+    match (&info.camera, &scene.camera) {
+        (Some(c), Some(cam)) => {
+            println!(
+                "camera         origin {:?} target {:?} up {:?}",
+                c.origin, c.target, c.up
+            );
+            println!(
+                "               fov {} ({}), {}x{} px, {} spp, {:?} filter",
+                c.fov, c.fov_axis, c.width, c.height, cam.sample_count, cam.rfilter
+            );
+        }
+        _ => println!("camera         none (the scene has no <sensor>)"),
+    }
+    for (i, s) in scene.shapes.iter().enumerate() {
+        let kind = match &s.shape.kind {
+            ShapeKind::Rectangle => "rectangle".to_string(),
+            ShapeKind::Cube => "cube".to_string(),
+            ShapeKind::Disk => "disk".to_string(),
+            ShapeKind::Sphere { .. } => "sphere".to_string(),
+            ShapeKind::Cylinder { .. } => "cylinder".to_string(),
+            ShapeKind::Mesh(m) => format!("obj ({} triangles)", m.triangles.len()),
+        };
+        println!(
+            "  shape {i:3} {:16} {kind:24} area {:.6}{}  (line {})",
+            s.id.as_deref().unwrap_or("-"),
+            trilux_scene::surface_area(&s.shape),
+            if s.emitter.is_some() { ", emitter" } else { "" },
+            s.location.line
+        );
+    }
+}
