@@ -1,13 +1,39 @@
 //! # trilux-brdf — reflectance
 //!
-//! Layer: depends on `trilux-color` (spectra) and `trilux-geometry`
-//! (elements, for area reflectance). Nothing here parses files.
+//! Layer: depends on `trilux-color` (spectra) and `glam`; nothing here parses
+//! files or knows about elements beyond points and normals (so it can be
+//! used alone). Every model is defined exactly as Mitsuba 3 defines it.
 //!
-//! Contents:
-//! - [`params`]: material parameters as plain data ([`BsdfParams`]), exactly
-//!   the Mitsuba 3 BSDF subset that trilux supports.
+//! Contents, in reading order:
+//! - [`params`]: material parameters as plain data ([`BsdfParams`]), the
+//!   Mitsuba 3 BSDF subset that trilux supports.
+//! - [`bsdf`]: [`Bsdf<N>`](Bsdf), a material ready to evaluate: `eval`
+//!   (fr), `sample` (fr·cos importance sampling), `pdf`, `albedo`, and the
+//!   Lambertian / glossy split the solver uses.
+//! - [`frame`]: local frames (z = front normal; `wi` to the light, `wo` to the
+//!   viewer).
+//! - [`lobe`]: one side of a material: `diffuse`, `roughconductor`,
+//!   `blendbsdf`.
+//! - [`microfacet`]: Mitsuba's Beckmann and GGX D, separable Smith G (its
+//!   rational G1 for Beckmann), and their sampling.
+//! - [`fresnel`]: conductor Fresnel from η and k.
+//! - [`area`]: area reflectance R(I→J→K) = π F_JI fr (paper Eq. 5) and the
+//!   BRDF variation estimate over three elements (notes §2).
 #![forbid(unsafe_code)]
+// Band loops index several arrays in step; iterators would hide that.
+#![allow(clippy::needless_range_loop)]
 
+pub mod area;
+pub mod bsdf;
+pub mod error;
+pub mod frame;
+pub mod fresnel;
+pub mod lobe;
+pub mod microfacet;
 pub mod params;
 
+pub use area::{AreaReflectance, BrdfVariation, ElementPoints, area_reflectance, brdf_variation};
+pub use bsdf::{Bsdf, BsdfSample, Side};
+pub use error::BrdfError;
+pub use frame::Frame;
 pub use params::{BsdfParams, Distribution, RoughConductorParams};
