@@ -23,10 +23,12 @@
 //! - [`film`]: splatting samples through the filter, per-pixel normalisation.
 //! - [`driver`]: tiles rendered in parallel (rayon), merged deterministically.
 //! - [`image`]: the finished [`Image`], EXR and PNG output (atomic writes).
+//! - [`analytic`]: analytic scenes with known answers (tests, benches).
 //! - [`bands`]: small helpers on per-band radiance arrays.
 //! - [`error`]: the error type, [`RenderError`].
 #![forbid(unsafe_code)]
 
+pub mod analytic;
 pub mod bands;
 pub mod camera;
 pub mod driver;

@@ -1,9 +1,7 @@
-//! The final gather on analytic mock scenes (tests/common).
+//! The final gather on analytic mock scenes (trilux_render::analytic).
 
-mod common;
-
-use common::{Furnace, LitFloor};
 use glam::DVec3;
+use trilux_render::analytic::{Furnace, LitFloor};
 use trilux_render::camera::look_at;
 use trilux_render::{
     Camera, ExtraBounce, FovAxis, Image, ReconstructionFilter, RenderSettings, render_image,

@@ -1,11 +1,17 @@
-//! Analytic mock scenes for the final gather: everything a [`GatherScene`]
-//! answers is written here by hand, independently of trilux's other crates.
-#![allow(dead_code)]
+//! Analytic scenes for testing and benchmarking the final gather.
+//!
+//! Everything a [`GatherScene`] answers is written here by hand, with closed
+//! forms, independently of trilux's geometry, BRDF and solver crates, so the
+//! estimator can be checked against known answers:
+//! - [`Furnace`]: the inside of an emitting, reflecting closed cube, whose
+//!   radiance is le / (1 − ρ) everywhere;
+//! - [`LitFloor`]: a diffuse floor under a square light, whose radiance is
+//!   ρ · Le · F(point → square) (Lambert's polygon formula).
 
 use std::f64::consts::PI;
 
+use crate::gather::{BsdfSample, GatherScene, LightSample, SurfacePoint};
 use glam::{DVec2, DVec3};
-use trilux_render::{BsdfSample, GatherScene, LightSample, SurfacePoint};
 
 /// An orthonormal frame around `n` (Duff et al. 2017).
 pub fn frame(n: DVec3) -> (DVec3, DVec3) {
