@@ -15,6 +15,8 @@
 //!
 //! Contents, in the order an image is made:
 //! - [`camera`]: Mitsuba 3's `perspective` sensor (fov, `fov_axis`, `lookat`).
+//! - [`view`]: the scene's sensor as a [`Camera`], with command-line
+//!   overrides (`--lookat`, `--fov`, film size).
 //! - [`sampler`]: Owen-scrambled Sobol samples (sobol_burley), one sequence
 //!   per pixel, decorrelated by the seed.
 //! - [`gather`]: the abstraction the integrator is written against
@@ -38,6 +40,7 @@ pub mod filter;
 pub mod gather;
 pub mod image;
 pub mod sampler;
+pub mod view;
 
 pub use camera::{Camera, FovAxis, Ray};
 pub use driver::{RenderSettings, RenderStats, render_image};
@@ -49,3 +52,4 @@ pub use gather::{
 };
 pub use image::Image;
 pub use sampler::PixelSampler;
+pub use view::{ViewOverrides, camera_of, filter_of};
