@@ -1,0 +1,328 @@
+//! Triangle meshes as charts, and chart elements as clusters of triangle
+//! pieces.
+//!
+//! # How charts are chosen
+//!
+//! A mesh never becomes one input surface per triangle (k input surfaces
+//! make k² root interactions, notes/algorithm.md §7). Instead its triangles
+//! are grouped into **charts**, each one input surface:
+//!
+//! 1. Triangles are connected through shared edges. Vertices are welded by
+//!    exact position first, so a mesh whose loader duplicated vertices (for
+//!    normals or texture coordinates) is still connected.
+//! 2. A chart grows from the first unassigned triangle (in file order),
+//!    always adding the connected candidate whose centroid is closest to the
+//!    seed's centroid (so charts are compact, roughly round), as long as
+//!    - the candidate's normal is within [`CHART_CONE_DEG`] (60°) of the
+//!      seed's normal (normal-cone bound), and
+//!    - the chart has fewer than [`CHART_MAX_TRIANGLES`] (512) triangles.
+//! 3. A chart left smaller than an eighth of the cap is merged into an
+//!    adjacent chart when that keeps both bounds (cap allowing 1.5×).
+//!
+//! Degenerate (zero-area) triangles belong to no chart and are not traced.
+//!
+//! # Elements of a chart
+//!
+//! An element of a chart is a **cluster of pieces**; a piece is a whole mesh
+//! triangle or a sub-triangle of one (in the triangle's barycentric
+//! coordinates). The root holds the chart's triangles. A cluster of n ≥ 4
+//! pieces splits into 4 sub-clusters by two median cuts of the piece
+//! centroids along the longest box axis; a cluster of fewer than 4 pieces
+//! first splits each piece at its edge midpoints (4 sub-triangles), so every
+//! element has exactly 4 children and the leaves of a fully subdivided tree
+//! partition every triangle exactly once.
+
+use std::collections::{BinaryHeap, HashMap};
+
+use glam::{DVec2, DVec3};
+use serde::{Deserialize, Serialize};
+
+/// Largest number of triangles in one chart.
+pub const CHART_MAX_TRIANGLES: usize = 512;
+/// Half-angle, in degrees, of the normal cone of a chart around its seed.
+pub const CHART_CONE_DEG: f64 = 60.0;
+
+/// A mesh in world space, with per-triangle data.
+#[derive(Clone, Debug)]
+pub(crate) struct MeshData {
+    pub positions: Vec<DVec3>,
+    pub triangles: Vec<[u32; 3]>,
+    /// World-space shading normals (unit), when the mesh has them and
+    /// `face_normals` is false.
+    pub shading_normals: Option<Vec<DVec3>>,
+    /// Front unit normal per triangle (after `flip_normals`); zero for
+    /// degenerate triangles.
+    pub tri_normal: Vec<DVec3>,
+    pub tri_area: Vec<f64>,
+    /// Input surface of each triangle (`u32::MAX` for degenerate ones).
+    pub tri_surface: Vec<u32>,
+    /// +1 or −1 (flip_normals), applied to shading normals.
+    pub sign: f64,
+}
+
+impl MeshData {
+    #[inline]
+    pub fn vertices(&self, tri: u32) -> [DVec3; 3] {
+        let t = self.triangles[tri as usize];
+        [
+            self.positions[t[0] as usize],
+            self.positions[t[1] as usize],
+            self.positions[t[2] as usize],
+        ]
+    }
+
+    /// The point with barycentrics (b1, b2) of a triangle.
+    #[inline]
+    pub fn point(&self, tri: u32, b: DVec2) -> DVec3 {
+        let [a, p1, p2] = self.vertices(tri);
+        a + b.x * (p1 - a) + b.y * (p2 - a)
+    }
+
+    /// Shading normal at barycentrics (b1, b2) (the face normal when the
+    /// mesh has no usable vertex normals).
+    pub fn shading_normal(&self, tri: u32, b: DVec2) -> DVec3 {
+        if let Some(ns) = &self.shading_normals {
+            let t = self.triangles[tri as usize];
+            let n = (1.0 - b.x - b.y) * ns[t[0] as usize]
+                + b.x * ns[t[1] as usize]
+                + b.y * ns[t[2] as usize];
+            let n = self.sign * n;
+            if let Some(n) = n.try_normalize() {
+                return n;
+            }
+        }
+        self.tri_normal[tri as usize]
+    }
+}
+
+/// A piece of a chart element: a mesh triangle or a sub-triangle of it,
+/// given by the barycentric coordinates (b1, b2) of its three corners.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Piece {
+    /// Index of the triangle in its mesh.
+    pub triangle: u32,
+    /// Corners in the triangle's barycentric coordinates (b1, b2).
+    pub bary: [DVec2; 3],
+}
+
+impl Piece {
+    /// The whole triangle.
+    pub fn whole(triangle: u32) -> Piece {
+        Piece {
+            triangle,
+            bary: [DVec2::ZERO, DVec2::X, DVec2::Y],
+        }
+    }
+
+    /// The four midpoint sub-triangles (three corners, then the middle one).
+    pub fn split(&self) -> [Piece; 4] {
+        let [a, b, c] = self.bary;
+        let (ab, bc, ca) = (0.5 * (a + b), 0.5 * (b + c), 0.5 * (c + a));
+        let t = self.triangle;
+        [
+            Piece {
+                triangle: t,
+                bary: [a, ab, ca],
+            },
+            Piece {
+                triangle: t,
+                bary: [ab, b, bc],
+            },
+            Piece {
+                triangle: t,
+                bary: [ca, bc, c],
+            },
+            Piece {
+                triangle: t,
+                bary: [bc, ca, ab],
+            },
+        ]
+    }
+
+    /// Barycentric coordinates of the triangle-barycentric point `b` with
+    /// respect to this piece's corners.
+    pub fn local(&self, b: DVec2) -> [f64; 3] {
+        let [p0, p1, p2] = self.bary;
+        let e1 = p1 - p0;
+        let e2 = p2 - p0;
+        let d = b - p0;
+        let det = e1.x * e2.y - e1.y * e2.x;
+        let l1 = (d.x * e2.y - d.y * e2.x) / det;
+        let l2 = (e1.x * d.y - e1.y * d.x) / det;
+        [1.0 - l1 - l2, l1, l2]
+    }
+
+    /// True if the triangle-barycentric point lies in this piece (with a
+    /// tolerance of 1e-9 in the piece's own barycentrics).
+    pub fn contains(&self, triangle: u32, b: DVec2) -> bool {
+        triangle == self.triangle && self.local(b).iter().all(|&l| l >= -1e-9)
+    }
+
+    /// The world corners of this piece.
+    pub(crate) fn corners(&self, mesh: &MeshData) -> [DVec3; 3] {
+        self.bary.map(|b| mesh.point(self.triangle, b))
+    }
+
+    /// Fraction of the triangle's area covered by this piece.
+    pub fn area_fraction(&self) -> f64 {
+        let [a, b, c] = self.bary;
+        let e1 = b - a;
+        let e2 = c - a;
+        (e1.x * e2.y - e1.y * e2.x).abs()
+    }
+}
+
+/// Groups the non-degenerate triangles of a mesh into charts (module docs).
+pub(crate) fn build_charts(mesh: &MeshData) -> Vec<Vec<u32>> {
+    let n = mesh.triangles.len();
+    // Weld vertices by exact position.
+    let mut weld: HashMap<[u64; 3], u32> = HashMap::new();
+    let canon: Vec<u32> = mesh
+        .positions
+        .iter()
+        .map(|p| {
+            let key = [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()];
+            let next = weld.len() as u32;
+            *weld.entry(key).or_insert(next)
+        })
+        .collect();
+    // Edge → triangles.
+    let mut edges: HashMap<(u32, u32), Vec<u32>> = HashMap::new();
+    for (t, tri) in mesh.triangles.iter().enumerate() {
+        if mesh.tri_area[t] <= 0.0 {
+            continue;
+        }
+        for k in 0..3 {
+            let a = canon[tri[k] as usize];
+            let b = canon[tri[(k + 1) % 3] as usize];
+            if a != b {
+                edges
+                    .entry((a.min(b), a.max(b)))
+                    .or_default()
+                    .push(t as u32);
+            }
+        }
+    }
+    let neighbours = |t: u32| -> Vec<u32> {
+        let tri = mesh.triangles[t as usize];
+        let mut out = Vec::new();
+        for k in 0..3 {
+            let a = canon[tri[k] as usize];
+            let b = canon[tri[(k + 1) % 3] as usize];
+            if let Some(list) = edges.get(&(a.min(b), a.max(b))) {
+                out.extend(list.iter().copied().filter(|&o| o != t));
+            }
+        }
+        out
+    };
+    let centroid = |t: u32| {
+        let [a, b, c] = mesh.vertices(t);
+        (a + b + c) / 3.0
+    };
+    let cos_cone = CHART_CONE_DEG.to_radians().cos();
+    let mut chart_of = vec![u32::MAX; n];
+    let mut charts: Vec<Vec<u32>> = Vec::new();
+    for seed in 0..n as u32 {
+        if chart_of[seed as usize] != u32::MAX || mesh.tri_area[seed as usize] <= 0.0 {
+            continue;
+        }
+        let id = charts.len() as u32;
+        let seed_n = mesh.tri_normal[seed as usize];
+        let seed_c = centroid(seed);
+        let mut members = Vec::new();
+        // Max-heap on negated distance (ordered bits of a non-negative f64).
+        let mut heap: BinaryHeap<(std::cmp::Reverse<u64>, u32)> = BinaryHeap::new();
+        heap.push((std::cmp::Reverse(0), seed));
+        while let Some((_, t)) = heap.pop() {
+            if chart_of[t as usize] != u32::MAX {
+                continue;
+            }
+            if members.len() >= CHART_MAX_TRIANGLES {
+                break;
+            }
+            chart_of[t as usize] = id;
+            members.push(t);
+            for o in neighbours(t) {
+                if chart_of[o as usize] == u32::MAX
+                    && mesh.tri_normal[o as usize].dot(seed_n) >= cos_cone
+                {
+                    let d = (centroid(o) - seed_c).length();
+                    heap.push((std::cmp::Reverse(d.to_bits()), o));
+                }
+            }
+        }
+        charts.push(members);
+    }
+    // Merge small charts into a neighbour when both bounds still hold.
+    let small = CHART_MAX_TRIANGLES / 8;
+    for c in 0..charts.len() {
+        if charts[c].is_empty() || charts[c].len() >= small {
+            continue;
+        }
+        let mut target = None;
+        'search: for &t in &charts[c] {
+            for o in neighbours(t) {
+                let oc = chart_of[o as usize] as usize;
+                if oc != c
+                    && !charts[oc].is_empty()
+                    && charts[oc].len() + charts[c].len() <= CHART_MAX_TRIANGLES * 3 / 2
+                {
+                    let seed_n = mesh.tri_normal[charts[oc][0] as usize];
+                    if charts[c]
+                        .iter()
+                        .all(|&m| mesh.tri_normal[m as usize].dot(seed_n) >= cos_cone)
+                    {
+                        target = Some(oc);
+                        break 'search;
+                    }
+                }
+            }
+        }
+        if let Some(oc) = target {
+            let moved = std::mem::take(&mut charts[c]);
+            for &m in &moved {
+                chart_of[m as usize] = oc as u32;
+            }
+            charts[oc].extend(moved);
+        }
+    }
+    charts.retain(|c| !c.is_empty());
+    charts
+}
+
+/// Splits a cluster's pieces into four non-empty groups (module docs).
+pub(crate) fn split_cluster(pieces: &[Piece], mesh: &MeshData) -> [Vec<Piece>; 4] {
+    let mut all: Vec<Piece> = if pieces.len() < 4 {
+        pieces.iter().flat_map(|p| p.split()).collect()
+    } else {
+        pieces.to_vec()
+    };
+    let centroid = |p: &Piece| {
+        let [a, b, c] = p.corners(mesh);
+        (a + b + c) / 3.0
+    };
+    let median_cut = |v: &mut Vec<Piece>| -> Vec<Piece> {
+        let mut lo = DVec3::splat(f64::INFINITY);
+        let mut hi = DVec3::splat(f64::NEG_INFINITY);
+        for p in v.iter() {
+            let c = centroid(p);
+            lo = lo.min(c);
+            hi = hi.max(c);
+        }
+        let d = hi - lo;
+        let axis = if d.x >= d.y && d.x >= d.z {
+            0
+        } else if d.y >= d.z {
+            1
+        } else {
+            2
+        };
+        v.sort_by(|a, b| centroid(a)[axis].total_cmp(&centroid(b)[axis]));
+        let half = v.len().div_ceil(2);
+        v.split_off(half)
+    };
+    let mut right = median_cut(&mut all);
+    let left_hi = median_cut(&mut all);
+    let right_hi = median_cut(&mut right);
+    [all, left_hi, right, right_hi]
+}

@@ -1,0 +1,29 @@
+//! Identifiers of input surfaces and elements: plain `u32` indices into the
+//! arenas of [`crate::SceneGeometry`].
+
+use serde::{Deserialize, Serialize};
+
+/// Index of an input surface in [`crate::SceneGeometry::surfaces`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+pub struct SurfaceId(pub u32);
+
+impl SurfaceId {
+    /// The index as a `usize`.
+    #[inline]
+    pub fn index(self) -> usize {
+        self.0 as usize
+    }
+}
+
+/// Index of an element (a node of an input surface's element tree) in the
+/// element arena of [`crate::SceneGeometry`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+pub struct ElementId(pub u32);
+
+impl ElementId {
+    /// The index as a `usize`.
+    #[inline]
+    pub fn index(self) -> usize {
+        self.0 as usize
+    }
+}

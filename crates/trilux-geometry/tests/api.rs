@@ -1,0 +1,126 @@
+//! The contract API end to end on a small scene of every shape kind.
+
+mod common;
+
+use common::*;
+use glam::{DMat4, DVec2, DVec3};
+use trilux_geometry::{Ray, SceneGeometry, SurfaceCoord, SurfaceKind};
+
+fn scene() -> SceneGeometry {
+    let (p, t) = curved_sheet(4);
+    SceneGeometry::build(&[
+        cube(DMat4::from_scale(DVec3::splat(3.0)), true),
+        sphere(DVec3::new(1.0, 0.0, 0.0), 0.5, DMat4::IDENTITY, false),
+        cylinder(
+            DVec3::new(-1.0, 0.0, -1.0),
+            DVec3::new(-1.0, 0.0, 1.0),
+            0.3,
+            DMat4::IDENTITY,
+            false,
+        ),
+        disk(DVec3::new(0.0, 1.5, 0.0), DVec3::X, DVec3::Z, 0.4, false),
+        rect(
+            DVec3::new(0.0, -1.5, 0.0),
+            0.5 * DVec3::X,
+            0.5 * DVec3::Z,
+            true,
+        ),
+        mesh(p, t, DMat4::from_translation(DVec3::new(0.0, 0.0, -2.5))),
+    ])
+    .expect("valid scene")
+}
+
+#[test]
+fn surfaces_per_shape() {
+    let g = scene();
+    let count = |s: u32| g.surfaces().iter().filter(|x| x.shape == s).count();
+    assert_eq!(count(0), 6);
+    assert_eq!(count(1), 8);
+    assert_eq!(count(2), 4);
+    assert_eq!(count(3), 1);
+    assert_eq!(count(4), 1);
+    assert_eq!(count(5), 1);
+    assert_eq!(g.surfaces()[0].kind, SurfaceKind::Planar);
+    assert_eq!(g.surfaces()[6].kind, SurfaceKind::Curved);
+    assert!(g.surfaces().last().unwrap().is_chart());
+    // Exact areas: cube face 36, sphere 4π r² / 8, tube 2π r h / 4, disk π r².
+    let pi = std::f64::consts::PI;
+    assert!((g.surfaces()[0].area() - 36.0).abs() < 1e-12);
+    assert!((g.surfaces()[6].area() - 4.0 * pi * 0.25 / 8.0).abs() < 1e-12);
+    assert!((g.surfaces()[14].area() - 2.0 * pi * 0.3 * 2.0 / 4.0).abs() < 1e-12);
+    assert!((g.surfaces()[18].area() - pi * 0.16).abs() < 1e-12);
+    // Flipped cube: normals point inwards.
+    for s in &g.surfaces()[..6] {
+        let e = g.element(s.root);
+        assert!(e.normal.dot(e.centre) < 0.0);
+    }
+}
+
+#[test]
+fn rays_hit_the_expected_surfaces() {
+    let g = scene();
+    let h = g
+        .intersect(
+            &Ray {
+                origin: DVec3::new(2.5, 0.0, 0.0),
+                dir: -DVec3::X,
+            },
+            f64::INFINITY,
+        )
+        .expect("hits the sphere");
+    assert!((h.point - DVec3::new(1.5, 0.0, 0.0)).length() < 1e-12);
+    assert!((h.geometric_normal - DVec3::X).length() < 1e-12);
+    assert_eq!(g.surfaces()[h.surface.index()].shape, 1);
+    let h = g
+        .intersect(
+            &Ray {
+                origin: DVec3::new(0.0, 0.0, 0.0),
+                dir: DVec3::Y,
+            },
+            f64::INFINITY,
+        )
+        .expect("hits the disk");
+    assert_eq!(g.surfaces()[h.surface.index()].shape, 3);
+    assert!((h.t - 1.5).abs() < 1e-12);
+    // A ray along +x from the cube's inside hits the cube's +x face.
+    let h = g
+        .intersect(
+            &Ray {
+                origin: DVec3::new(0.0, 2.0, 2.0),
+                dir: DVec3::X,
+            },
+            f64::INFINITY,
+        )
+        .expect("hits the cube");
+    assert_eq!(h.surface.0, 1);
+    assert!((h.t - 3.0).abs() < 1e-12);
+    assert!(g.occluded(DVec3::new(2.5, 0.0, 0.0), DVec3::new(0.0, 0.0, 0.0)));
+    assert!(!g.occluded(DVec3::new(2.5, 2.5, 2.5), DVec3::new(-2.5, 2.5, 2.5)));
+}
+
+#[test]
+fn subdivide_locate_sample() {
+    let mut g = scene();
+    for s in 0..g.surfaces().len() {
+        let root = g.surfaces()[s].root;
+        let kids = g.subdivide(root);
+        assert_eq!(g.subdivide(root), kids);
+        let sum: f64 = kids.iter().map(|&k| g.element(k).area).sum();
+        assert!(
+            (sum - g.element(root).area).abs() < 1e-9 * sum,
+            "surface {s}"
+        );
+        for &k in &kids {
+            assert_eq!(g.element(k).parent, Some(root));
+            let smp = g.sample_element(k, DVec2::new(0.3, 0.7));
+            assert!(smp.pdf_area > 0.0 && smp.pdf_area.is_finite());
+            assert!(g.element_contains(k, smp.coord));
+            assert_eq!(g.locate(trilux_geometry::SurfaceId(s as u32), smp.coord), k);
+            let sp = g
+                .surface_point(trilux_geometry::SurfaceId(s as u32), smp.coord)
+                .unwrap();
+            assert!((sp.point - smp.point).length() < 1e-12);
+        }
+    }
+    let _ = SurfaceCoord::Uv(DVec2::ZERO);
+}

@@ -1,0 +1,264 @@
+//! Form factors against the closed forms of notes/validation.md.
+
+mod common;
+
+use common::*;
+use glam::DVec3;
+use trilux_geometry::{FormFactorOptions, SceneGeometry};
+
+const X: DVec3 = DVec3::X;
+const Y: DVec3 = DVec3::Y;
+const Z: DVec3 = DVec3::Z;
+
+fn rel(a: f64, b: f64) -> f64 {
+    (a - b).abs() / b.abs()
+}
+
+/// Closed form (a): parallel, directly opposed equal rectangles.
+fn parallel(a: f64, b: f64, c: f64) -> f64 {
+    let (x, y) = (a / c, b / c);
+    let (x2, y2) = (x * x, y * y);
+    2.0 / (std::f64::consts::PI * x * y)
+        * ((((1.0 + x2) * (1.0 + y2)) / (1.0 + x2 + y2)).sqrt().ln()
+            + x * (1.0 + y2).sqrt() * (x / (1.0 + y2).sqrt()).atan()
+            + y * (1.0 + x2).sqrt() * (y / (1.0 + x2).sqrt()).atan()
+            - x * x.atan()
+            - y * y.atan())
+}
+
+/// Closed form (b): perpendicular rectangles with a common edge l; sender
+/// width w, receiver height h.
+fn perpendicular(l: f64, h: f64, w: f64) -> f64 {
+    let (hh, ww) = (h / l, w / l);
+    let (h2, w2) = (hh * hh, ww * ww);
+    let t1 = ww * (1.0 / ww).atan() + hh * (1.0 / hh).atan()
+        - (h2 + w2).sqrt() * (1.0 / (h2 + w2).sqrt()).atan();
+    let a = (1.0 + w2) * (1.0 + h2) / (1.0 + w2 + h2);
+    let b = (w2 * (1.0 + w2 + h2) / ((1.0 + w2) * (w2 + h2))).powf(w2);
+    let c = (h2 * (1.0 + w2 + h2) / ((1.0 + h2) * (w2 + h2))).powf(h2);
+    (t1 + 0.25 * (a * b * c).ln()) / (std::f64::consts::PI * ww)
+}
+
+#[test]
+fn closed_forms_reproduce_the_validation_tables() {
+    // The test's own formulas against the tabulated values (guards typos).
+    for (a, b, c, f) in [
+        (1.0, 1.0, 1.0, 0.199825),
+        (2.0, 2.0, 1.0, 0.415253),
+        (0.5, 0.5, 1.0, 0.068590),
+        (1.0, 2.0, 1.0, 0.285875),
+        (10.0, 10.0, 1.0, 0.826995),
+    ] {
+        assert!((parallel(a, b, c) - f).abs() < 2e-6, "{a} {b} {c}");
+    }
+    for (l, h, w, f) in [
+        (1.0, 1.0, 1.0, 0.200044),
+        (1.0, 2.0, 1.0, 0.232853),
+        (1.0, 1.0, 2.0, 0.116426),
+        (2.0, 1.0, 1.0, 0.240636),
+        (1.0, 0.5, 1.0, 0.146187),
+    ] {
+        assert!((perpendicular(l, h, w) - f).abs() < 2e-6, "{l} {h} {w}");
+    }
+}
+
+fn two(a: trilux_geometry::Shape, b: trilux_geometry::Shape) -> SceneGeometry {
+    SceneGeometry::build(&[a, b]).expect("valid shapes")
+}
+
+#[test]
+fn parallel_equal_rectangles_match_closed_form() {
+    for (a, b, c, expected) in [
+        (1.0, 1.0, 1.0, 0.199825),
+        (2.0, 2.0, 1.0, 0.415253),
+        (0.5, 0.5, 1.0, 0.068590),
+        (1.0, 2.0, 1.0, 0.285875),
+        (10.0, 10.0, 1.0, 0.826995),
+    ] {
+        let g = two(
+            rect(DVec3::ZERO, 0.5 * a * X, 0.5 * b * Y, false),
+            rect(c * Z, 0.5 * a * X, 0.5 * b * Y, true),
+        );
+        let (r0, r1) = (g.surfaces()[0].root, g.surfaces()[1].root);
+        let f = g.form_factor(r0, r1);
+        assert!(
+            rel(f.value, expected) < 5e-3,
+            "{a}×{b} at {c}: {} vs {expected}",
+            f.value
+        );
+        // The error estimate bounds the actual error.
+        assert!(
+            (f.value - parallel(a, b, c)).abs() <= f.error,
+            "{a}×{b} at {c}: {f:?} vs {}",
+            parallel(a, b, c)
+        );
+        let back = g.form_factor(r1, r0);
+        assert!(rel(back.value, expected) < 5e-3);
+    }
+}
+
+#[test]
+fn perpendicular_rectangles_with_common_edge_match_closed_form() {
+    for (l, h, w, expected) in [
+        (1.0, 1.0, 1.0, 0.200044),
+        (1.0, 2.0, 1.0, 0.232853),
+        (1.0, 1.0, 2.0, 0.116426),
+        (2.0, 1.0, 1.0, 0.240636),
+        (1.0, 0.5, 1.0, 0.146187),
+    ] {
+        let sender = rect(
+            DVec3::new(0.5 * l, 0.5 * w, 0.0),
+            0.5 * l * X,
+            0.5 * w * Y,
+            false,
+        );
+        let receiver = rect(
+            DVec3::new(0.5 * l, 0.0, 0.5 * h),
+            0.5 * l * X,
+            -0.5 * h * Z,
+            false,
+        );
+        let g = two(sender, receiver);
+        let (s, r) = (g.surfaces()[0].root, g.surfaces()[1].root);
+        assert!((g.element(r).normal - Y).length() < 1e-12);
+        let f = g.form_factor(s, r);
+        assert!(
+            rel(f.value, expected) < 5e-3,
+            "l={l} h={h} w={w}: {} vs {expected}",
+            f.value
+        );
+        let tight = g.form_factor_with(
+            s,
+            r,
+            &FormFactorOptions {
+                rel_tol: 1e-7,
+                max_depth: 10,
+                samples: 64,
+            },
+        );
+        assert!(
+            rel(tight.value, perpendicular(l, h, w)) < 1e-5,
+            "tight {} vs {}",
+            tight.value,
+            perpendicular(l, h, w)
+        );
+        // The error estimate bounds the actual error.
+        assert!(
+            (tight.value - perpendicular(l, h, w)).abs() <= tight.error.max(1e-12),
+            "err {}",
+            tight.error
+        );
+    }
+}
+
+#[test]
+fn small_patch_to_coaxial_disk() {
+    for (radius, h) in [(1.0, 1.0), (0.5, 2.0), (2.0, 0.5)] {
+        let s = 1e-3;
+        let g = two(
+            rect(DVec3::ZERO, s * X, s * Y, false),
+            disk(h * Z, X, Y, radius, true),
+        );
+        let f = g.form_factor(g.surfaces()[0].root, g.surfaces()[1].root);
+        let expected = radius * radius / (radius * radius + h * h);
+        assert!(
+            rel(f.value, expected) < 5e-3,
+            "R={radius} h={h}: {} vs {expected}",
+            f.value
+        );
+        assert!(
+            rel(f.value, expected) < 1e-4,
+            "R={radius} h={h}: {} vs {expected}",
+            f.value
+        );
+    }
+}
+
+#[test]
+fn disk_to_coaxial_disk() {
+    for (r1, r2, h) in [(1.0, 1.0, 1.0), (0.5, 1.5, 1.0), (2.0, 1.0, 3.0)] {
+        let g = two(
+            disk(DVec3::ZERO, X, Y, r1, false),
+            disk(h * Z, X, Y, r2, true),
+        );
+        let f = g.form_factor(g.surfaces()[0].root, g.surfaces()[1].root);
+        let (a, b) = (r1 / h, r2 / h);
+        let x = 1.0 + (1.0 + b * b) / (a * a);
+        let expected = 0.5 * (x - (x * x - 4.0 * (b / a) * (b / a)).sqrt());
+        assert!(
+            rel(f.value, expected) < 5e-3,
+            "{r1} {r2} {h}: {} vs {expected}",
+            f.value
+        );
+        if (r1, r2, h) == (1.0, 1.0, 1.0) {
+            assert!((expected - 0.381966).abs() < 1e-6);
+        }
+    }
+}
+
+#[test]
+fn reciprocity_for_separated_planar_elements() {
+    let opts = FormFactorOptions {
+        rel_tol: 1e-10,
+        max_depth: 8,
+        samples: 64,
+    };
+    // Tilted, offset rectangles of different sizes.
+    let a = rect(
+        DVec3::new(0.1, -0.2, 0.0),
+        0.7 * X,
+        DVec3::new(0.0, 0.4, 0.1),
+        false,
+    );
+    let b = rect(
+        DVec3::new(0.3, 0.5, 1.5),
+        DVec3::new(0.5, 0.2, 0.0),
+        DVec3::new(0.0, 0.3, 0.4),
+        true,
+    );
+    let mut g = two(a, b);
+    let (ra, rb) = (g.surfaces()[0].root, g.surfaces()[1].root);
+    let mut pairs = vec![(ra, rb)];
+    let ca = g.subdivide(ra);
+    let cb = g.subdivide(rb);
+    for &x in &ca {
+        for &y in &cb {
+            pairs.push((x, y));
+        }
+    }
+    for (i, j) in pairs {
+        let fij = g.form_factor_with(i, j, &opts).value;
+        let fji = g.form_factor_with(j, i, &opts).value;
+        let (ai, aj) = (g.element(i).area, g.element(j).area);
+        assert!(fij > 0.0);
+        assert!(
+            rel(ai * fij, aj * fji) < 1e-6,
+            "{} vs {}",
+            ai * fij,
+            aj * fji
+        );
+    }
+}
+
+#[test]
+fn reciprocity_for_edge_sharing_elements_within_stated_error() {
+    let sender = rect(DVec3::new(0.5, 0.5, 0.0), 0.5 * X, 0.5 * Y, false);
+    let receiver = rect(DVec3::new(0.5, 0.0, 0.5), 0.5 * X, -0.5 * Z, false);
+    let g = two(sender, receiver);
+    let (s, r) = (g.surfaces()[0].root, g.surfaces()[1].root);
+    for opts in [
+        FormFactorOptions::default(),
+        FormFactorOptions {
+            rel_tol: 1e-6,
+            max_depth: 10,
+            samples: 64,
+        },
+    ] {
+        let a = g.form_factor_with(s, r, &opts);
+        let b = g.form_factor_with(r, s, &opts);
+        assert!(
+            (a.value - b.value).abs() <= a.error + b.error,
+            "{a:?} {b:?}"
+        );
+    }
+}
