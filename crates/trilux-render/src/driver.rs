@@ -156,3 +156,41 @@ where
     stats.seconds = start.elapsed().as_secs_f64();
     Ok((image.develop(), stats))
 }
+
+impl RenderSettings {
+    /// The scene's own sample count and film filter, other settings default.
+    pub fn for_scene(camera: &trilux_scene::Camera) -> Self {
+        Self {
+            spp: camera.sample_count.max(1),
+            filter: crate::view::filter_of(camera),
+            ..Self::default()
+        }
+    }
+}
+
+/// Renders a loaded scene from its solution: the scene's camera (with
+/// `view`'s overrides) and `settings`. Spectral solutions (N ≠ 3) are
+/// converted per sample to linear sRGB through CIE XYZ.
+pub fn render<const N: usize, S: crate::solved::RadianceSolution<N>>(
+    scene: &trilux_scene::Scene,
+    solution: &S,
+    view: &crate::view::ViewOverrides,
+    settings: &RenderSettings,
+    progress: impl Fn(usize, usize) + Sync,
+) -> Result<(Image, RenderStats), RenderError> {
+    let cam = scene.camera.as_ref().ok_or_else(|| {
+        RenderError::Scene(format!(
+            "{}: the scene has no <sensor> to render from",
+            scene.path.display()
+        ))
+    })?;
+    let camera = crate::view::camera_of(cam, view)?;
+    let solved = crate::solved::SolvedScene::new(scene, solution)?;
+    render_image::<_, N>(
+        &solved,
+        &camera,
+        settings,
+        |l| trilux_color::Spectrum::<N>(*l).to_linear_srgb(),
+        progress,
+    )
+}

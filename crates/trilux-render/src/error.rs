@@ -11,6 +11,10 @@ pub enum RenderError {
     /// A render setting is out of range (samples per pixel, tile size).
     #[error("invalid render setting: {0}")]
     Settings(String),
+    /// The scene cannot be rendered as given (a material or emitter that
+    /// does not convert, a shape the geometry does not know).
+    #[error("{0}")]
+    Scene(String),
     /// An image could not be written; nothing is left at `path`.
     #[error("cannot write {path}: {reason}")]
     Write {

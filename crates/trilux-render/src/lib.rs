@@ -21,6 +21,8 @@
 //!   per pixel, decorrelated by the seed.
 //! - [`gather`]: the abstraction the integrator is written against
 //!   ([`GatherScene`]) and the final-gather estimator itself.
+//! - [`solved`]: [`GatherScene`] for trilux's geometry, BRDFs and a
+//!   solution ([`RadianceSolution`]).
 //! - [`filter`]: reconstruction filters (Mitsuba's Gaussian, box).
 //! - [`film`]: splatting samples through the filter, per-pixel normalisation.
 //! - [`driver`]: tiles rendered in parallel (rayon), merged deterministically.
@@ -40,10 +42,11 @@ pub mod filter;
 pub mod gather;
 pub mod image;
 pub mod sampler;
+pub mod solved;
 pub mod view;
 
 pub use camera::{Camera, FovAxis, Ray};
-pub use driver::{RenderSettings, RenderStats, render_image};
+pub use driver::{RenderSettings, RenderStats, render, render_image};
 pub use error::RenderError;
 pub use film::Film;
 pub use filter::ReconstructionFilter;
@@ -52,4 +55,5 @@ pub use gather::{
 };
 pub use image::Image;
 pub use sampler::PixelSampler;
+pub use solved::{DirectOnly, RadianceSolution, Site, SolvedScene};
 pub use view::{ViewOverrides, camera_of, filter_of};
