@@ -34,6 +34,8 @@ scene written beside it (so that relative OBJ paths resolve), removed after.
 Run from the repository root:
     python3 tests/golden/make_references.py                 # every scene
     python3 tests/golden/make_references.py --only cornell-box --spp 4096
+    python3 tests/golden/make_references.py --max-depth 2 --res 64 --spp 8192 \
+        --out tests/golden/direct        # direct light only, for trilux-render's tests
 Needs Mitsuba 3 (`pip install mitsuba`) and, for the llvm variants, LLVM
 (Debian: `apt-get install libllvm19`).
 """
@@ -115,6 +117,10 @@ def main():
     ap.add_argument("--spp", type=int, default=16384, help="total samples per pixel")
     ap.add_argument("--pass-spp", type=int, default=256)
     ap.add_argument("--mask-spp", type=int, default=256)
+    ap.add_argument("--max-depth", type=int, default=-1,
+                    help="path length limit: -1 unbounded (golden references); 2 = emission "
+                         "and direct light only (tests/golden/direct/, for the renderer's "
+                         "test with a solution that knows no indirect light)")
     args = ap.parse_args()
     if args.spp % args.pass_spp or (args.spp // args.pass_spp) % 2:
         raise SystemExit("--spp must be an even multiple of --pass-spp")
@@ -129,7 +135,7 @@ def main():
         mi.set_variant(variant)
         print(f"{name}: {variant}, {args.res}x{args.res}, {args.spp} spp", flush=True)
         t0 = time.time()
-        scene = load(path, args.res, -1)
+        scene = load(path, args.res, args.max_depth)
         even = np.zeros((args.res, args.res, 3))
         odd = np.zeros_like(even)
         for k in range(passes):
@@ -155,7 +161,7 @@ def main():
             "scene": f"scenes/{name}.xml",
             "mitsuba": mi.__version__,
             "variant": variant,
-            "integrator": "path, max_depth -1",
+            "integrator": f"path, max_depth {args.max_depth}",
             "width": args.res,
             "height": args.res,
             "spp": args.spp,

@@ -66,10 +66,20 @@ impl Film {
         if lo_x > hi_x || lo_y > hi_y {
             return;
         }
-        // At most 5 taps per axis for the default filter.
-        let wx: Vec<f64> = (lo_x..=hi_x)
-            .map(|i| self.filter.eval(i as f64 - cx))
-            .collect();
+        // At most 5 taps per axis for the default filter: keep them on the
+        // stack (wider filters fall back to the heap).
+        let taps = (hi_x - lo_x + 1) as usize;
+        let mut stack = [0.0f64; 8];
+        let mut heap = Vec::new();
+        let wx: &mut [f64] = if taps <= stack.len() {
+            &mut stack[..taps]
+        } else {
+            heap.resize(taps, 0.0);
+            &mut heap
+        };
+        for (k, w) in wx.iter_mut().enumerate() {
+            *w = self.filter.eval((lo_x + k as i64) as f64 - cx);
+        }
         for j in lo_y..=hi_y {
             let wy = self.filter.eval(j as f64 - cy);
             if wy == 0.0 {
