@@ -5,12 +5,9 @@
 //! `NAME.mask.exr` (1 where an emitter is directly visible, dilated by 1 px)
 //! and `NAME.json` (how it was made, its size and its own noise).
 //!
-//! Metrics (pixels where the mask is set are left out unless said):
-//! - relative RMSE: `sqrt(Σ (a − r)² / Σ r²)` over unmasked pixels and the
-//!   three channels, i.e. the RMS error normalised by the RMS of the
-//!   reference (robust against dark pixels, unlike a per-pixel ratio);
-//! - mean ratio: mean(a) / mean(r) over unmasked pixels and channels (the
-//!   energy bias); also over all pixels.
+//! Metrics: `trilux_render::compare` (relative RMSE `sqrt(Σ (a − r)² / Σ
+//! r²)` and mean ratio `Σ a / Σ r` over unmasked pixels and the three
+//! channels; both also over all pixels).
 //!
 //! Commands:
 //! - `cargo xtask golden compare IMAGE.exr REFERENCE.exr [--mask MASK.exr]`
@@ -24,7 +21,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use anyhow::{Context, Result, bail};
-use trilux_render::Image;
+use trilux_render::{Comparison, Image, compare};
 
 /// Largest accepted relative RMSE (unmasked) of a trilux render at the
 /// golden sample count against its reference. Provisional until the solver
@@ -32,69 +29,6 @@ use trilux_render::Image;
 pub const MAX_REL_RMSE: f64 = 0.10;
 /// Largest accepted |mean ratio − 1| (unmasked): issue 5 asks for 1 %.
 pub const MAX_MEAN_BIAS: f64 = 0.01;
-
-/// The metrics of one image against its reference.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Comparison {
-    /// Relative RMSE over unmasked pixels.
-    pub rel_rmse: f64,
-    /// Relative RMSE over all pixels.
-    pub rel_rmse_all: f64,
-    /// mean(image) / mean(reference) over unmasked pixels.
-    pub mean_ratio: f64,
-    /// mean(image) / mean(reference) over all pixels.
-    pub mean_ratio_all: f64,
-    /// Number of masked pixels.
-    pub masked: usize,
-}
-
-/// Compares `image` with `reference`; `mask` (same size, > 0.5 = masked)
-/// leaves pixels out.
-pub fn compare(image: &Image, reference: &Image, mask: Option<&Image>) -> Result<Comparison> {
-    let size = |i: &Image| (i.width(), i.height());
-    if size(image) != size(reference) {
-        bail!(
-            "image is {:?} but the reference is {:?}",
-            size(image),
-            size(reference)
-        );
-    }
-    if let Some(m) = mask
-        && size(m) != size(reference)
-    {
-        bail!(
-            "mask is {:?} but the reference is {:?}",
-            size(m),
-            size(reference)
-        );
-    }
-    let mut acc = [[0.0f64; 4]; 2]; // [unmasked, all] × [Σd², Σr², Σa, Σr]
-    let mut masked = 0;
-    for (k, (a, r)) in image.pixels().iter().zip(reference.pixels()).enumerate() {
-        let is_masked = mask.is_some_and(|m| m.pixels()[k][0] > 0.5);
-        masked += usize::from(is_masked);
-        for c in 0..3 {
-            let (a, r) = (a[c] as f64, r[c] as f64);
-            let terms = [(a - r) * (a - r), r * r, a, r];
-            for (set, acc) in acc.iter_mut().enumerate() {
-                if set == 1 || !is_masked {
-                    for (s, t) in acc.iter_mut().zip(terms) {
-                        *s += t;
-                    }
-                }
-            }
-        }
-    }
-    let rmse = |a: &[f64; 4]| (a[0] / a[1]).sqrt();
-    let ratio = |a: &[f64; 4]| a[2] / a[3];
-    Ok(Comparison {
-        rel_rmse: rmse(&acc[0]),
-        rel_rmse_all: rmse(&acc[1]),
-        mean_ratio: ratio(&acc[0]),
-        mean_ratio_all: ratio(&acc[1]),
-        masked,
-    })
-}
 
 /// The repository root (xtask lives one level below it).
 pub fn root() -> PathBuf {
@@ -257,32 +191,4 @@ pub fn main(args: &[String]) -> Result<()> {
         );
     }
     Ok(())
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn img(v: &[f32]) -> Image {
-        Image::from_pixels(v.len() as u32, 1, v.iter().map(|&x| [x, x, x]).collect()).unwrap()
-    }
-
-    #[test]
-    fn metrics_follow_their_definitions() {
-        let r = img(&[1.0, 2.0, 3.0, 100.0]);
-        let same = compare(&r, &r, None).unwrap();
-        assert_eq!((same.rel_rmse, same.mean_ratio), (0.0, 1.0));
-        // 10 % brighter everywhere: relRMSE 0.1, ratio 1.1.
-        let a = img(&[1.1, 2.2, 3.3, 110.0]);
-        let c = compare(&a, &r, None).unwrap();
-        assert!((c.rel_rmse - 0.1).abs() < 1e-6 && (c.mean_ratio - 1.1).abs() < 1e-6);
-        // Masking the bright pixel leaves sqrt(Σ d² / Σ r²) over the rest.
-        let b = img(&[1.0, 2.0, 4.0, 0.0]);
-        let m = img(&[0.0, 0.0, 0.0, 1.0]);
-        let c = compare(&b, &r, Some(&m)).unwrap();
-        assert!((c.rel_rmse - (1.0f64 / 14.0).sqrt()).abs() < 1e-9);
-        assert!((c.mean_ratio - 7.0 / 6.0).abs() < 1e-9);
-        assert_eq!(c.masked, 1);
-        assert!(compare(&img(&[1.0]), &r, None).is_err());
-    }
 }

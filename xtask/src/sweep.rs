@@ -6,7 +6,7 @@
 //! Mitsuba 3's path tracer renders at a range of sample counts (timed by
 //! `tests/golden/mitsuba_time.py`, kernel compilation excluded) when
 //! `python3 -c "import mitsuba"` works. Each image is compared with the
-//! reference ([`crate::golden::compare`], relative RMSE over unmasked
+//! reference (`trilux_render::compare`, relative RMSE over unmasked
 //! pixels).
 //!
 //! Output in `target/sweep/` (or `--out DIR`):
@@ -25,9 +25,9 @@ use std::path::PathBuf;
 use std::process::Command;
 
 use anyhow::{Context, Result, bail};
-use trilux_render::Image;
+use trilux_render::{Image, compare};
 
-use crate::golden::{compare, references, render_trilux, root};
+use crate::golden::{references, render_trilux, root};
 
 /// One measured point.
 #[derive(Clone, Debug)]

@@ -28,6 +28,7 @@
 //! - [`driver`]: tiles rendered in parallel (rayon), merged deterministically.
 //! - [`image`]: the finished [`Image`], EXR and PNG output (atomic writes).
 //! - [`analytic`]: analytic scenes with known answers (tests, benches).
+//! - [`compare`]: relative RMSE and mean ratio against a reference image.
 //! - [`bands`]: small helpers on per-band radiance arrays.
 //! - [`error`]: the error type, [`RenderError`].
 #![forbid(unsafe_code)]
@@ -35,6 +36,7 @@
 pub mod analytic;
 pub mod bands;
 pub mod camera;
+pub mod compare;
 pub mod driver;
 pub mod error;
 pub mod film;
@@ -46,6 +48,7 @@ pub mod solved;
 pub mod view;
 
 pub use camera::{Camera, FovAxis, Ray};
+pub use compare::{Comparison, compare};
 pub use driver::{RenderSettings, RenderStats, render, render_image};
 pub use error::RenderError;
 pub use film::Film;
