@@ -36,8 +36,8 @@ for variant in ("scalar_rgb", "scalar_spectral"):
         if variant == "scalar_rgb":
             for s in scene.shapes():
                 print(f"     shape {s.id():12s} area {s.surface_area():.6f} bbox {s.bbox()}".replace("\n", " "))
-            sensor = scene.sensors()[0]
-            params = mi.traverse(sensor)
-            print(f"     sensor x_fov {params['x_fov']} film {sensor.film().size()}")
-            print(f"     to_world {sensor.world_transform().matrix}".replace("\n", " "))
+            for sensor in scene.sensors():
+                params = mi.traverse(sensor)
+                print(f"     sensor x_fov {params['x_fov']} film {sensor.film().size()}")
+                print(f"     to_world {sensor.world_transform().matrix}".replace("\n", " "))
 sys.exit(1 if failed else 0)

@@ -1,4 +1,5 @@
-//! Project automation: `cargo xtask ci` runs everything the tests need.
+//! Project automation: `cargo xtask ci` runs everything the tests need;
+//! `cargo xtask color` checks trilux's colorimetry against colour-science.
 
 mod golden;
 mod sweep;
@@ -6,6 +7,8 @@ mod sweep;
 use std::process::Command;
 
 use anyhow::{Context, Result, bail};
+
+mod color;
 
 fn run(program: &str, args: &[&str]) -> Result<()> {
     eprintln!("xtask: {program} {}", args.join(" "));
@@ -33,6 +36,7 @@ fn ci() -> Result<()> {
         ],
     )?;
     run("cargo", &["test", "--workspace", "--release"])?;
+    color::color()?;
     Ok(())
 }
 
@@ -40,10 +44,11 @@ fn main() -> Result<()> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     match args.first().map(String::as_str) {
         Some("ci") => ci(),
+        Some("color") => color::color(),
         Some("golden") => golden::main(&args[1..]),
         Some("sweep") => sweep::main(&args[1..]),
         _ => {
-            eprintln!("usage: cargo xtask ci | golden | sweep");
+            eprintln!("usage: cargo xtask ci | color | golden | sweep");
             std::process::exit(2);
         }
     }

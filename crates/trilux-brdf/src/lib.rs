@@ -17,12 +17,15 @@
 //! - [`microfacet`]: Mitsuba's Beckmann and GGX D, separable Smith G (its
 //!   rational G1 for Beckmann), and their sampling.
 //! - [`fresnel`]: conductor Fresnel from η and k.
+//! - [`albedo`]: [`AlbedoTable`], the directional albedo tabulated per
+//!   degree for frequent use.
 //! - [`area`]: area reflectance R(I→J→K) = π F_JI fr (paper Eq. 5) and the
 //!   BRDF variation estimate over three elements (notes §2).
 #![forbid(unsafe_code)]
 // Band loops index several arrays in step; iterators would hide that.
 #![allow(clippy::needless_range_loop)]
 
+pub mod albedo;
 pub mod area;
 pub mod bsdf;
 pub mod error;
@@ -32,6 +35,7 @@ pub mod lobe;
 pub mod microfacet;
 pub mod params;
 
+pub use albedo::AlbedoTable;
 pub use area::{AreaReflectance, BrdfVariation, ElementPoints, area_reflectance, brdf_variation};
 pub use bsdf::{Bsdf, BsdfSample, Side};
 pub use error::BrdfError;

@@ -24,7 +24,7 @@ use crate::ColorError;
 use crate::cie::{SampledSpectrum, mitsuba};
 use crate::param::ColorParam;
 use crate::spectrum::Spectrum;
-use crate::upsample::{smooth_emission, smooth_reflectance};
+use crate::upsample::{smooth_emission, smooth_reflectance, smooth_unbounded};
 
 /// What a colour value describes; decides how it converts.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -95,8 +95,8 @@ impl ColorParam {
                 },
                 ColorParam::Constant(v) => Spectrum::splat(*v),
                 ColorParam::Rgb(c) => match role {
-                    Role::Reflectance => smooth_reflectance::<N>(*c).clamp(0.0, 1.0),
-                    Role::Unbounded => smooth_reflectance::<N>(*c).max(Spectrum::zero()),
+                    Role::Reflectance => smooth_reflectance::<N>(*c),
+                    Role::Unbounded => smooth_unbounded::<N>(*c),
                     Role::Emission => smooth_emission::<N>(*c),
                 },
                 ColorParam::Sampled(s) => {

@@ -25,12 +25,18 @@
 //!
 //! An element of a chart is a **cluster of pieces**; a piece is a whole mesh
 //! triangle or a sub-triangle of one (in the triangle's barycentric
-//! coordinates). The root holds the chart's triangles. A cluster of n ≥ 4
-//! pieces splits into 4 sub-clusters by two median cuts of the piece
-//! centroids along the longest box axis; a cluster of fewer than 4 pieces
-//! first splits each piece at its edge midpoints (4 sub-triangles), so every
-//! element has exactly 4 children and the leaves of a fully subdivided tree
-//! partition every triangle exactly once.
+//! coordinates). The root holds the chart's triangles. Every element has
+//! exactly 4 children:
+//! - n ≥ 4 pieces: 4 sub-clusters by two levels of median cuts of the piece
+//!   centroids along the longest axis of their box (sizes ⌈n/4⌉ or so);
+//! - 3 pieces: the largest is bisected (midpoint of its longest edge), the
+//!   other two stay whole: 4 single pieces;
+//! - 2 pieces: both are bisected: 4 single pieces;
+//! - 1 piece: the midpoint split in barycentrics (4 sub-triangles).
+//!
+//! So every branch reaches single-piece elements after about log₄ n levels,
+//! and the leaves of any subdivided tree partition every triangle of the
+//! chart exactly once.
 
 use std::collections::{BinaryHeap, HashMap};
 
@@ -135,6 +141,29 @@ impl Piece {
             Piece {
                 triangle: t,
                 bary: [bc, ca, ab],
+            },
+        ]
+    }
+
+    /// The two halves of this piece, cut from the midpoint of its longest
+    /// edge (in world space) to the opposite corner.
+    pub(crate) fn bisect(&self, mesh: &MeshData) -> [Piece; 2] {
+        let w = self.corners(mesh);
+        let len = |i: usize| (w[(i + 1) % 3] - w[i]).length_squared();
+        let k = (0..3)
+            .max_by(|&i, &j| len(i).total_cmp(&len(j)))
+            .unwrap_or(0);
+        let (a, b, c) = (self.bary[k], self.bary[(k + 1) % 3], self.bary[(k + 2) % 3]);
+        let m = 0.5 * (a + b);
+        let t = self.triangle;
+        [
+            Piece {
+                triangle: t,
+                bary: [a, m, c],
+            },
+            Piece {
+                triangle: t,
+                bary: [m, b, c],
             },
         ]
     }
@@ -292,11 +321,23 @@ pub(crate) fn build_charts(mesh: &MeshData) -> Vec<Vec<u32>> {
 
 /// Splits a cluster's pieces into four non-empty groups (module docs).
 pub(crate) fn split_cluster(pieces: &[Piece], mesh: &MeshData) -> [Vec<Piece>; 4] {
-    let mut all: Vec<Piece> = if pieces.len() < 4 {
-        pieces.iter().flat_map(|p| p.split()).collect()
-    } else {
-        pieces.to_vec()
-    };
+    let area = |p: &Piece| mesh.tri_area[p.triangle as usize] * p.area_fraction();
+    match pieces {
+        [p] => return p.split().map(|q| vec![q]),
+        [a, b] => {
+            let [a0, a1] = a.bisect(mesh);
+            let [b0, b1] = b.bisect(mesh);
+            return [vec![a0], vec![a1], vec![b0], vec![b1]];
+        }
+        [a, b, c] => {
+            let mut v = [*a, *b, *c];
+            v.sort_by(|x, y| area(y).total_cmp(&area(x)));
+            let [l0, l1] = v[0].bisect(mesh);
+            return [vec![l0], vec![l1], vec![v[1]], vec![v[2]]];
+        }
+        _ => {}
+    }
+    let mut all: Vec<Piece> = pieces.to_vec();
     let centroid = |p: &Piece| {
         let [a, b, c] = p.corners(mesh);
         (a + b + c) / 3.0

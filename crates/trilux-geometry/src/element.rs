@@ -58,9 +58,9 @@ pub struct Element {
     pub normal: DVec3,
     /// Cosine of the half-angle of a cone around `normal` containing the
     /// element's normals: 1 for planar elements. For curved pieces it is the
-    /// minimum over a 5×5 grid of the element (the normal field of a sphere
-    /// or cylinder piece is monotone along u and v, so its extremes are on
-    /// that grid's boundary); for clusters it is exact over the pieces.
+    /// largest angle to `normal` over a 5×5 uv grid plus the largest angle
+    /// between neighbouring grid normals (a conservative bound); for
+    /// clusters it is exact over the pieces.
     pub normal_cone_cos: f64,
     /// World-space bounds (exact for planar quads and clusters; for curved
     /// pieces the bounds of a 9×9 grid grown by the maximal sagitta).
@@ -368,18 +368,37 @@ pub(crate) fn rect_element(
         })
     };
     let (cone, bounds) = match patch {
-        Patch::Quad { .. } => (
-            1.0,
-            Bounds::from_points(
+        Patch::Quad { .. } => {
+            let b = Bounds::from_points(
                 [min, DVec2::new(max.x, min.y), max, DVec2::new(min.x, max.y)]
                     .map(|uv| patch.eval(uv).p),
-            ),
-        ),
+            );
+            // Interior points are computed with rounding: pad by a few ulps.
+            let pad = 1e-14 * b.min.abs().max(b.max.abs()).max_element();
+            (1.0, b.padded(pad))
+        }
         _ => {
-            let mut cone = 1.0f64;
-            for uv in grid(5) {
-                cone = cone.min(patch.eval(uv).n.dot(c.n));
+            // Smallest cosine to the centre normal over a 5×5 grid, widened
+            // by the largest angle between neighbouring grid normals: every
+            // point lies within half a grid step of a grid point, so this
+            // bounds the whole element's normals.
+            let n = 5;
+            let normals: Vec<DVec3> = grid(n).map(|uv| patch.eval(uv).n).collect();
+            let mut worst = 0.0f64;
+            let mut step = 0.0f64;
+            for i in 0..n {
+                for j in 0..n {
+                    let a = normals[i * n + j];
+                    worst = worst.max(a.dot(c.n).clamp(-1.0, 1.0).acos());
+                    if i + 1 < n {
+                        step = step.max(a.dot(normals[(i + 1) * n + j]).clamp(-1.0, 1.0).acos());
+                    }
+                    if j + 1 < n {
+                        step = step.max(a.dot(normals[i * n + j + 1]).clamp(-1.0, 1.0).acos());
+                    }
+                }
             }
+            let cone = (worst + step).min(std::f64::consts::PI).cos();
             let mut b = Bounds::EMPTY;
             let mut step = 0.0f64;
             for uv in grid(9) {

@@ -241,6 +241,12 @@ fn sensor(e: &Element) -> Result<Camera> {
             (fov, axis)
         }
         // Mitsuba's default: a 50 mm lens, fov along the diagonal.
+        None if props.has("fov_axis") => {
+            return Err(SceneError::at(
+                &props.loc("fov_axis"),
+                "fov_axis needs a fov (without fov, Mitsuba uses its 50 mm lens along the diagonal)",
+            ));
+        }
         None => (default_fov(), FovAxis::Diagonal),
     };
     let transform = props.transform("to_world")?;

@@ -9,12 +9,12 @@
 //! anything else with an error that displays as `FILE:LINE:COL: what is
 //! wrong`. Like Mitsuba's parser it works in stages:
 //!
-//! 1. [`xml`]: XML text → an intermediate tree of elements and attributes,
+//! 1. `xml`: XML text → an intermediate tree of elements and attributes,
 //!    each with its source location; `<default>` and `$name` substitution.
-//! 2. [`resolve`]: `<ref id>` replaced by the `<bsdf id>` it names.
-//! 3. [`build`]: typed parameters ([`props`], [`value`], [`transform`]) →
-//!    the model: shapes ([`shape`], [`obj`]), materials ([`material`]),
-//!    area lights and the camera ([`camera`]).
+//! 2. `resolve`: `<ref id>` replaced by the `<bsdf id>` it names.
+//! 3. `build`: typed parameters (`props`, `value`, [`transform`]) → the
+//!    model: shapes ([`shape`], [`obj`]), materials (`material`), area
+//!    lights and the camera ([`camera`]).
 //!
 //! The model ([`scene`]) knows nothing about XML:
 //! [`Scene`] → [`SceneShape`] (a `trilux_geometry::Shape`, a

@@ -6,11 +6,11 @@ use std::path::PathBuf;
 
 use serde::Serialize;
 use trilux_brdf::BsdfParams;
-use trilux_color::ColorParam;
-use trilux_geometry::Shape;
+use trilux_color::{ColorParam, Mode};
+use trilux_geometry::{SceneGeometry, Shape};
 
 use crate::camera::Camera;
-use crate::error::SourceLocation;
+use crate::error::{SceneError, SourceLocation};
 
 /// An area light (`<emitter type="area">` inside a shape): one-sided
 /// Lambertian emission from the front side of its shape.
@@ -61,9 +61,40 @@ pub struct Scene {
 }
 
 impl Scene {
+    /// The mode this scene solves in unless overridden (`--mode`): spectral
+    /// when [`Scene::spectral`], else RGB.
+    pub fn mode(&self) -> Mode {
+        if self.spectral {
+            Mode::Spectral
+        } else {
+            Mode::Rgb
+        }
+    }
+
     /// The shapes as the geometry layer takes them (`SceneGeometry::build`).
     pub fn geometry_shapes(&self) -> Vec<Shape> {
         self.shapes.iter().map(|s| s.shape.clone()).collect()
+    }
+
+    /// The geometry layer's view of the shapes (input surfaces, elements,
+    /// BVH). What the geometry layer refuses is reported at the `<shape>`
+    /// that causes it, as `FILE:LINE:COL: ...`.
+    pub fn build_geometry(&self) -> Result<SceneGeometry, SceneError> {
+        SceneGeometry::build(&self.geometry_shapes()).map_err(|e| match self.shapes.get(e.shape) {
+            Some(s) => SceneError::at(&s.location, e.problem.to_string()),
+            None => SceneError::at(
+                &self
+                    .shapes
+                    .first()
+                    .map(|s| s.location.clone())
+                    .unwrap_or_else(|| SourceLocation {
+                        file: self.path.as_path().into(),
+                        line: 1,
+                        col: 1,
+                    }),
+                e.to_string(),
+            ),
+        })
     }
 
     /// Indices and shapes of the emitting shapes.

@@ -26,7 +26,8 @@ use crate::transform::{coordinate_system, linear_part};
 /// Exact for every kind: parallelograms for rectangles and cube faces, an
 /// ellipse for a disk under any affine map, 4πr² for a uniformly scaled
 /// sphere, 2πrh for a cylinder whose cross-section stays circular, and the
-/// sum of the transformed triangles for a mesh.
+/// sum of the transformed triangles for a mesh. Never panics; a shape the
+/// loader would refuse may give 0 or a non-finite value.
 pub fn surface_area(shape: &Shape) -> f64 {
     let l = linear_part(&shape.world_from_object);
     let (x, y, z) = (l.x_axis, l.y_axis, l.z_axis);
@@ -46,8 +47,13 @@ pub fn surface_area(shape: &Shape) -> f64 {
             .triangles
             .iter()
             .map(|t| {
-                let [a, b, c] = t.map(|i| l * mesh.positions[i as usize]);
-                0.5 * (b - a).cross(c - a).length()
+                // A triangle naming a vertex that does not exist has no area
+                // (the loader never makes one; the geometry layer refuses it).
+                let p = |i: u32| mesh.positions.get(i as usize).map(|&p| l * p);
+                match (p(t[0]), p(t[1]), p(t[2])) {
+                    (Some(a), Some(b), Some(c)) => 0.5 * (b - a).cross(c - a).length(),
+                    _ => 0.0,
+                }
             })
             .sum(),
     }

@@ -96,7 +96,11 @@ pub(crate) fn parse(text: &str, file: &Arc<Path>, params: &[(String, String)]) -
             line: pos.row,
             col: pos.col,
         };
-        SceneError::at(&loc, format!("malformed XML: {e}"))
+        // roxmltree repeats the position inside its message: drop it there.
+        let message = e
+            .to_string()
+            .replace(&format!(" at {}:{}", pos.row, pos.col), "");
+        SceneError::at(&loc, format!("malformed XML: {message}"))
     })?;
     let mut ctx = Context {
         doc: &doc,
@@ -247,5 +251,67 @@ impl Context<'_, '_> {
         }
         out.push_str(rest);
         Ok(out)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn file() -> Arc<Path> {
+        Arc::from(Path::new("t.xml"))
+    }
+
+    fn attr_value(text: &str, params: &[(&str, &str)]) -> Result<String> {
+        let params: Vec<(String, String)> = params
+            .iter()
+            .map(|(a, b)| (a.to_string(), b.to_string()))
+            .collect();
+        let tree = parse(text, &file(), &params)?;
+        Ok(tree.children[0].attrs[0].value.clone())
+    }
+
+    #[test]
+    fn substitution_replaces_whole_names_only() {
+        let t = r#"<scene version="3.0.0"><a v="$x,$xy;$x_1"/></scene>"#;
+        let v = attr_value(t, &[("x", "1"), ("xy", "2"), ("x_1", "3")]);
+        assert_eq!(v.ok().as_deref(), Some("1,2;3"));
+        let e = attr_value(t, &[("x", "1")]).expect_err("$xy undefined");
+        assert!(e.to_string().contains("undefined parameter $xy"), "{e}");
+        let e =
+            attr_value(r#"<scene version="3.0.0"><a v="5$"/></scene>"#, &[]).expect_err("lone $");
+        assert!(e.to_string().contains("lone '$'"), "{e}");
+    }
+
+    #[test]
+    fn defaults_apply_in_document_order_and_yield_to_callers() {
+        let t = r#"<scene version="3.0.0"><default name="n" value="4"/><a v="$n"/></scene>"#;
+        assert_eq!(attr_value(t, &[]).ok().as_deref(), Some("4"));
+        assert_eq!(attr_value(t, &[("n", "9")]).ok().as_deref(), Some("9"));
+        // A <default> after its use is too late, as in Mitsuba.
+        let late = r#"<scene version="3.0.0"><a v="$n"/><default name="n" value="4"/></scene>"#;
+        assert!(attr_value(late, &[]).is_err());
+    }
+
+    #[test]
+    fn locations_are_one_based_line_and_column_of_values() {
+        let t = "<scene version=\"3.0.0\">\n  <a\n     v=\"x\"/>\n</scene>";
+        let tree = parse(t, &file(), &[]).unwrap_or_else(|e| panic!("{e}"));
+        let a = &tree.children[0];
+        assert_eq!((a.loc.line, a.loc.col), (2, 3));
+        assert_eq!((a.attrs[0].loc.line, a.attrs[0].loc.col), (3, 9));
+        assert_eq!((tree.loc.line, tree.loc.col), (1, 1));
+    }
+
+    #[test]
+    fn comments_and_whitespace_are_dropped_text_is_refused() {
+        let t = "<scene version=\"3.0.0\"> <!-- c --> <a/>\n</scene>";
+        let tree = parse(t, &file(), &[]).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(tree.children.len(), 1);
+        let e = parse("<scene version=\"3.0.0\">x</scene>", &file(), &[]).expect_err("text");
+        assert!(
+            e.to_string().starts_with("t.xml:1:24: unexpected text"),
+            "{e}"
+        );
     }
 }

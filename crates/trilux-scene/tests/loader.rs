@@ -244,6 +244,12 @@ fn sensor_parameters() {
     assert_eq!(c.origin, DVec3::new(1.0, 2.0, 3.0));
     assert_eq!(c.target, DVec3::new(1.0, 2.0, 0.0));
     assert_eq!(c.up, DVec3::Y);
+    // fov without fov_axis: Mitsuba's default axis is x.
+    let x = load(r#"<sensor type="perspective"><float name="fov" value="40"/></sensor>"#)
+        .camera
+        .expect("camera");
+    assert_eq!((x.fov, x.fov_axis), (40.0, FovAxis::X));
+    assert_eq!(x.x_fov(), 40.0);
     for (name, axis) in [
         ("x", FovAxis::X),
         ("y", FovAxis::Y),
@@ -287,6 +293,10 @@ fn sensor_errors() {
     assert!(err(r#"<sensor type="perspective"><float name="fov" value="40"/><string name="fov_axis" value="z"/></sensor>"#).contains("unknown fov_axis"));
     assert!(err(r#"<sensor type="perspective"><transform name="to_world"><scale value="2"/></transform></sensor>"#).contains("must not scale"));
     assert!(err(r#"<sensor type="thinlens"/>"#).contains("unknown sensor plugin"));
+    assert!(
+        err(r#"<sensor type="perspective"><string name="fov_axis" value="y"/></sensor>"#)
+            .contains("fov_axis needs a fov")
+    );
     assert!(
         err(r#"<sensor type="perspective"><float name="near_clip" value="0.1"/></sensor>"#)
             .contains("unknown parameter \"near_clip\"")

@@ -132,3 +132,79 @@ fn recomputed_vertex_normals_match_mitsuba() {
         }
     }
 }
+
+/// The geometry layer's input surfaces of each shape cover exactly the
+/// shape: their areas sum to Mitsuba's area (an independent implementation:
+/// trilux-geometry's patches and charts), and `build_geometry` accepts every
+/// case.
+#[test]
+fn input_surfaces_cover_mitsubas_area() {
+    let exp = expected();
+    for case in exp["areas"].as_array().expect("areas") {
+        let xml = case["xml"].as_str().expect("xml");
+        let scene = load(xml);
+        let geometry = scene.build_geometry().unwrap_or_else(|e| panic!("{e}"));
+        let total: f64 = geometry.surfaces().iter().map(|s| s.area()).sum();
+        let want = case["area"].as_f64().expect("area");
+        // Curved pieces integrate their area numerically: 1e-6 relative.
+        assert!(
+            (total - want).abs() <= 1e-6 * want.max(1.0),
+            "{xml}: surfaces cover {total}, Mitsuba {want}"
+        );
+    }
+}
+
+/// Rays against each shape, in trilux's geometry built from the loaded scene
+/// and in Mitsuba 3 from the same XML: same hit or miss, same distance and
+/// same geometric normal (after `flip_normals`). This checks that the scene
+/// layer hands the geometry layer Mitsuba's object-space conventions (sphere
+/// centre and radius, cylinder frame, disk and rectangle orientation, mesh
+/// winding). Tolerance 1e-4 relative on t and 1e-4 on normals: Mitsuba
+/// intersects in float32.
+#[test]
+fn rays_hit_what_mitsuba_hits() {
+    let exp = expected();
+    let num = |v: &Value| v.as_f64().expect("number");
+    let vec3 = |v: &Value| glam::DVec3::new(num(&v[0]), num(&v[1]), num(&v[2]));
+    let mut hits = 0;
+    for case in exp["rays"].as_array().expect("rays") {
+        let xml = case["xml"].as_str().expect("xml");
+        // WORKAROUND (reported to the geometry owner): trilux-geometry's BVH
+        // misses every ray when the whole scene lies in one axis-aligned
+        // plane (a lone rectangle or flat OBJ sheet: zero extent along one
+        // axis). A tiny sphere far away gives the scene depth without
+        // being on any ray's path.
+        let geometry = load(&format!(
+            "{xml}<shape type=\"sphere\"><point name=\"center\" value=\"1000, 1000, 1000\"/>\
+             <float name=\"radius\" value=\"0.001\"/></shape>"
+        ))
+        .build_geometry()
+        .unwrap_or_else(|e| panic!("{e}"));
+        for ray in case["rays"].as_array().expect("rays") {
+            let r = trilux_geometry::Ray {
+                origin: vec3(&ray["origin"]),
+                dir: vec3(&ray["dir"]),
+            };
+            let hit = geometry.intersect(&r, 1e30);
+            match (hit, ray["t"].as_f64()) {
+                (None, None) => {}
+                (Some(h), Some(t)) => {
+                    hits += 1;
+                    assert!(
+                        (h.t - t).abs() <= 1e-4 * t,
+                        "{xml}: t {} vs Mitsuba {t}",
+                        h.t
+                    );
+                    let n = vec3(&ray["n"]);
+                    assert!(
+                        h.geometric_normal.distance(n) < 1e-4,
+                        "{xml}: normal {} vs Mitsuba {n}",
+                        h.geometric_normal
+                    );
+                }
+                (h, t) => panic!("{xml}: trilux {:?} vs Mitsuba t = {t:?}", h.map(|h| h.t)),
+            }
+        }
+    }
+    assert!(hits > 200, "{hits} hits");
+}

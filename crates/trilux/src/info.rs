@@ -6,12 +6,12 @@ use std::path::PathBuf;
 use anyhow::Result;
 use clap::Args;
 use serde::Serialize;
+use trilux_color::Mode;
 use trilux_geometry::ShapeKind;
 use trilux_scene::Scene;
 
 use crate::ModeArg;
 use crate::power::emitted_power;
-use crate::surfaces::input_surfaces_provisional;
 
 /// Arguments of `trilux info`.
 #[derive(Debug, Args)]
@@ -21,7 +21,7 @@ pub struct InfoArgs {
     /// Print a JSON object instead of text.
     #[arg(long)]
     pub json: bool,
-    /// Override the scene's colour mode (spectral when some <spectrum> has
+    /// Override the scene's colour mode (spectral when some `<spectrum>` has
     /// wavelength:value pairs).
     #[arg(long, value_enum)]
     pub mode: Option<ModeArg>,
@@ -54,21 +54,18 @@ struct CameraJson {
 /// Runs `trilux info`.
 pub fn run(args: &InfoArgs) -> Result<()> {
     let scene = trilux_scene::load(&args.scene)?;
-    let mode = args.mode.unwrap_or(if scene.spectral {
-        ModeArg::Spectral
-    } else {
-        ModeArg::Rgb
-    });
+    let mode = match args.mode {
+        Some(ModeArg::Rgb) => Mode::Rgb,
+        Some(ModeArg::Spectral) => Mode::Spectral,
+        None => scene.mode(),
+    };
     let info = InfoJson {
         shapes: scene.shapes.len(),
-        input_surfaces: input_surfaces_provisional(&scene),
+        input_surfaces: scene.build_geometry()?.surfaces().len(),
         emitters: scene.emitters().count(),
         bsdfs: scene.bsdf_counts.clone(),
-        emitted_power: emitted_power(&scene, mode),
-        mode: match mode {
-            ModeArg::Rgb => "rgb",
-            ModeArg::Spectral => "spectral",
-        },
+        emitted_power: emitted_power(&scene, mode)?,
+        mode: mode.name(),
         camera: scene.camera.as_ref().map(|c| CameraJson {
             origin: c.origin.to_array(),
             target: c.target.to_array(),

@@ -2,11 +2,14 @@
 //!
 //! Runtime errors print one line `error: ...` on stderr and exit with status
 //! 1; command-line usage errors keep clap's message and exit with status 2.
-//! Subcommands live one per module; `render` and `solve` join `info` here.
+//! Subcommands live one per module; `render` and `solve` join `info` here
+//! as variants of [`Command`]. Number-list options whose values may begin
+//! with '-' (`--lookat -0.5,1,2,...`) need `#[arg(allow_hyphen_values =
+//! true)]` on the argument (`allow_negative_numbers` only covers plain
+//! numbers, not comma lists).
 
 mod info;
 mod power;
-mod surfaces;
 
 use std::path::PathBuf;
 use std::process::ExitCode;

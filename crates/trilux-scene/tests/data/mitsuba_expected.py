@@ -9,7 +9,11 @@ scalar_rgb, single precision) built from the same text:
 - "transforms": the `to_world` of a rectangle with that <transform>;
 - "sensors": the sensor's to_world matrix and its horizontal fov (x_fov);
 - "areas": the surface area of a shape;
-- "meshes": positions and vertex normals of an OBJ mesh without `vn`.
+- "meshes": positions and vertex normals of an OBJ mesh without `vn`;
+- "rays": for each shape of "areas" (and flip_normals variants), rays aimed
+  near the shape's bounding-box centre from fixed pseudo-random origins, with
+  Mitsuba's hit distance and geometric normal (or a miss): the scene's object
+  conventions as the geometry layer sees them.
 """
 import json
 
@@ -121,4 +125,50 @@ for m in MESHES:
         "positions": [p[i:i + 3] for i in range(0, len(p), 3)],
         "normals": [n[i:i + 3] for i in range(0, len(n), 3)],
     })
+
+def lcg(seed):
+    """A tiny deterministic generator (so the rays do not depend on numpy)."""
+    state = seed
+    while True:
+        state = (state * 6364136223846793005 + 1442695040888963407) % 2**64
+        yield (state >> 11) / 2**53
+
+
+out["rays"] = []
+RAY_SHAPES = [a for a in AREAS] + [
+    '<shape type="sphere"><boolean name="flip_normals" value="true"/></shape>',
+    '<shape type="cube"><boolean name="flip_normals" value="true"/></shape>',
+    '<shape type="cylinder"><boolean name="flip_normals" value="true"/></shape>',
+    '<shape type="disk"><boolean name="flip_normals" value="true"/>'
+    '<transform name="to_world"><rotate x="1" angle="30"/></transform></shape>',
+]
+for k, xml in enumerate(RAY_SHAPES):
+    scene = load(xml)
+    bbox = scene.bbox()
+    centre = (bbox.min + bbox.max) * 0.5
+    extent = float(dr_max) if (dr_max := max(bbox.extents())) > 0 else 1.0
+    rng = lcg(k + 1)
+    rays = []
+    for _ in range(24):
+        # Origin on a sphere of radius 3 * extent around the centre.
+        z = 2 * next(rng) - 1
+        phi = 2 * 3.141592653589793 * next(rng)
+        r = (1 - z * z) ** 0.5
+        import math
+        o = [centre[0] + 3 * extent * r * math.cos(phi),
+             centre[1] + 3 * extent * r * math.sin(phi),
+             centre[2] + 3 * extent * z]
+        target = [centre[i] + 0.6 * extent * (next(rng) - 0.5) for i in range(3)]
+        d = [target[i] - o[i] for i in range(3)]
+        norm = math.sqrt(sum(x * x for x in d))
+        d = [x / norm for x in d]
+        si = scene.ray_intersect(mi.Ray3f(o, d))
+        hit = bool(si.is_valid())
+        rays.append({
+            "origin": o,
+            "dir": d,
+            "t": float(si.t) if hit else None,
+            "n": [float(si.n[i]) for i in range(3)] if hit else None,
+        })
+    out["rays"].append({"xml": xml, "rays": rays})
 print(json.dumps(out, indent=1))

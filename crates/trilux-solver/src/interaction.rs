@@ -1,0 +1,266 @@
+//! Interactions and their hierarchies (paper §3.2, Fig. 2, 3 and 8).
+//!
+//! An interaction IJ is the light leaving element I towards element J: its
+//! radiance L, unshot radiance δL and gathered radiance L^G. Each root
+//! interaction (a pair of input-surface sides that exchange light) owns a
+//! hierarchy of nodes in one arena. A node has at most one set of four
+//! children, made by splitting its sender element (`From`) or its receiver
+//! element (`To`) — notes §7's proposal: when refinement later asks for the
+//! other side, it descends through the existing children first, so a point
+//! pair always has exactly one path down (which keeps push-pull and the
+//! renderer's lookup exact).
+//!
+//! Every node caches its throughput T = A_I F_{I→J} V (paper §4.6). A split
+//! node's T is redefined as the sum of its children's, so that pulling with
+//! flux weights T_c / Σ T_c conserves flux exactly (paper §5.6, corrected in
+//! notes §5: area weights are only the far-field limit).
+
+use serde::{Deserialize, Serialize};
+use trilux_color::Spectrum;
+use trilux_geometry::{ElementId, SceneGeometry, SurfaceCoord};
+
+use crate::sides::SideId;
+use crate::throughput::Throughput;
+
+/// Marks "no children".
+pub(crate) const NO_CHILD: u32 = u32::MAX;
+
+/// Which element of a node its children split.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Split {
+    /// A leaf.
+    None,
+    /// Children I_m J: the sender element was split.
+    From,
+    /// Children I J_m: the receiver element was split.
+    To,
+}
+
+/// One node IJ of an interaction hierarchy.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub(crate) struct Node<const N: usize> {
+    /// Sender element I.
+    pub from: ElementId,
+    /// Receiver element J.
+    pub to: ElementId,
+    /// Index of the first of four consecutive children, or [`NO_CHILD`].
+    pub first_child: u32,
+    /// Which element the children split.
+    pub split: Split,
+    /// T = A_I F_{I→J} V (the sum over children once split).
+    pub t: f64,
+    /// Visible fraction measured for this node's own elements.
+    pub v: f64,
+    /// Current radiance estimate L_IJ.
+    pub radiance: Spectrum<N>,
+    /// Unshot radiance δL_IJ.
+    pub unshot: Spectrum<N>,
+    /// Radiance gathered during shots, not yet pushed (L^G).
+    pub gathered: Spectrum<N>,
+}
+
+/// The hierarchy of one root interaction between two sides.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub(crate) struct Hierarchy<const N: usize> {
+    /// The sending side.
+    pub from: SideId,
+    /// The receiving side.
+    pub to: SideId,
+    /// Node arena; node 0 is the root.
+    pub nodes: Vec<Node<N>>,
+    /// Unshot flux of the whole hierarchy (the selection key δΦ, kept current
+    /// as energy arrives: paper Eq. 6 in its exact flux form, notes §4).
+    pub unshot_flux: Spectrum<N>,
+}
+
+impl<const N: usize> Hierarchy<N> {
+    /// A hierarchy with only its root node.
+    pub fn new(from: SideId, to: SideId, i: ElementId, j: ElementId, t: Throughput) -> Self {
+        Hierarchy {
+            from,
+            to,
+            nodes: vec![Node {
+                from: i,
+                to: j,
+                first_child: NO_CHILD,
+                split: Split::None,
+                t: t.t,
+                v: t.v,
+                radiance: Spectrum::zero(),
+                unshot: Spectrum::zero(),
+                gathered: Spectrum::zero(),
+            }],
+            unshot_flux: Spectrum::zero(),
+        }
+    }
+
+    /// The four children of node `n`, if split.
+    pub fn children(&self, n: u32) -> Option<[u32; 4]> {
+        let f = self.nodes[n as usize].first_child;
+        (f != NO_CHILD).then_some([f, f + 1, f + 2, f + 3])
+    }
+
+    /// Splits leaf `n` on `side` into children with the given elements and
+    /// throughputs. Pending energy (δL and L^G) is rescaled by T_old / T_new
+    /// so that its flux π T (δL + L^G) is unchanged; returns the flux that
+    /// could not be kept because the children carry no throughput at all.
+    pub fn split(
+        &mut self,
+        n: u32,
+        side: Split,
+        elements: [(ElementId, ElementId); 4],
+        throughputs: [Throughput; 4],
+    ) -> Spectrum<N> {
+        let first = self.nodes.len() as u32;
+        let parent = self.nodes[n as usize].clone();
+        let t_new: f64 = throughputs.iter().map(|t| t.t).sum();
+        let mut lost = Spectrum::zero();
+        let scale = if t_new > 0.0 {
+            parent.t / t_new
+        } else {
+            lost = (parent.unshot + parent.gathered) * (std::f64::consts::PI * parent.t);
+            0.0
+        };
+        for (k, (&(a, b), th)) in elements.iter().zip(throughputs.iter()).enumerate() {
+            let _ = k;
+            self.nodes.push(Node {
+                from: a,
+                to: b,
+                first_child: NO_CHILD,
+                split: Split::None,
+                t: th.t,
+                v: th.v,
+                radiance: parent.radiance,
+                unshot: parent.unshot * scale,
+                gathered: Spectrum::zero(),
+            });
+        }
+        let p = &mut self.nodes[n as usize];
+        p.first_child = first;
+        p.split = side;
+        p.gathered = p.gathered * scale;
+        p.unshot = p.unshot * scale;
+        p.t = t_new;
+        lost
+    }
+
+    /// Lazy push-pull of the whole hierarchy (paper §4.4): gathered radiance
+    /// is pushed down unchanged into L and δL of the leaves, then parents are
+    /// the flux-weighted averages of their children.
+    pub fn push_pull(&mut self) {
+        self.push_pull_rec(0, Spectrum::zero());
+    }
+
+    fn push_pull_rec(&mut self, n: u32, from_above: Spectrum<N>) -> (Spectrum<N>, Spectrum<N>) {
+        let down = from_above + self.nodes[n as usize].gathered;
+        self.nodes[n as usize].gathered = Spectrum::zero();
+        match self.children(n) {
+            None => {
+                let node = &mut self.nodes[n as usize];
+                node.radiance += down;
+                node.unshot += down;
+                (node.radiance, node.unshot)
+            }
+            Some(children) => {
+                let total: f64 = children.iter().map(|&c| self.nodes[c as usize].t).sum();
+                let mut l = Spectrum::zero();
+                let mut dl = Spectrum::zero();
+                for c in children {
+                    let w = if total > 0.0 {
+                        self.nodes[c as usize].t / total
+                    } else {
+                        0.25
+                    };
+                    let (cl, cdl) = self.push_pull_rec(c, down);
+                    l += cl * w;
+                    dl += cdl * w;
+                }
+                let node = &mut self.nodes[n as usize];
+                node.radiance = l;
+                node.unshot = dl;
+                (l, dl)
+            }
+        }
+    }
+
+    /// Sets δL to zero over the whole hierarchy (it has just shot).
+    pub fn clear_unshot(&mut self) {
+        for node in &mut self.nodes {
+            node.unshot = Spectrum::zero();
+        }
+    }
+
+    /// Unshot radiance for the element pair (i, j): that of the deepest node
+    /// whose elements contain i and j (after push-pull every node's δL is
+    /// the flux-weighted average of its subtree).
+    pub fn unshot_for(&self, geom: &SceneGeometry, i: ElementId, j: ElementId) -> Spectrum<N> {
+        let mut n = 0u32;
+        loop {
+            let node = &self.nodes[n as usize];
+            let Some(children) = self.children(n) else {
+                return node.unshot;
+            };
+            let next = children.into_iter().find(|&c| {
+                let child = &self.nodes[c as usize];
+                match node.split {
+                    Split::From => child.from != node.from && is_within(geom, i, child.from),
+                    Split::To => child.to != node.to && is_within(geom, j, child.to),
+                    Split::None => false,
+                }
+            });
+            match next {
+                Some(c) => n = c,
+                None => return node.unshot,
+            }
+        }
+    }
+
+    /// Radiance leaving the point `x` of the sender side towards the point
+    /// `y` of the receiver side: the leaf (deepest node) whose elements
+    /// contain both (paper §4.5, Fig. 11c).
+    pub fn radiance_at(
+        &self,
+        geom: &SceneGeometry,
+        x: SurfaceCoord,
+        y: SurfaceCoord,
+    ) -> Spectrum<N> {
+        let mut n = 0u32;
+        loop {
+            let node = &self.nodes[n as usize];
+            let Some(children) = self.children(n) else {
+                return node.radiance;
+            };
+            let next = children.into_iter().find(|&c| {
+                let child = &self.nodes[c as usize];
+                match node.split {
+                    Split::From => geom.element_contains(child.from, x),
+                    Split::To => geom.element_contains(child.to, y),
+                    Split::None => false,
+                }
+            });
+            match next {
+                Some(c) => n = c,
+                None => return node.radiance,
+            }
+        }
+    }
+}
+
+/// True when element `e` is `ancestor` or lies below it.
+pub(crate) fn is_within(geom: &SceneGeometry, e: ElementId, ancestor: ElementId) -> bool {
+    let target = geom.element(ancestor).depth;
+    let mut cur = e;
+    loop {
+        if cur == ancestor {
+            return true;
+        }
+        let el = geom.element(cur);
+        if el.depth <= target {
+            return false;
+        }
+        match el.parent {
+            Some(p) => cur = p,
+            None => return false,
+        }
+    }
+}

@@ -1,0 +1,90 @@
+//! Two-point radiance of Lambertian parts (design.md §2, notes §7).
+//!
+//! A Lambertian surface sends the same radiance in every direction, so its
+//! outgoing light is one spectrum per element and side, exactly as in
+//! hierarchical radiosity: L (reflected radiance, emission excluded), δL
+//! (unshot, emission included) and L^G (gathered during shots, not yet
+//! pushed). The element trees are pushed and pulled lazily, only when a side
+//! is about to shoot (paper §4.4).
+
+use trilux_color::Spectrum;
+use trilux_geometry::{ElementId, SceneGeometry};
+
+/// Per-element radiance of the two faces of every element.
+#[derive(Clone, Debug)]
+pub(crate) struct ElementRadiance<const N: usize> {
+    /// Reflected outgoing radiance L, indexed `[back][element]`.
+    pub radiance: [Vec<Spectrum<N>>; 2],
+    /// Unshot radiance δL.
+    pub unshot: [Vec<Spectrum<N>>; 2],
+    /// Gathered radiance L^G waiting to be pushed.
+    pub gathered: [Vec<Spectrum<N>>; 2],
+}
+
+impl<const N: usize> ElementRadiance<N> {
+    /// All zero for `elements` elements.
+    pub fn new(elements: usize) -> Self {
+        let z = || vec![Spectrum::zero(); elements];
+        ElementRadiance {
+            radiance: [z(), z()],
+            unshot: [z(), z()],
+            gathered: [z(), z()],
+        }
+    }
+
+    /// Push-pull of one side's tree under `root` (HSA91; paper §3.2.4 and
+    /// §4.4): gathered radiance goes down unchanged and lands in L and δL at
+    /// the leaves; parents become the area-weighted average of their
+    /// children. For Lambertian radiance the area weight *is* the flux weight
+    /// (flux = π A L whatever the orientation), so pulling over curved,
+    /// non-coplanar children conserves flux exactly.
+    pub fn push_pull(&mut self, geom: &SceneGeometry, root: ElementId, back: bool) {
+        let s = usize::from(back);
+        self.push_pull_rec(geom, root, s, Spectrum::zero());
+    }
+
+    fn push_pull_rec(
+        &mut self,
+        geom: &SceneGeometry,
+        e: ElementId,
+        s: usize,
+        from_above: Spectrum<N>,
+    ) -> (Spectrum<N>, Spectrum<N>) {
+        let i = e.index();
+        let down = from_above + self.gathered[s][i];
+        self.gathered[s][i] = Spectrum::zero();
+        match geom.element(e).children() {
+            None => {
+                self.radiance[s][i] += down;
+                self.unshot[s][i] += down;
+                (self.radiance[s][i], self.unshot[s][i])
+            }
+            Some(children) => {
+                let area = geom.element(e).area;
+                let mut l = Spectrum::zero();
+                let mut dl = Spectrum::zero();
+                for c in children {
+                    let w = geom.element(c).area / area;
+                    let (cl, cdl) = self.push_pull_rec(geom, c, s, down);
+                    l += cl * w;
+                    dl += cdl * w;
+                }
+                self.radiance[s][i] = l;
+                self.unshot[s][i] = dl;
+                (l, dl)
+            }
+        }
+    }
+
+    /// Sets δL to zero over one side's tree (the side has just shot).
+    pub fn clear_unshot(&mut self, geom: &SceneGeometry, root: ElementId, back: bool) {
+        let s = usize::from(back);
+        let mut stack = vec![root];
+        while let Some(e) = stack.pop() {
+            self.unshot[s][e.index()] = Spectrum::zero();
+            if let Some(children) = geom.element(e).children() {
+                stack.extend(children);
+            }
+        }
+    }
+}

@@ -1,0 +1,494 @@
+//! RefineAndLink (paper §3.2.2, Fig. 4–5, §4.3; notes §2–3).
+//!
+//! A shot refines in two stages, both creating links that live only for
+//! this shot (paper §4.2):
+//!
+//! 1. **Pair links** i → j between the source's elements and the elements
+//!    of every receiving side (the two-point part, as in hierarchical
+//!    radiosity): refined until the form-factor estimates are below FFErr and
+//!    visibility is not partial, or until the flux the link carries is below
+//!    the photometric threshold. The flux arriving through a pair link is
+//!    π T_ij δL_i; its Lambertian share goes straight into j's radiance.
+//! 2. **Three-point links** (i j) → (j k), from each pair link into every
+//!    stored interaction hierarchy leaving j's side (its glossy part):
+//!    refined by the BRDF error FrErr, the form factor and visibility of
+//!    (j, k), and the photometric criterion on the flux that would go on
+//!    towards k. The three subdivision cases of notes §3 apply: split I
+//!    (sender sub-pairs i_m j), split K (receiver nodes j k_m), or split J
+//!    (matched pairs i j_m → j_m k only).
+//!
+//! Senders are never stored in the sender's hierarchy by refinement: a
+//! finer sender pair than the stored nodes is *virtual*, with the unshot
+//! radiance of the deepest stored node containing it (piecewise constant, so
+//! this is exact). Only receiving hierarchies grow, and they are disjoint
+//! across the parallel tasks of one shot.
+
+use std::f64::consts::PI;
+
+use glam::DVec3;
+use trilux_brdf::area::Element as Driver;
+use trilux_brdf::{Bsdf, ElementPoints, brdf_variation};
+use trilux_color::Spectrum;
+use trilux_geometry::{ElementId, FormFactorOptions, SceneGeometry};
+
+use crate::interaction::{Hierarchy, Split};
+use crate::radiosity::ElementRadiance;
+use crate::settings::{SolverSettings, Transport};
+use crate::sides::{SideId, TransportSide};
+use crate::throughput::{SidedElement, Throughput, ThroughputCache, compute_throughput};
+
+/// What a shot sends from: unshot radiance by element pair.
+pub(crate) enum Sender<'a, const N: usize> {
+    /// A Lambertian side: δL of its element tree, the same towards every j.
+    Radiosity {
+        /// The side's per-element radiance.
+        field: &'a ElementRadiance<N>,
+        /// Back face.
+        back: bool,
+    },
+    /// A stored interaction hierarchy.
+    Stored(&'a Hierarchy<N>),
+}
+
+impl<const N: usize> Sender<'_, N> {
+    fn unshot(&self, geom: &SceneGeometry, i: ElementId, j: ElementId) -> Spectrum<N> {
+        match self {
+            Sender::Radiosity { field, back } => field.unshot[usize::from(*back)][i.index()],
+            Sender::Stored(h) => h.unshot_for(geom, i, j),
+        }
+    }
+}
+
+/// A transient link of stage 1.
+#[derive(Clone, Debug)]
+pub(crate) struct PairLink<const N: usize> {
+    /// Sending element.
+    pub i: ElementId,
+    /// Receiving element.
+    pub j: ElementId,
+    /// Receiving side.
+    pub side: SideId,
+    /// T_ij.
+    pub t: f64,
+    /// δL_i sent along the link.
+    pub unshot: Spectrum<N>,
+}
+
+/// A transient link of stage 2: a radiance increment for one node.
+#[derive(Clone, Debug)]
+pub(crate) struct NodeLink<const N: usize> {
+    /// Index of the receiving hierarchy.
+    pub hierarchy: u32,
+    /// Node within it.
+    pub node: u32,
+    /// The pair link (stage 1) this transfer belongs to.
+    pub group: u32,
+    /// ΔL^G = δL_ij · R(i→j→k) (paper §4.2, step 2).
+    pub gathered: Spectrum<N>,
+}
+
+/// Everything refinement reads, shared by the parallel tasks of a shot.
+pub(crate) struct RefineContext<'a, const N: usize> {
+    pub geom: &'a SceneGeometry,
+    pub settings: &'a SolverSettings,
+    pub sides: &'a [TransportSide<N>],
+    pub materials: &'a [Bsdf<N>],
+    pub cache: &'a ThroughputCache,
+    pub ff_options: FormFactorOptions,
+    /// Photometric threshold in watts (band sum): flux_eps × IF.
+    pub flux_threshold: f64,
+}
+
+/// Point-to-disc estimate of F_{a→b} (notes §2, HSA91): b seen from a's
+/// centre as a disc of the same area.
+fn disc_estimate(pa: DVec3, na: DVec3, pb: DVec3, nb: DVec3, area_b: f64) -> f64 {
+    let d = pb - pa;
+    let r2 = d.length_squared();
+    if r2 <= 0.0 {
+        return 1.0;
+    }
+    let r = r2.sqrt();
+    let ca = (na.dot(d) / r).max(0.0);
+    let cb = (-nb.dot(d) / r).max(0.0);
+    // Elements that do not face each other at their centres may still
+    // exchange light near their edges: use the larger cosines' bound.
+    let (ca, cb) = if ca == 0.0 || cb == 0.0 {
+        (1.0, 1.0)
+    } else {
+        (ca, cb)
+    };
+    (area_b * ca * cb / (PI * r2 + area_b)).min(1.0)
+}
+
+impl<const N: usize> RefineContext<'_, N> {
+    fn sided(&self, e: ElementId, side: SideId) -> SidedElement {
+        SidedElement {
+            element: e,
+            back: self.sides[side as usize].back,
+        }
+    }
+
+    /// T through the cache, for `recv` receiving from `send` (T is
+    /// symmetric; the spread is over the receiver).
+    pub fn throughput(
+        &self,
+        recv: ElementId,
+        sr: SideId,
+        send: ElementId,
+        ss: SideId,
+    ) -> Throughput {
+        let (a, b) = (self.sided(recv, sr), self.sided(send, ss));
+        if let Some(t) = self.cache.get(a, b) {
+            return t;
+        }
+        let t = compute_throughput(
+            self.geom,
+            a,
+            b,
+            self.settings.visibility_samples,
+            &self.ff_options,
+        );
+        self.cache.insert(a, b, t);
+        t
+    }
+
+    fn can_split(&self, e: ElementId) -> bool {
+        self.geom.element(e).children().is_some()
+    }
+
+    /// Both point-to-disc estimates F̂_{a→b} and F̂_{b→a}.
+    fn ff_estimates(&self, a: ElementId, sa: SideId, b: ElementId, sb: SideId) -> (f64, f64) {
+        let (ea, eb) = (self.geom.element(a), self.geom.element(b));
+        let na = ea.normal * self.sides[sa as usize].sign();
+        let nb = eb.normal * self.sides[sb as usize].sign();
+        (
+            disc_estimate(ea.centre, na, eb.centre, nb, eb.area),
+            disc_estimate(eb.centre, nb, ea.centre, na, ea.area),
+        )
+    }
+
+    /// Stage 1: refines the pair (i, j) and appends pair links.
+    #[allow(clippy::too_many_arguments)]
+    pub fn refine_pair(
+        &self,
+        sender: &Sender<'_, N>,
+        si: SideId,
+        sj: SideId,
+        i: ElementId,
+        j: ElementId,
+        out: &mut Vec<PairLink<N>>,
+    ) {
+        let th = self.throughput(j, sj, i, si);
+        let (ei, ej) = (self.geom.element(i), self.geom.element(j));
+        if th.t <= 0.0 {
+            // Fully occluded or facing away. Near the roots a handful of
+            // shadow rays may miss a gap: look one level further there.
+            if ei.depth + ej.depth < 2 && th.v == 0.0 && self.unoccluded_positive(i, si, j, sj) {
+                self.split_pair(sender, si, sj, i, j, out);
+            }
+            return;
+        }
+        let unshot = sender.unshot(self.geom, i, j);
+        if unshot.is_black() {
+            return;
+        }
+        let link = PairLink {
+            i,
+            j,
+            side: sj,
+            t: th.t,
+            unshot,
+        };
+        let flux = PI * th.t * unshot.sum();
+        if flux < self.flux_threshold || self.sides[sj as usize].is_absorber() {
+            out.push(link);
+            return;
+        }
+        // The transfer is accurate when the point form factor varies little
+        // over the receiver (so that pushing it down unchanged is right).
+        let partial = th.v > 0.0 && th.v < 1.0;
+        if th.spread <= self.settings.ff_eps && !partial {
+            out.push(link);
+            return;
+        }
+        if !self.split_pair(sender, si, sj, i, j, out) {
+            out.push(link);
+        }
+    }
+
+    fn unoccluded_positive(&self, i: ElementId, si: SideId, j: ElementId, sj: SideId) -> bool {
+        self.throughput(j, sj, i, si).f > 0.0
+    }
+
+    /// Splits the larger splittable element of the pair; false if neither
+    /// can be split.
+    fn split_pair(
+        &self,
+        sender: &Sender<'_, N>,
+        si: SideId,
+        sj: SideId,
+        i: ElementId,
+        j: ElementId,
+        out: &mut Vec<PairLink<N>>,
+    ) -> bool {
+        let (ei, ej) = (self.geom.element(i), self.geom.element(j));
+        let split_i = match (ei.children(), ej.children()) {
+            // Both splittable: the receiver, unless the sender is much larger.
+            (Some(_), Some(_)) => ei.area > 4.0 * ej.area,
+            (Some(_), None) => true,
+            (None, Some(_)) => false,
+            (None, None) => return false,
+        };
+        if split_i {
+            for c in ei.children().into_iter().flatten() {
+                self.refine_pair(sender, si, sj, c, j, out);
+            }
+        } else {
+            for c in ej.children().into_iter().flatten() {
+                self.refine_pair(sender, si, sj, i, c, out);
+            }
+        }
+        true
+    }
+
+    /// Representative fr(i→j→k) for stored transport and its variation.
+    fn brdf_terms(
+        &self,
+        bsdf: &Bsdf<N>,
+        i: ElementId,
+        j: ElementId,
+        k: ElementId,
+    ) -> (Spectrum<N>, f64, Driver) {
+        let g = self.geom;
+        let (pi, pj, pk) = (
+            g.element_points(i),
+            g.element_points(j),
+            g.element_points(k),
+        );
+        let (ei, ej, ek) = (g.element(i), g.element(j), g.element(k));
+        fn pts<'p>(e: &trilux_geometry::Element, p: &'p [DVec3; 5]) -> ElementPoints<'p> {
+            ElementPoints {
+                centre: e.centre,
+                normal: e.normal,
+                points: &p[..],
+            }
+        }
+        let (xi, xj, xk) = (pts(ei, &pi), pts(ej, &pj), pts(ek, &pk));
+        let variation = brdf_variation(bsdf, &xi, &xj, &xk);
+        let frame = trilux_brdf::Frame::from_normal(ej.normal);
+        let wi = (ei.centre - ej.centre).normalize_or_zero();
+        let wo = (ek.centre - ej.centre).normalize_or_zero();
+        let (wi, wo) = (frame.to_local(wi), frame.to_local(wo));
+        let fr = match self.settings.transport {
+            Transport::TwoPoint => bsdf.eval_glossy(wi, wo),
+            Transport::Uniform => bsdf.eval(wi, wo),
+        };
+        let spread = (variation.fr_max - variation.fr_min).max_value().max(0.0);
+        (fr, spread, variation.driver())
+    }
+
+    /// Stage 2: refines the three-point link (i j) → node of `h` (whose sender
+    /// element is j) and appends node links.
+    #[allow(clippy::too_many_arguments)]
+    pub fn refine_triple(
+        &self,
+        sender: &Sender<'_, N>,
+        si: SideId,
+        h: &mut Hierarchy<N>,
+        h_index: u32,
+        i: ElementId,
+        j: ElementId,
+        n: u32,
+        group: u32,
+        lost: &mut Spectrum<N>,
+        out: &mut Vec<NodeLink<N>>,
+    ) {
+        let (sj, sk) = (h.from, h.to);
+        let tij = self.throughput(j, sj, i, si);
+        if tij.t <= 0.0 {
+            return;
+        }
+        let unshot = sender.unshot(self.geom, i, j);
+        if unshot.is_black() {
+            return;
+        }
+        let node = &h.nodes[n as usize];
+        debug_assert_eq!(node.from, j);
+        let (k, tjk, vjk) = (node.to, node.t, node.v);
+        if tjk <= 0.0 {
+            return;
+        }
+        let bsdf = &self.materials[self.sides[sj as usize].shape];
+        let (fr, spread, driver) = self.brdf_terms(bsdf, i, j, k);
+        let aj = self.geom.element(j).area;
+        let r = fr * (PI * tij.t / aj);
+        let gathered = unshot * r;
+        if gathered.is_black() {
+            return;
+        }
+        let link = NodeLink {
+            hierarchy: h_index,
+            node: n,
+            group,
+            gathered,
+        };
+        let flux_to_k = PI * tjk * gathered.sum();
+        if flux_to_k < self.flux_threshold {
+            out.push(link);
+            return;
+        }
+        let (fji, _) = self.ff_estimates(j, sj, i, si);
+        let brdf_err = PI * fji * spread / self.settings.fr_eps;
+        let (fjk, fkj) = self.ff_estimates(j, sj, k, sk);
+        let ff_err = fjk.max(fkj) / self.settings.ff_eps;
+        let partial = vjk > 0.0 && vjk < 1.0;
+        if brdf_err <= 1.0 && ff_err <= 1.0 && !partial {
+            out.push(link);
+            return;
+        }
+        // The element to split: the BRDF's driver when the BRDF error
+        // dominates, otherwise the larger of J and K.
+        let (ej, ek) = (self.geom.element(j), self.geom.element(k));
+        let mut order: Vec<Driver> = if brdf_err >= ff_err.max(if partial { 1.0 } else { 0.0 }) {
+            vec![driver]
+        } else if ej.area >= ek.area {
+            vec![Driver::J, Driver::K]
+        } else {
+            vec![Driver::K, Driver::J]
+        };
+        for d in [Driver::I, Driver::J, Driver::K] {
+            if !order.contains(&d) {
+                order.push(d);
+            }
+        }
+        for d in order {
+            if self.split_triple(d, sender, si, h, h_index, i, j, n, group, lost, out) {
+                return;
+            }
+        }
+        out.push(link);
+    }
+
+    /// Applies one of the three subdivision cases (notes §3), following an
+    /// existing split of the receiving node when it is on the other side.
+    /// False when the chosen element cannot be split.
+    #[allow(clippy::too_many_arguments)]
+    fn split_triple(
+        &self,
+        which: Driver,
+        sender: &Sender<'_, N>,
+        si: SideId,
+        h: &mut Hierarchy<N>,
+        h_index: u32,
+        i: ElementId,
+        j: ElementId,
+        n: u32,
+        group: u32,
+        lost: &mut Spectrum<N>,
+        out: &mut Vec<NodeLink<N>>,
+    ) -> bool {
+        let node_split = h.nodes[n as usize].split;
+        let which = match (which, node_split) {
+            (Driver::I, _) => Driver::I,
+            (_, Split::From) => Driver::J,
+            (_, Split::To) => Driver::K,
+            (w, Split::None) => w,
+        };
+        match which {
+            Driver::I => {
+                let Some(children) = self.geom.element(i).children() else {
+                    return false;
+                };
+                for c in children {
+                    self.refine_triple(sender, si, h, h_index, c, j, n, group, lost, out);
+                }
+                true
+            }
+            Driver::K => {
+                let Some(nodes) = self.node_children(h, n, Split::To, lost) else {
+                    return false;
+                };
+                for c in nodes {
+                    self.refine_triple(sender, si, h, h_index, i, j, c, group, lost, out);
+                }
+                true
+            }
+            Driver::J => {
+                let Some(nodes) = self.node_children(h, n, Split::From, lost) else {
+                    return false;
+                };
+                for c in nodes {
+                    let jm = h.nodes[c as usize].from;
+                    self.refine_triple(sender, si, h, h_index, i, jm, c, group, lost, out);
+                }
+                true
+            }
+        }
+    }
+
+    /// The children of node `n`, splitting it on `side` first if it is a
+    /// leaf. `None` if it is a leaf whose element on that side cannot split.
+    pub fn node_children(
+        &self,
+        h: &mut Hierarchy<N>,
+        n: u32,
+        side: Split,
+        lost: &mut Spectrum<N>,
+    ) -> Option<[u32; 4]> {
+        if let Some(c) = h.children(n) {
+            return Some(c);
+        }
+        let (a, b) = (h.nodes[n as usize].from, h.nodes[n as usize].to);
+        let (sa, sb) = (h.from, h.to);
+        let split_elem = if side == Split::From { a } else { b };
+        let children = self.geom.element(split_elem).children()?;
+        let pairs = children.map(|c| if side == Split::From { (c, b) } else { (a, c) });
+        let throughputs = pairs.map(|(x, y)| self.throughput(y, sb, x, sa));
+        *lost += h.split(n, side, pairs, throughputs);
+        h.children(n)
+    }
+
+    /// The nodes of `h` whose sender element is exactly `j`, splitting on
+    /// the sender side down to `j` where needed and descending through
+    /// receiver-side splits (they keep the same sender element).
+    pub fn nodes_for(
+        &self,
+        h: &mut Hierarchy<N>,
+        j: ElementId,
+        lost: &mut Spectrum<N>,
+    ) -> Vec<u32> {
+        // The chain of elements from the surface's root down to j.
+        let mut chain = vec![j];
+        let mut cur = j;
+        while let Some(p) = self.geom.element(cur).parent {
+            chain.push(p);
+            cur = p;
+        }
+        chain.reverse();
+        let mut out = Vec::new();
+        let mut stack = vec![(0u32, 0usize)];
+        while let Some((n, depth)) = stack.pop() {
+            let from = h.nodes[n as usize].from;
+            if from != chain[depth] {
+                continue;
+            }
+            if depth + 1 == chain.len() {
+                out.push(n);
+                continue;
+            }
+            match h.nodes[n as usize].split {
+                Split::To => {
+                    if let Some(c) = h.children(n) {
+                        stack.extend(c.iter().map(|&c| (c, depth)));
+                    }
+                }
+                Split::From | Split::None => {
+                    if let Some(c) = self.node_children(h, n, Split::From, lost) {
+                        stack.extend(c.iter().map(|&c| (c, depth + 1)));
+                    }
+                }
+            }
+        }
+        out
+    }
+}

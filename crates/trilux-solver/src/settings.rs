@@ -1,0 +1,144 @@
+//! Solver settings: the paper's error bounds (FFErr, FrErr, MinArea), the
+//! photometric threshold of §4.3, and when to stop (§6).
+
+use serde::{Deserialize, Serialize};
+
+/// How light leaving Lambertian surfaces is represented.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum Transport {
+    /// Lambertian parts keep one outgoing radiance per element (two-point,
+    /// like hierarchical radiosity); interactions are stored only for glossy
+    /// senders (design.md §2, notes §7). The default.
+    TwoPoint,
+    /// The paper's uniform treatment: every sender, Lambertian or not, keeps
+    /// per-receiver interactions. For ablation and cross-checking.
+    Uniform,
+}
+
+/// Quality presets for the command line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum Quality {
+    /// Fast previews: CR 0.95, coarse elements.
+    Draft,
+    /// CR 0.99.
+    Default,
+    /// CR 0.999, fine elements.
+    High,
+}
+
+impl std::str::FromStr for Quality {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "draft" => Ok(Quality::Draft),
+            "default" => Ok(Quality::Default),
+            "high" => Ok(Quality::High),
+            other => Err(format!(
+                "unknown quality '{other}' (expected draft, default or high)"
+            )),
+        }
+    }
+}
+
+/// Everything that steers a solve. Part of the solution's hash.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SolverSettings {
+    /// Stop when the convergence ratio CR = (IF − RF)/IF reaches this
+    /// (paper §6).
+    pub convergence: f64,
+    /// Stop after this many shots whatever the convergence ratio.
+    pub max_shots: u32,
+    /// Depth limit of element trees (the paper's tables imply 3 to 4).
+    pub max_depth: u32,
+    /// MinArea as a fraction of the scene's bounding-box diagonal squared:
+    /// elements smaller than this are never split.
+    pub min_area_fraction: f64,
+    /// FFErr: a pair link is accurate enough when the point form factor to
+    /// the sender varies by less than this over the receiver (so that the
+    /// gathered radiance can be pushed down unchanged); three-point links
+    /// compare the point-to-disc estimates of (j, k) against it (HSA91).
+    pub ff_eps: f64,
+    /// FrErr: bound on π F (fr_max − fr_min) over the three elements.
+    pub fr_eps: f64,
+    /// Photometric criterion (paper §4.3): a link carrying less than this
+    /// fraction of the total emitted flux is not refined further.
+    pub flux_eps: f64,
+    /// Shadow rays per element pair for the visibility fraction (a square
+    /// number gives a full stratification).
+    pub visibility_samples: u32,
+    /// Two-point for Lambertian parts, or the paper's uniform treatment.
+    pub transport: Transport,
+}
+
+impl SolverSettings {
+    /// The settings of a quality preset.
+    pub fn preset(quality: Quality) -> Self {
+        match quality {
+            Quality::Draft => SolverSettings {
+                convergence: 0.95,
+                max_shots: 20_000,
+                max_depth: 4,
+                min_area_fraction: 1e-5,
+                ff_eps: 0.02,
+                fr_eps: 0.5,
+                flux_eps: 1e-4,
+                visibility_samples: 9,
+                transport: Transport::TwoPoint,
+            },
+            Quality::Default => SolverSettings {
+                convergence: 0.99,
+                max_shots: 100_000,
+                max_depth: 5,
+                min_area_fraction: 1e-6,
+                ff_eps: 0.005,
+                fr_eps: 0.25,
+                flux_eps: 1e-5,
+                visibility_samples: 16,
+                transport: Transport::TwoPoint,
+            },
+            Quality::High => SolverSettings {
+                convergence: 0.999,
+                max_shots: 500_000,
+                max_depth: 6,
+                min_area_fraction: 1e-7,
+                ff_eps: 0.001,
+                fr_eps: 0.1,
+                flux_eps: 1e-6,
+                visibility_samples: 25,
+                transport: Transport::TwoPoint,
+            },
+        }
+    }
+
+    /// Checks that every value is usable; the message names the field.
+    pub fn validate(&self) -> Result<(), String> {
+        let unit = |name: &str, v: f64| {
+            if v.is_finite() && (0.0..=1.0).contains(&v) {
+                Ok(())
+            } else {
+                Err(format!("{name} must be in [0, 1], got {v}"))
+            }
+        };
+        unit("convergence", self.convergence)?;
+        unit("min_area_fraction", self.min_area_fraction)?;
+        unit("flux_eps", self.flux_eps)?;
+        for (name, v) in [("ff_eps", self.ff_eps), ("fr_eps", self.fr_eps)] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(format!("{name} must be positive, got {v}"));
+            }
+        }
+        if self.visibility_samples == 0 {
+            return Err("visibility_samples must be at least 1".into());
+        }
+        if self.max_depth > 12 {
+            return Err(format!("max_depth {} is above 12", self.max_depth));
+        }
+        Ok(())
+    }
+}
+
+impl Default for SolverSettings {
+    fn default() -> Self {
+        SolverSettings::preset(Quality::Default)
+    }
+}

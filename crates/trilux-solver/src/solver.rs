@@ -1,0 +1,607 @@
+//! The progressive shooting loop (paper §4, Fig. 7 and 9; notes §4).
+//!
+//! ```text
+//! until CR ≥ target or the shot budget is spent:
+//!     S ← the source with the greatest unshot flux δΦ
+//!     push-pull S (lazily, only now: §4.4)
+//!     refine and link S to every receiver (two stages, see refine.rs)
+//!     shoot: every link adds δL·R to its receiver's L^G
+//!     unlink (links live for one shot: memory O(n + k²), §4.2)
+//!     zero δL over S
+//! ```
+//!
+//! A source is either the two-point tree of a Lambertian side (emission
+//! enters here) or a stored interaction hierarchy of a glossy side.
+
+use std::collections::HashMap;
+use std::f64::consts::PI;
+use std::time::Instant;
+
+use rayon::prelude::*;
+use trilux_brdf::{Bsdf, BsdfParams};
+use trilux_color::{ColorParam, Spectrum};
+use trilux_geometry::{ElementId, FormFactorOptions, SceneGeometry, Shape, SurfaceId};
+
+use crate::error::SolverError;
+use crate::interaction::Hierarchy;
+use crate::ledger::Ledger;
+use crate::radiosity::ElementRadiance;
+use crate::refine::{NodeLink, PairLink, RefineContext, Sender};
+use crate::settings::{SolverSettings, Transport};
+use crate::sides::{SideId, TransportSide, build_sides, eligible_pairs};
+use crate::solution::Solution;
+use crate::stats::SolveStats;
+use crate::throughput::ThroughputCache;
+
+/// What the solver needs of a scene: per shape its geometry, its material
+/// and its area emitter's radiance. (The scene layer builds this; the solver
+/// never parses files.)
+#[derive(Clone, Debug)]
+pub struct SolverInput<'a> {
+    /// The shapes.
+    pub shapes: &'a [Shape],
+    /// One material per shape.
+    pub bsdfs: &'a [BsdfParams],
+    /// One optional area-emitter radiance per shape.
+    pub emission: &'a [Option<ColorParam>],
+}
+
+/// Progress after each shot, for progress bars (the solver never prints).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Progress {
+    /// Shots so far.
+    pub shots: u64,
+    /// Convergence ratio CR = (IF − RF)/IF.
+    pub convergence_ratio: f64,
+    /// The target CR.
+    pub target: f64,
+    /// Stored interaction nodes.
+    pub interactions: usize,
+    /// Links alive during the last shot.
+    pub live_links: usize,
+}
+
+/// A light source for shooting.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Source {
+    /// The two-point tree of a side.
+    Radiosity(SideId),
+    /// A stored interaction hierarchy.
+    Stored(u32),
+}
+
+/// A prepared solve: geometry, materials, sides, root interactions.
+pub struct Solver<const N: usize> {
+    pub(crate) geom: SceneGeometry,
+    pub(crate) settings: SolverSettings,
+    pub(crate) materials: Vec<Bsdf<N>>,
+    pub(crate) sides: Vec<TransportSide<N>>,
+    partners: Vec<Vec<SideId>>,
+    pub(crate) field: ElementRadiance<N>,
+    side_flux: Vec<Spectrum<N>>,
+    pub(crate) hierarchies: Vec<Hierarchy<N>>,
+    hierarchies_from: Vec<Vec<u32>>,
+    cache: ThroughputCache,
+    pub(crate) ledger: Ledger,
+    emitted: Spectrum<N>,
+    pub(crate) depth_of: Vec<u32>,
+    pub(crate) stats: SolveStats,
+    used: Vec<bool>,
+}
+
+/// Per-surface depth limits from the global limit and MinArea.
+fn depth_limits(geom: &SceneGeometry, settings: &SolverSettings) -> Vec<u32> {
+    let diag = geom.bounds().diagonal().length();
+    let min_area = settings.min_area_fraction * diag * diag;
+    geom.surfaces()
+        .iter()
+        .map(|s| {
+            let mut d = 0;
+            let mut a = s.area();
+            while d < settings.max_depth && a / 4.0 >= min_area {
+                a /= 4.0;
+                d += 1;
+            }
+            d
+        })
+        .collect()
+}
+
+/// Subdivides every surface's tree uniformly to its depth limit, so that the
+/// geometry is immutable (and shareable across threads) during the solve.
+/// These are the paper's "potential elements"; their count is O(n).
+pub(crate) fn presubdivide(geom: &mut SceneGeometry, depths: &[u32]) {
+    for (s, &depth) in depths.iter().enumerate() {
+        let mut level = vec![geom.surfaces()[s].root];
+        for _ in 0..depth {
+            let mut next = Vec::with_capacity(level.len() * 4);
+            for e in level {
+                next.extend(geom.subdivide(e));
+            }
+            level = next;
+        }
+    }
+}
+
+impl<const N: usize> Solver<N> {
+    /// Builds geometry, materials, sides and root interactions.
+    pub fn new(input: &SolverInput<'_>, settings: SolverSettings) -> Result<Self, SolverError> {
+        settings.validate().map_err(SolverError::Settings)?;
+        let mut geom = SceneGeometry::build(input.shapes)?;
+        let mut materials = Vec::with_capacity(input.shapes.len());
+        let mut emission = Vec::with_capacity(input.shapes.len());
+        for shape in 0..input.shapes.len() {
+            let params = input.bsdfs.get(shape).cloned().unwrap_or_default();
+            let bsdf = Bsdf::<N>::new(&params).map_err(|e| SolverError::Material {
+                shape,
+                message: e.to_string(),
+            })?;
+            materials.push(bsdf);
+            let le = match input.emission.get(shape).and_then(Option::as_ref) {
+                Some(c) => c.emission::<N>().map_err(|e| SolverError::Material {
+                    shape,
+                    message: e.to_string(),
+                })?,
+                None => Spectrum::zero(),
+            };
+            if !(le.is_finite() && le.is_non_negative()) {
+                return Err(SolverError::Material {
+                    shape,
+                    message: "emitted radiance must be finite and non-negative".into(),
+                });
+            }
+            emission.push(le);
+        }
+        let depth_of = depth_limits(&geom, &settings);
+        presubdivide(&mut geom, &depth_of);
+        let mut sides = build_sides(&geom, &materials, &emission, settings.transport, |s| {
+            depth_of[s.index()]
+        });
+        let mut warnings = Vec::new();
+        for side in &mut sides {
+            if side.rho_d.max_value() > 1.0 {
+                warnings.push(format!(
+                    "shape {}: Lambertian reflectance above 1 clamped to 1 (it would create energy)",
+                    side.shape
+                ));
+                side.rho_d = side.rho_d.min(Spectrum::splat(1.0));
+            }
+        }
+        for (index, s) in geom.surfaces().iter().enumerate() {
+            let reflects = |back: bool| !sides[2 * index + usize::from(back)].is_absorber();
+            if (s.can_see_itself() && reflects(false))
+                || (s.back_can_see_itself() && reflects(true))
+            {
+                warnings.push(format!(
+                    "shape {}: a curved surface that sees itself; its self-exchange (paper §5 secondary interactions) is left out",
+                    s.shape
+                ));
+            }
+        }
+        warnings.dedup();
+        let partners = eligible_pairs(&geom, &sides);
+        let cache = ThroughputCache::new(1 << 22);
+        let ff_options = FormFactorOptions::default();
+
+        // Root interactions: every eligible pair whose sender needs stored
+        // interactions (a glossy part, or anything in uniform mode, where
+        // emitters store their emission too) and whose receiver reflects.
+        let uniform = settings.transport == Transport::Uniform;
+        let mut roots = Vec::new();
+        for (a, list) in partners.iter().enumerate() {
+            let sa = &sides[a];
+            if !(sa.stored || (uniform && !sa.emission.is_black())) {
+                continue;
+            }
+            for &b in list {
+                if !sides[b as usize].is_absorber() {
+                    roots.push((a as SideId, b));
+                }
+            }
+        }
+        let root_elem = |s: SideId| geom.surfaces()[sides[s as usize].surface.index()].root;
+        let th: Vec<_> = roots
+            .par_iter()
+            .map(|&(a, b)| {
+                let (ea, eb) = (root_elem(a), root_elem(b));
+                let sa = crate::throughput::SidedElement {
+                    element: ea,
+                    back: sides[a as usize].back,
+                };
+                let sb = crate::throughput::SidedElement {
+                    element: eb,
+                    back: sides[b as usize].back,
+                };
+                crate::throughput::compute_throughput(
+                    &geom,
+                    sb,
+                    sa,
+                    settings.visibility_samples,
+                    &ff_options,
+                )
+            })
+            .collect();
+        let mut hierarchies = Vec::with_capacity(roots.len());
+        let mut hierarchies_from = vec![Vec::new(); sides.len()];
+        for (&(a, b), t) in roots.iter().zip(th) {
+            hierarchies_from[a as usize].push(hierarchies.len() as u32);
+            hierarchies.push(Hierarchy::new(a, b, root_elem(a), root_elem(b), t));
+        }
+
+        // Emission: IF = π A Le per emitting side (paper §6).
+        let mut field = ElementRadiance::new(geom.element_count());
+        let mut side_flux = vec![Spectrum::zero(); sides.len()];
+        let mut emitted = Spectrum::zero();
+        let mut escaped_at_start = Spectrum::<N>::zero();
+        for (s, side) in sides.iter().enumerate() {
+            if side.emission.is_black() {
+                continue;
+            }
+            let surface = &geom.surfaces()[side.surface.index()];
+            let flux = side.emission * (PI * surface.area());
+            emitted += flux;
+            if uniform {
+                // The emission is stored per receiver; what no receiver
+                // takes leaves the scene at once.
+                let t_sum: f64 = hierarchies_from[s]
+                    .iter()
+                    .map(|&h| hierarchies[h as usize].nodes[0].t)
+                    .sum();
+                // Sampled root throughputs may over-count slightly: never
+                // store more than was emitted.
+                let scale = if PI * t_sum > PI * surface.area() {
+                    surface.area() / t_sum
+                } else {
+                    1.0
+                };
+                let mut taken = Spectrum::zero();
+                for &h in &hierarchies_from[s] {
+                    let hier = &mut hierarchies[h as usize];
+                    let t = hier.nodes[0].t;
+                    hier.nodes[0].unshot = side.emission * scale;
+                    hier.unshot_flux = side.emission * (PI * t * scale);
+                    taken += hier.unshot_flux;
+                }
+                escaped_at_start += (flux - taken).max(Spectrum::zero());
+            } else {
+                let mut stack = vec![surface.root];
+                while let Some(e) = stack.pop() {
+                    field.unshot[usize::from(side.back)][e.index()] = side.emission;
+                    if let Some(c) = geom.element(e).children() {
+                        stack.extend(c);
+                    }
+                }
+                side_flux[s] = flux;
+            }
+        }
+        let mut ledger = Ledger::new(emitted.to_array().to_vec());
+        for b in 0..N {
+            ledger.escaped[b] += escaped_at_start[b];
+        }
+        let potential: u64 = depth_of.iter().map(|&d| 4u64.pow(d)).sum();
+        let stats = SolveStats {
+            input_surfaces: geom.surfaces().len(),
+            potential_elements: potential,
+            potential_interactions: potential.saturating_mul(potential),
+            root_interactions: hierarchies.len(),
+            bands: N,
+            wavelengths_nm: (N != 3).then(trilux_color::Bands::<N>::edges),
+            warnings,
+            ..SolveStats::default()
+        };
+        let used = vec![false; geom.element_count()];
+        Ok(Solver {
+            geom,
+            settings,
+            materials,
+            sides,
+            partners,
+            field,
+            side_flux,
+            hierarchies,
+            hierarchies_from,
+            cache,
+            ledger,
+            emitted,
+            depth_of,
+            stats,
+            used,
+        })
+    }
+
+    /// Total unshot (residual) flux per band.
+    pub fn residual(&self) -> Spectrum<N> {
+        let mut r: Spectrum<N> = self.side_flux.iter().copied().sum();
+        r += self
+            .hierarchies
+            .iter()
+            .map(|h| h.unshot_flux)
+            .sum::<Spectrum<N>>();
+        r
+    }
+
+    /// CR = (IF − RF)/IF (paper §6); 1 for a scene that emits nothing.
+    pub fn convergence_ratio(&self) -> f64 {
+        let emitted = self.emitted.sum();
+        if emitted <= 0.0 {
+            return 1.0;
+        }
+        ((emitted - self.residual().sum()) / emitted).clamp(0.0, 1.0)
+    }
+
+    fn next_source(&self) -> Option<(Source, f64)> {
+        let mut best: Option<(Source, f64)> = None;
+        let mut consider = |s: Source, flux: f64| {
+            if flux > 0.0 && best.is_none_or(|(_, f)| flux > f) {
+                best = Some((s, flux));
+            }
+        };
+        for (s, f) in self.side_flux.iter().enumerate() {
+            consider(Source::Radiosity(s as SideId), f.sum());
+        }
+        for (h, hier) in self.hierarchies.iter().enumerate() {
+            consider(Source::Stored(h as u32), hier.unshot_flux.sum());
+        }
+        best
+    }
+
+    /// Runs shots until the target convergence ratio or the shot budget,
+    /// calling `progress` after each shot, then makes every hierarchy
+    /// consistent and returns the solution.
+    pub fn solve(mut self, mut progress: impl FnMut(&Progress)) -> Solution<N> {
+        let start = Instant::now();
+        while self.convergence_ratio() < self.settings.convergence
+            && self.stats.shots < u64::from(self.settings.max_shots)
+        {
+            let Some((source, _)) = self.next_source() else {
+                break;
+            };
+            let live = self.shoot(source);
+            self.stats.shots += 1;
+            progress(&Progress {
+                shots: self.stats.shots,
+                convergence_ratio: self.convergence_ratio(),
+                target: self.settings.convergence,
+                interactions: self.hierarchies.iter().map(|h| h.nodes.len()).sum(),
+                live_links: live,
+            });
+        }
+        self.finish(start.elapsed().as_secs_f64())
+    }
+
+    /// One shot from `source`; returns the number of links it made.
+    fn shoot(&mut self, source: Source) -> usize {
+        let geom = &self.geom;
+        // δΦ_S leaves the residual now.
+        let phi = match source {
+            Source::Radiosity(s) => std::mem::take(&mut self.side_flux[s as usize]),
+            Source::Stored(h) => std::mem::take(&mut self.hierarchies[h as usize].unshot_flux),
+        };
+        // Lazy push-pull (paper §4.4), and the sender.
+        let (send_side, src_hierarchy) = match source {
+            Source::Radiosity(s) => {
+                let side = &self.sides[s as usize];
+                let root = geom.surfaces()[side.surface.index()].root;
+                self.field.push_pull(geom, root, side.back);
+                (s, None)
+            }
+            Source::Stored(h) => {
+                let mut hier = std::mem::replace(
+                    &mut self.hierarchies[h as usize],
+                    Hierarchy::new(0, 0, ElementId(0), ElementId(0), Default::default()),
+                );
+                hier.push_pull();
+                (hier.from, Some((h, hier)))
+            }
+        };
+        let emitted_sum = self.emitted.sum();
+        let ctx = RefineContext {
+            geom,
+            settings: &self.settings,
+            sides: &self.sides,
+            materials: &self.materials,
+            cache: &self.cache,
+            ff_options: FormFactorOptions::default(),
+            flux_threshold: self.settings.flux_eps * emitted_sum,
+        };
+        let sender = match &src_hierarchy {
+            None => Sender::Radiosity {
+                field: &self.field,
+                back: self.sides[send_side as usize].back,
+            },
+            Some((_, hier)) => Sender::Stored(hier),
+        };
+        let root_of = |s: SideId| geom.surfaces()[self.sides[s as usize].surface.index()].root;
+
+        // Stage 1: pair links to every receiving side, in parallel.
+        let pairs: Vec<(ElementId, SideId, ElementId)> = match &src_hierarchy {
+            None => self.partners[send_side as usize]
+                .iter()
+                .map(|&r| (root_of(send_side), r, root_of(r)))
+                .collect(),
+            Some((_, hier)) => vec![(hier.nodes[0].from, hier.to, hier.nodes[0].to)],
+        };
+        let pair_links: Vec<PairLink<N>> = pairs
+            .par_iter()
+            .flat_map_iter(|&(i, r, j)| {
+                let mut out = Vec::new();
+                ctx.refine_pair(&sender, send_side, r, i, j, &mut out);
+                out
+            })
+            .collect();
+
+        // Shot-level renormalisation: the links may not carry more flux than
+        // the source had (form-factor error could otherwise create energy).
+        let mut arrived = Spectrum::<N>::zero();
+        for l in &pair_links {
+            arrived += l.unshot * (PI * l.t);
+        }
+        let shot_scale = Spectrum::<N>::new(std::array::from_fn(|b| {
+            if arrived[b] > phi[b] && arrived[b] > 0.0 {
+                phi[b] / arrived[b]
+            } else {
+                1.0
+            }
+        }));
+
+        // Stage 2: three-point links into the stored hierarchies of every
+        // glossy receiving side, in parallel over those hierarchies.
+        let mut groups_of_side: HashMap<SideId, Vec<u32>> = HashMap::new();
+        for (g, l) in pair_links.iter().enumerate() {
+            if self.sides[l.side as usize].stored {
+                groups_of_side.entry(l.side).or_default().push(g as u32);
+            }
+        }
+        let busy = src_hierarchy.as_ref().map(|(h, _)| *h);
+        let results: Vec<(Vec<NodeLink<N>>, u32, Spectrum<N>)> = self
+            .hierarchies
+            .par_iter_mut()
+            .enumerate()
+            .filter(|(h, hier)| Some(*h as u32) != busy && groups_of_side.contains_key(&hier.from))
+            .map(|(h, hier)| {
+                let mut out = Vec::new();
+                let mut lost = Spectrum::zero();
+                for &g in &groups_of_side[&hier.from] {
+                    let l = &pair_links[g as usize];
+                    for n in ctx.nodes_for(hier, l.j, &mut lost) {
+                        ctx.refine_triple(
+                            &sender, send_side, hier, h as u32, l.i, l.j, n, g, &mut lost, &mut out,
+                        );
+                    }
+                }
+                (out, h as u32, lost)
+            })
+            .collect();
+        let mut node_links = Vec::new();
+        for (links, h, lost) in results {
+            // Flux that a split could not keep leaves the residual.
+            let hier = &mut self.hierarchies[h as usize];
+            hier.unshot_flux = (hier.unshot_flux - lost).max(Spectrum::zero());
+            for b in 0..N {
+                self.ledger.escaped[b] += lost[b];
+            }
+            node_links.extend(links);
+        }
+
+        // Per-group renormalisation: what a receiving element reflects may
+        // not exceed what arrived there (notes §7).
+        let mut glossy_flux = vec![Spectrum::<N>::zero(); pair_links.len()];
+        for nl in &node_links {
+            let t = self.hierarchies[nl.hierarchy as usize].nodes[nl.node as usize].t;
+            glossy_flux[nl.group as usize] += nl.gathered * shot_scale * (PI * t);
+        }
+        let mut group_scale = vec![Spectrum::<N>::splat(1.0); pair_links.len()];
+        let mut total_arrived = Spectrum::<N>::zero();
+        let mut absorbed = Spectrum::<N>::zero();
+        for (g, l) in pair_links.iter().enumerate() {
+            let side = &self.sides[l.side as usize];
+            let arrived_g = l.unshot * shot_scale * (PI * l.t);
+            let diffuse_g = arrived_g * side.rho_d;
+            let room = (arrived_g - diffuse_g).max(Spectrum::zero());
+            let glossy_g = glossy_flux[g];
+            let scale = Spectrum::<N>::new(std::array::from_fn(|b| {
+                if glossy_g[b] > room[b] && glossy_g[b] > 0.0 {
+                    room[b] / glossy_g[b]
+                } else {
+                    1.0
+                }
+            }));
+            group_scale[g] = scale;
+            let absorbed_g = arrived_g - diffuse_g - glossy_g * scale;
+            self.ledger.min_element_absorbed = self
+                .ledger
+                .min_element_absorbed
+                .min(absorbed_g.min_value() / arrived_g.max_value().max(1e-300));
+            total_arrived += arrived_g;
+            absorbed += absorbed_g;
+            // The Lambertian share: straight into j's radiance (two-point).
+            if !side.rho_d.is_black() {
+                let aj = geom.element(l.j).area;
+                let dl = l.unshot * shot_scale * side.rho_d * (l.t / aj);
+                self.field.gathered[usize::from(side.back)][l.j.index()] += dl;
+                self.side_flux[l.side as usize] += dl * (PI * aj);
+            }
+            self.used[l.i.index()] = true;
+            self.used[l.j.index()] = true;
+        }
+        for nl in &node_links {
+            let hier = &mut self.hierarchies[nl.hierarchy as usize];
+            let node = &mut hier.nodes[nl.node as usize];
+            let dl = nl.gathered * shot_scale * group_scale[nl.group as usize];
+            node.gathered += dl;
+            let t = node.t;
+            hier.unshot_flux += dl * (PI * t);
+        }
+        let escaped = phi - total_arrived;
+        for b in 0..N {
+            self.ledger.escaped[b] += escaped[b];
+            self.ledger.absorbed[b] += absorbed[b];
+        }
+        let rel = escaped.min_value() / phi.max_value().max(1e-300);
+        self.ledger.min_shot_escaped = self.ledger.min_shot_escaped.min(rel);
+
+        // Unlink and zero δL over the source.
+        let live = pair_links.len() + node_links.len();
+        self.stats.links_peak = self.stats.links_peak.max(live);
+        self.stats.links_total += live as u64;
+        match (source, src_hierarchy) {
+            (Source::Radiosity(s), _) => {
+                let side = &self.sides[s as usize];
+                let root = self.geom.surfaces()[side.surface.index()].root;
+                self.field.clear_unshot(&self.geom, root, side.back);
+            }
+            (Source::Stored(h), Some((_, mut hier))) => {
+                hier.clear_unshot();
+                self.hierarchies[h as usize] = hier;
+            }
+            (Source::Stored(_), None) => {}
+        }
+        live
+    }
+
+    /// Final push-pull of everything, statistics, and the solution.
+    fn finish(mut self, seconds: f64) -> Solution<N> {
+        for side in &self.sides {
+            let root = self.geom.surfaces()[side.surface.index()].root;
+            self.field.push_pull(&self.geom, root, side.back);
+        }
+        // Pushing makes pending energy part of δL again; the residual keys
+        // already count it.
+        for h in &mut self.hierarchies {
+            h.push_pull();
+            for n in &h.nodes {
+                self.used[n.from.index()] = true;
+                self.used[n.to.index()] = true;
+            }
+        }
+        let residual = self.residual();
+        let stats = &mut self.stats;
+        stats.elements = self.used.iter().filter(|&&u| u).count();
+        stats.interactions = self.hierarchies.iter().map(|h| h.nodes.len()).sum();
+        let emitted_sum = self.emitted.sum();
+        stats.convergence_ratio = if emitted_sum > 0.0 {
+            ((emitted_sum - residual.sum()) / emitted_sum).clamp(0.0, 1.0)
+        } else {
+            1.0
+        };
+        stats.emitted_flux = self.ledger.emitted.clone();
+        stats.absorbed_flux = self.ledger.absorbed.clone();
+        stats.escaped_flux = self.ledger.escaped.clone();
+        stats.residual_flux = residual.to_array().to_vec();
+        stats.solve_seconds = seconds;
+        stats.min_shot_escaped = self.ledger.min_shot_escaped;
+        stats.min_element_absorbed = self.ledger.min_element_absorbed;
+        Solution::from_solver(self)
+    }
+
+    /// The geometry (with its pre-subdivided element trees).
+    pub fn geometry(&self) -> &SceneGeometry {
+        &self.geom
+    }
+
+    /// The input surface ids of a side table entry (front, back).
+    pub fn surface_sides(&self, surface: SurfaceId) -> [SideId; 2] {
+        let s = surface.0 * 2;
+        [s, s + 1]
+    }
+}

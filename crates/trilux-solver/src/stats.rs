@@ -1,0 +1,53 @@
+//! Statistics of a solve, as `--stats` writes them (design.md §3).
+
+use serde::{Deserialize, Serialize};
+
+/// What a solve did and where the energy went.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct SolveStats {
+    /// Input surfaces of the scene.
+    pub input_surfaces: usize,
+    /// Elements that took part in the solution (appear in a link or a stored
+    /// interaction).
+    pub elements: usize,
+    /// Elements of the uniform subdivision at the finest allowed level (the
+    /// paper's "potential elements").
+    pub potential_elements: u64,
+    /// Stored interaction nodes after the solve.
+    pub interactions: usize,
+    /// Interactions between potential elements (potential_elements²).
+    pub potential_interactions: u64,
+    /// Root interactions (pairs of input-surface sides that exchange light).
+    pub root_interactions: usize,
+    /// Most links alive at once (links live for one shot, paper §4.2).
+    pub links_peak: usize,
+    /// Links created over the whole solve.
+    pub links_total: u64,
+    /// Shooting iterations.
+    pub shots: u64,
+    /// CR = (IF − RF)/IF (paper §6).
+    pub convergence_ratio: f64,
+    /// Emitted flux per band (W).
+    pub emitted_flux: Vec<f64>,
+    /// Absorbed flux per band (W).
+    pub absorbed_flux: Vec<f64>,
+    /// Escaped flux per band (W).
+    pub escaped_flux: Vec<f64>,
+    /// Residual (unshot) flux per band (W).
+    pub residual_flux: Vec<f64>,
+    /// Wall-clock seconds of the solve.
+    pub solve_seconds: f64,
+    /// Spectral bands.
+    pub bands: usize,
+    /// Band edges in nm (`None` in RGB mode).
+    pub wavelengths_nm: Option<Vec<f64>>,
+    /// The smallest escaped flux of any shot, as a fraction of that shot's
+    /// flux (band minimum). Negative would mean a shot created energy.
+    pub min_shot_escaped: f64,
+    /// The smallest absorbed flux of any receiving element in any shot, as
+    /// a fraction of what arrived there (band minimum). Negative would mean
+    /// an element reflected more than it received.
+    pub min_element_absorbed: f64,
+    /// Warnings (e.g. self-exchange of concave surfaces left out).
+    pub warnings: Vec<String>,
+}

@@ -1,0 +1,147 @@
+//! The energy ledger on random scenes (notes §7): emitted = absorbed +
+//! escaped + residual, no shot and no receiving element creates energy, the
+//! residual never grows from one shot to the next, and no radiance is
+//! negative or not finite.
+
+use std::f64::consts::PI;
+
+use glam::{DMat4, DVec3};
+use proptest::prelude::*;
+use trilux_brdf::{BsdfParams, Distribution, RoughConductorParams};
+use trilux_color::ColorParam;
+use trilux_geometry::{Shape, ShapeKind};
+use trilux_solver::{Quality, Solver, SolverInput, SolverSettings, Transport};
+
+fn material() -> impl Strategy<Value = BsdfParams> {
+    let diffuse = (0.0..0.95f64).prop_map(|r| BsdfParams::Diffuse {
+        reflectance: ColorParam::Float(r),
+    });
+    let conductor = (0.01..1.0f64, any::<bool>(), 0.3..1.0f64).prop_map(|(alpha, ggx, spec)| {
+        BsdfParams::RoughConductor(RoughConductorParams {
+            distribution: if ggx {
+                Distribution::Ggx
+            } else {
+                Distribution::Beckmann
+            },
+            alpha,
+            eta_k: None,
+            specular_reflectance: ColorParam::Float(spec),
+        })
+    });
+    prop_oneof![
+        diffuse.clone(),
+        conductor.clone(),
+        (0.0..1.0f64, diffuse, conductor).prop_map(|(w, a, b)| BsdfParams::Blend {
+            weight: w,
+            first: Box::new(a),
+            second: Box::new(b),
+        }),
+    ]
+}
+
+#[derive(Clone, Debug)]
+struct Plate {
+    centre: DVec3,
+    angles: (f64, f64),
+    size: f64,
+    material: BsdfParams,
+}
+
+fn plate() -> impl Strategy<Value = Plate> {
+    (
+        (-0.6..0.6f64, -0.6..0.6f64, -0.6..0.4f64),
+        (0.0..PI, 0.0..2.0 * PI),
+        0.15..0.5f64,
+        material(),
+    )
+        .prop_map(|((x, y, z), angles, size, material)| Plate {
+            centre: DVec3::new(x, y, z),
+            angles,
+            size,
+            material,
+        })
+}
+
+fn scene(
+    closed: bool,
+    box_material: BsdfParams,
+    plates: &[Plate],
+    le: f64,
+) -> (Vec<Shape>, Vec<BsdfParams>, Vec<Option<ColorParam>>) {
+    let mut shapes = Vec::new();
+    let mut bsdfs = Vec::new();
+    let mut emission = Vec::new();
+    // The light: a small square under the ceiling, facing down.
+    shapes.push(Shape {
+        kind: ShapeKind::Rectangle,
+        world_from_object: DMat4::from_translation(DVec3::new(0.0, 0.0, 0.95))
+            * DMat4::from_rotation_x(PI)
+            * DMat4::from_scale(DVec3::splat(0.25)),
+        flip_normals: false,
+    });
+    bsdfs.push(BsdfParams::Diffuse {
+        reflectance: ColorParam::Float(0.3),
+    });
+    emission.push(Some(ColorParam::Float(le)));
+    if closed {
+        shapes.push(Shape {
+            kind: ShapeKind::Cube,
+            world_from_object: DMat4::IDENTITY,
+            flip_normals: true,
+        });
+        bsdfs.push(box_material);
+        emission.push(None);
+    }
+    for p in plates {
+        shapes.push(Shape {
+            kind: ShapeKind::Rectangle,
+            world_from_object: DMat4::from_translation(p.centre)
+                * DMat4::from_rotation_z(p.angles.1)
+                * DMat4::from_rotation_x(p.angles.0)
+                * DMat4::from_scale(DVec3::splat(p.size)),
+            flip_normals: false,
+        });
+        bsdfs.push(p.material.clone());
+        emission.push(None);
+    }
+    (shapes, bsdfs, emission)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
+    #[test]
+    fn ledger_balances_on_random_scenes(
+        closed in any::<bool>(),
+        box_material in material(),
+        plates in proptest::collection::vec(plate(), 0..3),
+        le in 0.5..20.0f64,
+        uniform in any::<bool>(),
+    ) {
+        let (shapes, bsdfs, emission) = scene(closed, box_material, &plates, le);
+        let input = SolverInput { shapes: &shapes, bsdfs: &bsdfs, emission: &emission };
+        let mut settings = SolverSettings::preset(Quality::Draft);
+        settings.max_depth = 3;
+        settings.max_shots = 25;
+        settings.visibility_samples = 4;
+        settings.transport = if uniform { Transport::Uniform } else { Transport::TwoPoint };
+        let mut last_cr = 0.0f64;
+        let mut monotone = true;
+        let solution = Solver::<3>::new(&input, settings).expect("builds").solve(|p| {
+            monotone &= p.convergence_ratio >= last_cr - 1e-12;
+            last_cr = p.convergence_ratio;
+        });
+        prop_assert!(monotone, "the residual grew between shots");
+        let stats = solution.stats();
+        for b in 0..3 {
+            let e = stats.emitted_flux[b];
+            let sum = stats.absorbed_flux[b] + stats.escaped_flux[b] + stats.residual_flux[b];
+            prop_assert!((e - sum).abs() <= 1e-6 * e, "band {}: emitted {} vs {}", b, e, sum);
+            prop_assert!(stats.escaped_flux[b] >= -1e-9 * e);
+            prop_assert!(stats.absorbed_flux[b] >= -1e-9 * e);
+        }
+        prop_assert!(stats.min_shot_escaped >= -1e-9, "a shot created energy: {}", stats.min_shot_escaped);
+        prop_assert!(stats.min_element_absorbed >= -1e-9, "an element created energy: {}", stats.min_element_absorbed);
+        let min = solution.min_radiance();
+        prop_assert!(min.is_finite() && min >= 0.0, "radiance minimum {}", min);
+    }
+}
