@@ -12,16 +12,18 @@
 //! Commands:
 //! - `cargo xtask golden compare IMAGE.exr REFERENCE.exr [--mask MASK.exr]`
 //!   prints the metrics of any two EXRs of the same size;
-//! - `cargo xtask golden [--spp N] [--only NAME]...` renders every scene that
-//!   has a reference with `target/release/trilux render` at the reference's
-//!   size and compares, failing above [`MAX_REL_RMSE`] or outside
-//!   [`MAX_MEAN_BIAS`].
+//! - `cargo xtask golden [--spp N] [--quality Q] [--only NAME]...` solves and
+//!   renders every scene that has a reference, at the reference's size
+//!   (in-process, with the library the `trilux` command uses), and compares,
+//!   failing above [`MAX_REL_RMSE`] or outside [`MAX_MEAN_BIAS`].
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 use anyhow::{Context, Result, bail};
-use trilux_render::{Comparison, Image, compare};
+use trilux_render::{
+    Comparison, ExtraBounce, Image, RenderSettings, ViewOverrides, compare, solve_and_render,
+};
+use trilux_solver::{Quality, SolverSettings};
 
 /// Largest accepted relative RMSE (unmasked) of a trilux render at the
 /// golden sample count against its reference. Provisional until the solver
@@ -87,43 +89,57 @@ pub fn references(only: &[String]) -> Result<Vec<Reference>> {
     Ok(out)
 }
 
-/// Renders `scenes/NAME.xml` with the trilux binary into `out`; returns the
-/// wall-clock seconds.
+/// One trilux run: solve plus render of `scenes/NAME.xml` at the given
+/// size, quality preset and samples per pixel, in-process through
+/// `trilux_render::solve_and_render` (the same code the command runs).
+pub struct TriluxRun {
+    /// The rendered image.
+    pub image: Image,
+    /// Seconds of the solve.
+    pub solve_seconds: f64,
+    /// Seconds of the render.
+    pub render_seconds: f64,
+    /// Convergence ratio reached.
+    pub convergence_ratio: f64,
+}
+
+/// Solves and renders `scenes/NAME.xml` (see [`TriluxRun`]).
 pub fn render_trilux(
     name: &str,
     width: u32,
     height: u32,
-    extra: &[String],
-    out: &Path,
-) -> Result<f64> {
-    let root = root();
-    let bin = root.join("target/release/trilux");
-    if !bin.exists() {
-        bail!(
-            "{} is missing: run `cargo build --release -p trilux` first",
-            bin.display()
-        );
-    }
-    let scene = root.join(format!("scenes/{name}.xml"));
-    let start = std::time::Instant::now();
-    let status = Command::new(&bin)
-        .arg("render")
-        .arg(&scene)
-        .args([
-            "--width",
-            &width.to_string(),
-            "--height",
-            &height.to_string(),
-        ])
-        .args(extra)
-        .arg("-o")
-        .arg(out)
-        .status()
-        .with_context(|| format!("starting {}", bin.display()))?;
-    if !status.success() {
-        bail!("trilux render {} failed ({status})", scene.display());
-    }
-    Ok(start.elapsed().as_secs_f64())
+    quality: &str,
+    spp: u32,
+    extra: ExtraBounce,
+) -> Result<TriluxRun> {
+    let path = root().join(format!("scenes/{name}.xml"));
+    let scene = trilux_scene::load(&path).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let quality = match quality {
+        "draft" => Quality::Draft,
+        "default" => Quality::Default,
+        "high" => Quality::High,
+        other => bail!("unknown quality {other}"),
+    };
+    let camera = scene.camera.as_ref().context("the scene has no camera")?;
+    let settings = RenderSettings {
+        spp,
+        seed: 0,
+        extra_bounce: extra,
+        ..RenderSettings::for_scene(camera)
+    };
+    let view = ViewOverrides {
+        width: Some(width),
+        height: Some(height),
+        ..Default::default()
+    };
+    let (image, stats) =
+        solve_and_render(&scene, SolverSettings::preset(quality), &view, &settings)?;
+    Ok(TriluxRun {
+        image,
+        solve_seconds: stats.solve_seconds,
+        render_seconds: stats.render.seconds,
+        convergence_ratio: stats.solve.convergence_ratio,
+    })
 }
 
 fn print(name: &str, c: &Comparison) {
@@ -154,36 +170,38 @@ pub fn main(args: &[String]) -> Result<()> {
         print(image, &c);
         return Ok(());
     }
-    let mut spp = 256u32;
+    let mut spp = 64u32;
+    let mut quality = "default".to_string();
     let mut only = Vec::new();
     let mut it = args.iter();
     while let Some(a) = it.next() {
         match a.as_str() {
             "--spp" => spp = it.next().context("--spp needs a value")?.parse()?,
+            "--quality" => quality = it.next().context("--quality needs a value")?.clone(),
             "--only" => only.push(it.next().context("--only needs a scene name")?.clone()),
             other => bail!("unknown argument {other}"),
         }
     }
-    let tmp = std::env::temp_dir().join(format!("trilux-golden-{}", std::process::id()));
-    std::fs::create_dir_all(&tmp)?;
     let mut failed = Vec::new();
     for r in references(&only)? {
-        let out = tmp.join(format!("{}.exr", r.name));
-        let seconds = render_trilux(
+        let run = render_trilux(
             &r.name,
             r.image.width(),
             r.image.height(),
-            &["--spp".into(), spp.to_string(), "--seed".into(), "0".into()],
-            &out,
+            &quality,
+            spp,
+            ExtraBounce::default(),
         )?;
-        let c = compare(&Image::read_exr(&out)?, &r.image, r.mask.as_ref())?;
+        let c = compare(&run.image, &r.image, r.mask.as_ref())?;
         print(&r.name, &c);
-        println!("{:<20} {seconds:.2} s, reference noise {:?}", "", r.noise);
+        println!(
+            "{:<20} solve {:.2} s (CR {:.4}), render {:.2} s, reference noise {:?}",
+            "", run.solve_seconds, run.convergence_ratio, run.render_seconds, r.noise
+        );
         if c.rel_rmse > MAX_REL_RMSE || (c.mean_ratio - 1.0).abs() > MAX_MEAN_BIAS {
             failed.push(r.name.clone());
         }
     }
-    let _ = std::fs::remove_dir_all(&tmp);
     if !failed.is_empty() {
         bail!(
             "golden images differ beyond relRMSE {MAX_REL_RMSE} or mean bias {MAX_MEAN_BIAS}: {}",

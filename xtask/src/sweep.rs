@@ -2,7 +2,8 @@
 //!
 //! For every scene with a reference in tests/golden/ (or those given with
 //! `--only`), trilux renders at each quality preset and sample count of the
-//! grid, timed as solve plus render (the wall time of `trilux render`), and
+//! grid, timed as solve plus render (in-process, the library the `trilux`
+//! command runs), and
 //! Mitsuba 3's path tracer renders at a range of sample counts (timed by
 //! `tests/golden/mitsuba_time.py`, kernel compilation excluded) when
 //! `python3 -c "import mitsuba"` works. Each image is compared with the
@@ -10,8 +11,8 @@
 //! pixels).
 //!
 //! Output in `target/sweep/` (or `--out DIR`):
-//! - `sweep.csv`: scene, renderer, quality, spp, seconds, rel_rmse,
-//!   mean_ratio;
+//! - `sweep.csv`: scene, renderer, quality, spp, seconds, solve_seconds,
+//!   rel_rmse, mean_ratio;
 //! - `sweep.png`: relative RMSE against seconds, both on log scales (one
 //!   decade per grid line), one panel row per scene; trilux series in warm
 //!   colours (draft orange, default red, high dark red), Mitsuba in blue;
@@ -25,7 +26,7 @@ use std::path::PathBuf;
 use std::process::Command;
 
 use anyhow::{Context, Result, bail};
-use trilux_render::{Image, compare};
+use trilux_render::{ExtraBounce, Image, compare};
 
 use crate::golden::{references, render_trilux, root};
 
@@ -42,6 +43,8 @@ pub struct Point {
     pub spp: u32,
     /// Seconds (trilux: solve + render wall time).
     pub seconds: f64,
+    /// Seconds of the solve alone (trilux; 0 for Mitsuba).
+    pub solve_seconds: f64,
     /// Relative RMSE against the reference (unmasked).
     pub rel_rmse: f64,
     /// Mean ratio against the reference (unmasked).
@@ -96,21 +99,18 @@ pub fn main(args: &[String]) -> Result<()> {
         let (w, h) = (r.image.width(), r.image.height());
         for q in &qualities {
             for &spp in &spps {
-                let exr = out.join(format!("{}-{q}-{spp}.exr", r.name));
-                let extra = [
-                    "--quality".into(),
-                    q.clone(),
-                    "--spp".into(),
-                    spp.to_string(),
-                ];
-                let seconds = render_trilux(&r.name, w, h, &extra, &exr)?;
-                let c = compare(&Image::read_exr(&exr)?, &r.image, r.mask.as_ref())?;
+                let run = render_trilux(&r.name, w, h, q, spp, ExtraBounce::default())?;
+                run.image
+                    .write_exr(&out.join(format!("{}-{q}-{spp}.exr", r.name)))?;
+                let seconds = run.solve_seconds + run.render_seconds;
+                let c = compare(&run.image, &r.image, r.mask.as_ref())?;
                 points.push(Point {
                     scene: r.name.clone(),
                     renderer: "trilux",
                     quality: q.clone(),
                     spp,
                     seconds,
+                    solve_seconds: run.solve_seconds,
                     rel_rmse: c.rel_rmse,
                     mean_ratio: c.mean_ratio,
                 });
@@ -151,6 +151,7 @@ pub fn main(args: &[String]) -> Result<()> {
                     quality: "path".into(),
                     spp,
                     seconds,
+                    solve_seconds: 0.0,
                     rel_rmse: c.rel_rmse,
                     mean_ratio: c.mean_ratio,
                 });
@@ -169,11 +170,19 @@ pub fn main(args: &[String]) -> Result<()> {
 }
 
 fn write_csv(path: &std::path::Path, points: &[Point]) -> Result<()> {
-    let mut s = String::from("scene,renderer,quality,spp,seconds,rel_rmse,mean_ratio\n");
+    let mut s =
+        String::from("scene,renderer,quality,spp,seconds,solve_seconds,rel_rmse,mean_ratio\n");
     for p in points {
         s += &format!(
-            "{},{},{},{},{:.4},{:.6},{:.6}\n",
-            p.scene, p.renderer, p.quality, p.spp, p.seconds, p.rel_rmse, p.mean_ratio
+            "{},{},{},{},{:.4},{:.4},{:.6},{:.6}\n",
+            p.scene,
+            p.renderer,
+            p.quality,
+            p.spp,
+            p.seconds,
+            p.solve_seconds,
+            p.rel_rmse,
+            p.mean_ratio
         );
     }
     std::fs::write(path, s).with_context(|| format!("writing {}", path.display()))

@@ -23,6 +23,7 @@
 //!   ([`GatherScene`]) and the final-gather estimator itself.
 //! - [`solved`]: [`GatherScene`] for trilux's geometry, BRDFs and a
 //!   solution ([`RadianceSolution`]).
+//! - [`pipeline`]: solve and render in the scene's mode, in one call.
 //! - [`filter`]: reconstruction filters (Mitsuba's Gaussian, box).
 //! - [`film`]: splatting samples through the filter, per-pixel normalisation.
 //! - [`driver`]: tiles rendered in parallel (rayon), merged deterministically.
@@ -43,6 +44,7 @@ pub mod film;
 pub mod filter;
 pub mod gather;
 pub mod image;
+pub mod pipeline;
 pub mod sampler;
 pub mod solved;
 pub mod view;
@@ -57,6 +59,7 @@ pub use gather::{
     BsdfSample, ExtraBounce, GatherScene, GatherStats, LightSample, SurfacePoint, power_heuristic,
 };
 pub use image::Image;
+pub use pipeline::{PipelineStats, solve_and_render};
 pub use sampler::PixelSampler;
-pub use solved::{DirectOnly, RadianceSolution, Site, SolvedScene};
+pub use solved::{DirectOnly, RadianceSolution, Site, SolvedScene, solve_scene};
 pub use view::{ViewOverrides, camera_of, filter_of};

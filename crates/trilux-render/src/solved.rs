@@ -336,3 +336,41 @@ impl<const N: usize, S: RadianceSolution<N>> GatherScene<N> for SolvedScene<'_, 
         self.shapes[at.locator.shape as usize].lobe_sr[back]
     }
 }
+
+/// The solver's solution answers the renderer's queries directly.
+impl<const N: usize> RadianceSolution<N> for trilux_solver::Solution<N> {
+    fn geometry(&self) -> &SceneGeometry {
+        trilux_solver::Solution::geometry(self)
+    }
+    fn reflected(&self, from: &Site, to: &Site) -> Spectrum<N> {
+        let site = |s: &Site| trilux_solver::SurfaceSite {
+            surface: s.surface,
+            coord: s.coord,
+            back: s.back,
+        };
+        self.radiance(&site(from), &site(to))
+    }
+}
+
+/// Solves a loaded scene with the solver (a convenience for tests, examples
+/// and tools; the `trilux` command drives the solver itself).
+pub fn solve_scene<const N: usize>(
+    scene: &trilux_scene::Scene,
+    settings: trilux_solver::SolverSettings,
+) -> Result<trilux_solver::Solution<N>, RenderError> {
+    let shapes = scene.geometry_shapes();
+    let bsdfs: Vec<BsdfParams> = scene.shapes.iter().map(|s| s.bsdf.clone()).collect();
+    let emission: Vec<_> = scene
+        .shapes
+        .iter()
+        .map(|s| s.emitter.as_ref().map(|e| e.radiance.clone()))
+        .collect();
+    let input = trilux_solver::SolverInput {
+        shapes: &shapes,
+        bsdfs: &bsdfs,
+        emission: &emission,
+    };
+    let solver = trilux_solver::Solver::<N>::new(&input, settings)
+        .map_err(|e| RenderError::Scene(format!("{}: {e}", scene.path.display())))?;
+    Ok(solver.solve(|_| {}))
+}

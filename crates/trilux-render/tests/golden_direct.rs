@@ -33,7 +33,13 @@ fn root() -> PathBuf {
 fn direct_light_matches_mitsuba_max_depth_2() {
     let mut report = Vec::new();
     let mut failed = false;
-    for name in ["cornell-box", "furnace", "paper-scene1", "paper-scene2", "paper-scene3"] {
+    for name in [
+        "cornell-box",
+        "furnace",
+        "paper-scene1",
+        "paper-scene2",
+        "paper-scene3",
+    ] {
         let dir = root().join("tests/golden/direct");
         let reference = Image::read_exr(&dir.join(format!("{name}.exr"))).unwrap();
         let mask = Image::read_exr(&dir.join(format!("{name}.mask.exr"))).unwrap();
@@ -50,10 +56,16 @@ fn direct_light_matches_mitsuba_max_depth_2() {
             ..Default::default()
         };
         let image = if scene.spectral {
-            let sol = DirectOnly::<10> { geometry, constant: Spectrum::splat(0.0) };
+            let sol = DirectOnly::<10> {
+                geometry,
+                constant: Spectrum::splat(0.0),
+            };
             render(&scene, &sol, &view, &settings, |_, _| {}).unwrap().0
         } else {
-            let sol = DirectOnly::<3> { geometry, constant: Spectrum::splat(0.0) };
+            let sol = DirectOnly::<3> {
+                geometry,
+                constant: Spectrum::splat(0.0),
+            };
             render(&scene, &sol, &view, &settings, |_, _| {}).unwrap().0
         };
         let c = compare(&image, &reference, Some(&mask)).unwrap();
@@ -64,5 +76,9 @@ fn direct_light_matches_mitsuba_max_depth_2() {
         failed |= !(c.rel_rmse <= 0.04 && (c.mean_ratio - 1.0).abs() <= 0.01);
     }
     println!("{}", report.join("\n"));
-    assert!(!failed, "direct light differs from Mitsuba:\n{}", report.join("\n"));
+    assert!(
+        !failed,
+        "direct light differs from Mitsuba:\n{}",
+        report.join("\n")
+    );
 }
