@@ -138,8 +138,8 @@ impl<const N: usize> Hierarchy<N> {
         let p = &mut self.nodes[n as usize];
         p.first_child = first;
         p.split = side;
-        p.gathered = p.gathered * scale;
-        p.unshot = p.unshot * scale;
+        p.gathered *= scale;
+        p.unshot *= scale;
         p.t = t_new;
         lost
     }

@@ -1,11 +1,13 @@
 //! # trilux-solver — progressive hierarchical three-point transport
 //!
-//! Layer: depends on `trilux-color`, `trilux-geometry` and `trilux-brdf`
-//! (never on file formats: the scene layer hands it a [`SolverInput`]).
+//! Layer: depends on `trilux-color`, `trilux-geometry`, `trilux-brdf` and
+//! `trilux-scene` (only for [`SceneInput::from_scene`]; the solver never
+//! parses: it works on a [`SolverInput`]).
 //! Implements Dumont, Bouatouch & Gosselin (1997), "A Progressive Algorithm
 //! for Three Point Transport", following `notes/algorithm.md`.
 //!
 //! Contents, in reading order:
+//! - [`input`]: what the solver takes from a loaded scene.
 //! - [`settings`]: FFErr, FrErr, MinArea, the photometric threshold, CR
 //!   target, quality presets, two-point or uniform transport.
 //! - `sides`: the faces of input surfaces that send and receive light.
@@ -19,8 +21,11 @@
 //! - [`solution`]: the radiance query for final gathering and the file format.
 //! - [`stats`]: what `--stats` writes.
 #![forbid(unsafe_code)]
+// Band loops index several per-band arrays in step.
+#![allow(clippy::needless_range_loop)]
 
 pub mod error;
+pub mod input;
 mod interaction;
 pub mod ledger;
 mod radiosity;
@@ -33,6 +38,7 @@ pub mod stats;
 mod throughput;
 
 pub use error::SolverError;
+pub use input::SceneInput;
 pub use interaction::Split;
 pub use ledger::Ledger;
 pub use settings::{Quality, SolverSettings, Transport};

@@ -152,10 +152,6 @@ impl<const N: usize> RefineContext<'_, N> {
         t
     }
 
-    fn can_split(&self, e: ElementId) -> bool {
-        self.geom.element(e).children().is_some()
-    }
-
     /// Both point-to-disc estimates F̂_{a→b} and F̂_{b→a}.
     fn ff_estimates(&self, a: ElementId, sa: SideId, b: ElementId, sb: SideId) -> (f64, f64) {
         let (ea, eb) = (self.geom.element(a), self.geom.element(b));

@@ -35,9 +35,6 @@ pub(crate) struct TransportSide<const N: usize> {
     pub stored: bool,
     /// Emitted radiance Le (front of an area emitter).
     pub emission: Spectrum<N>,
-    /// Depth limit of this surface's element tree (from MinArea and the
-    /// global depth limit).
-    pub max_depth: u32,
 }
 
 impl<const N: usize> TransportSide<N> {
@@ -50,15 +47,6 @@ impl<const N: usize> TransportSide<N> {
     pub fn sign(&self) -> f64 {
         if self.back { -1.0 } else { 1.0 }
     }
-
-    /// The brdf crate's name for this side.
-    pub fn bsdf_side(&self) -> BsdfSide {
-        if self.back {
-            BsdfSide::Back
-        } else {
-            BsdfSide::Front
-        }
-    }
 }
 
 /// Builds the sides of every input surface: a front side always (it receives
@@ -70,7 +58,6 @@ pub(crate) fn build_sides<const N: usize>(
     materials: &[Bsdf<N>],
     emission: &[Spectrum<N>],
     transport: Transport,
-    max_depth_of: impl Fn(SurfaceId) -> u32,
 ) -> Vec<TransportSide<N>> {
     let mut sides = Vec::new();
     for (index, surface) in geom.surfaces().iter().enumerate() {
@@ -101,7 +88,6 @@ pub(crate) fn build_sides<const N: usize>(
                 rho_d,
                 stored,
                 emission: le,
-                max_depth: max_depth_of(id),
             });
         }
     }

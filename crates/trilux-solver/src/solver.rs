@@ -80,7 +80,6 @@ pub struct Solver<const N: usize> {
     pub(crate) field: ElementRadiance<N>,
     side_flux: Vec<Spectrum<N>>,
     pub(crate) hierarchies: Vec<Hierarchy<N>>,
-    hierarchies_from: Vec<Vec<u32>>,
     cache: ThroughputCache,
     pub(crate) ledger: Ledger,
     emitted: Spectrum<N>,
@@ -154,9 +153,7 @@ impl<const N: usize> Solver<N> {
         }
         let depth_of = depth_limits(&geom, &settings);
         presubdivide(&mut geom, &depth_of);
-        let mut sides = build_sides(&geom, &materials, &emission, settings.transport, |s| {
-            depth_of[s.index()]
-        });
+        let mut sides = build_sides(&geom, &materials, &emission, settings.transport);
         let mut warnings = Vec::new();
         for side in &mut sides {
             if side.rho_d.max_value() > 1.0 {
@@ -299,7 +296,6 @@ impl<const N: usize> Solver<N> {
             field,
             side_flux,
             hierarchies,
-            hierarchies_from,
             cache,
             ledger,
             emitted,

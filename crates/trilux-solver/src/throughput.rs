@@ -90,14 +90,6 @@ impl ThroughputCache {
             shard.insert(key, t);
         }
     }
-
-    /// Number of cached pairs.
-    pub fn len(&self) -> usize {
-        self.shards
-            .iter()
-            .map(|s| s.read().map(|s| s.len()).unwrap_or(0))
-            .sum()
-    }
 }
 
 /// F_{i→j} between the given faces of two elements, unoccluded.

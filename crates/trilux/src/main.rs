@@ -10,6 +10,7 @@
 
 mod info;
 mod power;
+mod solve;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -29,6 +30,8 @@ enum Command {
     /// Print what a scene file loads to: shapes, input surfaces, materials,
     /// emitters, camera.
     Info(info::InfoArgs),
+    /// Solve the light of a scene once and save the solution.
+    Solve(solve::SolveArgs),
 }
 
 /// How light is carried: 3 RGB bands or spectral bands.
@@ -51,9 +54,20 @@ pub fn default_scene() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/cornell-box.xml")
 }
 
+/// The statistics JSON of design.md §3: the solver's figures plus the
+/// render time.
+pub fn stats_json(stats: &trilux_solver::SolveStats, render_seconds: f64) -> serde_json::Value {
+    let mut value = serde_json::to_value(stats).unwrap_or(serde_json::Value::Null);
+    if let Some(map) = value.as_object_mut() {
+        map.insert("render_seconds".into(), serde_json::json!(render_seconds));
+    }
+    value
+}
+
 fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Some(Command::Info(args)) => info::run(&args),
+        Some(Command::Solve(args)) => solve::run(&args),
         // Until the renderer lands, the main job describes the default scene.
         None => info::run(&info::InfoArgs {
             scene: default_scene(),
