@@ -59,7 +59,8 @@ fn mitsuba_available() -> bool {
 }
 
 /// `cargo xtask sweep [--only NAME]... [--out DIR] [--no-mitsuba]
-/// [--spp a,b,c] [--quality q1,q2] [--mitsuba-spp a,b,c]`
+/// [--spp a,b,c] [--quality q1,q2] [--mitsuba-spp a,b,c]`, or `--replot`
+/// (after `--out`, if any) to redraw the plot from an existing CSV.
 pub fn main(args: &[String]) -> Result<()> {
     let mut only = Vec::new();
     let mut out = root().join("target/sweep");
@@ -79,6 +80,12 @@ pub fn main(args: &[String]) -> Result<()> {
             "--only" => only.push(it.next().context("--only needs a name")?.clone()),
             "--out" => out = PathBuf::from(it.next().context("--out needs a folder")?),
             "--no-mitsuba" => with_mitsuba = false,
+            "--replot" => {
+                let points = read_csv(&out.join("sweep.csv"))?;
+                plot(&points)?.write_png(&out.join("sweep.png"), 0.0)?;
+                summary(&points);
+                return Ok(());
+            }
             "--spp" => spps = list(it.next())?,
             "--mitsuba-spp" => mitsuba_spps = list(it.next())?,
             "--quality" => {
@@ -169,6 +176,34 @@ pub fn main(args: &[String]) -> Result<()> {
     Ok(())
 }
 
+/// Reads back a `sweep.csv` written by [`write_csv`].
+fn read_csv(path: &std::path::Path) -> Result<Vec<Point>> {
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+    let mut points = Vec::new();
+    for line in text.lines().skip(1) {
+        let f: Vec<&str> = line.split(',').collect();
+        let [scene, renderer, quality, spp, seconds, solve, rmse, ratio] = f.as_slice() else {
+            bail!("bad line in {}: {line}", path.display());
+        };
+        points.push(Point {
+            scene: scene.to_string(),
+            renderer: if *renderer == "mitsuba" {
+                "mitsuba"
+            } else {
+                "trilux"
+            },
+            quality: quality.to_string(),
+            spp: spp.parse()?,
+            seconds: seconds.parse()?,
+            solve_seconds: solve.parse()?,
+            rel_rmse: rmse.parse()?,
+            mean_ratio: ratio.parse()?,
+        });
+    }
+    Ok(points)
+}
+
 fn write_csv(path: &std::path::Path, points: &[Point]) -> Result<()> {
     let mut s =
         String::from("scene,renderer,quality,spp,seconds,solve_seconds,rel_rmse,mean_ratio\n");
@@ -234,7 +269,48 @@ fn colour(renderer: &str, quality: &str) -> [f32; 3] {
     }
 }
 
-/// A log-log plot of error against time, one panel per scene.
+/// 3×5 pixel glyphs for axis labels: digits, `e`, `-` (rows top to bottom,
+/// 3 bits each, most significant bit = left column).
+fn glyph(c: char) -> Option<[u8; 5]> {
+    Some(match c {
+        '0' => [7, 5, 5, 5, 7],
+        '1' => [2, 6, 2, 2, 7],
+        '2' => [7, 1, 7, 4, 7],
+        '3' => [7, 1, 7, 1, 7],
+        '4' => [5, 5, 7, 1, 1],
+        '5' => [7, 4, 7, 1, 7],
+        '6' => [7, 4, 7, 5, 7],
+        '7' => [7, 1, 1, 1, 1],
+        '8' => [7, 5, 7, 5, 7],
+        '9' => [7, 5, 7, 1, 7],
+        'e' => [0, 7, 7, 4, 7],
+        '-' => [0, 0, 7, 0, 0],
+        _ => return None,
+    })
+}
+
+/// Draws `text` with its top-left corner at (x, y), 2 pixels per font pixel.
+fn draw_text(px: &mut [[f32; 3]], w: usize, h: usize, x: usize, y: usize, text: &str) {
+    for (k, c) in text.chars().enumerate() {
+        let Some(g) = glyph(c) else { continue };
+        for (row, bits) in g.iter().enumerate() {
+            for col in 0..3 {
+                if bits & (4 >> col) != 0 {
+                    for (dy, dx) in [(0, 0), (0, 1), (1, 0), (1, 1)] {
+                        let (xx, yy) = (x + k * 8 + col * 2 + dx, y + row * 2 + dy);
+                        if xx < w && yy < h {
+                            px[yy * w + xx] = [0.0; 3];
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// A log-log plot of error against time, one panel per scene (in the
+/// order of the CSV). Grid lines are decades, labelled `1eK` (seconds on x,
+/// relative RMSE on y).
 pub fn plot(points: &[Point]) -> Result<Image> {
     let mut scenes: Vec<&str> = points.iter().map(|p| p.scene.as_str()).collect();
     scenes.dedup();
@@ -256,7 +332,8 @@ pub fn plot(points: &[Point]) -> Result<Image> {
     if y0 >= y1 {
         (y0, y1) = (-3.0, 0.0);
     }
-    let margin = 20.0;
+    let margin = 40.0;
+    let mut all_labels: Vec<(usize, usize, String)> = Vec::new();
     for (k, scene) in scenes.iter().enumerate() {
         let oy = (k * ph) as f64;
         let to_px = |s: f64, e: f64| -> (f64, f64) {
@@ -277,18 +354,30 @@ pub fn plot(points: &[Point]) -> Result<Image> {
         let grey = [0.8, 0.8, 0.8];
         for d in (x0 as i64)..=(x1 as i64) {
             let (x, _) = to_px(10f64.powi(d as i32), 1.0);
-            for y in (oy as usize + 20)..(oy as usize + ph - 20) {
+            for y in (oy as usize + 40)..(oy as usize + ph - 40) {
                 put(x, y as f64, grey);
             }
         }
         for d in (y0 as i64)..=(y1 as i64) {
             let (_, y) = to_px(1.0, 10f64.powi(d as i32));
-            for x in 20..(pw - 20) {
+            for x in 40..(pw - 40) {
                 put(x as f64, y, grey);
             }
         }
         for x in 0..pw {
             put(x as f64, oy, [0.0; 3]);
+        }
+        for d in (x0 as i64)..=(x1 as i64) {
+            let (x, _) = to_px(10f64.powi(d as i32), 1.0);
+            all_labels.push((
+                (x - 8.0).max(0.0) as usize,
+                oy as usize + ph - 32,
+                format!("1e{d}"),
+            ));
+        }
+        for d in (y0 as i64)..=(y1 as i64) {
+            let (_, y) = to_px(1.0, 10f64.powi(d as i32));
+            all_labels.push((2, (y - 5.0).max(0.0) as usize, format!("1e{d}")));
         }
         let mut series: Vec<(&str, &str)> = points
             .iter()
@@ -324,6 +413,9 @@ pub fn plot(points: &[Point]) -> Result<Image> {
                 }
             }
         }
+    }
+    for (x, y, t) in &all_labels {
+        draw_text(&mut px, w, h, *x, *y, t);
     }
     Ok(Image::from_pixels(w as u32, h as u32, px)?)
 }
