@@ -25,10 +25,12 @@ use trilux_render::{
 };
 use trilux_solver::{Quality, SolverSettings};
 
-/// Largest accepted relative RMSE (unmasked) of a trilux render at the
-/// golden sample count against its reference. Provisional until the solver
-/// lands and the measured values are in docs/results.md.
-pub const MAX_REL_RMSE: f64 = 0.10;
+/// Largest accepted relative RMSE (unmasked) of a trilux render at 64 spp
+/// against its reference: the final gather's own noise at 64 spp and
+/// 128×128 (1.4–1.9 % on the paper scenes, measured by `cargo xtask
+/// sweep`), plus the references' noise (≤ 0.4 %), plus at most about 3 % of
+/// solution bias.
+pub const MAX_REL_RMSE: f64 = 0.05;
 /// Largest accepted |mean ratio − 1| (unmasked): issue 5 asks for 1 %.
 pub const MAX_MEAN_BIAS: f64 = 0.01;
 
