@@ -5,7 +5,7 @@
 //! - camera space looks along **+z**, with **+y up and +x to the left**;
 //!   `lookat(origin, target, up)` builds the columns
 //!   (left = normalize(up × dir), up' = dir × left, dir, origin);
-//! - a film position (s_x, s_y) ∈ [0,1]², (0, 0) being the top-left corner of
+//! - a film position (s_x, s_y) ∈ \[0,1\]², (0, 0) being the top-left corner of
 //!   the film, maps to the camera-space direction
 //!   ((1 − 2 s_x)·tan(fov_x/2), (1 − 2 s_y)·tan(fov_x/2)/aspect, 1),
 //!   aspect = width / height;
@@ -177,7 +177,7 @@ impl Camera {
         self.ray_unit(s)
     }
 
-    /// The ray through the film position `s` ∈ [0,1]² (Mitsuba's position
+    /// The ray through the film position `s` ∈ \[0,1\]² (Mitsuba's position
     /// sample: (0, 0) is the top-left corner).
     pub fn ray_unit(&self, s: DVec2) -> Ray {
         let d_cam = DVec3::new(

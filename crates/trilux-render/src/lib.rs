@@ -29,7 +29,7 @@
 //! - [`driver`]: tiles rendered in parallel (rayon), merged deterministically.
 //! - [`image`]: the finished [`Image`], EXR and PNG output (atomic writes).
 //! - [`analytic`]: analytic scenes with known answers (tests, benches).
-//! - [`compare`]: relative RMSE and mean ratio against a reference image.
+//! - [`mod@compare`]: relative RMSE and mean ratio against a reference image.
 //! - [`bands`]: small helpers on per-band radiance arrays.
 //! - [`error`]: the error type, [`RenderError`].
 #![forbid(unsafe_code)]
