@@ -1,6 +1,9 @@
 //! Project automation: `cargo xtask ci` runs everything the tests need;
 //! `cargo xtask color` checks trilux's colorimetry against colour-science.
 
+mod golden;
+mod sweep;
+
 use std::process::Command;
 
 use anyhow::{Context, Result, bail};
@@ -42,8 +45,10 @@ fn main() -> Result<()> {
     match args.first().map(String::as_str) {
         Some("ci") => ci(),
         Some("color") => color::color(),
+        Some("golden") => golden::main(&args[1..]),
+        Some("sweep") => sweep::main(&args[1..]),
         _ => {
-            eprintln!("usage: cargo xtask ci | color");
+            eprintln!("usage: cargo xtask ci | color | golden | sweep");
             std::process::exit(2);
         }
     }

@@ -97,7 +97,7 @@ impl<const N: usize> Hierarchy<N> {
     /// The four children of node `n`, if split.
     pub fn children(&self, n: u32) -> Option<[u32; 4]> {
         let f = self.nodes[n as usize].first_child;
-        (f != NO_CHILD).then_some([f, f + 1, f + 2, f + 3])
+        (f != NO_CHILD).then(|| [f, f + 1, f + 2, f + 3])
     }
 
     /// Splits leaf `n` on `side` into children with the given elements and

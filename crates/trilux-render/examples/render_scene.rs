@@ -1,0 +1,79 @@
+//! Solves a scene file and renders it by final gathering.
+//!
+//! Run: `cargo run --release -p trilux-render --example render_scene -- SCENE.xml OUT.exr [SIZE] [SPP] [draft|default|high] [never|auto|always]`
+//!
+//! Prints the solve and render times and the image mean. Spectral scenes
+//! solve and render in 10 bands.
+
+use std::path::Path;
+use std::time::Instant;
+
+use trilux_render::{ExtraBounce, RenderSettings, ViewOverrides, render, solve_scene};
+use trilux_solver::{Quality, SolverSettings};
+
+fn print_stats(s: &trilux_solver::SolveStats) {
+    let sum = |v: &[f64]| v.iter().sum::<f64>();
+    let e = sum(&s.emitted_flux);
+    println!(
+        "CR {:.4}, shots {}, elements {}, interactions {}; of emitted: absorbed {:.4}, escaped {:.4}, residual {:.4}",
+        s.convergence_ratio,
+        s.shots,
+        s.elements,
+        s.interactions,
+        sum(&s.absorbed_flux) / e,
+        sum(&s.escaped_flux) / e,
+        sum(&s.residual_flux) / e
+    );
+}
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let [scene, out, rest @ ..] = args.as_slice() else {
+        return Err("usage: render_scene SCENE.xml OUT.exr [SIZE] [SPP] [QUALITY] [EXTRA]".into());
+    };
+    let size: Option<u32> = rest.first().map(|s| s.parse()).transpose()?;
+    let spp: Option<u32> = rest.get(1).map(|s| s.parse()).transpose()?;
+    let quality = match rest.get(2).map(String::as_str) {
+        Some("draft") => Quality::Draft,
+        Some("high") => Quality::High,
+        _ => Quality::Default,
+    };
+    let extra = match rest.get(3).map(String::as_str) {
+        Some("never") => ExtraBounce::Never,
+        Some("always") => ExtraBounce::Always,
+        _ => ExtraBounce::default(),
+    };
+    let scene = trilux_scene::load(scene)?;
+    let camera = scene.camera.as_ref().ok_or("the scene has no camera")?;
+    let mut settings = RenderSettings::for_scene(camera);
+    settings.spp = spp.unwrap_or(settings.spp);
+    settings.extra_bounce = extra;
+    let view = ViewOverrides {
+        width: size,
+        height: size,
+        ..Default::default()
+    };
+    let t = Instant::now();
+    let (image, stats, solve_s) = if scene.spectral {
+        let sol = solve_scene::<10>(&scene, SolverSettings::preset(quality))?;
+        let solve_s = t.elapsed().as_secs_f64();
+        print_stats(sol.stats());
+        let (i, s) = render(&scene, &sol, &view, &settings, |_, _| {})?;
+        (i, s, solve_s)
+    } else {
+        let sol = solve_scene::<3>(&scene, SolverSettings::preset(quality))?;
+        let solve_s = t.elapsed().as_secs_f64();
+        print_stats(sol.stats());
+        let (i, s) = render(&scene, &sol, &view, &settings, |_, _| {})?;
+        (i, s, solve_s)
+    };
+    image.write_exr(Path::new(out))?;
+    println!(
+        "solve {solve_s:.2} s, render {:.2} s, extra bounces {} of {} gather rays, mean {:?}",
+        stats.seconds,
+        stats.gather.extra_bounces,
+        stats.gather.gather_rays,
+        image.mean()
+    );
+    Ok(())
+}

@@ -1,0 +1,310 @@
+//! Analytic scenes for testing and benchmarking the final gather.
+//!
+//! Everything a [`GatherScene`] answers is written here by hand, with closed
+//! forms, independently of trilux's geometry, BRDF and solver crates, so the
+//! estimator can be checked against known answers:
+//! - [`Furnace`]: the inside of an emitting, reflecting closed cube, whose
+//!   radiance is le / (1 − ρ) everywhere;
+//! - [`LitFloor`]: a diffuse floor under a square light, whose radiance is
+//!   ρ · Le · F(point → square) (Lambert's polygon formula).
+
+use std::f64::consts::PI;
+
+use crate::gather::{BsdfSample, GatherScene, LightSample, SurfacePoint};
+use glam::{DVec2, DVec3};
+
+/// An orthonormal frame around `n` (Duff et al. 2017).
+pub fn frame(n: DVec3) -> (DVec3, DVec3) {
+    let s = 1f64.copysign(n.z);
+    let a = -1.0 / (s + n.z);
+    let b = n.x * n.y * a;
+    (
+        DVec3::new(1.0 + s * n.x * n.x * a, s * b, -s * n.x),
+        DVec3::new(b, s + n.y * n.y * a, -n.y),
+    )
+}
+
+/// Cosine-weighted hemisphere direction around `n`.
+pub fn cosine_sample(n: DVec3, u: DVec2) -> DVec3 {
+    let r = u.x.sqrt();
+    let phi = 2.0 * PI * u.y;
+    let (t, b) = frame(n);
+    (t * (r * phi.cos()) + b * (r * phi.sin()) + n * (1.0 - u.x).max(0.0).sqrt()).normalize()
+}
+
+/// Diffuse BSDF pieces shared by the mocks (front side only).
+fn diffuse_cos(rho: f64, n: DVec3, wi: DVec3, wo: DVec3) -> f64 {
+    let ci = n.dot(wi);
+    if ci > 0.0 && n.dot(wo) > 0.0 {
+        rho / PI * ci
+    } else {
+        0.0
+    }
+}
+
+fn diffuse_sample<const N: usize>(
+    rho: f64,
+    n: DVec3,
+    wo: DVec3,
+    u: DVec2,
+) -> Option<BsdfSample<N>> {
+    if n.dot(wo) <= 0.0 {
+        return None;
+    }
+    let wi = cosine_sample(n, u);
+    let c = n.dot(wi);
+    if c <= 0.0 {
+        return None;
+    }
+    Some(BsdfSample {
+        wi,
+        weight: [rho; N],
+        pdf: c / PI,
+    })
+}
+
+fn diffuse_pdf(n: DVec3, wo: DVec3, wi: DVec3) -> f64 {
+    if n.dot(wo) > 0.0 {
+        n.dot(wi).max(0.0) / PI
+    } else {
+        0.0
+    }
+}
+
+/// The inside of the cube [-1, 1]³: every face emits `le` inwards, reflects
+/// diffusely with albedo `rho`, and the "solution" answers `reflected`
+/// everywhere. The radiance everywhere is le / (1 − rho) when
+/// `reflected` = rho·le / (1 − rho).
+pub struct Furnace {
+    /// Emitted radiance of every face.
+    pub le: f64,
+    /// Diffuse albedo.
+    pub rho: f64,
+    /// What the solution answers for the reflected radiance.
+    pub reflected: f64,
+    /// Element size the solution reports.
+    pub element: f64,
+}
+
+impl<const N: usize> GatherScene<N> for Furnace {
+    type Locator = usize;
+
+    fn intersect(&self, o: DVec3, d: DVec3) -> Option<SurfacePoint<usize>> {
+        // Leave the cube through the nearest slab.
+        let mut best = (f64::INFINITY, 0usize);
+        for a in 0..3 {
+            if d[a] != 0.0 {
+                let t = (d[a].signum() - o[a]) / d[a];
+                if t > 1e-9 && t < best.0 {
+                    best = (t, a);
+                }
+            }
+        }
+        if !best.0.is_finite() {
+            return None;
+        }
+        let (t, a) = best;
+        let mut n = DVec3::ZERO;
+        n[a] = -d[a].signum();
+        let face = 2 * a + usize::from(d[a] > 0.0);
+        Some(SurfacePoint {
+            point: o + d * t,
+            normal: n,
+            t,
+            locator: face,
+        })
+    }
+    fn unoccluded(&self, _from: &SurfacePoint<usize>, _to: DVec3) -> bool {
+        true // convex: nothing inside
+    }
+    fn emitted(&self, at: &SurfacePoint<usize>, wo: DVec3) -> [f64; N] {
+        if at.normal.dot(wo) > 0.0 {
+            [self.le; N]
+        } else {
+            [0.0; N]
+        }
+    }
+    fn sample_light(&self, r: &SurfacePoint<usize>, pick: f64, u: DVec2) -> Option<LightSample<N>> {
+        if self.le == 0.0 {
+            return None;
+        }
+        let face = ((pick * 6.0) as usize).min(5);
+        let a = face / 2;
+        let sign = if face % 2 == 1 { 1.0 } else { -1.0 };
+        let mut p = DVec3::ZERO;
+        p[a] = sign;
+        p[(a + 1) % 3] = 2.0 * u.x - 1.0;
+        p[(a + 2) % 3] = 2.0 * u.y - 1.0;
+        let mut n = DVec3::ZERO;
+        n[a] = -sign;
+        let radiance = if n.dot(r.point - p) > 0.0 {
+            [self.le; N]
+        } else {
+            [0.0; N]
+        };
+        Some(LightSample {
+            point: p,
+            normal: n,
+            radiance,
+            pdf_area: 1.0 / 24.0,
+        })
+    }
+    fn light_pdf_area(&self, _at: &SurfacePoint<usize>) -> f64 {
+        if self.le == 0.0 { 0.0 } else { 1.0 / 24.0 }
+    }
+    fn bsdf_cos(&self, at: &SurfacePoint<usize>, wi: DVec3, wo: DVec3) -> [f64; N] {
+        [diffuse_cos(self.rho, at.normal, wi, wo); N]
+    }
+    fn sample_bsdf(&self, at: &SurfacePoint<usize>, wo: DVec3, u: DVec2) -> Option<BsdfSample<N>> {
+        diffuse_sample(self.rho, at.normal, wo, u)
+    }
+    fn bsdf_pdf(&self, at: &SurfacePoint<usize>, wo: DVec3, wi: DVec3) -> f64 {
+        diffuse_pdf(at.normal, wo, wi)
+    }
+    fn reflected(&self, _from: &SurfacePoint<usize>, _towards: &SurfacePoint<usize>) -> [f64; N] {
+        [self.reflected; N]
+    }
+    fn element_size(&self, _at: &SurfacePoint<usize>) -> f64 {
+        self.element
+    }
+    fn lobe_solid_angle(&self, _at: &SurfacePoint<usize>, _wo: DVec3) -> f64 {
+        2.0 * PI
+    }
+}
+
+/// A diffuse floor z = 0 (albedo `rho`, unbounded) under a square emitter
+/// [-s, s]² at height `h`, facing down with radiance `le`, black itself.
+/// Nothing else: the solution's reflected radiance is zero (light reaching
+/// the floor only once is all there is).
+pub struct LitFloor {
+    /// Floor albedo.
+    pub rho: f64,
+    /// Half side of the emitter.
+    pub s: f64,
+    /// Height of the emitter.
+    pub h: f64,
+    /// Emitted radiance.
+    pub le: f64,
+}
+
+impl LitFloor {
+    /// Irradiance-based closed form: the radiance leaving floor point p is
+    /// rho · le · F(p → square), with F from Lambert's formula for a
+    /// polygon seen from a differential area (normal +z).
+    pub fn expected(&self, p: DVec3) -> f64 {
+        let s = self.s;
+        let h = self.h;
+        let corners = [
+            DVec3::new(-s, -s, h),
+            DVec3::new(s, -s, h),
+            DVec3::new(s, s, h),
+            DVec3::new(-s, s, h),
+        ];
+        let mut f = 0.0;
+        for i in 0..4 {
+            let a = (corners[i] - p).normalize();
+            let b = (corners[(i + 1) % 4] - p).normalize();
+            let g = a.cross(b);
+            let gamma = a.dot(b).clamp(-1.0, 1.0).acos();
+            f += gamma * g.z / g.length();
+        }
+        self.rho * self.le * (f / (2.0 * PI)).abs()
+    }
+}
+
+impl<const N: usize> GatherScene<N> for LitFloor {
+    /// 0 = floor, 1 = emitter.
+    type Locator = u8;
+
+    fn intersect(&self, o: DVec3, d: DVec3) -> Option<SurfacePoint<u8>> {
+        let mut best: Option<SurfacePoint<u8>> = None;
+        if d.z != 0.0 {
+            let t = -o.z / d.z;
+            if t > 1e-9 {
+                best = Some(SurfacePoint {
+                    point: o + d * t,
+                    normal: DVec3::Z,
+                    t,
+                    locator: 0,
+                });
+            }
+            let t = (self.h - o.z) / d.z;
+            let p = o + d * t;
+            if t > 1e-9
+                && p.x.abs() <= self.s
+                && p.y.abs() <= self.s
+                && best.is_none_or(|b| t < b.t)
+            {
+                best = Some(SurfacePoint {
+                    point: p,
+                    normal: -DVec3::Z,
+                    t,
+                    locator: 1,
+                });
+            }
+        }
+        best
+    }
+    fn unoccluded(&self, _from: &SurfacePoint<u8>, _to: DVec3) -> bool {
+        true
+    }
+    fn emitted(&self, at: &SurfacePoint<u8>, wo: DVec3) -> [f64; N] {
+        if at.locator == 1 && at.normal.dot(wo) > 0.0 {
+            [self.le; N]
+        } else {
+            [0.0; N]
+        }
+    }
+    fn sample_light(&self, r: &SurfacePoint<u8>, _pick: f64, u: DVec2) -> Option<LightSample<N>> {
+        let p = DVec3::new(
+            (2.0 * u.x - 1.0) * self.s,
+            (2.0 * u.y - 1.0) * self.s,
+            self.h,
+        );
+        let radiance = if r.point.z < self.h {
+            [self.le; N]
+        } else {
+            [0.0; N]
+        };
+        Some(LightSample {
+            point: p,
+            normal: -DVec3::Z,
+            radiance,
+            pdf_area: 1.0 / (4.0 * self.s * self.s),
+        })
+    }
+    fn light_pdf_area(&self, at: &SurfacePoint<u8>) -> f64 {
+        if at.locator == 1 {
+            1.0 / (4.0 * self.s * self.s)
+        } else {
+            0.0
+        }
+    }
+    fn bsdf_cos(&self, at: &SurfacePoint<u8>, wi: DVec3, wo: DVec3) -> [f64; N] {
+        let rho = if at.locator == 0 { self.rho } else { 0.0 };
+        [diffuse_cos(rho, at.normal, wi, wo); N]
+    }
+    fn sample_bsdf(&self, at: &SurfacePoint<u8>, wo: DVec3, u: DVec2) -> Option<BsdfSample<N>> {
+        if at.locator == 0 {
+            diffuse_sample(self.rho, at.normal, wo, u)
+        } else {
+            None
+        }
+    }
+    fn bsdf_pdf(&self, at: &SurfacePoint<u8>, wo: DVec3, wi: DVec3) -> f64 {
+        if at.locator == 0 {
+            diffuse_pdf(at.normal, wo, wi)
+        } else {
+            0.0
+        }
+    }
+    fn reflected(&self, _from: &SurfacePoint<u8>, _towards: &SurfacePoint<u8>) -> [f64; N] {
+        [0.0; N]
+    }
+    fn element_size(&self, _at: &SurfacePoint<u8>) -> f64 {
+        0.1
+    }
+    fn lobe_solid_angle(&self, _at: &SurfacePoint<u8>, _wo: DVec3) -> f64 {
+        2.0 * PI
+    }
+}

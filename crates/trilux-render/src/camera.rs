@@ -1,0 +1,221 @@
+//! Mitsuba 3's `perspective` sensor.
+//!
+//! Conventions, checked against Mitsuba 3.9 (`sensor.sample_ray`, see
+//! `tests/data/mitsuba_camera.py` and the test `camera_matches_mitsuba`):
+//! - camera space looks along **+z**, with **+y up and +x to the left**;
+//!   `lookat(origin, target, up)` builds the columns
+//!   (left = normalize(up × dir), up' = dir × left, dir, origin);
+//! - a film position (s_x, s_y) ∈ \[0,1\]², (0, 0) being the top-left corner of
+//!   the film, maps to the camera-space direction
+//!   ((1 − 2 s_x)·tan(fov_x/2), (1 − 2 s_y)·tan(fov_x/2)/aspect, 1),
+//!   aspect = width / height;
+//! - `fov` is measured along `fov_axis`: `x` (Mitsuba's default), `y`,
+//!   `smaller` / `larger` (the shorter / longer film side; on a square film
+//!   `smaller` means x and `larger` means y, as Mitsuba decides with
+//!   `aspect > 1`), or `diagonal`.
+//!
+//! Mitsuba starts its rays at the near clip plane (0.01 along the optical
+//! axis); trilux starts them at the camera's origin. Nothing lies that close
+//! to a camera in our scenes, so the two see the same first hit.
+
+use glam::{DMat4, DVec2, DVec3};
+
+use crate::error::RenderError;
+
+/// Which film axis the field of view is measured along (Mitsuba `fov_axis`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FovAxis {
+    /// Horizontal (Mitsuba's default).
+    X,
+    /// Vertical.
+    Y,
+    /// The shorter side of the film.
+    Smaller,
+    /// The longer side of the film.
+    Larger,
+    /// The film's diagonal.
+    Diagonal,
+}
+
+impl FovAxis {
+    /// Parses Mitsuba's spelling (`x`, `y`, `smaller`, `larger`, `diagonal`).
+    pub fn parse(s: &str) -> Option<Self> {
+        match s {
+            "x" => Some(Self::X),
+            "y" => Some(Self::Y),
+            "smaller" => Some(Self::Smaller),
+            "larger" => Some(Self::Larger),
+            "diagonal" => Some(Self::Diagonal),
+            _ => None,
+        }
+    }
+}
+
+/// A ray in world space; `dir` has unit length.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Ray {
+    /// Start point.
+    pub origin: DVec3,
+    /// Unit direction.
+    pub dir: DVec3,
+}
+
+/// A pinhole camera with Mitsuba 3's conventions.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Camera {
+    world_from_camera: DMat4,
+    origin: DVec3,
+    tan_half_x: f64,
+    tan_half_y: f64,
+    width: u32,
+    height: u32,
+}
+
+/// Mitsuba's `Transform4f.look_at`: camera space (+x left, +y up, +z
+/// forward) to world space.
+pub fn look_at(origin: DVec3, target: DVec3, up: DVec3) -> Result<DMat4, RenderError> {
+    let dir = (target - origin).normalize_or_zero();
+    let left = up.cross(dir).normalize_or_zero();
+    if dir == DVec3::ZERO || left == DVec3::ZERO || !origin.is_finite() {
+        return Err(RenderError::Camera(format!(
+            "lookat origin {origin}, target {target}, up {up} is degenerate"
+        )));
+    }
+    let new_up = dir.cross(left);
+    Ok(DMat4::from_cols(
+        left.extend(0.0),
+        new_up.extend(0.0),
+        dir.extend(0.0),
+        origin.extend(1.0),
+    ))
+}
+
+/// Mitsuba's `parse_fov`: the horizontal field of view (degrees) that
+/// `fov` along `axis` means on a film of the given aspect (width / height).
+pub fn horizontal_fov(fov_deg: f64, axis: FovAxis, aspect: f64) -> f64 {
+    let axis = match axis {
+        FovAxis::Smaller if aspect > 1.0 => FovAxis::Y,
+        FovAxis::Smaller => FovAxis::X,
+        FovAxis::Larger if aspect > 1.0 => FovAxis::X,
+        FovAxis::Larger => FovAxis::Y,
+        a => a,
+    };
+    let t = (fov_deg.to_radians() * 0.5).tan();
+    match axis {
+        FovAxis::Y => (2.0 * (t * aspect).atan()).to_degrees(),
+        FovAxis::Diagonal => {
+            (2.0 * (t * aspect / (aspect * aspect + 1.0).sqrt()).atan()).to_degrees()
+        }
+        _ => fov_deg,
+    }
+}
+
+impl Camera {
+    /// A camera at `world_from_camera` (any rigid transform; scale is
+    /// removed by normalising directions) with field of view `fov_deg`
+    /// along `axis` and a film of `width` × `height` pixels.
+    pub fn new(
+        world_from_camera: DMat4,
+        fov_deg: f64,
+        axis: FovAxis,
+        width: u32,
+        height: u32,
+    ) -> Result<Self, RenderError> {
+        if width == 0 || height == 0 {
+            return Err(RenderError::Camera(format!(
+                "film size {width}x{height} must be at least 1x1"
+            )));
+        }
+        if !(fov_deg.is_finite() && fov_deg > 0.0 && fov_deg < 180.0) {
+            return Err(RenderError::Camera(format!(
+                "fov {fov_deg} must lie strictly between 0 and 180 degrees"
+            )));
+        }
+        if !world_from_camera.is_finite() || world_from_camera.determinant().abs() < 1e-300 {
+            return Err(RenderError::Camera(
+                "to_world is singular or not finite".into(),
+            ));
+        }
+        let aspect = width as f64 / height as f64;
+        let fov_x = horizontal_fov(fov_deg, axis, aspect);
+        if !(fov_x > 0.0 && fov_x < 180.0) {
+            return Err(RenderError::Camera(format!(
+                "fov {fov_deg} along {axis:?} means a horizontal fov of {fov_x} degrees"
+            )));
+        }
+        let tan_half_x = (fov_x.to_radians() * 0.5).tan();
+        Ok(Self {
+            origin: world_from_camera.transform_point3(DVec3::ZERO),
+            world_from_camera,
+            tan_half_x,
+            tan_half_y: tan_half_x / aspect,
+            width,
+            height,
+        })
+    }
+
+    /// Film width in pixels.
+    pub fn width(&self) -> u32 {
+        self.width
+    }
+
+    /// Film height in pixels.
+    pub fn height(&self) -> u32 {
+        self.height
+    }
+
+    /// The camera's position in world space.
+    pub fn origin(&self) -> DVec3 {
+        self.origin
+    }
+
+    /// The ray through the film position `film` given in pixels
+    /// (x ∈ [0, width], y ∈ [0, height], (0, 0) the top-left corner; pixel
+    /// (i, j) covers [i, i+1] × [j, j+1]).
+    pub fn ray(&self, film: DVec2) -> Ray {
+        let s = DVec2::new(film.x / self.width as f64, film.y / self.height as f64);
+        self.ray_unit(s)
+    }
+
+    /// The ray through the film position `s` ∈ \[0,1\]² (Mitsuba's position
+    /// sample: (0, 0) is the top-left corner).
+    pub fn ray_unit(&self, s: DVec2) -> Ray {
+        let d_cam = DVec3::new(
+            (1.0 - 2.0 * s.x) * self.tan_half_x,
+            (1.0 - 2.0 * s.y) * self.tan_half_y,
+            1.0,
+        );
+        let dir = self.world_from_camera.transform_vector3(d_cam).normalize();
+        Ray {
+            origin: self.origin,
+            dir,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fov_axes_on_square_film_are_all_equal_but_diagonal() {
+        for a in [FovAxis::X, FovAxis::Y, FovAxis::Smaller, FovAxis::Larger] {
+            assert!((horizontal_fov(40.0, a, 1.0) - 40.0).abs() < 1e-12);
+        }
+        // Diagonal of a square: tan(h/2) = tan(d/2)/sqrt(2).
+        let h = horizontal_fov(90.0, FovAxis::Diagonal, 1.0);
+        assert!(((h.to_radians() / 2.0).tan() - 1.0 / 2f64.sqrt()).abs() < 1e-12);
+    }
+
+    #[test]
+    fn bad_cameras_are_errors() {
+        let m = DMat4::IDENTITY;
+        assert!(Camera::new(m, 0.0, FovAxis::X, 8, 8).is_err());
+        assert!(Camera::new(m, 180.0, FovAxis::X, 8, 8).is_err());
+        assert!(Camera::new(m, f64::NAN, FovAxis::X, 8, 8).is_err());
+        assert!(Camera::new(m, 40.0, FovAxis::X, 0, 8).is_err());
+        assert!(Camera::new(DMat4::ZERO, 40.0, FovAxis::X, 8, 8).is_err());
+        assert!(look_at(DVec3::ZERO, DVec3::ZERO, DVec3::Y).is_err());
+        assert!(look_at(DVec3::ZERO, DVec3::Y, DVec3::Y).is_err());
+    }
+}

@@ -1,0 +1,103 @@
+//! From a loaded scene's sensor to a [`Camera`] and render settings, with
+//! the command line's overrides (another view of the same solution:
+//! `--lookat`, `--fov`, `--width`, `--height`).
+
+use glam::DVec3;
+
+use crate::camera::{Camera, FovAxis, look_at};
+use crate::error::RenderError;
+use crate::filter::ReconstructionFilter;
+
+/// Changes to the scene's camera asked for on the command line.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ViewOverrides {
+    /// New eye, target and up (up defaults to the scene camera's up).
+    pub lookat: Option<(DVec3, DVec3, Option<DVec3>)>,
+    /// New field of view in degrees, along the scene's `fov_axis`.
+    pub fov: Option<f64>,
+    /// New film width.
+    pub width: Option<u32>,
+    /// New film height.
+    pub height: Option<u32>,
+}
+
+fn axis(a: trilux_scene::camera::FovAxis) -> FovAxis {
+    use trilux_scene::camera::FovAxis as S;
+    match a {
+        S::X => FovAxis::X,
+        S::Y => FovAxis::Y,
+        S::Smaller => FovAxis::Smaller,
+        S::Larger => FovAxis::Larger,
+        S::Diagonal => FovAxis::Diagonal,
+    }
+}
+
+/// The film filter a scene asks for.
+pub fn filter_of(c: &trilux_scene::Camera) -> ReconstructionFilter {
+    match c.rfilter {
+        trilux_scene::camera::ReconstructionFilter::Gaussian => ReconstructionFilter::default(),
+        trilux_scene::camera::ReconstructionFilter::Box => ReconstructionFilter::Box,
+    }
+}
+
+/// The camera of the scene's sensor, with overrides applied.
+pub fn camera_of(c: &trilux_scene::Camera, o: &ViewOverrides) -> Result<Camera, RenderError> {
+    let world_from_camera = match o.lookat {
+        Some((origin, target, up)) => look_at(origin, target, up.unwrap_or(c.up))?,
+        None => c.world_from_camera,
+    };
+    Camera::new(
+        world_from_camera,
+        o.fov.unwrap_or(c.fov),
+        axis(c.fov_axis),
+        o.width.unwrap_or(c.width),
+        o.height.unwrap_or(c.height),
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::DVec2;
+
+    const SCENE: &str = r#"<scene version="3.0.0">
+        <sensor type="perspective">
+            <float name="fov" value="40"/>
+            <string name="fov_axis" value="y"/>
+            <transform name="to_world"><lookat origin="1, 2, 3" target="1, 2, 0" up="0, 1, 0"/></transform>
+            <film type="hdrfilm"><integer name="width" value="30"/><integer name="height" value="20"/>
+                <rfilter type="box"/></film>
+        </sensor>
+        <shape type="rectangle"/>
+    </scene>"#;
+
+    #[test]
+    fn scene_camera_and_overrides() {
+        let scene = trilux_scene::load_str(SCENE, "inline.xml").unwrap();
+        let c = scene.camera.as_ref().unwrap();
+        assert_eq!(filter_of(c), ReconstructionFilter::Box);
+        let cam = camera_of(c, &ViewOverrides::default()).unwrap();
+        assert_eq!((cam.width(), cam.height()), (30, 20));
+        let centre = cam.ray_unit(DVec2::splat(0.5));
+        assert!((centre.dir - DVec3::new(0.0, 0.0, -1.0)).length() < 1e-12);
+        assert!((centre.origin - DVec3::new(1.0, 2.0, 3.0)).length() < 1e-12);
+        // fov 40 along y: the top edge of the film is 20° above the axis.
+        let top = cam.ray_unit(DVec2::new(0.5, 0.0));
+        assert!((top.dir.y.atan2(-top.dir.z).to_degrees() - 20.0).abs() < 1e-9);
+
+        let o = ViewOverrides {
+            lookat: Some((DVec3::ZERO, DVec3::X, None)),
+            fov: Some(60.0),
+            width: Some(8),
+            height: None,
+        };
+        let cam = camera_of(c, &o).unwrap();
+        assert_eq!((cam.width(), cam.height()), (8, 20));
+        assert!((cam.ray_unit(DVec2::splat(0.5)).dir - DVec3::X).length() < 1e-12);
+        let bad = ViewOverrides {
+            fov: Some(-1.0),
+            ..Default::default()
+        };
+        assert!(camera_of(c, &bad).is_err());
+    }
+}

@@ -1,0 +1,214 @@
+//! Golden images: trilux renders against Mitsuba 3 references.
+//!
+//! References live in `tests/golden/` (made by
+//! `tests/golden/make_references.py`): `NAME.exr` (linear sRGB),
+//! `NAME.mask.exr` (1 where an emitter is directly visible, dilated by 1 px)
+//! and `NAME.json` (how it was made, its size and its own noise).
+//!
+//! Metrics: `trilux_render::compare` (relative RMSE `sqrt(Σ (a − r)² / Σ
+//! r²)` and mean ratio `Σ a / Σ r` over unmasked pixels and the three
+//! channels; both also over all pixels).
+//!
+//! Commands:
+//! - `cargo xtask golden compare IMAGE.exr REFERENCE.exr [--mask MASK.exr]`
+//!   prints the metrics of any two EXRs of the same size;
+//! - `cargo xtask golden [--spp N] [--quality Q] [--only NAME]...` solves and
+//!   renders every scene that has a reference, at the reference's size
+//!   (in-process, with the library the `trilux` command uses), and compares,
+//!   failing above [`MAX_REL_RMSE`] or outside [`MAX_MEAN_BIAS`].
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, bail};
+use trilux_render::{
+    Comparison, ExtraBounce, Image, RenderSettings, ViewOverrides, compare, solve_and_render,
+};
+use trilux_solver::{Quality, SolverSettings};
+
+/// Largest accepted relative RMSE (unmasked) of a trilux render at 64 spp
+/// against its reference: the final gather's own noise at 64 spp and
+/// 128×128 (1.4–1.9 % on the paper scenes, measured by `cargo xtask
+/// sweep`), plus the references' noise (≤ 0.4 %), plus at most about 3 % of
+/// solution bias.
+pub const MAX_REL_RMSE: f64 = 0.05;
+/// Largest accepted |mean ratio − 1| (unmasked): issue 5 asks for 1 %.
+pub const MAX_MEAN_BIAS: f64 = 0.01;
+
+/// The repository root (xtask lives one level below it).
+pub fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .map(Path::to_path_buf)
+        .unwrap_or_else(|| PathBuf::from("."))
+}
+
+/// One stored reference.
+#[derive(Clone, Debug)]
+pub struct Reference {
+    /// Scene name (file stem in scenes/).
+    pub name: String,
+    /// The reference image.
+    pub image: Image,
+    /// Its emitter mask, if stored.
+    pub mask: Option<Image>,
+    /// Its own estimated relative RMSE (from the sidecar JSON).
+    pub noise: Option<f64>,
+}
+
+/// Every reference in tests/golden/ (optionally only those named).
+pub fn references(only: &[String]) -> Result<Vec<Reference>> {
+    let dir = root().join("tests/golden");
+    let mut names: Vec<String> = std::fs::read_dir(&dir)
+        .with_context(|| format!("reading {}", dir.display()))?
+        .filter_map(|e| e.ok())
+        .filter_map(|e| {
+            let n = e.file_name().to_string_lossy().into_owned();
+            n.strip_suffix(".json").map(str::to_owned)
+        })
+        .filter(|n| only.is_empty() || only.contains(n))
+        .collect();
+    names.sort();
+    let mut out = Vec::new();
+    for name in names {
+        let image = Image::read_exr(&dir.join(format!("{name}.exr")))?;
+        let mask_path = dir.join(format!("{name}.mask.exr"));
+        let mask = if mask_path.exists() {
+            Some(Image::read_exr(&mask_path)?)
+        } else {
+            None
+        };
+        let json: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.join(format!("{name}.json")))?)
+                .with_context(|| format!("parsing tests/golden/{name}.json"))?;
+        let noise = json.get("noise_rel_rmse_unmasked").and_then(|v| v.as_f64());
+        out.push(Reference {
+            name,
+            image,
+            mask,
+            noise,
+        });
+    }
+    Ok(out)
+}
+
+/// One trilux run: solve plus render of `scenes/NAME.xml` at the given
+/// size, quality preset and samples per pixel, in-process through
+/// `trilux_render::solve_and_render` (the same code the command runs).
+pub struct TriluxRun {
+    /// The rendered image.
+    pub image: Image,
+    /// Seconds of the solve.
+    pub solve_seconds: f64,
+    /// Seconds of the render.
+    pub render_seconds: f64,
+    /// Convergence ratio reached.
+    pub convergence_ratio: f64,
+}
+
+/// Solves and renders `scenes/NAME.xml` (see [`TriluxRun`]).
+pub fn render_trilux(
+    name: &str,
+    width: u32,
+    height: u32,
+    quality: &str,
+    spp: u32,
+    extra: ExtraBounce,
+) -> Result<TriluxRun> {
+    let path = root().join(format!("scenes/{name}.xml"));
+    let scene = trilux_scene::load(&path).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let quality = match quality {
+        "draft" => Quality::Draft,
+        "default" => Quality::Default,
+        "high" => Quality::High,
+        other => bail!("unknown quality {other}"),
+    };
+    let camera = scene.camera.as_ref().context("the scene has no camera")?;
+    let settings = RenderSettings {
+        spp,
+        seed: 0,
+        extra_bounce: extra,
+        ..RenderSettings::for_scene(camera)
+    };
+    let view = ViewOverrides {
+        width: Some(width),
+        height: Some(height),
+        ..Default::default()
+    };
+    let (image, stats) =
+        solve_and_render(&scene, SolverSettings::preset(quality), &view, &settings)?;
+    Ok(TriluxRun {
+        image,
+        solve_seconds: stats.solve_seconds,
+        render_seconds: stats.render.seconds,
+        convergence_ratio: stats.solve.convergence_ratio,
+    })
+}
+
+fn print(name: &str, c: &Comparison) {
+    println!(
+        "{name:<20} relRMSE {:.4} (all pixels {:.4})  mean ratio {:.4} (all pixels {:.4})  masked {}",
+        c.rel_rmse, c.rel_rmse_all, c.mean_ratio, c.mean_ratio_all, c.masked
+    );
+}
+
+/// `cargo xtask golden ...`
+pub fn main(args: &[String]) -> Result<()> {
+    if args.first().map(String::as_str) == Some("compare") {
+        let [image, reference, rest @ ..] = &args[1..] else {
+            bail!("usage: cargo xtask golden compare IMAGE.exr REFERENCE.exr [--mask MASK.exr]");
+        };
+        let mask = match rest {
+            [flag, m] if flag == "--mask" => Some(Image::read_exr(Path::new(m))?),
+            [] => None,
+            _ => {
+                bail!("usage: cargo xtask golden compare IMAGE.exr REFERENCE.exr [--mask MASK.exr]")
+            }
+        };
+        let c = compare(
+            &Image::read_exr(Path::new(image))?,
+            &Image::read_exr(Path::new(reference))?,
+            mask.as_ref(),
+        )?;
+        print(image, &c);
+        return Ok(());
+    }
+    let mut spp = 64u32;
+    let mut quality = "default".to_string();
+    let mut only = Vec::new();
+    let mut it = args.iter();
+    while let Some(a) = it.next() {
+        match a.as_str() {
+            "--spp" => spp = it.next().context("--spp needs a value")?.parse()?,
+            "--quality" => quality = it.next().context("--quality needs a value")?.clone(),
+            "--only" => only.push(it.next().context("--only needs a scene name")?.clone()),
+            other => bail!("unknown argument {other}"),
+        }
+    }
+    let mut failed = Vec::new();
+    for r in references(&only)? {
+        let run = render_trilux(
+            &r.name,
+            r.image.width(),
+            r.image.height(),
+            &quality,
+            spp,
+            ExtraBounce::default(),
+        )?;
+        let c = compare(&run.image, &r.image, r.mask.as_ref())?;
+        print(&r.name, &c);
+        println!(
+            "{:<20} solve {:.2} s (CR {:.4}), render {:.2} s, reference noise {:?}",
+            "", run.solve_seconds, run.convergence_ratio, run.render_seconds, r.noise
+        );
+        if c.rel_rmse > MAX_REL_RMSE || (c.mean_ratio - 1.0).abs() > MAX_MEAN_BIAS {
+            failed.push(r.name.clone());
+        }
+    }
+    if !failed.is_empty() {
+        bail!(
+            "golden images differ beyond relRMSE {MAX_REL_RMSE} or mean bias {MAX_MEAN_BIAS}: {}",
+            failed.join(", ")
+        );
+    }
+    Ok(())
+}
