@@ -319,6 +319,39 @@ pub(crate) fn build_charts(mesh: &MeshData) -> Vec<Vec<u32>> {
     charts
 }
 
+/// Sorts pieces along the Morton (Z-order) curve of their centroids in their
+/// bounding box (21 bits per axis).
+pub(crate) fn morton_sort(pieces: &mut [Piece], mesh: &MeshData) {
+    if pieces.len() < 3 {
+        return;
+    }
+    let centroid = |p: &Piece| {
+        let [a, b, c] = p.corners(mesh);
+        (a + b + c) / 3.0
+    };
+    let mut lo = DVec3::splat(f64::INFINITY);
+    let mut hi = DVec3::splat(f64::NEG_INFINITY);
+    for p in pieces.iter() {
+        let c = centroid(p);
+        lo = lo.min(c);
+        hi = hi.max(c);
+    }
+    let scale = (hi - lo).max_element().max(1e-300);
+    let spread = |v: u64| {
+        let mut x = v & 0x1f_ffff;
+        x = (x | (x << 32)) & 0x1f_0000_0000_ffff;
+        x = (x | (x << 16)) & 0x1f_0000_ff00_00ff;
+        x = (x | (x << 8)) & 0x100f_00f0_0f00_f00f;
+        x = (x | (x << 4)) & 0x10c3_0c30_c30c_30c3;
+        (x | (x << 2)) & 0x1249_2492_4924_9249
+    };
+    let key = |p: &Piece| {
+        let q = (centroid(p) - lo) / scale * 2_097_151.0;
+        spread(q.x as u64) | (spread(q.y as u64) << 1) | (spread(q.z as u64) << 2)
+    };
+    pieces.sort_by_cached_key(key);
+}
+
 /// Splits a cluster's pieces into four non-empty groups (module docs).
 pub(crate) fn split_cluster(pieces: &[Piece], mesh: &MeshData) -> [Vec<Piece>; 4] {
     let area = |p: &Piece| mesh.tri_area[p.triangle as usize] * p.area_fraction();

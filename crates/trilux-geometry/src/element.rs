@@ -185,11 +185,15 @@ impl SceneGeometry {
         &mut self,
         surface: SurfaceId,
         mesh: u32,
-        pieces: Vec<Piece>,
+        mut pieces: Vec<Piece>,
         parent: Option<ElementId>,
         depth: u32,
     ) -> Element {
         let m = &self.meshes[mesh as usize];
+        // Order the pieces along a Morton curve of their centroids, so that
+        // the area-CDF sampling of `sample_element` maps stratified u.x to
+        // spatially stratified points.
+        crate::chart::morton_sort(&mut pieces, m);
         let mut area = 0.0;
         let mut sum_n = DVec3::ZERO;
         let mut sum_c = DVec3::ZERO;
