@@ -10,7 +10,10 @@
 //! pruning. Boxes are padded by 4e-6 × the scene's extent, and rays are
 //! first clipped (in f64) to the scene's box so that the f32 origin is never
 //! far outside it: the f32 ray error is then far below the padding, so the
-//! traversal never misses a primitive the f64 ray hits.
+//! traversal never misses a primitive the f64 ray hits. obvhs also culls
+//! boxes that end within 1e-4 (absolute) of the ray's origin, so the f32 ray
+//! starts 2e-4 + 2 × padding before the first point of interest (found by a
+//! Mitsuba cross-check: a ray entering an axis-aligned cube face missed it).
 //!
 //! # Robustness
 //!
@@ -448,7 +451,11 @@ impl SceneGeometry {
         if tn > tf {
             return None;
         }
-        let start = tn.max(tmin).max(0.0);
+        // obvhs culls every box whose exit lies within 1e-4 (absolute) of the
+        // traversal ray's origin (`EPSILON` in its node test): start the f32
+        // ray a little before the first point we care about.
+        let back = 2e-4 + 2.0 * self.bvh.pad;
+        let start = tn.max(tmin).max(0.0) - back / len;
         let origin = o + start * d;
         let dn = d / len;
         let span = ((tf - start) * len) as f32;
