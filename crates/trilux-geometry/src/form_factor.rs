@@ -21,9 +21,9 @@
 //!   over the receiver and using reciprocity A_i F_ij = A_j F_ji.
 //! - **Neither polygonal** (disks, sphere and cylinder pieces): adaptive
 //!   cubature of the kernel over the pair (the product of the two degree-5
-//!   rules, refined by splitting the larger element, as hierarchical
-//!   radiosity refines links, up to `max_depth + 2` splits): a
-//!   deterministic point-sampled estimate.
+//!   rules; each step compares splitting either element and refines the one
+//!   that matters more, as hierarchical radiosity refines links, up to
+//!   `max_depth + 2` splits): a deterministic point-sampled estimate.
 //! - **Large clusters** (more than [`MAX_POLYGON_PIECES`] pieces on a side
 //!   that must be integrated): a stratified (Owen-scrambled Sobol) sampled
 //!   estimate with `samples` points, Lambert's form on the other side when
@@ -183,13 +183,18 @@ impl QDom<'_> {
         out
     }
 
-    /// A size measure: the longest corner-to-corner distance.
+    /// A size measure: the diagonal of the box of a 3×3 grid of the domain
+    /// (corners alone miss the extent of disk sectors and annuli).
     fn size(&self) -> f64 {
         match *self {
             QDom::Rect { patch, min, max } => {
-                let p = [min, DVec2::new(max.x, min.y), max, DVec2::new(min.x, max.y)]
-                    .map(|uv| patch.eval(uv).p);
-                (p[0] - p[2]).length().max((p[1] - p[3]).length())
+                let d = max - min;
+                let b = crate::bounds::Bounds::from_points((0..9).map(|k| {
+                    patch
+                        .eval(min + d * DVec2::new((k % 3) as f64 * 0.5, (k / 3) as f64 * 0.5))
+                        .p
+                }));
+                b.diagonal().length()
             }
             QDom::Tri { v: [a, b, c], .. } => {
                 (a - b).length().max((b - c).length()).max((c - a).length())
@@ -297,30 +302,31 @@ fn pair_rule(a: &QDom<'_>, b: &QDom<'_>) -> f64 {
         .sum()
 }
 
-/// Adaptive cubature of the kernel over a pair of domains, splitting the
-/// larger one (as hierarchical radiosity refines links).
+/// Adaptive cubature of the kernel over a pair of domains. Both one-sided
+/// refinements (split `a`, split `b`) are compared with the parent
+/// estimate: the error is the larger difference (refining one side alone
+/// cannot see the other side's rule error), and the side whose refinement
+/// changed the estimate most is refined further (as hierarchical radiosity
+/// refines the link's worse end).
 fn pair_adaptive(a: &QDom<'_>, b: &QDom<'_>, q0: f64, tol: f64, depth: u32) -> (f64, f64) {
-    let split_a = a.size() >= b.size();
-    let children = if split_a { a.split() } else { b.split() };
-    let qs = children.map(|c| {
-        if split_a {
-            pair_rule(&c, b)
-        } else {
-            pair_rule(a, &c)
-        }
-    });
-    let q1: f64 = qs.iter().sum();
-    let err = (q1 - q0).abs();
-    if err <= tol || depth == 0 {
-        return (q1, err);
+    let ca = a.split();
+    let cb = b.split();
+    let qa = ca.map(|c| pair_rule(&c, b));
+    let qb = cb.map(|c| pair_rule(a, &c));
+    let (sa, sb): (f64, f64) = (qa.iter().sum(), qb.iter().sum());
+    let (ea, eb) = ((sa - q0).abs(), (sb - q0).abs());
+    let split_a = ea > eb || (ea == eb && a.size() >= b.size());
+    let q1 = if split_a { sa } else { sb };
+    if ea.max(eb) <= tol || depth == 0 {
+        return (q1, ea.max(eb));
     }
     let mut v = 0.0;
     let mut e = 0.0;
-    for (c, q) in children.iter().zip(qs) {
+    for k in 0..4 {
         let (cv, ce) = if split_a {
-            pair_adaptive(c, b, q, 0.5 * tol, depth - 1)
+            pair_adaptive(&ca[k], b, qa[k], 0.5 * tol, depth - 1)
         } else {
-            pair_adaptive(a, c, q, 0.5 * tol, depth - 1)
+            pair_adaptive(a, &cb[k], qb[k], 0.5 * tol, depth - 1)
         };
         v += cv;
         e += ce;
