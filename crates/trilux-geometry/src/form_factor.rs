@@ -52,6 +52,25 @@ use crate::surface::SurfaceGeom;
 /// (Lambert's formula, deterministic cubature); larger ones are sampled.
 pub const MAX_POLYGON_PIECES: usize = 8;
 
+/// Which side of an element light leaves or arrives on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Side {
+    /// The front (the side the normal points to, after `flip_normals`).
+    Front,
+    /// The back.
+    Back,
+}
+
+impl Side {
+    /// +1 for the front, −1 for the back.
+    pub fn sign(self) -> f64 {
+        match self {
+            Side::Front => 1.0,
+            Side::Back => -1.0,
+        }
+    }
+}
+
 /// A form factor estimate.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct FormFactor {
@@ -101,6 +120,8 @@ pub(crate) enum QDom<'a> {
         patch: &'a Patch,
         min: DVec2,
         max: DVec2,
+        /// ±1: which side's normal the rules report.
+        s: f64,
     },
     Tri {
         v: [DVec3; 3],
@@ -111,28 +132,32 @@ pub(crate) enum QDom<'a> {
 impl QDom<'_> {
     fn split(&self) -> [Self; 4] {
         match *self {
-            QDom::Rect { patch, min, max } => {
+            QDom::Rect { patch, min, max, s } => {
                 let mid = 0.5 * (min + max);
                 [
                     QDom::Rect {
                         patch,
                         min,
                         max: mid,
+                        s,
                     },
                     QDom::Rect {
                         patch,
                         min: DVec2::new(mid.x, min.y),
                         max: DVec2::new(max.x, mid.y),
+                        s,
                     },
                     QDom::Rect {
                         patch,
                         min: DVec2::new(min.x, mid.y),
                         max: DVec2::new(mid.x, max.y),
+                        s,
                     },
                     QDom::Rect {
                         patch,
                         min: mid,
                         max,
+                        s,
                     },
                 ]
             }
@@ -151,10 +176,10 @@ impl QDom<'_> {
     /// The one-point (centre) rule: a cheap first estimate.
     fn centre_rule(&self, f: &mut dyn FnMut(DVec3, DVec3) -> (f64, f64)) -> f64 {
         match *self {
-            QDom::Rect { patch, min, max } => {
+            QDom::Rect { patch, min, max, s } => {
                 let d = max - min;
                 let pp = patch.eval(min + 0.5 * d);
-                pp.jacobian() * d.x * d.y * f(pp.p, pp.n).0
+                pp.jacobian() * d.x * d.y * f(pp.p, s * pp.n).0
             }
             QDom::Tri { v: [a, b, c], n } => triangle_area(a, b, c) * f((a + b + c) / 3.0, n).0,
         }
@@ -164,12 +189,16 @@ impl QDom<'_> {
     fn points(&self) -> Vec<(DVec3, DVec3, f64)> {
         let mut out = Vec::with_capacity(9);
         match *self {
-            QDom::Rect { patch, min, max } => {
+            QDom::Rect { patch, min, max, s } => {
                 let d = max - min;
                 for i in 0..3 {
                     for j in 0..3 {
                         let pp = patch.eval(min + d * DVec2::new(GL3_X[i], GL3_X[j]));
-                        out.push((pp.p, pp.n, GL3_W[i] * GL3_W[j] * pp.jacobian() * d.x * d.y));
+                        out.push((
+                            pp.p,
+                            s * pp.n,
+                            GL3_W[i] * GL3_W[j] * pp.jacobian() * d.x * d.y,
+                        ));
                     }
                 }
             }
@@ -187,7 +216,9 @@ impl QDom<'_> {
     /// (corners alone miss the extent of disk sectors and annuli).
     fn size(&self) -> f64 {
         match *self {
-            QDom::Rect { patch, min, max } => {
+            QDom::Rect {
+                patch, min, max, ..
+            } => {
                 let d = max - min;
                 let b = crate::bounds::Bounds::from_points((0..9).map(|k| {
                     patch
@@ -204,18 +235,18 @@ impl QDom<'_> {
 
     /// Applies the degree-5 rule: Σ w f(x, n), and Σ w · (inner error).
     fn rule(&self, f: &mut dyn FnMut(DVec3, DVec3) -> (f64, f64)) -> (f64, f64) {
-        let mut s = 0.0;
+        let mut sum = 0.0;
         let mut e = 0.0;
         match *self {
-            QDom::Rect { patch, min, max } => {
+            QDom::Rect { patch, min, max, s } => {
                 let d = max - min;
                 for i in 0..3 {
                     for j in 0..3 {
                         let uv = min + d * DVec2::new(GL3_X[i], GL3_X[j]);
                         let pp = patch.eval(uv);
                         let w = GL3_W[i] * GL3_W[j] * pp.jacobian() * d.x * d.y;
-                        let (v, ve) = f(pp.p, pp.n);
-                        s += w * v;
+                        let (v, ve) = f(pp.p, s * pp.n);
+                        sum += w * v;
                         e += w * ve;
                     }
                 }
@@ -225,12 +256,12 @@ impl QDom<'_> {
                 for (l, w) in TRI7 {
                     let p = l[0] * a + l[1] * b + l[2] * c;
                     let (v, ve) = f(p, n);
-                    s += w * area * v;
+                    sum += w * area * v;
                     e += w * area * ve;
                 }
             }
         }
-        (s, e)
+        (sum, e)
     }
 }
 
@@ -471,8 +502,8 @@ pub(crate) fn seed_of(a: ElementId, b: ElementId) -> u32 {
 }
 
 impl SceneGeometry {
-    /// The element as polygons, if it is polygonal.
-    pub(crate) fn element_polygons(&self, id: ElementId) -> Option<Vec<Poly>> {
+    /// The element as polygons (fronts on side `s` = ±1), if it is polygonal.
+    pub(crate) fn element_polygons(&self, id: ElementId, s: f64) -> Option<Vec<Poly>> {
         let e = &self.elements[id.index()];
         match (e.domain, &self.surfaces[e.surface.index()].geom) {
             (ElementDomain::Rect { min, max }, SurfaceGeom::Patch(patch))
@@ -485,7 +516,7 @@ impl SceneGeometry {
                 Some(vec![Poly {
                     v,
                     len: 4,
-                    n: *normal,
+                    n: s * *normal,
                 }])
             }
             (ElementDomain::Cluster { count, .. }, SurfaceGeom::Chart { mesh })
@@ -500,7 +531,7 @@ impl SceneGeometry {
                             Poly {
                                 v: [a, b, c, c],
                                 len: 3,
-                                n: m.tri_normal[p.triangle as usize],
+                                n: s * m.tri_normal[p.triangle as usize],
                             }
                         })
                         .collect(),
@@ -510,12 +541,13 @@ impl SceneGeometry {
         }
     }
 
-    /// The element as integration domains, unless it is a large cluster.
-    pub(crate) fn element_domains(&self, id: ElementId) -> Option<Vec<QDom<'_>>> {
+    /// The element as integration domains (normals on side `s` = ±1), unless
+    /// it is a large cluster.
+    pub(crate) fn element_domains(&self, id: ElementId, s: f64) -> Option<Vec<QDom<'_>>> {
         let e = &self.elements[id.index()];
         match (e.domain, &self.surfaces[e.surface.index()].geom) {
             (ElementDomain::Rect { min, max }, SurfaceGeom::Patch(patch)) => {
-                Some(vec![QDom::Rect { patch, min, max }])
+                Some(vec![QDom::Rect { patch, min, max, s }])
             }
             (ElementDomain::Cluster { count, .. }, SurfaceGeom::Chart { mesh })
                 if count as usize <= MAX_POLYGON_PIECES =>
@@ -526,7 +558,7 @@ impl SceneGeometry {
                         .iter()
                         .map(|p| QDom::Tri {
                             v: p.corners(m),
-                            n: m.tri_normal[p.triangle as usize],
+                            n: s * m.tri_normal[p.triangle as usize],
                         })
                         .collect(),
                 )
@@ -560,6 +592,22 @@ impl SceneGeometry {
         to: ElementId,
         opts: &FormFactorOptions,
     ) -> FormFactor {
+        self.form_factor_sided(from, Side::Front, to, Side::Front, opts)
+    }
+
+    /// Unoccluded form factor from one side of `from` to one side of `to`
+    /// (for two-sided materials: light leaving the back of an element, or
+    /// arriving on its back), with the same method and accuracy as
+    /// [`SceneGeometry::form_factor_with`].
+    pub fn form_factor_sided(
+        &self,
+        from: ElementId,
+        from_side: Side,
+        to: ElementId,
+        to_side: Side,
+        opts: &FormFactorOptions,
+    ) -> FormFactor {
+        let (sf, st) = (from_side.sign(), to_side.sign());
         let a_from = self.elements[from.index()].area;
         let a_to = self.elements[to.index()].area;
         if from == to && self.elements[from.index()].planar {
@@ -567,8 +615,8 @@ impl SceneGeometry {
         }
         let depth = opts.max_depth;
         let tol = opts.rel_tol.max(1e-14);
-        let to_polys = self.element_polygons(to);
-        let from_doms = self.element_domains(from);
+        let to_polys = self.element_polygons(to, st);
+        let from_doms = self.element_domains(from, sf);
         let mut lo = f64::INFINITY;
         let mut hi = f64::NEG_INFINITY;
         let result = |v: f64, e: f64, lo: f64, hi: f64| FormFactor {
@@ -586,8 +634,8 @@ impl SceneGeometry {
             let (v, e) = integrate(doms, &mut f, tol, depth);
             return result(v / a_from, e / a_from, lo, hi);
         }
-        let from_polys = self.element_polygons(from);
-        let to_doms = self.element_domains(to);
+        let from_polys = self.element_polygons(from, sf);
+        let to_doms = self.element_domains(to, st);
         let ratio = a_to / a_from;
         if let (Some(polys), Some(doms)) = (&from_polys, &to_doms) {
             let mut f = |y: DVec3, m: DVec3| {
@@ -608,24 +656,24 @@ impl SceneGeometry {
         // `samples` pieces.
         let seed = seed_of(from, to);
         let (values, weights): (Vec<f64>, Vec<f64>) = if let Some(polys) = &to_polys {
-            self.stratified_points(from, seed, 0, opts.samples)
+            self.stratified_points(from, seed, 0, opts.samples, sf)
                 .into_iter()
                 .map(|(x, n, w)| (lambert_sum(x, n, polys), w))
                 .unzip()
         } else if let Some(polys) = &from_polys {
-            self.stratified_points(to, seed, 2, opts.samples)
+            self.stratified_points(to, seed, 2, opts.samples, st)
                 .into_iter()
                 .map(|(y, m, w)| (lambert_sum(y, m, polys) * a_to / a_from, w * a_from / a_to))
                 .unzip()
         } else {
-            let xs = self.stratified_points(from, seed, 0, opts.samples);
+            let xs = self.stratified_points(from, seed, 0, opts.samples, sf);
             let n = xs.len() as u32;
             xs.into_iter()
                 .enumerate()
                 .map(|(k, (x, nx, w))| {
                     let y = self.sample_element(to, sobol2(k as u32 % n, 2, seed));
                     let g = if y.pdf_area > 0.0 {
-                        (kernel(x, nx, y.point, y.normal) / y.pdf_area).min(1.0)
+                        (kernel(x, nx, y.point, st * y.normal) / y.pdf_area).min(1.0)
                     } else {
                         0.0
                     };
@@ -664,6 +712,7 @@ impl SceneGeometry {
         seed: u32,
         dim: u32,
         samples: u32,
+        sign: f64,
     ) -> Vec<(DVec3, DVec3, f64)> {
         let samples = samples.clamp(4, 1 << 16);
         let e = &self.elements[id.index()];
@@ -682,7 +731,11 @@ impl SceneGeometry {
                         let l = crate::sampling::square_to_triangle(sobol2(k as u32, dim, seed));
                         let b = l[0] * p.bary[0] + l[1] * p.bary[1] + l[2] * p.bary[2];
                         let a = m.tri_area[p.triangle as usize] * p.area_fraction();
-                        (m.point(p.triangle, b), m.tri_normal[p.triangle as usize], a)
+                        (
+                            m.point(p.triangle, b),
+                            sign * m.tri_normal[p.triangle as usize],
+                            a,
+                        )
                     })
                     .collect();
             }
@@ -695,7 +748,7 @@ impl SceneGeometry {
                 } else {
                     0.0
                 };
-                (s.point, s.normal, w)
+                (s.point, sign * s.normal, w)
             })
             .collect()
     }

@@ -50,7 +50,8 @@ pub use chart::{CHART_CONE_DEG, CHART_MAX_TRIANGLES, Piece};
 pub use element::{Element, ElementDomain};
 pub use error::{GeometryError, ShapeProblem};
 pub use form_factor::{
-    FormFactor, FormFactorOptions, MAX_POLYGON_PIECES, point_to_polygon, point_to_polygon_front,
+    FormFactor, FormFactorOptions, MAX_POLYGON_PIECES, Side, point_to_polygon,
+    point_to_polygon_front,
 };
 pub use ids::{ElementId, SurfaceId};
 pub use sampling::SurfaceSample;

@@ -11,14 +11,27 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
-use crate::form_factor::{seed_of, sobol2};
+use crate::form_factor::{Side, seed_of, sobol2};
 use crate::ids::ElementId;
 use crate::scene_geometry::SceneGeometry;
 
 impl SceneGeometry {
     /// Visible fraction between elements `a` and `b` from `samples` shadow
-    /// segments (at most 65 536).
+    /// segments (at most 65 536), counting the segments between their fronts.
     pub fn visibility(&self, a: ElementId, b: ElementId, samples: u32) -> f64 {
+        self.visibility_sided(a, Side::Front, b, Side::Front, samples)
+    }
+
+    /// [`SceneGeometry::visibility`] between given sides of the elements
+    /// (the facing test uses those sides' normals).
+    pub fn visibility_sided(
+        &self,
+        a: ElementId,
+        a_side: Side,
+        b: ElementId,
+        b_side: Side,
+        samples: u32,
+    ) -> f64 {
         let n = samples.clamp(1, 1 << 16);
         let seed = seed_of(a, b);
         let mut facing = 0u32;
@@ -28,7 +41,8 @@ impl SceneGeometry {
             let x = self.sample_element(a, sobol2(k, 0, seed));
             let y = self.sample_element(b, sobol2(k, 2, seed ^ 0x5bd1_e995));
             let d = y.point - x.point;
-            let faces = x.normal.dot(d) > 0.0 && y.normal.dot(d) < 0.0;
+            let faces =
+                a_side.sign() * x.normal.dot(d) > 0.0 && b_side.sign() * y.normal.dot(d) < 0.0;
             let vis = !self.occluded(x.point, y.point);
             visible += u32::from(vis);
             if faces {
