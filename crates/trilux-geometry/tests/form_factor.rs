@@ -484,3 +484,34 @@ fn sided_form_factors() {
         .sum();
     assert_eq!(outside, 0.0);
 }
+
+#[test]
+fn inside_a_sphere_every_form_factor_is_the_area_fraction() {
+    // Inside a sphere, F(dA → region) = A_region / (4π r²) for any region:
+    // between the eight pieces of a flipped sphere (normals inwards), every
+    // F_ij = 1/8, including i = j and pieces sharing an edge or a pole.
+    let g = SceneGeometry::build(&[sphere(
+        DVec3::new(0.3, -0.2, 0.1),
+        1.7,
+        glam::DMat4::IDENTITY,
+        true,
+    )])
+    .expect("valid");
+    assert!(g.surfaces().iter().all(|s| s.can_see_itself()));
+    let o = FormFactorOptions::default();
+    let mut worst: f64 = 0.0;
+    for i in 0..8 {
+        let mut row = 0.0;
+        for j in 0..8 {
+            let f = g.form_factor_with(g.surfaces()[i].root, g.surfaces()[j].root, &o);
+            assert!(
+                (f.value - 0.125).abs() <= f.error.max(1e-3 * 0.125),
+                "{i}→{j}: {f:?}"
+            );
+            worst = worst.max((f.value - 0.125).abs() / 0.125);
+            row += f.value;
+        }
+        assert!((row - 1.0).abs() < 5e-3, "row {i}: {row}");
+    }
+    println!("worst relative deviation {worst:.2e}");
+}
