@@ -124,3 +124,20 @@ fn subdivide_locate_sample() {
     }
     let _ = SurfaceCoord::Uv(DVec2::ZERO);
 }
+
+#[test]
+fn scene_geometry_is_shareable_across_threads() {
+    fn check<T: Send + Sync + Clone>() {}
+    check::<SceneGeometry>();
+    // Reading in parallel while elements exist.
+    let g = scene();
+    let rays: Vec<Ray> = (0..1000)
+        .map(|k| Ray {
+            origin: DVec3::ZERO,
+            dir: DVec3::new((k as f64).sin(), (k as f64).cos(), 0.3),
+        })
+        .collect();
+    let a = g.intersect_batch(&rays, f64::INFINITY);
+    let b: Vec<_> = rays.iter().map(|r| g.intersect(r, f64::INFINITY)).collect();
+    assert_eq!(a, b);
+}
