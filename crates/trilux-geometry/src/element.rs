@@ -48,7 +48,8 @@ pub struct Element {
     pub parent: Option<ElementId>,
     /// Depth below the root (root = 0).
     pub depth: u32,
-    /// Area (exact, see [`crate::patch`] and [`crate::chart`]).
+    /// Area (exact: closed forms or adaptive quadrature for parametric
+    /// pieces, sums of triangle areas for clusters; see [`crate::chart`]).
     pub area: f64,
     /// A point on the element near its middle: the image of the uv centre,
     /// or for a cluster the centroid of the piece nearest the area centroid.

@@ -515,3 +515,40 @@ fn inside_a_sphere_every_form_factor_is_the_area_fraction() {
     }
     println!("worst relative deviation {worst:.2e}");
 }
+
+/// A flat n×n-quad sheet (2n² triangles) of side 1 centred at `c`, normal
+/// +z (or −z when `down`).
+fn sheet(n: u32, c: DVec3, down: bool) -> trilux_geometry::Shape {
+    let mut p = Vec::new();
+    for j in 0..=n {
+        for i in 0..=n {
+            p.push(c + DVec3::new(i as f64 / n as f64 - 0.5, j as f64 / n as f64 - 0.5, 0.0));
+        }
+    }
+    let mut t = Vec::new();
+    for j in 0..n {
+        for i in 0..n {
+            let a = j * (n + 1) + i;
+            if down {
+                t.push([a, a + n + 2, a + 1]);
+                t.push([a, a + n + 1, a + n + 2]);
+            } else {
+                t.push([a, a + 1, a + n + 2]);
+                t.push([a, a + n + 2, a + n + 1]);
+            }
+        }
+    }
+    mesh(p, t, glam::DMat4::IDENTITY)
+}
+
+#[test]
+fn chart_to_chart_form_factor() {
+    // Two parallel 512-triangle charts one unit apart: closed form (a).
+    let g = two(sheet(16, DVec3::ZERO, false), sheet(16, Z, true));
+    assert_eq!(g.surfaces().len(), 2);
+    let (a, b) = (g.surfaces()[0].root, g.surfaces()[1].root);
+    let f = g.form_factor(a, b);
+    println!("chart→chart {f:?}");
+    assert!((f.value - 0.199825).abs() <= f.error.max(1e-6), "{f:?}");
+    assert!(rel(f.value, 0.199825) < 5e-3, "{f:?}");
+}
