@@ -11,7 +11,10 @@
 //!   is Lambert's closed form for a point and a polygon,
 //!   F(dA_x → P) = (1/2π) |Σ_e β_e n_x · u_e| (notes/validation.md), after
 //!   clipping P to x's tangent plane and dropping pieces whose front does not
-//!   face x. The outer integral over the sender is adaptive cubature: a
+//!   face x. The sender is first clipped to the receiver's front half-space
+//!   when the receiver is planar (the integrand vanishes behind it, with a
+//!   kink along the plane). The outer integral over the sender is adaptive
+//!   cubature: a
 //!   degree-5 rule (3×3 Gauss–Legendre on uv rectangles, Dunavant's 7-point
 //!   rule on triangles) on a domain is compared with the same rule on its
 //!   four children; where they differ by more than the tolerance the
@@ -468,6 +471,81 @@ fn lambert_sum(x: DVec3, n: DVec3, polys: &[Poly]) -> f64 {
         .min(1.0)
 }
 
+/// The part of planar integration domains in front of the common plane of
+/// `polys` (when they are coplanar): only there is Lambert's integrand
+/// non-zero, and it has a kink along that plane that the cubature would
+/// otherwise have to resolve. Domains entirely in front are kept as they
+/// are, domains entirely behind are dropped, the others are clipped and
+/// fanned into triangles. Curved domains are kept unchanged.
+fn clip_to_plane<'a>(doms: &[QDom<'a>], polys: &[Poly]) -> Vec<QDom<'a>> {
+    let Some(first) = polys.first() else {
+        return Vec::new();
+    };
+    let (n, p0) = (first.n, first.v[0]);
+    let scale = polys
+        .iter()
+        .flat_map(|p| p.v[..p.len].iter())
+        .map(|v| (*v - p0).length())
+        .fold(0.0, f64::max);
+    let coplanar = polys.iter().all(|p| {
+        p.n.dot(n) > 1.0 - 1e-12
+            && p.v[..p.len]
+                .iter()
+                .all(|v| n.dot(*v - p0).abs() <= 1e-12 * scale.max(1e-300))
+    });
+    if !coplanar {
+        return doms.to_vec();
+    }
+    let mut out = Vec::with_capacity(doms.len());
+    for d in doms {
+        let (corners, normal): (Vec<DVec3>, DVec3) = match *d {
+            QDom::Rect { patch, min, max, s }
+                if patch.is_planar() && matches!(patch, Patch::Quad { .. }) =>
+            {
+                (
+                    [min, DVec2::new(max.x, min.y), max, DVec2::new(min.x, max.y)]
+                        .iter()
+                        .map(|&uv| patch.eval(uv).p)
+                        .collect(),
+                    s * patch.eval(min).n,
+                )
+            }
+            QDom::Tri { v, n } => (v.to_vec(), n),
+            _ => {
+                out.push(*d);
+                continue;
+            }
+        };
+        let dist: Vec<f64> = corners.iter().map(|c| n.dot(*c - p0)).collect();
+        if dist.iter().all(|&x| x >= 0.0) {
+            out.push(*d);
+            continue;
+        }
+        if dist.iter().all(|&x| x <= 0.0) {
+            continue;
+        }
+        let k = corners.len();
+        let mut poly = Vec::with_capacity(k + 1);
+        for i in 0..k {
+            let (a, b) = (corners[i], corners[(i + 1) % k]);
+            let (da, db) = (dist[i], dist[(i + 1) % k]);
+            if da >= 0.0 {
+                poly.push(a);
+            }
+            if (da >= 0.0) != (db >= 0.0) {
+                poly.push(a + (b - a) * (da / (da - db)));
+            }
+        }
+        for i in 1..poly.len().saturating_sub(1) {
+            let t = [poly[0], poly[i], poly[i + 1]];
+            if triangle_area(t[0], t[1], t[2]) > 0.0 {
+                out.push(QDom::Tri { v: t, n: normal });
+            }
+        }
+    }
+    out
+}
+
 /// The point-to-point kernel cos θ_x cos θ_y / (π r²), one-sided.
 #[inline]
 fn kernel(x: DVec3, nx: DVec3, y: DVec3, ny: DVec3) -> f64 {
@@ -631,7 +709,11 @@ impl SceneGeometry {
                 hi = hi.max(g);
                 (g, 0.0)
             };
-            let (v, e) = integrate(doms, &mut f, tol, depth);
+            let doms = clip_to_plane(doms, polys);
+            if doms.is_empty() {
+                return FormFactor::default();
+            }
+            let (v, e) = integrate(&doms, &mut f, tol, depth);
             return result(v / a_from, e / a_from, lo, hi);
         }
         let from_polys = self.element_polygons(from, sf);
@@ -644,7 +726,11 @@ impl SceneGeometry {
                 hi = hi.max(g * ratio);
                 (g, 0.0)
             };
-            let (v, e) = integrate(doms, &mut f, tol, depth);
+            let doms = clip_to_plane(doms, polys);
+            if doms.is_empty() {
+                return FormFactor::default();
+            }
+            let (v, e) = integrate(&doms, &mut f, tol, depth);
             return result(v / a_from, e / a_from, lo, hi);
         }
         if let (Some(fd), Some(td)) = (&from_doms, &to_doms) {
