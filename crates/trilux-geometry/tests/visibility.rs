@@ -102,3 +102,41 @@ fn unblocked_and_fully_blocked() {
         0.0
     );
 }
+
+#[test]
+fn concave_surfaces_see_their_own_pieces() {
+    use glam::DMat4;
+    use trilux_geometry::Side;
+    // Inside a sphere (flipped) and inside a tube (back sides), every pair
+    // of pieces, including a piece with itself, is fully visible: the
+    // chords touch the surface only at their ends.
+    let g = SceneGeometry::build(&[
+        sphere(DVec3::new(0.1, 0.2, 0.3), 1.3, DMat4::IDENTITY, true),
+        cylinder(
+            DVec3::new(5.0, 0.0, 0.0),
+            DVec3::new(5.0, 0.0, 3.0),
+            0.8,
+            DMat4::IDENTITY,
+            false,
+        ),
+    ])
+    .expect("valid");
+    for i in 0..8 {
+        for j in 0..8 {
+            let v = g.visibility(g.surfaces()[i].root, g.surfaces()[j].root, 256);
+            assert_eq!(v, 1.0, "sphere pieces {i} {j}");
+        }
+    }
+    for i in 8..12 {
+        for j in 8..12 {
+            let v = g.visibility_sided(
+                g.surfaces()[i].root,
+                Side::Back,
+                g.surfaces()[j].root,
+                Side::Back,
+                256,
+            );
+            assert_eq!(v, 1.0, "tube pieces {i} {j}");
+        }
+    }
+}
