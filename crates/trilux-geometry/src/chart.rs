@@ -62,6 +62,9 @@ pub(crate) struct MeshData {
     pub tri_area: Vec<f64>,
     /// Input surface of each triangle (`u32::MAX` for degenerate ones).
     pub tri_surface: Vec<u32>,
+    /// The deepest existing element whose pieces include each whole
+    /// triangle (a shortcut for `locate`; `u32::MAX` before the roots exist).
+    pub tri_element: Vec<u32>,
     /// +1 or −1 (flip_normals), applied to shading normals.
     pub sign: f64,
 }
@@ -112,6 +115,11 @@ pub struct Piece {
 }
 
 impl Piece {
+    /// True if this piece is its whole triangle.
+    pub fn is_whole(&self) -> bool {
+        self.bary == [DVec2::ZERO, DVec2::X, DVec2::Y]
+    }
+
     /// The whole triangle.
     pub fn whole(triangle: u32) -> Piece {
         Piece {

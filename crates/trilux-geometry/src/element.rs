@@ -241,6 +241,13 @@ impl SceneGeometry {
         }
         let first = self.pieces.len() as u32;
         let count = pieces.len() as u32;
+        // The caller pushes this element next: it becomes the deepest
+        // element holding each of its whole triangles.
+        let id = self.elements.len() as u32;
+        let mesh_data = &mut self.meshes[mesh as usize];
+        for p in pieces.iter().filter(|p| p.is_whole()) {
+            mesh_data.tri_element[p.triangle as usize] = id;
+        }
         self.pieces.extend(pieces);
         Element {
             surface,
@@ -277,6 +284,19 @@ impl SceneGeometry {
     /// root if the coordinate kind does not match the surface).
     pub fn locate(&self, surface: SurfaceId, coord: SurfaceCoord) -> ElementId {
         let mut id = self.surfaces[surface.index()].root;
+        // Charts: jump to the deepest element holding the whole triangle
+        // (below it, clusters have fewer than 4 pieces).
+        if let (SurfaceGeom::Chart { mesh }, SurfaceCoord::Triangle { index, .. }) =
+            (&self.surfaces[surface.index()].geom, coord)
+        {
+            let m = &self.meshes[*mesh as usize];
+            if m.tri_surface.get(index as usize) == Some(&surface.0) {
+                let e = m.tri_element[index as usize];
+                if e != u32::MAX {
+                    id = ElementId(e);
+                }
+            }
+        }
         while let Some(children) = self.elements[id.index()].children() {
             let next = match (self.elements[id.index()].domain, coord) {
                 (ElementDomain::Rect { min, max }, SurfaceCoord::Uv(uv)) => {

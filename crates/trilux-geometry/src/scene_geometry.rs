@@ -408,6 +408,7 @@ impl SceneGeometry {
             tri_normal,
             tri_area,
             tri_surface: vec![u32::MAX; mesh.triangles.len()],
+            tri_element: vec![u32::MAX; mesh.triangles.len()],
             sign,
         };
         let charts = build_charts(&data);

@@ -177,3 +177,46 @@ fn concave_and_convex_charts() {
             .all(|s| g.element(s.root).normal.z > 0.0)
     );
 }
+
+#[test]
+fn locate_agrees_with_a_descent_from_the_root() {
+    // Uneven subdivision, then every sampled point is located both by
+    // `locate` (which jumps to the deepest element holding the whole
+    // triangle) and by descending from the root through the children that
+    // contain it.
+    let (p, t) = curved_sheet(24);
+    let mut g = SceneGeometry::build(&[mesh(p, t, DMat4::IDENTITY)]).expect("valid mesh");
+    let mut frontier: Vec<ElementId> = g.surfaces().iter().map(|s| s.root).collect();
+    for level in 0..7 {
+        let next: Vec<ElementId> = frontier
+            .iter()
+            .enumerate()
+            .filter(|(k, _)| (k + level) % 3 != 0)
+            .flat_map(|(_, &e)| g.subdivide(e))
+            .collect();
+        frontier = next;
+    }
+    let reference = |g: &SceneGeometry, s: trilux_geometry::SurfaceId, c: SurfaceCoord| {
+        let mut id = g.surface(s).root;
+        while let Some(kids) = g.element(id).children() {
+            match kids.iter().find(|&&k| g.element_contains(k, c)) {
+                Some(&k) => id = k,
+                None => break,
+            }
+        }
+        id
+    };
+    let mut checked = 0;
+    for e in 0..g.element_count() as u32 {
+        for k in 0..3 {
+            let smp = g.sample_element(
+                ElementId(e),
+                DVec2::new(0.13 + 0.3 * k as f64, 0.71 - 0.2 * k as f64),
+            );
+            let s = g.element(ElementId(e)).surface;
+            assert_eq!(g.locate(s, smp.coord), reference(&g, s, smp.coord));
+            checked += 1;
+        }
+    }
+    assert!(checked > 3000, "{checked}");
+}
