@@ -1,7 +1,7 @@
 //! Shape conventions against Mitsuba 3: ray hits (t and geometric normal)
 //! recorded from Mitsuba 3.9 (scalar_rgb, float32) by
 //! `tests/data/mitsuba_hits.py`, for rectangles, cubes, disks, spheres and
-//! cylinders with transforms and `flip_normals`.
+//! cylinders and OBJ meshes (one mirrored) with transforms and `flip_normals`.
 
 use glam::{DMat4, DVec3};
 use trilux_geometry::{Ray, SceneGeometry, Shape, ShapeKind};
@@ -40,6 +40,25 @@ fn hits_match_mitsuba() {
                         p1: DVec3::new(extra[3], extra[4], extra[5]),
                         radius: extra[6],
                     },
+                    "obj" => {
+                        let nv = extra[0] as usize;
+                        let positions = (0..nv)
+                            .map(|k| {
+                                DVec3::new(extra[1 + 3 * k], extra[2 + 3 * k], extra[3 + 3 * k])
+                            })
+                            .collect();
+                        let nt = extra[1 + 3 * nv] as usize;
+                        let base = 2 + 3 * nv;
+                        let triangles = (0..nt)
+                            .map(|k| [0, 1, 2].map(|c| extra[base + 3 * k + c] as u32))
+                            .collect();
+                        ShapeKind::Mesh(trilux_geometry::TriangleMesh {
+                            positions,
+                            normals: None,
+                            triangles,
+                            face_normals: true,
+                        })
+                    }
                     other => panic!("unknown shape {other}"),
                 };
                 let shape = Shape {
@@ -86,7 +105,7 @@ fn hits_match_mitsuba() {
             other => panic!("unknown line kind {other}"),
         }
     }
-    assert_eq!(shapes.len(), 9);
-    assert_eq!(checked, 9 * 150);
+    assert_eq!(shapes.len(), 11);
+    assert_eq!(checked, 11 * 150);
     assert!(hits > 500, "{hits}");
 }

@@ -13,6 +13,7 @@ Run: python3 crates/trilux-geometry/tests/data/mitsuba_hits.py
 import math
 import os
 import random
+import tempfile
 
 import mitsuba as mi
 
@@ -24,6 +25,11 @@ def mat(t):
     m = t.matrix
     return [float(m[i][j]) for i in range(4) for j in range(4)]
 
+
+MESH = {
+    "v": [[x * 0.5 - 0.5, y * 0.5 - 0.5, 0.3 * math.sin(1.5 * x) * (y - 1.0)] for y in range(3) for x in range(3)],
+    "f": [[0, 1, 4], [0, 4, 3], [1, 2, 5], [1, 5, 4], [3, 4, 7], [3, 7, 6], [4, 5, 8], [4, 8, 7]],
+}
 
 SHAPES = [
     ("rectangle", False, T().translate([0.3, -0.2, 0.5]) @ T().rotate([1, 2, 0.5], 37) @ T().scale([1.5, 0.7, 1.0]), {}),
@@ -39,11 +45,24 @@ SHAPES = [
     # uses either p0/p1/radius or to_world, not both.
     ("cylinder", False, T(), {"p0": [0.1, 0.0, -0.5], "p1": [-0.2, 0.3, 0.9], "radius": 0.45}),
     ("cylinder", True, T().translate([0.2, -0.1, 0.3]) @ T().rotate([0, 1, 0], 90) @ T().scale(0.8), {"p0": [0.0, 0.0, 0.0], "p1": [0.0, 0.0, 1.0], "radius": 1.0}),
+    # An OBJ mesh (a bent sheet of 8 triangles) with a mirroring transform:
+    # Mitsuba computes face normals from the world-space winding.
+    ("obj", False, T().translate([0.1, 0.0, 0.2]) @ T().scale([-1.0, 1.2, 0.9]) @ T().rotate([1, 0, 1], 20), MESH),
+    ("obj", True, T().rotate([0, 1, 0], 35), MESH),
 ]
 
 
 def load(kind, flip, to_world, params):
     d = {"type": kind, "flip_normals": flip}
+    if kind == "obj":
+        path = os.path.join(tempfile.mkdtemp(), "mesh.obj")
+        with open(path, "w") as f:
+            for v in params["v"]:
+                f.write("v %r %r %r\n" % tuple(v))
+            for t in params["f"]:
+                f.write("f %d %d %d\n" % (t[0] + 1, t[1] + 1, t[2] + 1))
+        d["filename"] = path
+        d["face_normals"] = True
     if kind in ("sphere",):
         d["center"] = params["center"]
         d["radius"] = params["radius"]
@@ -74,6 +93,8 @@ def main():
             extra = params["center"] + [params["radius"]]
         if kind == "cylinder":
             extra = params["p0"] + params["p1"] + [params["radius"]]
+        if kind == "obj":
+            extra = [len(params["v"])] + [c for v in params["v"] for c in v] + [len(params["f"])] + [i for t in params["f"] for i in t]
         out.append(",".join(["shape", kind, str(int(flip))] + [repr(x) for x in mat(tw)] + [repr(float(x)) for x in extra]))
         shape = load(kind, flip, tw, params)
         bb = shape.bbox()
