@@ -46,7 +46,14 @@ fn main() -> Result<(), trilux_geometry::GeometryError> {
             flip_normals: true,
         },
     ];
+    let t0 = std::time::Instant::now();
     let g = SceneGeometry::build(&shapes)?;
+    println!(
+        "build: {:.2} s, {} primitives, {} input surfaces",
+        t0.elapsed().as_secs_f64(),
+        g.primitive_count(),
+        g.surfaces().len()
+    );
     let mut st = 7u64;
     let mut rnd = || {
         st ^= st << 13;
