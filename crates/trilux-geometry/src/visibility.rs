@@ -37,13 +37,14 @@ impl SceneGeometry {
         let mut facing = 0u32;
         let mut facing_visible = 0u32;
         let mut visible = 0u32;
+        let mut hint = None;
         for k in 0..n {
             let x = self.sample_element(a, sobol2(k, 0, seed));
             let y = self.sample_element(b, sobol2(k, 2, seed ^ 0x5bd1_e995));
             let d = y.point - x.point;
             let faces =
                 a_side.sign() * x.normal.dot(d) > 0.0 && b_side.sign() * y.normal.dot(d) < 0.0;
-            let vis = !self.occluded(x.point, y.point);
+            let vis = !self.occluded_hint(x.point, y.point, &mut hint);
             visible += u32::from(vis);
             if faces {
                 facing += 1;

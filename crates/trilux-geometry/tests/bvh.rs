@@ -127,10 +127,14 @@ proptest! {
     #[test]
     fn occluded_segments_agree_with_brute_force(shapes in prop::collection::vec(arb_shape(true), 1..8), pts in prop::collection::vec((arb_vec(5.0), arb_vec(5.0)), 64)) {
         let g = SceneGeometry::build(&shapes).expect("valid shapes");
+        // The hinted form (last occluder tested first, carried across
+        // unrelated segments here) must give the same answers.
+        let mut hint = None;
         for (p, q) in pts {
             let d = q - p;
             let brute = g.intersect_brute_force(&Ray { origin: p, dir: d }, 1.0 - 1e-9 * (q.abs().max_element() + 10.0) / d.length()).is_some();
             prop_assert_eq!(g.occluded(p, q), brute);
+            prop_assert_eq!(g.occluded_hint(p, q, &mut hint), brute);
         }
     }
 
