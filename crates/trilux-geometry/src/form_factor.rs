@@ -580,6 +580,29 @@ pub(crate) fn seed_of(a: ElementId, b: ElementId) -> u32 {
 }
 
 impl SceneGeometry {
+    /// True if both elements are planar and lie in the same plane (then no
+    /// light passes between them, whatever the sides).
+    pub(crate) fn coplanar(&self, a: ElementId, b: ElementId) -> bool {
+        let (ea, eb) = (&self.elements[a.index()], &self.elements[b.index()]);
+        if !(ea.planar && eb.planar) {
+            return false;
+        }
+        if a == b {
+            return true;
+        }
+        let scale = ea
+            .bounds
+            .diagonal()
+            .length()
+            .max(eb.bounds.diagonal().length())
+            + ea.centre
+                .abs()
+                .max_element()
+                .max(eb.centre.abs().max_element());
+        ea.normal.dot(eb.normal).abs() > 1.0 - 1e-12
+            && ea.normal.dot(eb.centre - ea.centre).abs() <= 1e-12 * scale
+    }
+
     /// The element as polygons (fronts on side `s` = ±1), if it is polygonal.
     pub(crate) fn element_polygons(&self, id: ElementId, s: f64) -> Option<Vec<Poly>> {
         let e = &self.elements[id.index()];
@@ -688,7 +711,7 @@ impl SceneGeometry {
         let (sf, st) = (from_side.sign(), to_side.sign());
         let a_from = self.elements[from.index()].area;
         let a_to = self.elements[to.index()].area;
-        if from == to && self.elements[from.index()].planar {
+        if self.coplanar(from, to) {
             return FormFactor::default();
         }
         let depth = opts.max_depth;

@@ -585,3 +585,29 @@ fn form_factors_from_inside_a_closed_box_sum_to_one() {
     }
     println!("worst |Σ F − 1| = {worst:.2e}");
 }
+
+#[test]
+fn coplanar_elements_exchange_nothing() {
+    use trilux_geometry::Side;
+    let mut g = SceneGeometry::build(&[rect(DVec3::ZERO, X, Y, false), rect(3.0 * X, X, Y, true)])
+        .expect("valid");
+    let (a, b) = (g.surfaces()[0].root, g.surfaces()[1].root);
+    let kids = g.subdivide(a);
+    let o = FormFactorOptions::default();
+    for (i, j) in [
+        (a, b),
+        (b, a),
+        (kids[0], kids[3]),
+        (kids[1], kids[2]),
+        (kids[2], b),
+        (a, kids[0]),
+    ] {
+        for (si, sj) in [
+            (Side::Front, Side::Front),
+            (Side::Front, Side::Back),
+            (Side::Back, Side::Back),
+        ] {
+            assert_eq!(g.form_factor_sided(i, si, j, sj, &o).value, 0.0);
+        }
+    }
+}
