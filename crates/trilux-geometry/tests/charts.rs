@@ -220,3 +220,35 @@ fn locate_agrees_with_a_descent_from_the_root() {
     }
     assert!(checked > 3000, "{checked}");
 }
+
+#[test]
+fn a_triangle_soup_becomes_a_handful_of_charts() {
+    // 8192 separate (unconnected) small triangles scattered over a gently
+    // curved sheet, all facing up: never one input surface per triangle.
+    let (p, t) = curved_sheet(64);
+    let mut positions = Vec::new();
+    let mut triangles = Vec::new();
+    for tri in &t {
+        let k = positions.len() as u32;
+        let c = (p[tri[0] as usize] + p[tri[1] as usize] + p[tri[2] as usize]) / 3.0;
+        for &v in tri {
+            positions.push(c + 0.8 * (p[v as usize] - c));
+        }
+        triangles.push([k, k + 1, k + 2]);
+    }
+    let mut g =
+        SceneGeometry::build(&[mesh(positions, triangles, DMat4::IDENTITY)]).expect("valid mesh");
+    let charts = g.surfaces().len();
+    println!("{charts} charts for a soup of 8192 triangles");
+    assert!((16..=32).contains(&charts), "{charts} charts");
+    // Every triangle is in exactly one chart and reachable by locate.
+    let mut seen = vec![0u32; 8192];
+    for s in 0..charts {
+        let root = g.surfaces()[s].root;
+        for p in g.element_pieces(root) {
+            seen[p.triangle as usize] += 1;
+        }
+        let _ = g.subdivide(root);
+    }
+    assert!(seen.iter().all(|&n| n == 1));
+}
