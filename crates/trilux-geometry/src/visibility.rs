@@ -58,6 +58,54 @@ impl SceneGeometry {
         }
     }
 
+    /// Kernel-weighted visible fraction Σ K vis / Σ K over the same
+    /// stratified segments, K = cos θ_a cos θ_b / r² (the form-factor
+    /// kernel): the factor V such that F · V estimates the occluded form
+    /// factor ∫∫ K vis / (π A_a) when occlusion and K are correlated (a
+    /// blocker near one end, partial occlusion of a large element). Falls
+    /// back to [`SceneGeometry::visibility_sided`] when no segment carries
+    /// light.
+    pub fn visibility_weighted(
+        &self,
+        a: ElementId,
+        a_side: Side,
+        b: ElementId,
+        b_side: Side,
+        samples: u32,
+    ) -> f64 {
+        let n = samples.clamp(1, 1 << 16);
+        let seed = seed_of(a, b);
+        let (sa, sb) = (a_side.sign(), b_side.sign());
+        let mut total = 0.0;
+        let mut seen = 0.0;
+        let mut hint = None;
+        for k in 0..n {
+            let x = self.sample_element(a, sobol2(k, 0, seed));
+            let y = self.sample_element(b, sobol2(k, 2, seed ^ 0x5bd1_e995));
+            let d = y.point - x.point;
+            let r2 = d.length_squared();
+            let (ca, cb) = (sa * x.normal.dot(d), -sb * y.normal.dot(d));
+            if ca <= 0.0 || cb <= 0.0 || r2 <= 0.0 || x.pdf_area <= 0.0 || y.pdf_area <= 0.0 {
+                continue;
+            }
+            // Weight by the kernel over the sampling densities (the
+            // integrand of ∫∫ K dA dA).
+            let w = ca * cb / (r2 * r2 * x.pdf_area * y.pdf_area);
+            if !w.is_finite() {
+                continue;
+            }
+            total += w;
+            if !self.occluded_hint(x.point, y.point, &mut hint) {
+                seen += w;
+            }
+        }
+        if total > 0.0 {
+            (seen / total).clamp(0.0, 1.0)
+        } else {
+            self.visibility_sided(a, a_side, b, b_side, samples)
+        }
+    }
+
     /// [`SceneGeometry::visibility`] for many element pairs, in parallel.
     pub fn visibility_batch(&self, pairs: &[(ElementId, ElementId)], samples: u32) -> Vec<f64> {
         pairs
