@@ -3,7 +3,8 @@
 //!
 //! Segment k joins the k-th point of an Owen-scrambled Sobol sequence on
 //! each element (independent scrambles on the two sides, seeded by the
-//! element ids, so results are deterministic). Only segments whose end
+//! element ids, so results are deterministic, and the same for (a, b) and
+//! (b, a)). Only segments whose end
 //! points face each other (both one-sided cosines positive) carry light and
 //! are counted; if none do, the plain fraction over all segments is
 //! returned (the form factor is then zero anyway).
@@ -13,6 +14,7 @@ use rayon::prelude::*;
 
 use crate::form_factor::{Side, seed_of, sobol2};
 use crate::ids::ElementId;
+use crate::sampling::SurfaceSample;
 use crate::scene_geometry::SceneGeometry;
 
 impl SceneGeometry {
@@ -33,14 +35,13 @@ impl SceneGeometry {
         samples: u32,
     ) -> f64 {
         let n = samples.clamp(1, 1 << 16);
-        let seed = seed_of(a, b);
+        let seed = seed_of(a.min(b), a.max(b));
         let mut facing = 0u32;
         let mut facing_visible = 0u32;
         let mut visible = 0u32;
         let mut hint = None;
         for k in 0..n {
-            let x = self.sample_element(a, sobol2(k, 0, seed));
-            let y = self.sample_element(b, sobol2(k, 2, seed ^ 0x5bd1_e995));
+            let (x, y) = self.segment_ends(a, b, k, seed);
             let d = y.point - x.point;
             let faces =
                 a_side.sign() * x.normal.dot(d) > 0.0 && b_side.sign() * y.normal.dot(d) < 0.0;
@@ -74,14 +75,13 @@ impl SceneGeometry {
         samples: u32,
     ) -> f64 {
         let n = samples.clamp(1, 1 << 16);
-        let seed = seed_of(a, b);
+        let seed = seed_of(a.min(b), a.max(b));
         let (sa, sb) = (a_side.sign(), b_side.sign());
         let mut total = 0.0;
         let mut seen = 0.0;
         let mut hint = None;
         for k in 0..n {
-            let x = self.sample_element(a, sobol2(k, 0, seed));
-            let y = self.sample_element(b, sobol2(k, 2, seed ^ 0x5bd1_e995));
+            let (x, y) = self.segment_ends(a, b, k, seed);
             let d = y.point - x.point;
             let r2 = d.length_squared();
             let (ca, cb) = (sa * x.normal.dot(d), -sb * y.normal.dot(d));
@@ -106,6 +106,25 @@ impl SceneGeometry {
         }
     }
 
+    /// The ends of shadow segment `k` between `a` and `b`. The lower element
+    /// id always draws from the same Sobol dimensions, so (a, b) and (b, a)
+    /// trace the same segments and visibility is symmetric.
+    fn segment_ends(
+        &self,
+        a: ElementId,
+        b: ElementId,
+        k: u32,
+        seed: u32,
+    ) -> (SurfaceSample, SurfaceSample) {
+        let first = |e: ElementId| self.sample_element(e, sobol2(k, 0, seed));
+        let second = |e: ElementId| self.sample_element(e, sobol2(k, 2, seed ^ 0x5bd1_e995));
+        if a <= b {
+            (first(a), second(b))
+        } else {
+            (second(a), first(b))
+        }
+    }
+
     /// [`SceneGeometry::visibility`] for many element pairs, in parallel.
     pub fn visibility_batch(&self, pairs: &[(ElementId, ElementId)], samples: u32) -> Vec<f64> {
         pairs
@@ -123,14 +142,11 @@ impl SceneGeometry {
         samples: u32,
     ) -> Vec<(DVec3, DVec3)> {
         let n = samples.clamp(1, 1 << 16);
-        let seed = seed_of(a, b);
+        let seed = seed_of(a.min(b), a.max(b));
         (0..n)
             .map(|k| {
-                (
-                    self.sample_element(a, sobol2(k, 0, seed)).point,
-                    self.sample_element(b, sobol2(k, 2, seed ^ 0x5bd1_e995))
-                        .point,
-                )
+                let (x, y) = self.segment_ends(a, b, k, seed);
+                (x.point, y.point)
             })
             .collect()
     }
