@@ -28,9 +28,10 @@
 //!   that matters more, as hierarchical radiosity refines links, up to
 //!   `max_depth + 2` splits): a deterministic point-sampled estimate.
 //! - **Large clusters** (more than [`MAX_POLYGON_PIECES`] pieces on a side
-//!   that must be integrated): a stratified (Owen-scrambled Sobol) sampled
-//!   estimate with `samples` points, Lambert's form on the other side when
-//!   it is polygonal.
+//!   that must be integrated): a sampled estimate stratified by piece (at
+//!   least one Owen-scrambled Sobol point in every piece, `samples` in all
+//!   at least), with Lambert's form on the other side when it is polygonal
+//!   and the kernel with a sampled point of the other element otherwise.
 //!
 //! `error` is the sum over the final subdomains of |fine − coarse| (a
 //! conservative estimate of the error of the returned fine value; a domain
@@ -833,9 +834,10 @@ impl SceneGeometry {
     }
 
     /// Stratified points of an element with weights summing (in
-    /// expectation) to its area: one point per piece for a cluster of at
-    /// least `samples` (and at most 4096) pieces, otherwise `samples`
-    /// Sobol points mapped by `sample_element` with weight 1/(pdf · n).
+    /// expectation) to its area: for a cluster of at most 4096 pieces,
+    /// ⌈samples / pieces⌉ (at least one) Sobol points in every piece, each
+    /// weighted by its share of the piece's area; otherwise `samples` Sobol
+    /// points mapped by `sample_element` with weight 1/(pdf · n).
     fn stratified_points(
         &self,
         id: ElementId,
@@ -848,27 +850,27 @@ impl SceneGeometry {
         let e = &self.elements[id.index()];
         if let (ElementDomain::Cluster { count, .. }, SurfaceGeom::Chart { mesh }) =
             (e.domain, &self.surfaces[e.surface.index()].geom)
-            && count >= samples
             && count <= 4096
         {
-            {
-                let m = &self.meshes[*mesh as usize];
-                return self
-                    .element_pieces(id)
-                    .iter()
-                    .enumerate()
-                    .map(|(k, p)| {
-                        let l = crate::sampling::square_to_triangle(sobol2(k as u32, dim, seed));
-                        let b = l[0] * p.bary[0] + l[1] * p.bary[1] + l[2] * p.bary[2];
-                        let a = m.tri_area[p.triangle as usize] * p.area_fraction();
-                        (
-                            m.point(p.triangle, b),
-                            sign * m.tri_normal[p.triangle as usize],
-                            a,
-                        )
-                    })
-                    .collect();
+            let m = &self.meshes[*mesh as usize];
+            let per_piece = samples.div_ceil(count).max(1);
+            let mut out = Vec::with_capacity((count * per_piece) as usize);
+            for (k, p) in self.element_pieces(id).iter().enumerate() {
+                let a = m.tri_area[p.triangle as usize] * p.area_fraction() / per_piece as f64;
+                let n = sign * m.tri_normal[p.triangle as usize];
+                let piece_seed = seed ^ (k as u32).wrapping_mul(0x9E37_79B9);
+                for j in 0..per_piece {
+                    let u = if per_piece == 1 {
+                        sobol2(k as u32, dim, seed)
+                    } else {
+                        sobol2(j, dim, piece_seed)
+                    };
+                    let l = crate::sampling::square_to_triangle(u);
+                    let b = l[0] * p.bary[0] + l[1] * p.bary[1] + l[2] * p.bary[2];
+                    out.push((m.point(p.triangle, b), n, a));
+                }
             }
+            return out;
         }
         (0..samples)
             .map(|k| {

@@ -369,8 +369,8 @@ fn tessellated_sheet_chart_to_parallel_square() {
     assert_eq!(g.surfaces().len(), 2);
     assert!(g.surfaces()[0].is_planar());
     let (c, s) = (g.surfaces()[0].root, g.surfaces()[1].root);
-    // With more samples than pieces the estimate is pdf-sampled instead: it
-    // stays within its stated error.
+    // With more samples than pieces, several points per piece: still within
+    // the stated error.
     for n in [1024, 4096] {
         let f = g.form_factor_with(
             c,
