@@ -434,6 +434,60 @@ fn integrate_pairs(
     (v, e, lo, hi)
 }
 
+/// atan2(y, x) for y ≥ 0 (an angle in [0, π]), by Cephes' double-precision
+/// arctangent (range reduction to |t| ≤ tan(π/8), then a 4/5 rational
+/// approximation; error ≲ 2 ulp). About twice as fast as libm's general
+/// atan2, which dominated the cost of Lambert's formula.
+#[inline]
+fn atan2_nonneg(y: f64, x: f64) -> f64 {
+    const MOREBITS: f64 = 6.123_233_995_736_766e-17;
+    const T3P8: f64 = 2.414_213_562_373_095;
+    const P: [f64; 5] = [
+        -8.750_608_600_031_904e-1,
+        -1.615_753_718_733_365e1,
+        -7.500_855_792_314_705e1,
+        -1.228_866_684_490_136e2,
+        -6.485_021_904_942_025e1,
+    ];
+    const Q: [f64; 5] = [
+        2.485_846_490_142_306e1,
+        1.650_270_098_316_988e2,
+        4.328_810_604_912_903e2,
+        4.853_903_996_359_137e2,
+        1.945_506_571_482_614e2,
+    ];
+    let atan_pos = |t: f64| -> f64 {
+        // atan(t) for t ≥ 0.
+        let (base, more, t) = if t > T3P8 {
+            (std::f64::consts::FRAC_PI_2, MOREBITS, -1.0 / t)
+        } else if t > 0.66 {
+            (
+                std::f64::consts::FRAC_PI_4,
+                0.5 * MOREBITS,
+                (t - 1.0) / (t + 1.0),
+            )
+        } else {
+            (0.0, 0.0, t)
+        };
+        let z = t * t;
+        let p = (((P[0] * z + P[1]) * z + P[2]) * z + P[3]) * z + P[4];
+        let q = ((((z + Q[0]) * z + Q[1]) * z + Q[2]) * z + Q[3]) * z + Q[4];
+        base + (t * (z * p / q) + t + more)
+    };
+    if !(y.is_finite() && x.is_finite()) {
+        return y.atan2(x);
+    }
+    if x > 0.0 {
+        atan_pos(y / x)
+    } else if x < 0.0 {
+        std::f64::consts::PI - atan_pos(y / -x)
+    } else if y > 0.0 {
+        std::f64::consts::FRAC_PI_2
+    } else {
+        0.0
+    }
+}
+
 /// Lambert's form factor from a differential area at `x` with unit normal
 /// `n` to a planar polygon, clipped to the half-space in front of `x`. The
 /// polygon's own orientation is not checked (see
@@ -469,7 +523,7 @@ pub fn point_to_polygon(x: DVec3, n: DVec3, poly: &[DVec3]) -> f64 {
         let c = r0.cross(r1);
         let cl = c.length();
         if cl > 0.0 {
-            let beta = cl.atan2(r0.dot(r1));
+            let beta = atan2_nonneg(cl, r0.dot(r1));
             sum += beta * n.dot(c) / cl;
         }
     }
@@ -883,5 +937,45 @@ impl SceneGeometry {
                 (s.point, sign * s.normal, w)
             })
             .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::atan2_nonneg;
+
+    #[test]
+    fn fast_atan2_matches_libm() {
+        let mut worst: f64 = 0.0;
+        let mut state = 12345u64;
+        let mut rnd = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for k in 0..2_000_000i32 {
+            let scale = 10f64.powi(k % 41 - 20);
+            let y = rnd() * scale;
+            let x = (2.0 * rnd() - 1.0) * 10f64.powi(k % 37 - 18);
+            let (a, b) = (atan2_nonneg(y, x), y.atan2(x));
+            worst = worst.max((a - b).abs());
+        }
+        for (y, x) in [
+            (0.0, 1.0),
+            (0.0, -1.0),
+            (1.0, 0.0),
+            (0.0, 0.0),
+            (1e-300, 1.0),
+            (1.0, 1e-300),
+            (1.0, -1e-300),
+            (f64::MAX, 1.0),
+        ] {
+            assert!(
+                (atan2_nonneg(y, x) - y.atan2(x)).abs() <= 4.0 * f64::EPSILON,
+                "{y} {x}"
+            );
+        }
+        assert!(worst <= 4.0 * f64::EPSILON, "worst {worst:e}");
     }
 }
