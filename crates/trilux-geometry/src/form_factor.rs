@@ -318,10 +318,13 @@ fn integrate(
 ) -> (f64, f64) {
     let q0: Vec<(f64, f64)> = doms.iter().map(|d| d.rule(f)).collect();
     let total: f64 = q0.iter().map(|q| q.0.abs()).sum();
-    let tol = (rel_tol * total).max(1e-300) / doms.len().max(1) as f64;
+    // Each domain's share of the tolerance: half by its share of the
+    // estimate, half evenly (the shares sum to rel_tol · total).
+    let even = total / doms.len().max(1) as f64;
     let mut v = 0.0;
     let mut e = 0.0;
     for (d, q) in doms.iter().zip(q0) {
+        let tol = (0.5 * rel_tol * (q.0.abs() + even)).max(1e-300);
         let c = d.centre_rule(f);
         if (c - q.0).abs() <= tol {
             v += q.0;
@@ -396,12 +399,13 @@ fn integrate_pairs(
         }
     }
     let total: f64 = q0.iter().sum();
-    let tol = (rel_tol * total).max(1e-300) / q0.len().max(1) as f64;
+    let even = total / q0.len().max(1) as f64;
     let mut v = 0.0;
     let mut e = 0.0;
     let mut k = 0;
     for a in from {
         for b in to {
+            let tol = (0.5 * rel_tol * (q0[k].abs() + even)).max(1e-300);
             // Accept at once when the one-point pair rule agrees with the
             // product rule (error: their difference, conservative for
             // smooth kernels).
@@ -724,7 +728,32 @@ impl SceneGeometry {
         let e = &self.elements[id.index()];
         match (e.domain, &self.surfaces[e.surface.index()].geom) {
             (ElementDomain::Rect { min, max }, SurfaceGeom::Patch(patch)) => {
-                Some(vec![QDom::Rect { patch, min, max, s }])
+                // Disk elements spanning more than a quarter turn are
+                // integrated as quarter-turn sectors: a 3-point rule over a
+                // whole revolution is poor.
+                let turns = if matches!(patch.as_ref(), Patch::Disk { .. }) {
+                    ((max.y - min.y) / 0.25 - 1e-9).ceil().max(1.0) as usize
+                } else {
+                    1
+                };
+                let dv = (max.y - min.y) / turns as f64;
+                Some(
+                    (0..turns)
+                        .map(|k| QDom::Rect {
+                            patch,
+                            min: DVec2::new(min.x, min.y + k as f64 * dv),
+                            max: DVec2::new(
+                                max.x,
+                                if k + 1 == turns {
+                                    max.y
+                                } else {
+                                    min.y + (k + 1) as f64 * dv
+                                },
+                            ),
+                            s,
+                        })
+                        .collect(),
+                )
             }
             (ElementDomain::Cluster { count, .. }, SurfaceGeom::Chart { mesh })
                 if count as usize <= MAX_POLYGON_PIECES =>
