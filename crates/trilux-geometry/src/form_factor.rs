@@ -14,12 +14,14 @@
 //!   face x. The sender is first clipped to the receiver's front half-space
 //!   when the receiver is planar (the integrand vanishes behind it, with a
 //!   kink along the plane). The outer integral over the sender is adaptive
-//!   cubature: a
-//!   degree-5 rule (3×3 Gauss–Legendre on uv rectangles, Dunavant's 7-point
-//!   rule on triangles) on a domain is compared with the same rule on its
-//!   four children; where they differ by more than the tolerance the
-//!   children are refined in turn (to `max_depth` levels). This resolves the
-//!   logarithmic singularity along an edge shared with the receiver.
+//!   cubature: a degree-5 rule (3×3 Gauss–Legendre on uv rectangles,
+//!   Dunavant's 7-point rule on triangles) on a domain is accepted at once
+//!   if it agrees with the one-point rule within the domain's share of the
+//!   tolerance; otherwise it is compared with the same rule on its four
+//!   children, and where they differ by more than the tolerance the children
+//!   are refined in turn (to `max_depth` levels). This resolves the
+//!   logarithmic singularity along an edge shared with the receiver. Disk
+//!   elements are integrated as quarter-turn sectors.
 //! - **Polygonal sender, non-polygonal receiver**: the same, integrating
 //!   over the receiver and using reciprocity A_i F_ij = A_j F_ji.
 //! - **Neither polygonal** (disks, sphere and cylinder pieces): adaptive
@@ -35,10 +37,11 @@
 //!
 //! `error` is the sum over the final subdomains of |fine − coarse| (a
 //! conservative estimate of the error of the returned fine value; a domain
-//! accepted at once contributes |degree-5 − one-point|), or the standard
-//! error of the mean for sampled estimates. `spread` is max − min of the point estimates
-//! of F_{from→to} seen during the integration: how much the transfer varies
-//! over the integrated element, the usual refinement oracle.
+//! accepted at once contributes |degree-5 − one-point|), or, for sampled
+//! estimates, the standard error from collapsing neighbouring strata in
+//! pairs. `spread` is max − min of the point estimates of F_{from→to} seen
+//! during the integration: how much the transfer varies over the integrated
+//! element, the usual refinement oracle.
 
 use std::f64::consts::PI;
 
@@ -691,13 +694,12 @@ impl SceneGeometry {
                 if matches!(patch.as_ref(), Patch::Quad { .. }) =>
             {
                 let normal = patch.eval(DVec2::ZERO).n;
-                let normal = &normal;
                 let v = [min, DVec2::new(max.x, min.y), max, DVec2::new(min.x, max.y)]
                     .map(|uv| patch.eval(uv).p);
                 Some(vec![Poly {
                     v,
                     len: 4,
-                    n: s * *normal,
+                    n: s * normal,
                 }])
             }
             (ElementDomain::Cluster { count, .. }, SurfaceGeom::Chart { mesh })
