@@ -11,8 +11,7 @@
 use std::collections::HashMap;
 use std::sync::RwLock;
 
-use glam::{DVec2, DVec3};
-use trilux_geometry::{ElementId, FormFactorOptions, SceneGeometry};
+use trilux_geometry::{ElementId, FormFactorOptions, SceneGeometry, Side};
 
 /// One element seen from one of its sides.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -24,6 +23,10 @@ pub(crate) struct SidedElement {
 }
 
 impl SidedElement {
+    fn side(self) -> Side {
+        if self.back { Side::Back } else { Side::Front }
+    }
+
     fn key(self) -> u64 {
         (u64::from(self.element.0) << 1) | u64::from(self.back)
     }
@@ -92,73 +95,6 @@ impl ThroughputCache {
     }
 }
 
-/// F_{i→j} between the given faces of two elements, unoccluded.
-///
-/// Front to front is the geometry layer's accurate estimate (Lambert's
-/// closed form with adaptive cubature). When a back face is involved (a
-/// `twosided` material) the kernel cos θ_i cos θ_j / (π r²) is integrated with
-/// the faces' normals on a stratified 8×8 × 8×8 grid of point pairs: a
-/// deterministic estimate good to about a percent away from shared edges.
-pub(crate) fn sided_form_factor(
-    geom: &SceneGeometry,
-    i: SidedElement,
-    j: SidedElement,
-    ff_options: &FormFactorOptions,
-) -> (f64, f64) {
-    if !i.back && !j.back {
-        let ff = geom.form_factor_with(i.element, j.element, ff_options);
-        return (ff.value, ff.spread);
-    }
-    const G: usize = 8;
-    let grid = |e: ElementId, back: bool| -> Vec<(DVec3, DVec3, f64)> {
-        let mut pts = Vec::with_capacity(G * G);
-        for a in 0..G {
-            for b in 0..G {
-                let u = DVec2::new((a as f64 + 0.5) / G as f64, (b as f64 + 0.5) / G as f64);
-                let s = geom.sample_element(e, u);
-                let n = if back { -s.normal } else { s.normal };
-                pts.push((s.point, n, 1.0 / s.pdf_area.max(1e-300)));
-            }
-        }
-        pts
-    };
-    let (pi, pj) = (grid(i.element, i.back), grid(j.element, j.back));
-    let mut sum = 0.0;
-    let mut weight_i = 0.0;
-    let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
-    for &(x, nx, wx) in &pi {
-        weight_i += wx;
-        let mut inner = 0.0;
-        for &(y, ny, wy) in &pj {
-            let d = y - x;
-            let r2 = d.length_squared();
-            if r2 <= 0.0 {
-                continue;
-            }
-            let c1 = nx.dot(d);
-            let c2 = -ny.dot(d);
-            if c1 > 0.0 && c2 > 0.0 {
-                inner += wy * c1 * c2 / (std::f64::consts::PI * r2 * r2);
-            }
-        }
-        let point = (inner / pj.len() as f64).min(1.0);
-        lo = lo.min(point);
-        hi = hi.max(point);
-        sum += wx * point;
-    }
-    let spread = if hi >= lo { hi - lo } else { 0.0 };
-    if weight_i > 0.0 {
-        let f = sum / weight_i;
-        if f.is_finite() {
-            (f.clamp(0.0, 1.0), spread)
-        } else {
-            (0.0, 0.0)
-        }
-    } else {
-        (0.0, 0.0)
-    }
-}
-
 /// Computes T_ij = A_i F_{i→j} V_ij for the given faces, without the cache
 /// (`i` is the receiver: the spread is measured over it).
 pub(crate) fn compute_throughput(
@@ -168,7 +104,8 @@ pub(crate) fn compute_throughput(
     visibility_samples: u32,
     ff_options: &FormFactorOptions,
 ) -> Throughput {
-    let (f, spread) = sided_form_factor(geom, i, j, ff_options);
+    let ff = geom.form_factor_sided(i.element, i.side(), j.element, j.side(), ff_options);
+    let (f, spread) = (ff.value, ff.spread);
     if !(f.is_finite() && f > 0.0) {
         return Throughput::default();
     }
@@ -181,7 +118,7 @@ pub(crate) fn compute_throughput(
         2 | 3 => visibility_samples * 4,
         _ => visibility_samples,
     };
-    let v = geom.visibility(i.element, j.element, samples);
+    let v = geom.visibility_sided(i.element, i.side(), j.element, j.side(), samples);
     let area = geom.element(i.element).area;
     let t = area * f * v;
     if t.is_finite() && t > 0.0 {
