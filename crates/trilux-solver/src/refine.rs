@@ -323,18 +323,26 @@ impl<const N: usize> RefineContext<'_, N> {
         i: ElementId,
         j: ElementId,
         n: u32,
+        known: Option<(Throughput, Spectrum<N>)>,
         group: (u32, f64),
         lost: &mut Spectrum<N>,
         out: &mut Vec<NodeLink<N>>,
     ) {
         let (sj, sk) = (h.from, h.to);
-        let mut tij = self.throughput(j, sj, i, si);
-        tij.t *= group.1;
-        if tij.t <= 0.0 {
-            return;
-        }
-        let unshot = sender.unshot(self.geom, i, j);
-        if unshot.is_black() {
+        // T_ij and δL_ij are the same for every receiver node of one (i, j):
+        // the K-side recursion hands them down instead of looking them up.
+        let (tij, unshot) = match known {
+            Some(k) => k,
+            None => {
+                let mut tij = self.throughput(j, sj, i, si);
+                tij.t *= group.1;
+                if tij.t <= 0.0 {
+                    return;
+                }
+                (tij, sender.unshot(self.geom, i, j))
+            }
+        };
+        if tij.t <= 0.0 || unshot.is_black() {
             return;
         }
         let node = &h.nodes[n as usize];
@@ -350,7 +358,20 @@ impl<const N: usize> RefineContext<'_, N> {
                 } else {
                     Driver::K
                 };
-                self.split_triple(side, sender, si, h, h_index, i, j, n, group, lost, out);
+                self.split_triple(
+                    side,
+                    sender,
+                    si,
+                    h,
+                    h_index,
+                    i,
+                    j,
+                    n,
+                    (tij, unshot),
+                    group,
+                    lost,
+                    out,
+                );
             }
             return;
         }
@@ -376,7 +397,20 @@ impl<const N: usize> RefineContext<'_, N> {
                 (false, false) => return,
             };
             for d in order {
-                if self.split_triple(d, sender, si, h, h_index, i, j, n, group, lost, out) {
+                if self.split_triple(
+                    d,
+                    sender,
+                    si,
+                    h,
+                    h_index,
+                    i,
+                    j,
+                    n,
+                    (tij, unshot),
+                    group,
+                    lost,
+                    out,
+                ) {
                     return;
                 }
             }
@@ -404,7 +438,20 @@ impl<const N: usize> RefineContext<'_, N> {
             return;
         }
         if straddle_i && brdf_err <= 1.0 && ff_err <= 1.0 && !partial {
-            if self.split_triple(Driver::I, sender, si, h, h_index, i, j, n, group, lost, out) {
+            if self.split_triple(
+                Driver::I,
+                sender,
+                si,
+                h,
+                h_index,
+                i,
+                j,
+                n,
+                (tij, unshot),
+                group,
+                lost,
+                out,
+            ) {
                 return;
             }
             out.push(link);
@@ -429,7 +476,20 @@ impl<const N: usize> RefineContext<'_, N> {
         };
         let order = [first, rest[0], rest[1]];
         for d in order {
-            if self.split_triple(d, sender, si, h, h_index, i, j, n, group, lost, out) {
+            if self.split_triple(
+                d,
+                sender,
+                si,
+                h,
+                h_index,
+                i,
+                j,
+                n,
+                (tij, unshot),
+                group,
+                lost,
+                out,
+            ) {
                 return;
             }
         }
@@ -450,6 +510,7 @@ impl<const N: usize> RefineContext<'_, N> {
         i: ElementId,
         j: ElementId,
         n: u32,
+        known: (Throughput, Spectrum<N>),
         group: (u32, f64),
         lost: &mut Spectrum<N>,
         out: &mut Vec<NodeLink<N>>,
@@ -467,7 +528,7 @@ impl<const N: usize> RefineContext<'_, N> {
                     return false;
                 };
                 for c in children {
-                    self.refine_triple(sender, si, h, h_index, c, j, n, group, lost, out);
+                    self.refine_triple(sender, si, h, h_index, c, j, n, None, group, lost, out);
                 }
                 true
             }
@@ -476,7 +537,19 @@ impl<const N: usize> RefineContext<'_, N> {
                     return false;
                 };
                 for c in nodes {
-                    self.refine_triple(sender, si, h, h_index, i, j, c, group, lost, out);
+                    self.refine_triple(
+                        sender,
+                        si,
+                        h,
+                        h_index,
+                        i,
+                        j,
+                        c,
+                        Some(known),
+                        group,
+                        lost,
+                        out,
+                    );
                 }
                 true
             }
@@ -486,7 +559,7 @@ impl<const N: usize> RefineContext<'_, N> {
                 };
                 for c in nodes {
                     let jm = h.nodes[c as usize].from;
-                    self.refine_triple(sender, si, h, h_index, i, jm, c, group, lost, out);
+                    self.refine_triple(sender, si, h, h_index, i, jm, c, None, group, lost, out);
                 }
                 true
             }

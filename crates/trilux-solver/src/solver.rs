@@ -452,6 +452,7 @@ impl<const N: usize> Solver<N> {
                             l.i,
                             l.j,
                             n,
+                            None,
                             (g, l.t_scale),
                             &mut lost,
                             &mut out,
