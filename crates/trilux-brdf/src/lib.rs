@@ -16,6 +16,7 @@
 //!   `blendbsdf`.
 //! - [`microfacet`]: Mitsuba's Beckmann and GGX D, separable Smith G (its
 //!   rational G1 for Beckmann), and their sampling.
+//! - [`special`]: erf and its inverse (Beckmann visible-normal sampling).
 //! - [`fresnel`]: conductor Fresnel from η and k.
 //! - [`albedo`]: [`AlbedoTable`], the directional albedo tabulated per
 //!   degree for frequent use.
@@ -34,6 +35,7 @@ pub mod fresnel;
 pub mod lobe;
 pub mod microfacet;
 pub mod params;
+pub mod special;
 
 pub use albedo::AlbedoTable;
 pub use area::{AreaReflectance, BrdfVariation, ElementPoints, area_reflectance, brdf_variation};

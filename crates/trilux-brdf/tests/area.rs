@@ -217,3 +217,75 @@ fn variation_shrinks_with_element_size() {
     assert_eq!(big_j.driver(), Element::J);
     assert_eq!(small.evaluations, 13);
 }
+
+mod random {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn point() -> impl Strategy<Value = DVec3> {
+        prop_oneof![
+            [-3.0..3.0f64, -3.0..3.0, -3.0..3.0].prop_map(DVec3::from_array),
+            Just(DVec3::ZERO),
+        ]
+    }
+
+    fn material() -> impl Strategy<Value = BsdfParams> {
+        (0.001..1.0f64, 0.0..=1.0f64, any::<bool>(), any::<bool>()).prop_map(
+            |(alpha, w, ggx, two)| {
+                let d = if ggx {
+                    Distribution::Ggx
+                } else {
+                    Distribution::Beckmann
+                };
+                let m = BsdfParams::Blend {
+                    weight: w,
+                    first: Box::new(diffuse(0.5)),
+                    second: Box::new(common::gold(d, alpha)),
+                };
+                if two {
+                    BsdfParams::TwoSided {
+                        front: Box::new(m),
+                        back: None,
+                    }
+                } else {
+                    m
+                }
+            },
+        )
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(2000))]
+
+        /// Non-negative, finite, reciprocal, for any geometry (coincident
+        /// points included: they give zero, never NaN).
+        #[test]
+        fn area_reflectance_is_sane(p in material(), i in point(), k in point(),
+                                    n in [-1.0..1.0f64, -1.0..1.0, -1.0..1.0],
+                                    f_ji in 0.0..1.0f64, f_jk in 0.0..1.0f64) {
+            let n = DVec3::from_array(n).try_normalize().unwrap_or(DVec3::Z);
+            let b = Bsdf::<3>::new(&p).unwrap();
+            let j = DVec3::ZERO;
+            let r = area_reflectance(&b, f_ji, i, j, n, k);
+            prop_assert!(r.total().is_finite() && r.total().is_non_negative());
+            let a = area_reflectance(&b, f_ji, i, j, n, k).total() * f_jk;
+            let c = area_reflectance(&b, f_jk, k, j, n, i).total() * f_ji;
+            for q in 0..3 {
+                prop_assert!((a[q] - c[q]).abs() <= 1e-9 * a[q].max(c[q]) + 1e-300);
+            }
+            let pts = |c: DVec3| [c + DVec3::X * 0.1, c - DVec3::X * 0.1, c + DVec3::Y * 0.1, c];
+            let (pi, pj, pk) = (pts(i), pts(j), pts(k));
+            let v = brdf_variation(
+                &b,
+                &ElementPoints { centre: i, normal: -n, points: &pi },
+                &ElementPoints { centre: j, normal: n, points: &pj },
+                &ElementPoints { centre: k, normal: -n, points: &pk },
+            );
+            prop_assert!(v.fr_min.is_finite() && v.fr_max.is_finite());
+            prop_assert!((v.fr_max - v.fr_min).min_value() >= 0.0);
+            let d = v.delta_r(f_ji);
+            prop_assert!(d.is_finite() && d >= 0.0);
+            prop_assert!(v.spread_i >= 0.0 && v.spread_j >= 0.0 && v.spread_k >= 0.0);
+        }
+    }
+}

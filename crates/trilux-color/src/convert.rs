@@ -8,9 +8,9 @@
 //! | written | [`Role::Reflectance`] | [`Role::Emission`] | [`Role::Unbounded`] |
 //! |---|---|---|---|
 //! | `<float v>` | v everywhere | v everywhere (spectral: v · D65) | v everywhere |
-//! | `<rgb>` | as given (spectral: smooth, clamped [0,1]) | as given (spectral: D65 · smooth) | as given (spectral: smooth, ≥ 0) |
+//! | `<rgb>` | as given (spectral: smooth, within 0…1) | as given (spectral: D65 · smooth) | as given (spectral: smooth, ≥ 0) |
 //! | `<spectrum v>` | v everywhere | equal-energy v: RGB (1.20479, 0.948291, 0.908916)·v | v everywhere |
-//! | `<spectrum λ:v …>` | RGB: under D65, clamped [0,1]; spectral: band averages | RGB: through XYZ, ≥ 0; spectral: band averages | RGB: under D65, ≥ 0; spectral: band averages |
+//! | `<spectrum λ:v …>` | RGB: under D65, clamped to 0…1; spectral: band averages | RGB: through XYZ, ≥ 0; spectral: band averages | RGB: under D65, ≥ 0; spectral: band averages |
 //!
 //! Spectral band averages are weighted by the observer (x̄ + ȳ + z̄) within
 //! each band ([`SampledSpectrum::observer_weighted_average`]).

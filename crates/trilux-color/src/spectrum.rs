@@ -53,6 +53,11 @@ impl<const N: usize> Spectrum<N> {
         Spectrum(v)
     }
 
+    /// Band `i` set to `f(i)`.
+    pub fn from_fn(f: impl FnMut(usize) -> f64) -> Self {
+        Spectrum(std::array::from_fn(f))
+    }
+
     /// The band values.
     pub const fn to_array(self) -> [f64; N] {
         self.0

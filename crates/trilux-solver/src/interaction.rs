@@ -239,8 +239,12 @@ impl<const N: usize> Hierarchy<N> {
                 }
             });
             match next {
-                Some(c) => n = c,
-                None => return node.radiance,
+                // A child whose elements were found not to see each other
+                // never received light; the caller only asks about points
+                // that do see each other, so the parent's value is the
+                // better estimate there.
+                Some(c) if self.nodes[c as usize].t > 0.0 => n = c,
+                _ => return node.radiance,
             }
         }
     }

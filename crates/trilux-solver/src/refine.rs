@@ -70,6 +70,10 @@ pub(crate) struct PairLink<const N: usize> {
     pub side: SideId,
     /// T_ij.
     pub t: f64,
+    /// The factor already applied to `t` (and to be applied to every
+    /// sub-pair of this link in stage 2) so that a stored sender shoots
+    /// exactly the flux it holds.
+    pub t_scale: f64,
     /// δL_i sent along the link.
     pub unshot: Spectrum<N>,
 }
@@ -193,6 +197,7 @@ impl<const N: usize> RefineContext<'_, N> {
             j,
             side: sj,
             t: th.t,
+            t_scale: 1.0,
             unshot,
         };
         let flux = PI * th.t * unshot.sum();
@@ -283,6 +288,20 @@ impl<const N: usize> RefineContext<'_, N> {
         (fr, spread, variation.driver())
     }
 
+    /// True when element `e` has points on both sides of the tangent plane
+    /// of `j` at its centre.
+    fn straddles(&self, e: ElementId, j: ElementId) -> bool {
+        let ej = self.geom.element(j);
+        let scale = ej.bounds.diagonal().length().max(1e-300);
+        let (mut front, mut back) = (false, false);
+        for p in self.geom.element_points(e) {
+            let d = (p - ej.centre).dot(ej.normal);
+            front |= d > 1e-9 * scale;
+            back |= d < -1e-9 * scale;
+        }
+        front && back
+    }
+
     /// Stage 2: refines the three-point link (i j) → node of `h` (whose sender
     /// element is j) and appends node links.
     #[allow(clippy::too_many_arguments)]
@@ -295,12 +314,13 @@ impl<const N: usize> RefineContext<'_, N> {
         i: ElementId,
         j: ElementId,
         n: u32,
-        group: u32,
+        group: (u32, f64),
         lost: &mut Spectrum<N>,
         out: &mut Vec<NodeLink<N>>,
     ) {
         let (sj, sk) = (h.from, h.to);
-        let tij = self.throughput(j, sj, i, si);
+        let mut tij = self.throughput(j, sj, i, si);
+        tij.t *= group.1;
         if tij.t <= 0.0 {
             return;
         }
@@ -312,6 +332,17 @@ impl<const N: usize> RefineContext<'_, N> {
         debug_assert_eq!(node.from, j);
         let (k, tjk, vjk) = (node.to, node.t, node.v);
         if tjk <= 0.0 {
+            // As in stage 1: near the roots a few shadow rays may miss a gap,
+            // so look one level further before giving the pair up.
+            let (dj, dk) = (self.geom.element(j).depth, self.geom.element(k).depth);
+            if dj + dk < 2 && self.throughput(k, sk, j, sj).f > 0.0 {
+                let side = if self.geom.element(j).area >= self.geom.element(k).area {
+                    Driver::J
+                } else {
+                    Driver::K
+                };
+                self.split_triple(side, sender, si, h, h_index, i, j, n, group, lost, out);
+            }
             return;
         }
         let bsdf = &self.materials[self.sides[sj as usize].shape];
@@ -319,13 +350,33 @@ impl<const N: usize> RefineContext<'_, N> {
         let aj = self.geom.element(j).area;
         let r = fr * (PI * tij.t / aj);
         let gathered = unshot * r;
+        // An element that lies partly behind j's tangent plane gets a
+        // BRDF value of its centre's side only: refine it like partial
+        // visibility (its part in front may carry light even when the
+        // centre's direction is below the horizon).
+        let straddle_i = self.straddles(i, j);
+        let straddle_k = self.straddles(k, j);
         if gathered.is_black() {
+            let order = match (straddle_i, straddle_k) {
+                (true, true) if self.geom.element(i).area >= self.geom.element(k).area => {
+                    [Driver::I, Driver::K]
+                }
+                (true, true) => [Driver::K, Driver::I],
+                (true, false) => [Driver::I, Driver::I],
+                (false, true) => [Driver::K, Driver::K],
+                (false, false) => return,
+            };
+            for d in order {
+                if self.split_triple(d, sender, si, h, h_index, i, j, n, group, lost, out) {
+                    return;
+                }
+            }
             return;
         }
         let link = NodeLink {
             hierarchy: h_index,
             node: n,
-            group,
+            group: group.0,
             gathered,
         };
         let flux_to_k = PI * tjk * gathered.sum();
@@ -337,8 +388,15 @@ impl<const N: usize> RefineContext<'_, N> {
         let brdf_err = PI * fji * spread / self.settings.fr_eps;
         let (fjk, fkj) = self.ff_estimates(j, sj, k, sk);
         let ff_err = fjk.max(fkj) / self.settings.ff_eps;
-        let partial = vjk > 0.0 && vjk < 1.0;
-        if brdf_err <= 1.0 && ff_err <= 1.0 && !partial {
+        let partial = (vjk > 0.0 && vjk < 1.0) || straddle_k;
+        if brdf_err <= 1.0 && ff_err <= 1.0 && !partial && !straddle_i {
+            out.push(link);
+            return;
+        }
+        if straddle_i && brdf_err <= 1.0 && ff_err <= 1.0 && !partial {
+            if self.split_triple(Driver::I, sender, si, h, h_index, i, j, n, group, lost, out) {
+                return;
+            }
             out.push(link);
             return;
         }
@@ -379,7 +437,7 @@ impl<const N: usize> RefineContext<'_, N> {
         i: ElementId,
         j: ElementId,
         n: u32,
-        group: u32,
+        group: (u32, f64),
         lost: &mut Spectrum<N>,
         out: &mut Vec<NodeLink<N>>,
     ) -> bool {

@@ -27,7 +27,7 @@ use crate::interaction::Hierarchy;
 use crate::ledger::Ledger;
 use crate::radiosity::ElementRadiance;
 use crate::refine::{NodeLink, PairLink, RefineContext, Sender};
-use crate::settings::{SolverSettings, Transport};
+use crate::settings::SolverSettings;
 use crate::sides::{SideId, TransportSide, build_sides, eligible_pairs};
 use crate::solution::Solution;
 use crate::stats::SolveStats;
@@ -181,13 +181,14 @@ impl<const N: usize> Solver<N> {
         let ff_options = FormFactorOptions::default();
 
         // Root interactions: every eligible pair whose sender needs stored
-        // interactions (a glossy part, or anything in uniform mode, where
-        // emitters store their emission too) and whose receiver reflects.
-        let uniform = settings.transport == Transport::Uniform;
+        // interactions (a glossy part, or any reflection in uniform mode)
+        // and whose receiver reflects. Emission is Lambertian (Mitsuba's area
+        // emitter) and always enters as a two-point source, whose flux
+        // π A Le is exact.
         let mut roots = Vec::new();
         for (a, list) in partners.iter().enumerate() {
             let sa = &sides[a];
-            if !(sa.stored || (uniform && !sa.emission.is_black())) {
+            if !sa.stored {
                 continue;
             }
             for &b in list {
@@ -229,7 +230,6 @@ impl<const N: usize> Solver<N> {
         let mut field = ElementRadiance::new(geom.element_count());
         let mut side_flux = vec![Spectrum::zero(); sides.len()];
         let mut emitted = Spectrum::zero();
-        let mut escaped_at_start = Spectrum::<N>::zero();
         for (s, side) in sides.iter().enumerate() {
             if side.emission.is_black() {
                 continue;
@@ -237,30 +237,7 @@ impl<const N: usize> Solver<N> {
             let surface = &geom.surfaces()[side.surface.index()];
             let flux = side.emission * (PI * surface.area());
             emitted += flux;
-            if uniform {
-                // The emission is stored per receiver; what no receiver
-                // takes leaves the scene at once.
-                let t_sum: f64 = hierarchies_from[s]
-                    .iter()
-                    .map(|&h| hierarchies[h as usize].nodes[0].t)
-                    .sum();
-                // Sampled root throughputs may over-count slightly: never
-                // store more than was emitted.
-                let scale = if PI * t_sum > PI * surface.area() {
-                    surface.area() / t_sum
-                } else {
-                    1.0
-                };
-                let mut taken = Spectrum::zero();
-                for &h in &hierarchies_from[s] {
-                    let hier = &mut hierarchies[h as usize];
-                    let t = hier.nodes[0].t;
-                    hier.nodes[0].unshot = side.emission * scale;
-                    hier.unshot_flux = side.emission * (PI * t * scale);
-                    taken += hier.unshot_flux;
-                }
-                escaped_at_start += (flux - taken).max(Spectrum::zero());
-            } else {
+            {
                 let mut stack = vec![surface.root];
                 while let Some(e) = stack.pop() {
                     field.unshot[usize::from(side.back)][e.index()] = side.emission;
@@ -271,10 +248,7 @@ impl<const N: usize> Solver<N> {
                 side_flux[s] = flux;
             }
         }
-        let mut ledger = Ledger::new(emitted.to_array().to_vec());
-        for b in 0..N {
-            ledger.escaped[b] += escaped_at_start[b];
-        }
+        let ledger = Ledger::new(emitted.to_array().to_vec());
         let potential: u64 = depth_of.iter().map(|&d| 4u64.pow(d)).sum();
         let stats = SolveStats {
             input_surfaces: geom.surfaces().len(),
@@ -409,7 +383,10 @@ impl<const N: usize> Solver<N> {
         };
         let root_of = |s: SideId| geom.surfaces()[self.sides[s as usize].surface.index()].root;
 
-        // Stage 1: pair links to every receiving side, in parallel.
+        // Stage 1: pair links to every receiving side, in parallel: from the
+        // roots of the two surfaces for a Lambertian source, from the root
+        // pair of a stored hierarchy (whose nodes give the unshot radiance
+        // of every sub-pair: Sender::unshot).
         let pairs: Vec<(ElementId, SideId, ElementId)> = match &src_hierarchy {
             None => self.partners[send_side as usize]
                 .iter()
@@ -461,7 +438,16 @@ impl<const N: usize> Solver<N> {
                     let l = &pair_links[g as usize];
                     for n in ctx.nodes_for(hier, l.j, &mut lost) {
                         ctx.refine_triple(
-                            &sender, send_side, hier, h as u32, l.i, l.j, n, g, &mut lost, &mut out,
+                            &sender,
+                            send_side,
+                            hier,
+                            h as u32,
+                            l.i,
+                            l.j,
+                            n,
+                            (g, l.t_scale),
+                            &mut lost,
+                            &mut out,
                         );
                     }
                 }
@@ -493,6 +479,7 @@ impl<const N: usize> Solver<N> {
             let side = &self.sides[l.side as usize];
             let arrived_g = l.unshot * shot_scale * (PI * l.t);
             let diffuse_g = arrived_g * side.rho_d;
+            // What an element reflects may not exceed what arrived there.
             let room = (arrived_g - diffuse_g).max(Spectrum::zero());
             let glossy_g = glossy_flux[g];
             let scale = Spectrum::<N>::new(std::array::from_fn(|b| {
@@ -520,13 +507,18 @@ impl<const N: usize> Solver<N> {
             self.used[l.i.index()] = true;
             self.used[l.j.index()] = true;
         }
+        // The radiance increments are kept as computed; only the flux they
+        // add to the residual is bounded. Where the bound bites (estimated
+        // throughputs that sum to more than the element's area), the
+        // hierarchy holds more π T L than its key, and its own shot is
+        // normalised to the key (shot_scale above).
         for nl in &node_links {
             let hier = &mut self.hierarchies[nl.hierarchy as usize];
             let node = &mut hier.nodes[nl.node as usize];
-            let dl = nl.gathered * shot_scale * group_scale[nl.group as usize];
+            let dl = nl.gathered * shot_scale;
             node.gathered += dl;
             let t = node.t;
-            hier.unshot_flux += dl * (PI * t);
+            hier.unshot_flux += dl * group_scale[nl.group as usize] * (PI * t);
         }
         let escaped = phi - total_arrived;
         for b in 0..N {

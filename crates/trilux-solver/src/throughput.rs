@@ -172,7 +172,16 @@ pub(crate) fn compute_throughput(
     if !(f.is_finite() && f > 0.0) {
         return Throughput::default();
     }
-    let v = geom.visibility(i.element, j.element, visibility_samples);
+    // Coarse pairs decide a lot of transport from one number: give them
+    // more shadow rays (×16 for whole input surfaces, ×4 one or two levels
+    // down).
+    let depth = geom.element(i.element).depth + geom.element(j.element).depth;
+    let samples = match depth {
+        0 | 1 => visibility_samples * 16,
+        2 | 3 => visibility_samples * 4,
+        _ => visibility_samples,
+    };
+    let v = geom.visibility(i.element, j.element, samples);
     let area = geom.element(i.element).area;
     let t = area * f * v;
     if t.is_finite() && t > 0.0 {
