@@ -10,7 +10,10 @@
 //! pruning. Boxes are padded by 4e-6 × the scene's extent, and rays are
 //! first clipped (in f64) to the scene's box so that the f32 origin is never
 //! far outside it: the f32 ray error is then far below the padding, so the
-//! traversal never misses a primitive the f64 ray hits.
+//! traversal never misses a primitive the f64 ray hits. obvhs also culls
+//! boxes that end within 1e-4 (absolute) of the ray's origin, so the f32 ray
+//! starts 2e-4 + 2 × padding before the first point of interest (found by a
+//! Mitsuba cross-check: a ray entering an axis-aligned cube face missed it).
 //!
 //! # Robustness
 //!
@@ -448,7 +451,11 @@ impl SceneGeometry {
         if tn > tf {
             return None;
         }
-        let start = tn.max(tmin).max(0.0);
+        // obvhs culls every box whose exit lies within 1e-4 (absolute) of the
+        // traversal ray's origin (`EPSILON` in its node test): start the f32
+        // ray a little before the first point we care about.
+        let back = 2e-4 + 2.0 * self.bvh.pad;
+        let start = tn.max(tmin).max(0.0) - back / len;
         let origin = o + start * d;
         let dn = d / len;
         let span = ((tf - start) * len) as f32;
@@ -482,23 +489,50 @@ impl SceneGeometry {
     }
 
     fn any_prim(&self, o: DVec3, d: DVec3, tmin: f64, tmax: f64) -> bool {
+        self.any_prim_hint(o, d, tmin, tmax, &mut None)
+    }
+
+    /// Occlusion test that first tries the primitive in `hint` (the last
+    /// occluder found, for coherent segments) and stores the occluder it
+    /// finds there.
+    fn any_prim_hint(
+        &self,
+        o: DVec3,
+        d: DVec3,
+        tmin: f64,
+        tmax: f64,
+        hint: &mut Option<u32>,
+    ) -> bool {
         let Some(cw) = self.bvh.cw.as_ref() else {
             return false;
         };
+        let pre = RayPre::new(o, d);
+        if let Some(h) = *hint
+            && self
+                .test_prim(&self.bvh.prims[h as usize], &pre, tmin, tmax)
+                .is_some()
+        {
+            return true;
+        }
         let Some((ray32, _, _)) = self.traversal_ray(o, d, tmin, tmax) else {
             return false;
         };
-        let pre = RayPre::new(o, d);
-        !cw.ray_traverse_miss(ray32, |_, id| {
+        let mut found = None;
+        let miss = cw.ray_traverse_miss(ray32, |_, id| {
             if self
                 .test_prim(&self.bvh.prims[id], &pre, tmin, tmax)
                 .is_some()
             {
+                found = Some(id as u32);
                 0.0
             } else {
                 f32::INFINITY
             }
-        })
+        });
+        if found.is_some() {
+            *hint = found;
+        }
+        !miss
     }
 
     pub(crate) fn make_hit(&self, o: DVec3, d: DVec3, h: PrimHit) -> Hit {
@@ -571,6 +605,13 @@ impl SceneGeometry {
     /// True if something lies strictly between points `p` and `q`. Safe when
     /// `p` and `q` lie on surfaces: hits within ε of either end are ignored.
     pub fn occluded(&self, p: DVec3, q: DVec3) -> bool {
+        self.occluded_hint(p, q, &mut None)
+    }
+
+    /// [`SceneGeometry::occluded`] for coherent segments (e.g. between the
+    /// same two elements): `hint` carries the last occluder found from one
+    /// call to the next and is tested first. Start with `None`.
+    pub fn occluded_hint(&self, p: DVec3, q: DVec3, hint: &mut Option<u32>) -> bool {
         let d = q - p;
         let len = d.length();
         if len <= 0.0 || !len.is_finite() {
@@ -581,7 +622,7 @@ impl SceneGeometry {
         if tmin >= tmax {
             return false;
         }
-        self.any_prim(p, d, tmin, tmax)
+        self.any_prim_hint(p, d, tmin, tmax, hint)
     }
 
     /// [`SceneGeometry::intersect`] for many rays, in parallel (rayon).

@@ -18,6 +18,11 @@
 //!    - the chart has fewer than [`CHART_MAX_TRIANGLES`] (512) triangles.
 //! 3. A chart left smaller than an eighth of the cap is merged into an
 //!    adjacent chart when that keeps both bounds (cap allowing 1.5×).
+//! 4. Charts still smaller than that (disconnected pieces: triangle soups,
+//!    separate parts) are grouped along the Morton curve of their centroids,
+//!    consecutive ones joining while the group stays under the cap and within
+//!    the normal cone. A chart need not be connected, so a soup of 8192
+//!    separate triangles still makes a handful of input surfaces.
 //!
 //! Degenerate (zero-area) triangles belong to no chart and are not traced.
 //!
@@ -62,6 +67,9 @@ pub(crate) struct MeshData {
     pub tri_area: Vec<f64>,
     /// Input surface of each triangle (`u32::MAX` for degenerate ones).
     pub tri_surface: Vec<u32>,
+    /// The deepest existing element whose pieces include each whole
+    /// triangle (a shortcut for `locate`; `u32::MAX` before the roots exist).
+    pub tri_element: Vec<u32>,
     /// +1 or −1 (flip_normals), applied to shading normals.
     pub sign: f64,
 }
@@ -112,6 +120,11 @@ pub struct Piece {
 }
 
 impl Piece {
+    /// True if this piece is its whole triangle.
+    pub fn is_whole(&self) -> bool {
+        self.bary == [DVec2::ZERO, DVec2::X, DVec2::Y]
+    }
+
     /// The whole triangle.
     pub fn whole(triangle: u32) -> Piece {
         Piece {
@@ -316,7 +329,101 @@ pub(crate) fn build_charts(mesh: &MeshData) -> Vec<Vec<u32>> {
         }
     }
     charts.retain(|c| !c.is_empty());
-    charts
+    group_small_charts(mesh, charts, cos_cone)
+}
+
+/// Groups the charts still smaller than an eighth of the cap (disconnected
+/// pieces: triangle soups, foliage, separate parts) along the Morton curve of
+/// their centroids: consecutive small charts join while the group stays under
+/// the cap and within the normal cone of its first triangle.
+fn group_small_charts(mesh: &MeshData, charts: Vec<Vec<u32>>, cos_cone: f64) -> Vec<Vec<u32>> {
+    let small = CHART_MAX_TRIANGLES / 8;
+    let (mut out, smalls): (Vec<Vec<u32>>, Vec<Vec<u32>>) =
+        charts.into_iter().partition(|c| c.len() >= small);
+    if smalls.len() < 2 {
+        out.extend(smalls);
+        return out;
+    }
+    let centroid = |c: &[u32]| {
+        let mut s = DVec3::ZERO;
+        for &t in c {
+            let [a, b, d] = mesh.vertices(t);
+            s += (a + b + d) / 3.0;
+        }
+        s / c.len() as f64
+    };
+    let cents: Vec<DVec3> = smalls.iter().map(|c| centroid(c)).collect();
+    let lo = cents
+        .iter()
+        .fold(DVec3::splat(f64::INFINITY), |a, b| a.min(*b));
+    let hi = cents
+        .iter()
+        .fold(DVec3::splat(f64::NEG_INFINITY), |a, b| a.max(*b));
+    let scale = (hi - lo).max_element().max(1e-300);
+    let mut order: Vec<usize> = (0..smalls.len()).collect();
+    order.sort_by_cached_key(|&k| morton3((cents[k] - lo) / scale));
+    let mut group: Vec<u32> = Vec::new();
+    let mut seed_n = DVec3::ZERO;
+    for k in order {
+        let c = &smalls[k];
+        let fits = !group.is_empty()
+            && group.len() + c.len() <= CHART_MAX_TRIANGLES
+            && c.iter()
+                .all(|&t| mesh.tri_normal[t as usize].dot(seed_n) >= cos_cone);
+        if !fits {
+            if !group.is_empty() {
+                out.push(std::mem::take(&mut group));
+            }
+            seed_n = mesh.tri_normal[c[0] as usize];
+            if !c
+                .iter()
+                .all(|&t| mesh.tri_normal[t as usize].dot(seed_n) >= cos_cone)
+            {
+                out.push(c.clone());
+                continue;
+            }
+        }
+        group.extend_from_slice(c);
+    }
+    if !group.is_empty() {
+        out.push(group);
+    }
+    out
+}
+
+/// Morton code of a point in [0, 1]³ (21 bits per axis).
+fn morton3(q: DVec3) -> u64 {
+    let spread = |v: u64| {
+        let mut x = v & 0x1f_ffff;
+        x = (x | (x << 32)) & 0x1f_0000_0000_ffff;
+        x = (x | (x << 16)) & 0x1f_0000_ff00_00ff;
+        x = (x | (x << 8)) & 0x100f_00f0_0f00_f00f;
+        x = (x | (x << 4)) & 0x10c3_0c30_c30c_30c3;
+        (x | (x << 2)) & 0x1249_2492_4924_9249
+    };
+    let q = q.clamp(DVec3::ZERO, DVec3::ONE) * 2_097_151.0;
+    spread(q.x as u64) | (spread(q.y as u64) << 1) | (spread(q.z as u64) << 2)
+}
+
+/// Sorts pieces along the Morton (Z-order) curve of their centroids in their
+/// bounding box (21 bits per axis).
+pub(crate) fn morton_sort(pieces: &mut [Piece], mesh: &MeshData) {
+    if pieces.len() < 3 {
+        return;
+    }
+    let centroid = |p: &Piece| {
+        let [a, b, c] = p.corners(mesh);
+        (a + b + c) / 3.0
+    };
+    let mut lo = DVec3::splat(f64::INFINITY);
+    let mut hi = DVec3::splat(f64::NEG_INFINITY);
+    for p in pieces.iter() {
+        let c = centroid(p);
+        lo = lo.min(c);
+        hi = hi.max(c);
+    }
+    let scale = (hi - lo).max_element().max(1e-300);
+    pieces.sort_by_cached_key(|p| morton3((centroid(p) - lo) / scale));
 }
 
 /// Splits a cluster's pieces into four non-empty groups (module docs).

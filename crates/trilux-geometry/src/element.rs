@@ -48,7 +48,8 @@ pub struct Element {
     pub parent: Option<ElementId>,
     /// Depth below the root (root = 0).
     pub depth: u32,
-    /// Area (exact, see [`crate::patch`] and [`crate::chart`]).
+    /// Area (exact: closed forms or adaptive quadrature for parametric
+    /// pieces, sums of triangle areas for clusters; see [`crate::chart`]).
     pub area: f64,
     /// A point on the element near its middle: the image of the uv centre,
     /// or for a cluster the centroid of the piece nearest the area centroid.
@@ -185,11 +186,15 @@ impl SceneGeometry {
         &mut self,
         surface: SurfaceId,
         mesh: u32,
-        pieces: Vec<Piece>,
+        mut pieces: Vec<Piece>,
         parent: Option<ElementId>,
         depth: u32,
     ) -> Element {
         let m = &self.meshes[mesh as usize];
+        // Order the pieces along a Morton curve of their centroids, so that
+        // the area-CDF sampling of `sample_element` maps stratified u.x to
+        // spatially stratified points.
+        crate::chart::morton_sort(&mut pieces, m);
         let mut area = 0.0;
         let mut sum_n = DVec3::ZERO;
         let mut sum_c = DVec3::ZERO;
@@ -236,6 +241,13 @@ impl SceneGeometry {
         }
         let first = self.pieces.len() as u32;
         let count = pieces.len() as u32;
+        // The caller pushes this element next: it becomes the deepest
+        // element holding each of its whole triangles.
+        let id = self.elements.len() as u32;
+        let mesh_data = &mut self.meshes[mesh as usize];
+        for p in pieces.iter().filter(|p| p.is_whole()) {
+            mesh_data.tri_element[p.triangle as usize] = id;
+        }
         self.pieces.extend(pieces);
         Element {
             surface,
@@ -272,6 +284,19 @@ impl SceneGeometry {
     /// root if the coordinate kind does not match the surface).
     pub fn locate(&self, surface: SurfaceId, coord: SurfaceCoord) -> ElementId {
         let mut id = self.surfaces[surface.index()].root;
+        // Charts: jump to the deepest element holding the whole triangle
+        // (below it, clusters have fewer than 4 pieces).
+        if let (SurfaceGeom::Chart { mesh }, SurfaceCoord::Triangle { index, .. }) =
+            (&self.surfaces[surface.index()].geom, coord)
+        {
+            let m = &self.meshes[*mesh as usize];
+            if m.tri_surface.get(index as usize) == Some(&surface.0) {
+                let e = m.tri_element[index as usize];
+                if e != u32::MAX {
+                    id = ElementId(e);
+                }
+            }
+        }
         while let Some(children) = self.elements[id.index()].children() {
             let next = match (self.elements[id.index()].domain, coord) {
                 (ElementDomain::Rect { min, max }, SurfaceCoord::Uv(uv)) => {

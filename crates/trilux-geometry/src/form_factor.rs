@@ -11,7 +11,10 @@
 //!   is Lambert's closed form for a point and a polygon,
 //!   F(dA_x → P) = (1/2π) |Σ_e β_e n_x · u_e| (notes/validation.md), after
 //!   clipping P to x's tangent plane and dropping pieces whose front does not
-//!   face x. The outer integral over the sender is adaptive cubature: a
+//!   face x. The sender is first clipped to the receiver's front half-space
+//!   when the receiver is planar (the integrand vanishes behind it, with a
+//!   kink along the plane). The outer integral over the sender is adaptive
+//!   cubature: a
 //!   degree-5 rule (3×3 Gauss–Legendre on uv rectangles, Dunavant's 7-point
 //!   rule on triangles) on a domain is compared with the same rule on its
 //!   four children; where they differ by more than the tolerance the
@@ -19,19 +22,21 @@
 //!   logarithmic singularity along an edge shared with the receiver.
 //! - **Polygonal sender, non-polygonal receiver**: the same, integrating
 //!   over the receiver and using reciprocity A_i F_ij = A_j F_ji.
-//! - **Neither polygonal** (disks, sphere and cylinder pieces): nested
-//!   adaptive cubature of the kernel over both elements (a deterministic
-//!   point-sampled estimate; the point form factor of a receiver point is
-//!   clamped to 1).
+//! - **Neither polygonal** (disks, sphere and cylinder pieces): adaptive
+//!   cubature of the kernel over the pair (the product of the two degree-5
+//!   rules; each step compares splitting either element and refines the one
+//!   that matters more, as hierarchical radiosity refines links, up to
+//!   `max_depth + 2` splits): a deterministic point-sampled estimate.
 //! - **Large clusters** (more than [`MAX_POLYGON_PIECES`] pieces on a side
-//!   that must be integrated): a stratified (Owen-scrambled Sobol) sampled
-//!   estimate with `samples` points, Lambert's form on the other side when
-//!   it is polygonal.
+//!   that must be integrated): a sampled estimate stratified by piece (at
+//!   least one Owen-scrambled Sobol point in every piece, `samples` in all
+//!   at least), with Lambert's form on the other side when it is polygonal
+//!   and the kernel with a sampled point of the other element otherwise.
 //!
 //! `error` is the sum over the final subdomains of |fine − coarse| (a
-//! conservative estimate of the error of the returned fine value), plus the
-//! inner integrals' error for nested cubature, or the standard error of the
-//! mean for sampled estimates. `spread` is max − min of the point estimates
+//! conservative estimate of the error of the returned fine value; a domain
+//! accepted at once contributes |degree-5 − one-point|), or the standard
+//! error of the mean for sampled estimates. `spread` is max − min of the point estimates
 //! of F_{from→to} seen during the integration: how much the transfer varies
 //! over the integrated element, the usual refinement oracle.
 
@@ -50,6 +55,25 @@ use crate::surface::SurfaceGeom;
 /// Clusters with at most this many pieces are treated as polygon sets
 /// (Lambert's formula, deterministic cubature); larger ones are sampled.
 pub const MAX_POLYGON_PIECES: usize = 8;
+
+/// Which side of an element light leaves or arrives on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Side {
+    /// The front (the side the normal points to, after `flip_normals`).
+    Front,
+    /// The back.
+    Back,
+}
+
+impl Side {
+    /// +1 for the front, −1 for the back.
+    pub fn sign(self) -> f64 {
+        match self {
+            Side::Front => 1.0,
+            Side::Back => -1.0,
+        }
+    }
+}
 
 /// A form factor estimate.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -100,6 +124,8 @@ pub(crate) enum QDom<'a> {
         patch: &'a Patch,
         min: DVec2,
         max: DVec2,
+        /// ±1: which side's normal the rules report.
+        s: f64,
     },
     Tri {
         v: [DVec3; 3],
@@ -110,28 +136,32 @@ pub(crate) enum QDom<'a> {
 impl QDom<'_> {
     fn split(&self) -> [Self; 4] {
         match *self {
-            QDom::Rect { patch, min, max } => {
+            QDom::Rect { patch, min, max, s } => {
                 let mid = 0.5 * (min + max);
                 [
                     QDom::Rect {
                         patch,
                         min,
                         max: mid,
+                        s,
                     },
                     QDom::Rect {
                         patch,
                         min: DVec2::new(mid.x, min.y),
                         max: DVec2::new(max.x, mid.y),
+                        s,
                     },
                     QDom::Rect {
                         patch,
                         min: DVec2::new(min.x, mid.y),
                         max: DVec2::new(mid.x, max.y),
+                        s,
                     },
                     QDom::Rect {
                         patch,
                         min: mid,
                         max,
+                        s,
                     },
                 ]
             }
@@ -147,20 +177,92 @@ impl QDom<'_> {
         }
     }
 
+    /// The one-point (centre) rule: a cheap first estimate.
+    fn centre_rule(&self, f: &mut dyn FnMut(DVec3, DVec3) -> (f64, f64)) -> f64 {
+        match *self {
+            QDom::Rect { patch, min, max, s } => {
+                let d = max - min;
+                let pp = patch.eval(min + 0.5 * d);
+                pp.jacobian() * d.x * d.y * f(pp.p, s * pp.n).0
+            }
+            QDom::Tri { v: [a, b, c], n } => triangle_area(a, b, c) * f((a + b + c) / 3.0, n).0,
+        }
+    }
+
+    /// The one-point rule's point (position, normal, weight = area).
+    fn centre_point(&self) -> (DVec3, DVec3, f64) {
+        match *self {
+            QDom::Rect { patch, min, max, s } => {
+                let d = max - min;
+                let pp = patch.eval(min + 0.5 * d);
+                (pp.p, s * pp.n, pp.jacobian() * d.x * d.y)
+            }
+            QDom::Tri { v: [a, b, c], n } => ((a + b + c) / 3.0, n, triangle_area(a, b, c)),
+        }
+    }
+
+    /// The rule's points (position, normal, weight).
+    fn points(&self) -> Vec<(DVec3, DVec3, f64)> {
+        let mut out = Vec::with_capacity(9);
+        match *self {
+            QDom::Rect { patch, min, max, s } => {
+                let d = max - min;
+                for i in 0..3 {
+                    for j in 0..3 {
+                        let pp = patch.eval(min + d * DVec2::new(GL3_X[i], GL3_X[j]));
+                        out.push((
+                            pp.p,
+                            s * pp.n,
+                            GL3_W[i] * GL3_W[j] * pp.jacobian() * d.x * d.y,
+                        ));
+                    }
+                }
+            }
+            QDom::Tri { v: [a, b, c], n } => {
+                let area = triangle_area(a, b, c);
+                for (l, w) in TRI7 {
+                    out.push((l[0] * a + l[1] * b + l[2] * c, n, w * area));
+                }
+            }
+        }
+        out
+    }
+
+    /// A size measure: the diagonal of the box of a 3×3 grid of the domain
+    /// (corners alone miss the extent of disk sectors and annuli).
+    fn size(&self) -> f64 {
+        match *self {
+            QDom::Rect {
+                patch, min, max, ..
+            } => {
+                let d = max - min;
+                let b = crate::bounds::Bounds::from_points((0..9).map(|k| {
+                    patch
+                        .eval(min + d * DVec2::new((k % 3) as f64 * 0.5, (k / 3) as f64 * 0.5))
+                        .p
+                }));
+                b.diagonal().length()
+            }
+            QDom::Tri { v: [a, b, c], .. } => {
+                (a - b).length().max((b - c).length()).max((c - a).length())
+            }
+        }
+    }
+
     /// Applies the degree-5 rule: Σ w f(x, n), and Σ w · (inner error).
     fn rule(&self, f: &mut dyn FnMut(DVec3, DVec3) -> (f64, f64)) -> (f64, f64) {
-        let mut s = 0.0;
+        let mut sum = 0.0;
         let mut e = 0.0;
         match *self {
-            QDom::Rect { patch, min, max } => {
+            QDom::Rect { patch, min, max, s } => {
                 let d = max - min;
                 for i in 0..3 {
                     for j in 0..3 {
                         let uv = min + d * DVec2::new(GL3_X[i], GL3_X[j]);
                         let pp = patch.eval(uv);
                         let w = GL3_W[i] * GL3_W[j] * pp.jacobian() * d.x * d.y;
-                        let (v, ve) = f(pp.p, pp.n);
-                        s += w * v;
+                        let (v, ve) = f(pp.p, s * pp.n);
+                        sum += w * v;
                         e += w * ve;
                     }
                 }
@@ -170,12 +272,12 @@ impl QDom<'_> {
                 for (l, w) in TRI7 {
                     let p = l[0] * a + l[1] * b + l[2] * c;
                     let (v, ve) = f(p, n);
-                    s += w * area * v;
+                    sum += w * area * v;
                     e += w * area * ve;
                 }
             }
         }
-        (s, e)
+        (sum, e)
     }
 }
 
@@ -204,7 +306,10 @@ fn adaptive(
     (v, e)
 }
 
-/// Integrates `f` over a list of domains to a relative tolerance.
+/// Integrates `f` over a list of domains to a relative tolerance. A domain
+/// whose degree-5 estimate agrees with its one-point estimate within the
+/// tolerance is accepted at once (error: their difference, a conservative
+/// bound for smooth integrands); the others are refined adaptively.
 fn integrate(
     doms: &[QDom<'_>],
     f: &mut dyn FnMut(DVec3, DVec3) -> (f64, f64),
@@ -217,11 +322,116 @@ fn integrate(
     let mut v = 0.0;
     let mut e = 0.0;
     for (d, q) in doms.iter().zip(q0) {
+        let c = d.centre_rule(f);
+        if (c - q.0).abs() <= tol {
+            v += q.0;
+            e += (c - q.0).abs() + q.1;
+            continue;
+        }
         let (dv, de) = adaptive(d, f, q, tol, depth);
         v += dv;
         e += de;
     }
     (v, e)
+}
+
+/// The product rule over two domains: Σ_i Σ_j w_i w_j K(x_i, y_j).
+fn pair_rule(a: &QDom<'_>, b: &QDom<'_>) -> f64 {
+    let pb = b.points();
+    a.points()
+        .iter()
+        .map(|&(x, nx, wx)| {
+            wx * pb
+                .iter()
+                .map(|&(y, ny, wy)| wy * kernel(x, nx, y, ny))
+                .sum::<f64>()
+        })
+        .sum()
+}
+
+/// Adaptive cubature of the kernel over a pair of domains. Both one-sided
+/// refinements (split `a`, split `b`) are compared with the parent
+/// estimate: the error is the larger difference (refining one side alone
+/// cannot see the other side's rule error), and the side whose refinement
+/// changed the estimate most is refined further (as hierarchical radiosity
+/// refines the link's worse end).
+fn pair_adaptive(a: &QDom<'_>, b: &QDom<'_>, q0: f64, tol: f64, depth: u32) -> (f64, f64) {
+    let ca = a.split();
+    let cb = b.split();
+    let qa = ca.map(|c| pair_rule(&c, b));
+    let qb = cb.map(|c| pair_rule(a, &c));
+    let (sa, sb): (f64, f64) = (qa.iter().sum(), qb.iter().sum());
+    let (ea, eb) = ((sa - q0).abs(), (sb - q0).abs());
+    let split_a = ea > eb || (ea == eb && a.size() >= b.size());
+    let q1 = if split_a { sa } else { sb };
+    if ea.max(eb) <= tol || depth == 0 {
+        return (q1, ea.max(eb));
+    }
+    let mut v = 0.0;
+    let mut e = 0.0;
+    for k in 0..4 {
+        let (cv, ce) = if split_a {
+            pair_adaptive(&ca[k], b, qa[k], 0.5 * tol, depth - 1)
+        } else {
+            pair_adaptive(a, &cb[k], qb[k], 0.5 * tol, depth - 1)
+        };
+        v += cv;
+        e += ce;
+    }
+    (v, e)
+}
+
+/// ∫∫ K over all pairs of domains to a relative tolerance; also the min and
+/// max of the point-to-element estimates at the sender's rule points.
+fn integrate_pairs(
+    from: &[QDom<'_>],
+    to: &[QDom<'_>],
+    rel_tol: f64,
+    depth: u32,
+) -> (f64, f64, f64, f64) {
+    let mut q0 = Vec::with_capacity(from.len() * to.len());
+    for a in from {
+        for b in to {
+            q0.push(pair_rule(a, b));
+        }
+    }
+    let total: f64 = q0.iter().sum();
+    let tol = (rel_tol * total).max(1e-300) / q0.len().max(1) as f64;
+    let mut v = 0.0;
+    let mut e = 0.0;
+    let mut k = 0;
+    for a in from {
+        for b in to {
+            // Accept at once when the one-point pair rule agrees with the
+            // product rule (error: their difference, conservative for
+            // smooth kernels).
+            let ((x, nx, wx), (y, ny, wy)) = (a.centre_point(), b.centre_point());
+            let c = wx * wy * kernel(x, nx, y, ny);
+            let (dv, de) = if (c - q0[k]).abs() <= tol {
+                (q0[k], (c - q0[k]).abs())
+            } else {
+                pair_adaptive(a, b, q0[k], tol, depth)
+            };
+            v += dv;
+            e += de;
+            k += 1;
+        }
+    }
+    let to_points: Vec<(DVec3, DVec3, f64)> = to.iter().flat_map(|b| b.points()).collect();
+    let mut lo = f64::INFINITY;
+    let mut hi = f64::NEG_INFINITY;
+    for a in from {
+        for (x, nx, _) in a.points() {
+            let g: f64 = to_points
+                .iter()
+                .map(|&(y, ny, wy)| wy * kernel(x, nx, y, ny))
+                .sum::<f64>()
+                .min(1.0);
+            lo = lo.min(g);
+            hi = hi.max(g);
+        }
+    }
+    (v, e, lo, hi)
 }
 
 /// Lambert's form factor from a differential area at `x` with unit normal
@@ -283,6 +493,81 @@ fn lambert_sum(x: DVec3, n: DVec3, polys: &[Poly]) -> f64 {
         .min(1.0)
 }
 
+/// The part of planar integration domains in front of the common plane of
+/// `polys` (when they are coplanar): only there is Lambert's integrand
+/// non-zero, and it has a kink along that plane that the cubature would
+/// otherwise have to resolve. Domains entirely in front are kept as they
+/// are, domains entirely behind are dropped, the others are clipped and
+/// fanned into triangles. Curved domains are kept unchanged.
+fn clip_to_plane<'a>(doms: &[QDom<'a>], polys: &[Poly]) -> Vec<QDom<'a>> {
+    let Some(first) = polys.first() else {
+        return Vec::new();
+    };
+    let (n, p0) = (first.n, first.v[0]);
+    let scale = polys
+        .iter()
+        .flat_map(|p| p.v[..p.len].iter())
+        .map(|v| (*v - p0).length())
+        .fold(0.0, f64::max);
+    let coplanar = polys.iter().all(|p| {
+        p.n.dot(n) > 1.0 - 1e-12
+            && p.v[..p.len]
+                .iter()
+                .all(|v| n.dot(*v - p0).abs() <= 1e-12 * scale.max(1e-300))
+    });
+    if !coplanar {
+        return doms.to_vec();
+    }
+    let mut out = Vec::with_capacity(doms.len());
+    for d in doms {
+        let (corners, normal): (Vec<DVec3>, DVec3) = match *d {
+            QDom::Rect { patch, min, max, s }
+                if patch.is_planar() && matches!(patch, Patch::Quad { .. }) =>
+            {
+                (
+                    [min, DVec2::new(max.x, min.y), max, DVec2::new(min.x, max.y)]
+                        .iter()
+                        .map(|&uv| patch.eval(uv).p)
+                        .collect(),
+                    s * patch.eval(min).n,
+                )
+            }
+            QDom::Tri { v, n } => (v.to_vec(), n),
+            _ => {
+                out.push(*d);
+                continue;
+            }
+        };
+        let dist: Vec<f64> = corners.iter().map(|c| n.dot(*c - p0)).collect();
+        if dist.iter().all(|&x| x >= 0.0) {
+            out.push(*d);
+            continue;
+        }
+        if dist.iter().all(|&x| x <= 0.0) {
+            continue;
+        }
+        let k = corners.len();
+        let mut poly = Vec::with_capacity(k + 1);
+        for i in 0..k {
+            let (a, b) = (corners[i], corners[(i + 1) % k]);
+            let (da, db) = (dist[i], dist[(i + 1) % k]);
+            if da >= 0.0 {
+                poly.push(a);
+            }
+            if (da >= 0.0) != (db >= 0.0) {
+                poly.push(a + (b - a) * (da / (da - db)));
+            }
+        }
+        for i in 1..poly.len().saturating_sub(1) {
+            let t = [poly[0], poly[i], poly[i + 1]];
+            if triangle_area(t[0], t[1], t[2]) > 0.0 {
+                out.push(QDom::Tri { v: t, n: normal });
+            }
+        }
+    }
+    out
+}
+
 /// The point-to-point kernel cos θ_x cos θ_y / (π r²), one-sided.
 #[inline]
 fn kernel(x: DVec3, nx: DVec3, y: DVec3, ny: DVec3) -> f64 {
@@ -317,8 +602,31 @@ pub(crate) fn seed_of(a: ElementId, b: ElementId) -> u32 {
 }
 
 impl SceneGeometry {
-    /// The element as polygons, if it is polygonal.
-    pub(crate) fn element_polygons(&self, id: ElementId) -> Option<Vec<Poly>> {
+    /// True if both elements are planar and lie in the same plane (then no
+    /// light passes between them, whatever the sides).
+    pub(crate) fn coplanar(&self, a: ElementId, b: ElementId) -> bool {
+        let (ea, eb) = (&self.elements[a.index()], &self.elements[b.index()]);
+        if !(ea.planar && eb.planar) {
+            return false;
+        }
+        if a == b {
+            return true;
+        }
+        let scale = ea
+            .bounds
+            .diagonal()
+            .length()
+            .max(eb.bounds.diagonal().length())
+            + ea.centre
+                .abs()
+                .max_element()
+                .max(eb.centre.abs().max_element());
+        ea.normal.dot(eb.normal).abs() > 1.0 - 1e-12
+            && ea.normal.dot(eb.centre - ea.centre).abs() <= 1e-12 * scale
+    }
+
+    /// The element as polygons (fronts on side `s` = ±1), if it is polygonal.
+    pub(crate) fn element_polygons(&self, id: ElementId, s: f64) -> Option<Vec<Poly>> {
         let e = &self.elements[id.index()];
         match (e.domain, &self.surfaces[e.surface.index()].geom) {
             (ElementDomain::Rect { min, max }, SurfaceGeom::Patch(patch))
@@ -331,7 +639,7 @@ impl SceneGeometry {
                 Some(vec![Poly {
                     v,
                     len: 4,
-                    n: *normal,
+                    n: s * *normal,
                 }])
             }
             (ElementDomain::Cluster { count, .. }, SurfaceGeom::Chart { mesh })
@@ -346,7 +654,7 @@ impl SceneGeometry {
                             Poly {
                                 v: [a, b, c, c],
                                 len: 3,
-                                n: m.tri_normal[p.triangle as usize],
+                                n: s * m.tri_normal[p.triangle as usize],
                             }
                         })
                         .collect(),
@@ -356,12 +664,13 @@ impl SceneGeometry {
         }
     }
 
-    /// The element as integration domains, unless it is a large cluster.
-    pub(crate) fn element_domains(&self, id: ElementId) -> Option<Vec<QDom<'_>>> {
+    /// The element as integration domains (normals on side `s` = ±1), unless
+    /// it is a large cluster.
+    pub(crate) fn element_domains(&self, id: ElementId, s: f64) -> Option<Vec<QDom<'_>>> {
         let e = &self.elements[id.index()];
         match (e.domain, &self.surfaces[e.surface.index()].geom) {
             (ElementDomain::Rect { min, max }, SurfaceGeom::Patch(patch)) => {
-                Some(vec![QDom::Rect { patch, min, max }])
+                Some(vec![QDom::Rect { patch, min, max, s }])
             }
             (ElementDomain::Cluster { count, .. }, SurfaceGeom::Chart { mesh })
                 if count as usize <= MAX_POLYGON_PIECES =>
@@ -372,7 +681,7 @@ impl SceneGeometry {
                         .iter()
                         .map(|p| QDom::Tri {
                             v: p.corners(m),
-                            n: m.tri_normal[p.triangle as usize],
+                            n: s * m.tri_normal[p.triangle as usize],
                         })
                         .collect(),
                 )
@@ -406,15 +715,31 @@ impl SceneGeometry {
         to: ElementId,
         opts: &FormFactorOptions,
     ) -> FormFactor {
+        self.form_factor_sided(from, Side::Front, to, Side::Front, opts)
+    }
+
+    /// Unoccluded form factor from one side of `from` to one side of `to`
+    /// (for two-sided materials: light leaving the back of an element, or
+    /// arriving on its back), with the same method and accuracy as
+    /// [`SceneGeometry::form_factor_with`].
+    pub fn form_factor_sided(
+        &self,
+        from: ElementId,
+        from_side: Side,
+        to: ElementId,
+        to_side: Side,
+        opts: &FormFactorOptions,
+    ) -> FormFactor {
+        let (sf, st) = (from_side.sign(), to_side.sign());
         let a_from = self.elements[from.index()].area;
         let a_to = self.elements[to.index()].area;
-        if from == to && self.elements[from.index()].planar {
+        if self.coplanar(from, to) {
             return FormFactor::default();
         }
         let depth = opts.max_depth;
         let tol = opts.rel_tol.max(1e-14);
-        let to_polys = self.element_polygons(to);
-        let from_doms = self.element_domains(from);
+        let to_polys = self.element_polygons(to, st);
+        let from_doms = self.element_domains(from, sf);
         let mut lo = f64::INFINITY;
         let mut hi = f64::NEG_INFINITY;
         let result = |v: f64, e: f64, lo: f64, hi: f64| FormFactor {
@@ -429,11 +754,15 @@ impl SceneGeometry {
                 hi = hi.max(g);
                 (g, 0.0)
             };
-            let (v, e) = integrate(doms, &mut f, tol, depth);
+            let doms = clip_to_plane(doms, polys);
+            if doms.is_empty() {
+                return FormFactor::default();
+            }
+            let (v, e) = integrate(&doms, &mut f, tol, depth);
             return result(v / a_from, e / a_from, lo, hi);
         }
-        let from_polys = self.element_polygons(from);
-        let to_doms = self.element_domains(to);
+        let from_polys = self.element_polygons(from, sf);
+        let to_doms = self.element_domains(to, st);
         let ratio = a_to / a_from;
         if let (Some(polys), Some(doms)) = (&from_polys, &to_doms) {
             let mut f = |y: DVec3, m: DVec3| {
@@ -442,59 +771,117 @@ impl SceneGeometry {
                 hi = hi.max(g * ratio);
                 (g, 0.0)
             };
-            let (v, e) = integrate(doms, &mut f, tol, depth);
+            let doms = clip_to_plane(doms, polys);
+            if doms.is_empty() {
+                return FormFactor::default();
+            }
+            let (v, e) = integrate(&doms, &mut f, tol, depth);
             return result(v / a_from, e / a_from, lo, hi);
         }
         if let (Some(fd), Some(td)) = (&from_doms, &to_doms) {
-            let inner_depth = depth.min(3);
-            let mut f = |x: DVec3, n: DVec3| {
-                let mut k = |y: DVec3, m: DVec3| (kernel(x, n, y, m), 0.0);
-                let (g, ge) = integrate(td, &mut k, tol, inner_depth);
-                let g = g.min(1.0);
-                lo = lo.min(g);
-                hi = hi.max(g);
-                (g, ge)
-            };
-            let (v, e) = integrate(fd, &mut f, tol, depth);
+            let (v, e, lo, hi) = integrate_pairs(fd, td, tol, depth + 2);
             return result(v / a_from, e / a_from, lo, hi);
         }
-        // Sampled estimate.
-        let n = opts.samples.clamp(4, 1 << 16);
+        // Sampled estimate (large clusters): stratified points on the
+        // integrated side; one point per piece when the cluster has at least
+        // `samples` pieces.
         let seed = seed_of(from, to);
-        let mut sum = 0.0;
-        let mut sum2 = 0.0;
-        for k in 0..n {
-            let est = if let Some(polys) = &to_polys {
-                let x = self.sample_element(from, sobol2(k, 0, seed));
-                if x.pdf_area > 0.0 {
-                    lambert_sum(x.point, x.normal, polys) / (x.pdf_area * a_from)
+        let (values, weights): (Vec<f64>, Vec<f64>) = if let Some(polys) = &to_polys {
+            self.stratified_points(from, seed, 0, opts.samples, sf)
+                .into_iter()
+                .map(|(x, n, w)| (lambert_sum(x, n, polys), w))
+                .unzip()
+        } else if let Some(polys) = &from_polys {
+            self.stratified_points(to, seed, 2, opts.samples, st)
+                .into_iter()
+                .map(|(y, m, w)| (lambert_sum(y, m, polys) * a_to / a_from, w * a_from / a_to))
+                .unzip()
+        } else {
+            let xs = self.stratified_points(from, seed, 0, opts.samples, sf);
+            let n = xs.len() as u32;
+            xs.into_iter()
+                .enumerate()
+                .map(|(k, (x, nx, w))| {
+                    let y = self.sample_element(to, sobol2(k as u32 % n, 2, seed));
+                    let g = if y.pdf_area > 0.0 {
+                        (kernel(x, nx, y.point, st * y.normal) / y.pdf_area).min(1.0)
+                    } else {
+                        0.0
+                    };
+                    (g, w)
+                })
+                .unzip()
+        };
+        // F = Σ w g / A_from; variance by collapsing neighbouring strata in
+        // pairs (Morton or Sobol neighbours): Var ≈ Σ (y_a − y_b)², y = w g.
+        let total: f64 = values.iter().zip(&weights).map(|(g, w)| g * w).sum();
+        let var: f64 = values
+            .chunks(2)
+            .zip(weights.chunks(2))
+            .map(|(g, w)| {
+                if g.len() == 2 {
+                    (g[0] * w[0] - g[1] * w[1]).powi(2)
                 } else {
                     0.0
                 }
-            } else if let Some(polys) = &from_polys {
-                let y = self.sample_element(to, sobol2(k, 2, seed));
-                if y.pdf_area > 0.0 {
-                    lambert_sum(y.point, y.normal, polys) / (y.pdf_area * a_from)
-                } else {
-                    0.0
-                }
-            } else {
-                let x = self.sample_element(from, sobol2(k, 0, seed));
-                let y = self.sample_element(to, sobol2(k, 2, seed));
-                if x.pdf_area > 0.0 && y.pdf_area > 0.0 {
-                    let g = (kernel(x.point, x.normal, y.point, y.normal) / y.pdf_area).min(1.0);
-                    g / (x.pdf_area * a_from)
-                } else {
-                    0.0
-                }
-            };
-            lo = lo.min(est);
-            hi = hi.max(est);
-            sum += est;
-            sum2 += est * est;
+            })
+            .sum();
+        for &g in &values {
+            lo = lo.min(g);
+            hi = hi.max(g);
         }
-        let mean = sum / n as f64;
-        let var = (sum2 / n as f64 - mean * mean).max(0.0);
-        result(mean, (var / n as f64).sqrt(), lo, hi)
+        result(total / a_from, var.sqrt() / a_from, lo, hi)
+    }
+
+    /// Stratified points of an element with weights summing (in
+    /// expectation) to its area: for a cluster of at most 4096 pieces,
+    /// ⌈samples / pieces⌉ (at least one) Sobol points in every piece, each
+    /// weighted by its share of the piece's area; otherwise `samples` Sobol
+    /// points mapped by `sample_element` with weight 1/(pdf · n).
+    fn stratified_points(
+        &self,
+        id: ElementId,
+        seed: u32,
+        dim: u32,
+        samples: u32,
+        sign: f64,
+    ) -> Vec<(DVec3, DVec3, f64)> {
+        let samples = samples.clamp(4, 1 << 16);
+        let e = &self.elements[id.index()];
+        if let (ElementDomain::Cluster { count, .. }, SurfaceGeom::Chart { mesh }) =
+            (e.domain, &self.surfaces[e.surface.index()].geom)
+            && count <= 4096
+        {
+            let m = &self.meshes[*mesh as usize];
+            let per_piece = samples.div_ceil(count).max(1);
+            let mut out = Vec::with_capacity((count * per_piece) as usize);
+            for (k, p) in self.element_pieces(id).iter().enumerate() {
+                let a = m.tri_area[p.triangle as usize] * p.area_fraction() / per_piece as f64;
+                let n = sign * m.tri_normal[p.triangle as usize];
+                let piece_seed = seed ^ (k as u32).wrapping_mul(0x9E37_79B9);
+                for j in 0..per_piece {
+                    let u = if per_piece == 1 {
+                        sobol2(k as u32, dim, seed)
+                    } else {
+                        sobol2(j, dim, piece_seed)
+                    };
+                    let l = crate::sampling::square_to_triangle(u);
+                    let b = l[0] * p.bary[0] + l[1] * p.bary[1] + l[2] * p.bary[2];
+                    out.push((m.point(p.triangle, b), n, a));
+                }
+            }
+            return out;
+        }
+        (0..samples)
+            .map(|k| {
+                let s = self.sample_element(id, sobol2(k, dim, seed));
+                let w = if s.pdf_area > 0.0 {
+                    1.0 / (s.pdf_area * samples as f64)
+                } else {
+                    0.0
+                };
+                (s.point, sign * s.normal, w)
+            })
+            .collect()
     }
 }

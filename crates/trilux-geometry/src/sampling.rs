@@ -3,9 +3,14 @@
 //!
 //! The maps are stratification-friendly: nearby `u` give nearby points, so
 //! stratified or low-discrepancy `u` give stratified points.
-//! - uv rectangles: `u` maps linearly onto the rectangle; the area density
-//!   is `1 / (|∂p/∂u × ∂p/∂v| · Δu · Δv)` (uniform for parallelograms, exact
-//!   but not uniform on curved pieces and disks).
+//! - uv rectangles of quads and cylinder pieces: `u` maps linearly onto the
+//!   rectangle; the area density is `1 / (|∂p/∂u × ∂p/∂v| · Δu · Δv)`
+//!   (uniform for parallelograms and circular cylinders).
+//! - disk elements: uniform in r² and φ, i.e. uniform in area (the polar map
+//!   degenerates at the centre).
+//! - sphere pieces: uniform in φ and z = cos θ on the object sphere (uniform
+//!   in area unless scaled non-uniformly; the (φ, θ) map degenerates at the
+//!   poles). Densities are finite and positive everywhere.
 //! - clusters: `u.x` picks a piece by its area (and is rescaled to [0,1)
 //!   within that piece), then the square-root map gives a uniform point of
 //!   the triangle: density `1 / area` of the cluster.
@@ -14,6 +19,7 @@ use glam::{DVec2, DVec3};
 
 use crate::element::ElementDomain;
 use crate::ids::{ElementId, SurfaceId};
+use crate::patch::{PIECE_ANGLE, Patch};
 use crate::scene_geometry::SceneGeometry;
 use crate::surface::{SurfaceCoord, SurfaceGeom};
 
@@ -45,13 +51,54 @@ impl SceneGeometry {
         let e = &self.elements[id.index()];
         match (e.domain, &self.surfaces[e.surface.index()].geom) {
             (ElementDomain::Rect { min, max }, SurfaceGeom::Patch(patch)) => {
-                let uv = min + u * (max - min);
+                // Where the uv map degenerates (disk centres, sphere poles)
+                // sample uniformly in r² or cos θ instead: the density then
+                // stays finite and positive everywhere.
+                let (uv, dens) = match patch.as_ref() {
+                    Patch::Disk { .. } => {
+                        let r2 = min.x * min.x + u.x * (max.x * max.x - min.x * min.x);
+                        let v = min.y + u.y * (max.y - min.y);
+                        (DVec2::new(r2.sqrt(), v), None)
+                    }
+                    Patch::Sphere { theta0, .. } => {
+                        let c0 = (theta0 + min.y * PIECE_ANGLE).cos();
+                        let c1 = (theta0 + max.y * PIECE_ANGLE).cos();
+                        let z = c0 + u.y * (c1 - c0);
+                        let theta = z.clamp(-1.0, 1.0).acos();
+                        let v = ((theta - theta0) / PIECE_ANGLE).clamp(min.y, max.y);
+                        (
+                            DVec2::new(min.x + u.x * (max.x - min.x), v),
+                            Some((c0 - c1).abs()),
+                        )
+                    }
+                    _ => (min + u * (max - min), None),
+                };
                 let pp = patch.eval(uv);
-                let jac = pp.jacobian() * (max.x - min.x) * (max.y - min.y);
+                let pdf = match (patch.as_ref(), dens) {
+                    // Uniform in area: the exact element area.
+                    (Patch::Disk { .. }, _) => 1.0 / e.area,
+                    // Uniform in (φ, z) on the object sphere: the world area
+                    // element is r² dφ dz times the tangent-plane area scale
+                    // |det L| |L⁻ᵀ n| of the linear map L.
+                    (Patch::Sphere { xf, radius, .. }, Some(dz)) => {
+                        let p_obj = xf.object_from_world.transform_point3(pp.p);
+                        let n_obj = match patch.as_ref() {
+                            Patch::Sphere { centre, .. } => (p_obj - *centre).normalize(),
+                            _ => DVec3::Z,
+                        };
+                        let scale = xf.linear.determinant().abs() * (xf.normal * n_obj).length();
+                        let jac = scale * radius * radius * (max.x - min.x) * PIECE_ANGLE * dz;
+                        if jac > 0.0 { 1.0 / jac } else { 0.0 }
+                    }
+                    _ => {
+                        let jac = pp.jacobian() * (max.x - min.x) * (max.y - min.y);
+                        if jac > 0.0 { 1.0 / jac } else { 0.0 }
+                    }
+                };
                 SurfaceSample {
                     point: pp.p,
                     normal: pp.n,
-                    pdf_area: if jac > 0.0 { 1.0 / jac } else { 0.0 },
+                    pdf_area: pdf,
                     coord: SurfaceCoord::Uv(uv),
                 }
             }

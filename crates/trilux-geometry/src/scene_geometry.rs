@@ -408,6 +408,7 @@ impl SceneGeometry {
             tri_normal,
             tri_area,
             tri_surface: vec![u32::MAX; mesh.triangles.len()],
+            tri_element: vec![u32::MAX; mesh.triangles.len()],
             sign,
         };
         let charts = build_charts(&data);
@@ -476,36 +477,52 @@ fn push_quad_prims(prims: &mut Vec<Prim>, surface: u32, p: &[DVec3; 4]) {
 /// Whether the front (back) side of a chart can see its own front (back)
 /// side: some triangle j has a vertex strictly in front of (behind) the
 /// plane of triangle i while i has one strictly in front of (behind) j.
+/// Only triangles with some chart vertex in front of (behind) their plane
+/// can take part, so those are found first (O(n · vertices)); a convex
+/// chart then costs no pair test at all.
 fn chart_self_visibility(mesh: &MeshData, chart: &[u32]) -> (bool, bool) {
     let b = Bounds::from_points(chart.iter().flat_map(|&t| mesh.vertices(t)));
     let tol = 1e-9 * b.diagonal().length();
-    let mut front = false;
-    let mut back = false;
-    let side = |i: u32, j: u32| -> (bool, bool) {
-        let n = mesh.tri_normal[i as usize];
-        let o = mesh.vertices(i)[0];
-        let mut above = false;
-        let mut below = false;
-        for v in mesh.vertices(j) {
-            let d = n.dot(v - o);
-            above |= d > tol;
-            below |= d < -tol;
+    let mut verts: Vec<u32> = chart
+        .iter()
+        .flat_map(|&t| mesh.triangles[t as usize])
+        .collect();
+    verts.sort_unstable();
+    verts.dedup();
+    let plane = |i: u32| (mesh.tri_normal[i as usize], mesh.vertices(i)[0]);
+    let mut above = Vec::new();
+    let mut below = Vec::new();
+    for &i in chart {
+        let (n, o) = plane(i);
+        let d = verts.iter().map(|&v| n.dot(mesh.positions[v as usize] - o));
+        let (mut a, mut bl) = (false, false);
+        for x in d {
+            a |= x > tol;
+            bl |= x < -tol;
+            if a && bl {
+                break;
+            }
         }
-        (above, below)
-    };
-    for (a, &i) in chart.iter().enumerate() {
-        for &j in &chart[a + 1..] {
-            let (ja, jb) = side(i, j);
-            if !(ja || jb) {
-                continue;
-            }
-            let (ia, ib) = side(j, i);
-            front |= ja && ia;
-            back |= jb && ib;
-            if front && back {
-                return (true, true);
-            }
+        if a {
+            above.push(i);
+        }
+        if bl {
+            below.push(i);
         }
     }
-    (front, back)
+    let mutual = |set: &[u32], sign: f64| -> bool {
+        let side = |i: u32, j: u32| {
+            let (n, o) = plane(i);
+            mesh.vertices(j).iter().any(|v| sign * n.dot(*v - o) > tol)
+        };
+        for (k, &i) in set.iter().enumerate() {
+            for &j in &set[k + 1..] {
+                if side(i, j) && side(j, i) {
+                    return true;
+                }
+            }
+        }
+        false
+    };
+    (mutual(&above, 1.0), mutual(&below, -1.0))
 }

@@ -24,7 +24,7 @@ pub enum SurfaceKind {
 /// A point of an input surface, in its own coordinates.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub enum SurfaceCoord {
-    /// (u, v) ∈ [0,1]² on a parametric surface (planar or curved).
+    /// (u, v) ∈ \[0,1\]² on a parametric surface (planar or curved).
     Uv(DVec2),
     /// A point of a mesh triangle (its index in the mesh of the shape), with
     /// barycentric coordinates (b1, b2) for its second and third vertex.

@@ -3,7 +3,8 @@
 //!
 //! Segment k joins the k-th point of an Owen-scrambled Sobol sequence on
 //! each element (independent scrambles on the two sides, seeded by the
-//! element ids, so results are deterministic). Only segments whose end
+//! element ids, so results are deterministic, and the same for (a, b) and
+//! (b, a)). Only segments whose end
 //! points face each other (both one-sided cosines positive) carry light and
 //! are counted; if none do, the plain fraction over all segments is
 //! returned (the form factor is then zero anyway).
@@ -11,25 +12,40 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
-use crate::form_factor::{seed_of, sobol2};
+use crate::form_factor::{Side, seed_of, sobol2};
 use crate::ids::ElementId;
+use crate::sampling::SurfaceSample;
 use crate::scene_geometry::SceneGeometry;
 
 impl SceneGeometry {
     /// Visible fraction between elements `a` and `b` from `samples` shadow
-    /// segments (at most 65 536).
+    /// segments (at most 65 536), counting the segments between their fronts.
     pub fn visibility(&self, a: ElementId, b: ElementId, samples: u32) -> f64 {
+        self.visibility_sided(a, Side::Front, b, Side::Front, samples)
+    }
+
+    /// [`SceneGeometry::visibility`] between given sides of the elements
+    /// (the facing test uses those sides' normals).
+    pub fn visibility_sided(
+        &self,
+        a: ElementId,
+        a_side: Side,
+        b: ElementId,
+        b_side: Side,
+        samples: u32,
+    ) -> f64 {
         let n = samples.clamp(1, 1 << 16);
-        let seed = seed_of(a, b);
+        let seed = seed_of(a.min(b), a.max(b));
         let mut facing = 0u32;
         let mut facing_visible = 0u32;
         let mut visible = 0u32;
+        let mut hint = None;
         for k in 0..n {
-            let x = self.sample_element(a, sobol2(k, 0, seed));
-            let y = self.sample_element(b, sobol2(k, 2, seed ^ 0x5bd1_e995));
+            let (x, y) = self.segment_ends(a, b, k, seed);
             let d = y.point - x.point;
-            let faces = x.normal.dot(d) > 0.0 && y.normal.dot(d) < 0.0;
-            let vis = !self.occluded(x.point, y.point);
+            let faces =
+                a_side.sign() * x.normal.dot(d) > 0.0 && b_side.sign() * y.normal.dot(d) < 0.0;
+            let vis = !self.occluded_hint(x.point, y.point, &mut hint);
             visible += u32::from(vis);
             if faces {
                 facing += 1;
@@ -40,6 +56,72 @@ impl SceneGeometry {
             facing_visible as f64 / facing as f64
         } else {
             visible as f64 / n as f64
+        }
+    }
+
+    /// Kernel-weighted visible fraction Σ K vis / Σ K over the same
+    /// stratified segments, K = cos θ_a cos θ_b / r² (the form-factor
+    /// kernel): the factor V such that F · V estimates the occluded form
+    /// factor ∫∫ K vis / (π A_a) when occlusion and K are correlated (a
+    /// blocker near one end, partial occlusion of a large element). Falls
+    /// back to [`SceneGeometry::visibility_sided`] when no segment carries
+    /// light.
+    pub fn visibility_weighted(
+        &self,
+        a: ElementId,
+        a_side: Side,
+        b: ElementId,
+        b_side: Side,
+        samples: u32,
+    ) -> f64 {
+        let n = samples.clamp(1, 1 << 16);
+        let seed = seed_of(a.min(b), a.max(b));
+        let (sa, sb) = (a_side.sign(), b_side.sign());
+        let mut total = 0.0;
+        let mut seen = 0.0;
+        let mut hint = None;
+        for k in 0..n {
+            let (x, y) = self.segment_ends(a, b, k, seed);
+            let d = y.point - x.point;
+            let r2 = d.length_squared();
+            let (ca, cb) = (sa * x.normal.dot(d), -sb * y.normal.dot(d));
+            if ca <= 0.0 || cb <= 0.0 || r2 <= 0.0 || x.pdf_area <= 0.0 || y.pdf_area <= 0.0 {
+                continue;
+            }
+            // Weight by the kernel over the sampling densities (the
+            // integrand of ∫∫ K dA dA).
+            let w = ca * cb / (r2 * r2 * x.pdf_area * y.pdf_area);
+            if !w.is_finite() {
+                continue;
+            }
+            total += w;
+            if !self.occluded_hint(x.point, y.point, &mut hint) {
+                seen += w;
+            }
+        }
+        if total > 0.0 {
+            (seen / total).clamp(0.0, 1.0)
+        } else {
+            self.visibility_sided(a, a_side, b, b_side, samples)
+        }
+    }
+
+    /// The ends of shadow segment `k` between `a` and `b`. The lower element
+    /// id always draws from the same Sobol dimensions, so (a, b) and (b, a)
+    /// trace the same segments and visibility is symmetric.
+    fn segment_ends(
+        &self,
+        a: ElementId,
+        b: ElementId,
+        k: u32,
+        seed: u32,
+    ) -> (SurfaceSample, SurfaceSample) {
+        let first = |e: ElementId| self.sample_element(e, sobol2(k, 0, seed));
+        let second = |e: ElementId| self.sample_element(e, sobol2(k, 2, seed ^ 0x5bd1_e995));
+        if a <= b {
+            (first(a), second(b))
+        } else {
+            (second(a), first(b))
         }
     }
 
@@ -60,14 +142,11 @@ impl SceneGeometry {
         samples: u32,
     ) -> Vec<(DVec3, DVec3)> {
         let n = samples.clamp(1, 1 << 16);
-        let seed = seed_of(a, b);
+        let seed = seed_of(a.min(b), a.max(b));
         (0..n)
             .map(|k| {
-                (
-                    self.sample_element(a, sobol2(k, 0, seed)).point,
-                    self.sample_element(b, sobol2(k, 2, seed ^ 0x5bd1_e995))
-                        .point,
-                )
+                let (x, y) = self.segment_ends(a, b, k, seed);
+                (x.point, y.point)
             })
             .collect()
     }

@@ -124,3 +124,55 @@ fn subdivide_locate_sample() {
     }
     let _ = SurfaceCoord::Uv(DVec2::ZERO);
 }
+
+#[test]
+fn scene_geometry_is_shareable_across_threads() {
+    fn check<T: Send + Sync + Clone>() {}
+    check::<SceneGeometry>();
+    // Reading in parallel while elements exist.
+    let g = scene();
+    let rays: Vec<Ray> = (0..1000)
+        .map(|k| Ray {
+            origin: DVec3::ZERO,
+            dir: DVec3::new((k as f64).sin(), (k as f64).cos(), 0.3),
+        })
+        .collect();
+    let a = g.intersect_batch(&rays, f64::INFINITY);
+    let b: Vec<_> = rays.iter().map(|r| g.intersect(r, f64::INFINITY)).collect();
+    assert_eq!(a, b);
+}
+
+#[test]
+fn sampling_densities_are_finite_and_positive_everywhere() {
+    // Including the disk's centre and the sphere's poles (u on the corners
+    // and edges of the unit square), under a non-uniform scale too.
+    let m = DMat4::from_scale(DVec3::new(1.0, 2.0, 0.5));
+    let mut g = SceneGeometry::build(&[
+        sphere(DVec3::ZERO, 1.0, m, false),
+        disk(DVec3::ZERO, DVec3::X, DVec3::Y, 1.0, false),
+        cylinder(DVec3::ZERO, DVec3::Z, 0.5, m, true),
+    ])
+    .expect("valid");
+    for s in 0..g.surfaces().len() {
+        let root = g.surfaces()[s].root;
+        let kids = g.subdivide(root);
+        for e in std::iter::once(root).chain(kids) {
+            for u in [
+                DVec2::ZERO,
+                DVec2::ONE,
+                DVec2::new(0.0, 1.0),
+                DVec2::new(1.0, 0.0),
+                DVec2::new(0.5, 0.0),
+                DVec2::new(0.0, 0.5),
+            ] {
+                let smp = g.sample_element(e, u);
+                assert!(
+                    smp.pdf_area.is_finite() && smp.pdf_area > 0.0,
+                    "surface {s} u {u}: {}",
+                    smp.pdf_area
+                );
+                assert!(smp.point.is_finite() && smp.normal.is_finite());
+            }
+        }
+    }
+}

@@ -177,3 +177,78 @@ fn concave_and_convex_charts() {
             .all(|s| g.element(s.root).normal.z > 0.0)
     );
 }
+
+#[test]
+fn locate_agrees_with_a_descent_from_the_root() {
+    // Uneven subdivision, then every sampled point is located both by
+    // `locate` (which jumps to the deepest element holding the whole
+    // triangle) and by descending from the root through the children that
+    // contain it.
+    let (p, t) = curved_sheet(24);
+    let mut g = SceneGeometry::build(&[mesh(p, t, DMat4::IDENTITY)]).expect("valid mesh");
+    let mut frontier: Vec<ElementId> = g.surfaces().iter().map(|s| s.root).collect();
+    for level in 0..7 {
+        let next: Vec<ElementId> = frontier
+            .iter()
+            .enumerate()
+            .filter(|(k, _)| (k + level) % 3 != 0)
+            .flat_map(|(_, &e)| g.subdivide(e))
+            .collect();
+        frontier = next;
+    }
+    let reference = |g: &SceneGeometry, s: trilux_geometry::SurfaceId, c: SurfaceCoord| {
+        let mut id = g.surface(s).root;
+        while let Some(kids) = g.element(id).children() {
+            match kids.iter().find(|&&k| g.element_contains(k, c)) {
+                Some(&k) => id = k,
+                None => break,
+            }
+        }
+        id
+    };
+    let mut checked = 0;
+    for e in 0..g.element_count() as u32 {
+        for k in 0..3 {
+            let smp = g.sample_element(
+                ElementId(e),
+                DVec2::new(0.13 + 0.3 * k as f64, 0.71 - 0.2 * k as f64),
+            );
+            let s = g.element(ElementId(e)).surface;
+            assert_eq!(g.locate(s, smp.coord), reference(&g, s, smp.coord));
+            checked += 1;
+        }
+    }
+    assert!(checked > 3000, "{checked}");
+}
+
+#[test]
+fn a_triangle_soup_becomes_a_handful_of_charts() {
+    // 8192 separate (unconnected) small triangles scattered over a gently
+    // curved sheet, all facing up: never one input surface per triangle.
+    let (p, t) = curved_sheet(64);
+    let mut positions = Vec::new();
+    let mut triangles = Vec::new();
+    for tri in &t {
+        let k = positions.len() as u32;
+        let c = (p[tri[0] as usize] + p[tri[1] as usize] + p[tri[2] as usize]) / 3.0;
+        for &v in tri {
+            positions.push(c + 0.8 * (p[v as usize] - c));
+        }
+        triangles.push([k, k + 1, k + 2]);
+    }
+    let mut g =
+        SceneGeometry::build(&[mesh(positions, triangles, DMat4::IDENTITY)]).expect("valid mesh");
+    let charts = g.surfaces().len();
+    println!("{charts} charts for a soup of 8192 triangles");
+    assert!((16..=32).contains(&charts), "{charts} charts");
+    // Every triangle is in exactly one chart and reachable by locate.
+    let mut seen = vec![0u32; 8192];
+    for s in 0..charts {
+        let root = g.surfaces()[s].root;
+        for p in g.element_pieces(root) {
+            seen[p.triangle as usize] += 1;
+        }
+        let _ = g.subdivide(root);
+    }
+    assert!(seen.iter().all(|&n| n == 1));
+}
