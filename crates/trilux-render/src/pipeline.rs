@@ -20,7 +20,8 @@ pub struct PipelineStats {
     pub solve_seconds: f64,
 }
 
-/// Solves `scene` with `solver` settings and renders it from its camera.
+/// Solves `scene` with `solver` settings and renders it from its camera,
+/// in the scene's own colour mode (`Scene::mode`).
 pub fn solve_and_render(
     scene: &trilux_scene::Scene,
     solver: trilux_solver::SolverSettings,
@@ -28,7 +29,7 @@ pub fn solve_and_render(
     settings: &RenderSettings,
 ) -> Result<(Image, PipelineStats), RenderError> {
     let start = Instant::now();
-    if scene.spectral {
+    if scene.mode() == trilux_color::Mode::Spectral {
         let sol = solve_scene::<10>(scene, solver)?;
         let solve_seconds = start.elapsed().as_secs_f64();
         let (image, render) = render(scene, &sol, view, settings, |_, _| {})?;

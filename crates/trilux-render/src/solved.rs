@@ -358,19 +358,8 @@ pub fn solve_scene<const N: usize>(
     scene: &trilux_scene::Scene,
     settings: trilux_solver::SolverSettings,
 ) -> Result<trilux_solver::Solution<N>, RenderError> {
-    let shapes = scene.geometry_shapes();
-    let bsdfs: Vec<BsdfParams> = scene.shapes.iter().map(|s| s.bsdf.clone()).collect();
-    let emission: Vec<_> = scene
-        .shapes
-        .iter()
-        .map(|s| s.emitter.as_ref().map(|e| e.radiance.clone()))
-        .collect();
-    let input = trilux_solver::SolverInput {
-        shapes: &shapes,
-        bsdfs: &bsdfs,
-        emission: &emission,
-    };
-    let solver = trilux_solver::Solver::<N>::new(&input, settings)
+    let input = trilux_solver::SceneInput::from_scene(scene);
+    let solver = trilux_solver::Solver::<N>::new(&input.as_input(), settings)
         .map_err(|e| RenderError::Scene(format!("{}: {e}", scene.path.display())))?;
     Ok(solver.solve(|_| {}))
 }

@@ -1,0 +1,69 @@
+//! View independence: one solve, several views. Solves a scene once, then
+//! renders a short walkthrough (the camera moves along a line and turns
+//! towards a fixed target) into `out/walkthrough-NN.png` and `.exr`.
+//!
+//! Run: `cargo run --release -p trilux-render --example walkthrough [-- SCENE.xml [FRAMES] [SIZE] [SPP]]`
+//! (default scenes/paper-scene1.xml, 6 frames, 128×128, 32 spp).
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use glam::DVec3;
+use trilux_render::{RenderSettings, ViewOverrides, render, solve_scene};
+use trilux_solver::{Quality, SolverSettings};
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let path = args.first().map(PathBuf::from).unwrap_or_else(|| {
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/paper-scene1.xml")
+    });
+    let frames: usize = args
+        .get(1)
+        .map(|s| s.parse())
+        .transpose()?
+        .unwrap_or(6)
+        .max(1);
+    let size: u32 = args.get(2).map(|s| s.parse()).transpose()?.unwrap_or(128);
+    let spp: u32 = args.get(3).map(|s| s.parse()).transpose()?.unwrap_or(32);
+    let scene = trilux_scene::load(&path)?;
+    let camera = scene.camera.clone().ok_or("the scene has no camera")?;
+    if scene.spectral {
+        return Err("this example renders RGB scenes; spectral scenes solve in 10 bands".into());
+    }
+    let t = Instant::now();
+    let solution = solve_scene::<3>(&scene, SolverSettings::preset(Quality::Default))?;
+    println!("solved once in {:.2} s", t.elapsed().as_secs_f64());
+
+    // Walk sideways across the view and a little forward, looking at the
+    // scene camera's target.
+    let forward = (camera.target - camera.origin).normalize();
+    let side = forward.cross(camera.up).normalize();
+    let reach = 0.25 * (camera.target - camera.origin).length();
+    std::fs::create_dir_all("out")?;
+    let settings = RenderSettings {
+        spp,
+        ..RenderSettings::for_scene(&camera)
+    };
+    for k in 0..frames {
+        let s = if frames > 1 {
+            k as f64 / (frames - 1) as f64
+        } else {
+            0.5
+        };
+        let eye: DVec3 = camera.origin + side * reach * (s - 0.5) + forward * reach * 0.3 * s;
+        let view = ViewOverrides {
+            lookat: Some((eye, camera.target, Some(camera.up))),
+            width: Some(size),
+            height: Some(size),
+            ..Default::default()
+        };
+        let (image, stats) = render(&scene, &solution, &view, &settings, |_, _| {})?;
+        image.write_png(Path::new(&format!("out/walkthrough-{k:02}.png")), 0.0)?;
+        image.write_exr(Path::new(&format!("out/walkthrough-{k:02}.exr")))?;
+        println!(
+            "frame {k}: eye {eye:.3}, rendered in {:.2} s (no solve)",
+            stats.seconds
+        );
+    }
+    Ok(())
+}
