@@ -31,7 +31,10 @@ fn bench(c: &mut Criterion) {
         };
         let input = SceneInput::from_scene(&scene);
         let settings = SolverSettings::preset(quality);
-        let name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+        let name = path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
         match scene.mode() {
             Mode::Rgb => group.bench_function(&name, |b| {
                 b.iter(|| {
