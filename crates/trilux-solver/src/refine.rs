@@ -91,6 +91,25 @@ pub(crate) struct NodeLink<const N: usize> {
     pub gathered: Spectrum<N>,
 }
 
+/// One receiving hierarchy refined against the pair links of one shot
+/// (stage 2): what the recursion carries besides the three elements.
+pub(crate) struct TripleTask<'t, const N: usize> {
+    /// Where the shot's unshot radiance comes from.
+    pub sender: &'t Sender<'t, N>,
+    /// The sending side.
+    pub si: SideId,
+    /// The receiving hierarchy (this task owns it for the shot).
+    pub h: &'t mut Hierarchy<N>,
+    /// Its index among the solver's hierarchies.
+    pub h_index: u32,
+    /// The pair link being refined and its throughput scale.
+    pub group: (u32, f64),
+    /// Flux that splits could not keep.
+    pub lost: Spectrum<N>,
+    /// The links made.
+    pub out: Vec<NodeLink<N>>,
+}
+
 /// Everything refinement reads, shared by the parallel tasks of a shot.
 pub(crate) struct RefineContext<'a, const N: usize> {
     pub geom: &'a SceneGeometry,
@@ -316,19 +335,13 @@ impl<const N: usize> RefineContext<'_, N> {
     #[allow(clippy::too_many_arguments)]
     pub fn refine_triple(
         &self,
-        sender: &Sender<'_, N>,
-        si: SideId,
-        h: &mut Hierarchy<N>,
-        h_index: u32,
+        task: &mut TripleTask<'_, N>,
         i: ElementId,
         j: ElementId,
         n: u32,
         known: Option<(Throughput, Spectrum<N>)>,
-        group: (u32, f64),
-        lost: &mut Spectrum<N>,
-        out: &mut Vec<NodeLink<N>>,
     ) {
-        let (sj, sk) = (h.from, h.to);
+        let (si, sj, sk, group) = (task.si, task.h.from, task.h.to, task.group);
         // T_ij and δL_ij are the same for every receiver node of one (i, j):
         // the K-side recursion hands them down instead of looking them up.
         let (tij, unshot) = match known {
@@ -339,13 +352,13 @@ impl<const N: usize> RefineContext<'_, N> {
                 if tij.t <= 0.0 {
                     return;
                 }
-                (tij, sender.unshot(self.geom, i, j))
+                (tij, task.sender.unshot(self.geom, i, j))
             }
         };
         if tij.t <= 0.0 || unshot.is_black() {
             return;
         }
-        let node = &h.nodes[n as usize];
+        let node = &task.h.nodes[n as usize];
         debug_assert_eq!(node.from, j);
         let (k, tjk, vjk) = (node.to, node.t, node.v);
         if tjk <= 0.0 {
@@ -358,20 +371,7 @@ impl<const N: usize> RefineContext<'_, N> {
                 } else {
                     Driver::K
                 };
-                self.split_triple(
-                    side,
-                    sender,
-                    si,
-                    h,
-                    h_index,
-                    i,
-                    j,
-                    n,
-                    (tij, unshot),
-                    group,
-                    lost,
-                    out,
-                );
+                self.split_triple(side, task, i, j, n, (tij, unshot));
             }
             return;
         }
@@ -397,34 +397,21 @@ impl<const N: usize> RefineContext<'_, N> {
                 (false, false) => return,
             };
             for d in order {
-                if self.split_triple(
-                    d,
-                    sender,
-                    si,
-                    h,
-                    h_index,
-                    i,
-                    j,
-                    n,
-                    (tij, unshot),
-                    group,
-                    lost,
-                    out,
-                ) {
+                if self.split_triple(d, task, i, j, n, (tij, unshot)) {
                     return;
                 }
             }
             return;
         }
         let link = NodeLink {
-            hierarchy: h_index,
+            hierarchy: task.h_index,
             node: n,
             group: group.0,
             gathered,
         };
         let flux_to_k = PI * tjk * gathered.sum();
         if flux_to_k < self.flux_threshold {
-            out.push(link);
+            task.out.push(link);
             return;
         }
         let (spread, driver) = self.fr_variation(bsdf, i, j, k);
@@ -434,27 +421,14 @@ impl<const N: usize> RefineContext<'_, N> {
         let ff_err = fjk.max(fkj) / self.settings.ff_eps;
         let partial = (vjk > 0.0 && vjk < 1.0) || straddle_k;
         if brdf_err <= 1.0 && ff_err <= 1.0 && !partial && !straddle_i {
-            out.push(link);
+            task.out.push(link);
             return;
         }
         if straddle_i && brdf_err <= 1.0 && ff_err <= 1.0 && !partial {
-            if self.split_triple(
-                Driver::I,
-                sender,
-                si,
-                h,
-                h_index,
-                i,
-                j,
-                n,
-                (tij, unshot),
-                group,
-                lost,
-                out,
-            ) {
+            if self.split_triple(Driver::I, task, i, j, n, (tij, unshot)) {
                 return;
             }
-            out.push(link);
+            task.out.push(link);
             return;
         }
         // The element to split: the BRDF's driver when the BRDF error
@@ -476,24 +450,11 @@ impl<const N: usize> RefineContext<'_, N> {
         };
         let order = [first, rest[0], rest[1]];
         for d in order {
-            if self.split_triple(
-                d,
-                sender,
-                si,
-                h,
-                h_index,
-                i,
-                j,
-                n,
-                (tij, unshot),
-                group,
-                lost,
-                out,
-            ) {
+            if self.split_triple(d, task, i, j, n, (tij, unshot)) {
                 return;
             }
         }
-        out.push(link);
+        task.out.push(link);
     }
 
     /// Applies one of the three subdivision cases (notes §3), following an
@@ -503,19 +464,13 @@ impl<const N: usize> RefineContext<'_, N> {
     fn split_triple(
         &self,
         which: Driver,
-        sender: &Sender<'_, N>,
-        si: SideId,
-        h: &mut Hierarchy<N>,
-        h_index: u32,
+        task: &mut TripleTask<'_, N>,
         i: ElementId,
         j: ElementId,
         n: u32,
         known: (Throughput, Spectrum<N>),
-        group: (u32, f64),
-        lost: &mut Spectrum<N>,
-        out: &mut Vec<NodeLink<N>>,
     ) -> bool {
-        let node_split = h.nodes[n as usize].split;
+        let node_split = task.h.nodes[n as usize].split;
         let which = match (which, node_split) {
             (Driver::I, _) => Driver::I,
             (_, Split::From) => Driver::J,
@@ -528,38 +483,26 @@ impl<const N: usize> RefineContext<'_, N> {
                     return false;
                 };
                 for c in children {
-                    self.refine_triple(sender, si, h, h_index, c, j, n, None, group, lost, out);
+                    self.refine_triple(task, c, j, n, None);
                 }
                 true
             }
             Driver::K => {
-                let Some(nodes) = self.node_children(h, n, Split::To, lost) else {
+                let Some(nodes) = self.node_children(task.h, n, Split::To, &mut task.lost) else {
                     return false;
                 };
                 for c in nodes {
-                    self.refine_triple(
-                        sender,
-                        si,
-                        h,
-                        h_index,
-                        i,
-                        j,
-                        c,
-                        Some(known),
-                        group,
-                        lost,
-                        out,
-                    );
+                    self.refine_triple(task, i, j, c, Some(known));
                 }
                 true
             }
             Driver::J => {
-                let Some(nodes) = self.node_children(h, n, Split::From, lost) else {
+                let Some(nodes) = self.node_children(task.h, n, Split::From, &mut task.lost) else {
                     return false;
                 };
                 for c in nodes {
-                    let jm = h.nodes[c as usize].from;
-                    self.refine_triple(sender, si, h, h_index, i, jm, c, None, group, lost, out);
+                    let jm = task.h.nodes[c as usize].from;
+                    self.refine_triple(task, i, jm, c, None);
                 }
                 true
             }

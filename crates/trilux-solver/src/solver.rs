@@ -26,7 +26,7 @@ use crate::error::SolverError;
 use crate::interaction::Hierarchy;
 use crate::ledger::Ledger;
 use crate::radiosity::ElementRadiance;
-use crate::refine::{NodeLink, PairLink, RefineContext, Sender};
+use crate::refine::{NodeLink, PairLink, RefineContext, Sender, TripleTask};
 use crate::settings::SolverSettings;
 use crate::sides::{SideId, TransportSide, build_sides, eligible_pairs};
 use crate::solution::Solution;
@@ -439,27 +439,24 @@ impl<const N: usize> Solver<N> {
             .enumerate()
             .filter(|(h, hier)| Some(*h as u32) != busy && groups_of_side.contains_key(&hier.from))
             .map(|(h, hier)| {
-                let mut out = Vec::new();
-                let mut lost = Spectrum::zero();
-                for &g in &groups_of_side[&hier.from] {
+                let from = hier.from;
+                let mut task = TripleTask {
+                    sender: &sender,
+                    si: send_side,
+                    h: hier,
+                    h_index: h as u32,
+                    group: (0, 1.0),
+                    lost: Spectrum::zero(),
+                    out: Vec::new(),
+                };
+                for &g in &groups_of_side[&from] {
                     let l = &pair_links[g as usize];
-                    for n in ctx.nodes_for(hier, l.j, &mut lost) {
-                        ctx.refine_triple(
-                            &sender,
-                            send_side,
-                            hier,
-                            h as u32,
-                            l.i,
-                            l.j,
-                            n,
-                            None,
-                            (g, l.t_scale),
-                            &mut lost,
-                            &mut out,
-                        );
+                    task.group = (g, l.t_scale);
+                    for n in ctx.nodes_for(task.h, l.j, &mut task.lost) {
+                        ctx.refine_triple(&mut task, l.i, l.j, n, None);
                     }
                 }
-                (out, h as u32, lost)
+                (task.out, h as u32, task.lost)
             })
             .collect();
         let mut node_links = Vec::new();
