@@ -169,17 +169,7 @@ fn rays_hit_what_mitsuba_hits() {
     let mut hits = 0;
     for case in exp["rays"].as_array().expect("rays") {
         let xml = case["xml"].as_str().expect("xml");
-        // WORKAROUND (reported to the geometry owner): trilux-geometry's BVH
-        // misses every ray when the whole scene lies in one axis-aligned
-        // plane (a lone rectangle or flat OBJ sheet: zero extent along one
-        // axis). A tiny sphere far away gives the scene depth without
-        // being on any ray's path.
-        let geometry = load(&format!(
-            "{xml}<shape type=\"sphere\"><point name=\"center\" value=\"1000, 1000, 1000\"/>\
-             <float name=\"radius\" value=\"0.001\"/></shape>"
-        ))
-        .build_geometry()
-        .unwrap_or_else(|e| panic!("{e}"));
+        let geometry = load(xml).build_geometry().unwrap_or_else(|e| panic!("{e}"));
         for ray in case["rays"].as_array().expect("rays") {
             let r = trilux_geometry::Ray {
                 origin: vec3(&ray["origin"]),
