@@ -121,8 +121,7 @@ impl<const N: usize> Hierarchy<N> {
             lost = (parent.unshot + parent.gathered) * (std::f64::consts::PI * parent.t);
             0.0
         };
-        for (k, (&(a, b), th)) in elements.iter().zip(throughputs.iter()).enumerate() {
-            let _ = k;
+        for (&(a, b), th) in elements.iter().zip(throughputs.iter()) {
             self.nodes.push(Node {
                 from: a,
                 to: b,
@@ -203,8 +202,8 @@ impl<const N: usize> Hierarchy<N> {
             let next = children.into_iter().find(|&c| {
                 let child = &self.nodes[c as usize];
                 match node.split {
-                    Split::From => child.from != node.from && is_within(geom, i, child.from),
-                    Split::To => child.to != node.to && is_within(geom, j, child.to),
+                    Split::From => is_within(geom, i, child.from),
+                    Split::To => is_within(geom, j, child.to),
                     Split::None => false,
                 }
             });

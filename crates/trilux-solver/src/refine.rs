@@ -70,10 +70,6 @@ pub(crate) struct PairLink<const N: usize> {
     pub side: SideId,
     /// T_ij.
     pub t: f64,
-    /// The factor already applied to `t` (and to be applied to every
-    /// sub-pair of this link in stage 2) so that a stored sender shoots
-    /// exactly the flux it holds.
-    pub t_scale: f64,
     /// δL_i sent along the link.
     pub unshot: Spectrum<N>,
 }
@@ -102,8 +98,8 @@ pub(crate) struct TripleTask<'t, const N: usize> {
     pub h: &'t mut Hierarchy<N>,
     /// Its index among the solver's hierarchies.
     pub h_index: u32,
-    /// The pair link being refined and its throughput scale.
-    pub group: (u32, f64),
+    /// The pair link being refined.
+    pub group: u32,
     /// Flux that splits could not keep.
     pub lost: Spectrum<N>,
     /// The links made.
@@ -218,7 +214,6 @@ impl<const N: usize> RefineContext<'_, N> {
             j,
             side: sj,
             t: th.t,
-            t_scale: 1.0,
             unshot,
         };
         let flux = PI * th.t * unshot.sum();
@@ -347,8 +342,7 @@ impl<const N: usize> RefineContext<'_, N> {
         let (tij, unshot) = match known {
             Some(k) => k,
             None => {
-                let mut tij = self.throughput(j, sj, i, si);
-                tij.t *= group.1;
+                let tij = self.throughput(j, sj, i, si);
                 if tij.t <= 0.0 {
                     return;
                 }
@@ -406,7 +400,7 @@ impl<const N: usize> RefineContext<'_, N> {
         let link = NodeLink {
             hierarchy: task.h_index,
             node: n,
-            group: group.0,
+            group,
             gathered,
         };
         let flux_to_k = PI * tjk * gathered.sum();

@@ -445,13 +445,13 @@ impl<const N: usize> Solver<N> {
                     si: send_side,
                     h: hier,
                     h_index: h as u32,
-                    group: (0, 1.0),
+                    group: 0,
                     lost: Spectrum::zero(),
                     out: Vec::new(),
                 };
                 for &g in &groups_of_side[&from] {
                     let l = &pair_links[g as usize];
-                    task.group = (g, l.t_scale);
+                    task.group = g;
                     for n in ctx.nodes_for(task.h, l.j, &mut task.lost) {
                         ctx.refine_triple(&mut task, l.i, l.j, n, None);
                     }
