@@ -411,8 +411,9 @@ impl<const N: usize> RefineContext<'_, N> {
         let (spread, driver) = self.fr_variation(bsdf, i, j, k);
         let (fji, _) = self.ff_estimates(j, sj, i, si);
         let brdf_err = PI * fji * spread / self.settings.fr_eps;
-        let (fjk, fkj) = self.ff_estimates(j, sj, k, sk);
-        let ff_err = fjk.max(fkj) / self.settings.ff_eps;
+        // The same oracle as stage 1, for the flux this node will carry on:
+        // how much the point form factor F(y → j) varies over y in k.
+        let ff_err = self.throughput(k, sk, j, sj).spread / self.settings.ff_eps;
         let partial = (vjk > 0.0 && vjk < 1.0) || straddle_k;
         if brdf_err <= 1.0 && ff_err <= 1.0 && !partial && !straddle_i {
             task.out.push(link);
