@@ -5,20 +5,8 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-fn trilux(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_trilux"))
-        .args(args)
-        .output()
-        .expect("the trilux binary runs")
-}
-
-/// A fresh folder for one test's files.
-fn folder(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("cli-{name}"));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("temp folder");
-    dir
-}
+mod common;
+use common::{folder, trilux};
 
 fn write(dir: &Path, file: &str, text: &str) -> PathBuf {
     let path = dir.join(file);

@@ -2,22 +2,11 @@
 //! saved solution does no solving, a solution made for another scene is
 //! refused, bad outputs and bad options fail cleanly (design.md §3).
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::path::Path;
+use std::process::Output;
 
-fn trilux(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_trilux"))
-        .args(args)
-        .output()
-        .expect("the trilux binary runs")
-}
-
-fn folder(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("render-cli-{name}"));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("temp folder");
-    dir
-}
+mod common;
+use common::{folder, trilux};
 
 fn scene(name: &str) -> String {
     Path::new(env!("CARGO_MANIFEST_DIR"))
