@@ -3,7 +3,7 @@
 //! with clap's status 2; `info --json` has exactly design.md §3's keys.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Command;
 
 mod common;
 use common::{folder, trilux};
