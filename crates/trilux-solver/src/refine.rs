@@ -101,6 +101,8 @@ pub(crate) struct RefineContext<'a, const N: usize> {
     pub ff_options: FormFactorOptions,
     /// Photometric threshold in watts (band sum): flux_eps × IF.
     pub flux_threshold: f64,
+    /// `element_points` of every element, computed once.
+    pub points: &'a [[DVec3; 5]],
 }
 
 /// Point-to-disc estimate of F_{a→b} (notes §2, HSA91): b seen from a's
@@ -252,20 +254,31 @@ impl<const N: usize> RefineContext<'_, N> {
         true
     }
 
-    /// Representative fr(i→j→k) for stored transport and its variation.
-    fn brdf_terms(
+    /// fr(i→j→k) at the three centres, for stored transport (the glossy
+    /// part in two-point mode, the whole BRDF in uniform mode).
+    fn fr_centre(&self, bsdf: &Bsdf<N>, i: ElementId, j: ElementId, k: ElementId) -> Spectrum<N> {
+        let g = self.geom;
+        let (ei, ej, ek) = (g.element(i), g.element(j), g.element(k));
+        let frame = trilux_brdf::Frame::from_normal(ej.normal);
+        let wi = frame.to_local((ei.centre - ej.centre).normalize_or_zero());
+        let wo = frame.to_local((ek.centre - ej.centre).normalize_or_zero());
+        match self.settings.transport {
+            Transport::TwoPoint => bsdf.eval_glossy(wi, wo),
+            Transport::Uniform => bsdf.eval(wi, wo),
+        }
+    }
+
+    /// The spread of fr over the three elements and the element driving it
+    /// (notes §2, step 3): only computed when the cheaper tests did not
+    /// already decide.
+    fn fr_variation(
         &self,
         bsdf: &Bsdf<N>,
         i: ElementId,
         j: ElementId,
         k: ElementId,
-    ) -> (Spectrum<N>, f64, Driver) {
+    ) -> (f64, Driver) {
         let g = self.geom;
-        let (pi, pj, pk) = (
-            g.element_points(i),
-            g.element_points(j),
-            g.element_points(k),
-        );
         let (ei, ej, ek) = (g.element(i), g.element(j), g.element(k));
         fn pts<'p>(e: &trilux_geometry::Element, p: &'p [DVec3; 5]) -> ElementPoints<'p> {
             ElementPoints {
@@ -274,18 +287,14 @@ impl<const N: usize> RefineContext<'_, N> {
                 points: &p[..],
             }
         }
-        let (xi, xj, xk) = (pts(ei, &pi), pts(ej, &pj), pts(ek, &pk));
-        let variation = brdf_variation(bsdf, &xi, &xj, &xk);
-        let frame = trilux_brdf::Frame::from_normal(ej.normal);
-        let wi = (ei.centre - ej.centre).normalize_or_zero();
-        let wo = (ek.centre - ej.centre).normalize_or_zero();
-        let (wi, wo) = (frame.to_local(wi), frame.to_local(wo));
-        let fr = match self.settings.transport {
-            Transport::TwoPoint => bsdf.eval_glossy(wi, wo),
-            Transport::Uniform => bsdf.eval(wi, wo),
-        };
+        let variation = brdf_variation(
+            bsdf,
+            &pts(ei, &self.points[i.index()]),
+            &pts(ej, &self.points[j.index()]),
+            &pts(ek, &self.points[k.index()]),
+        );
         let spread = (variation.fr_max - variation.fr_min).max_value().max(0.0);
-        (fr, spread, variation.driver())
+        (spread, variation.driver())
     }
 
     /// True when element `e` has points on both sides of the tangent plane
@@ -294,7 +303,7 @@ impl<const N: usize> RefineContext<'_, N> {
         let ej = self.geom.element(j);
         let scale = ej.bounds.diagonal().length().max(1e-300);
         let (mut front, mut back) = (false, false);
-        for p in self.geom.element_points(e) {
+        for &p in &self.points[e.index()] {
             let d = (p - ej.centre).dot(ej.normal);
             front |= d > 1e-9 * scale;
             back |= d < -1e-9 * scale;
@@ -314,18 +323,26 @@ impl<const N: usize> RefineContext<'_, N> {
         i: ElementId,
         j: ElementId,
         n: u32,
+        known: Option<(Throughput, Spectrum<N>)>,
         group: (u32, f64),
         lost: &mut Spectrum<N>,
         out: &mut Vec<NodeLink<N>>,
     ) {
         let (sj, sk) = (h.from, h.to);
-        let mut tij = self.throughput(j, sj, i, si);
-        tij.t *= group.1;
-        if tij.t <= 0.0 {
-            return;
-        }
-        let unshot = sender.unshot(self.geom, i, j);
-        if unshot.is_black() {
+        // T_ij and δL_ij are the same for every receiver node of one (i, j):
+        // the K-side recursion hands them down instead of looking them up.
+        let (tij, unshot) = match known {
+            Some(k) => k,
+            None => {
+                let mut tij = self.throughput(j, sj, i, si);
+                tij.t *= group.1;
+                if tij.t <= 0.0 {
+                    return;
+                }
+                (tij, sender.unshot(self.geom, i, j))
+            }
+        };
+        if tij.t <= 0.0 || unshot.is_black() {
             return;
         }
         let node = &h.nodes[n as usize];
@@ -341,12 +358,25 @@ impl<const N: usize> RefineContext<'_, N> {
                 } else {
                     Driver::K
                 };
-                self.split_triple(side, sender, si, h, h_index, i, j, n, group, lost, out);
+                self.split_triple(
+                    side,
+                    sender,
+                    si,
+                    h,
+                    h_index,
+                    i,
+                    j,
+                    n,
+                    (tij, unshot),
+                    group,
+                    lost,
+                    out,
+                );
             }
             return;
         }
         let bsdf = &self.materials[self.sides[sj as usize].shape];
-        let (fr, spread, driver) = self.brdf_terms(bsdf, i, j, k);
+        let fr = self.fr_centre(bsdf, i, j, k);
         let aj = self.geom.element(j).area;
         let r = fr * (PI * tij.t / aj);
         let gathered = unshot * r;
@@ -367,7 +397,20 @@ impl<const N: usize> RefineContext<'_, N> {
                 (false, false) => return,
             };
             for d in order {
-                if self.split_triple(d, sender, si, h, h_index, i, j, n, group, lost, out) {
+                if self.split_triple(
+                    d,
+                    sender,
+                    si,
+                    h,
+                    h_index,
+                    i,
+                    j,
+                    n,
+                    (tij, unshot),
+                    group,
+                    lost,
+                    out,
+                ) {
                     return;
                 }
             }
@@ -384,6 +427,7 @@ impl<const N: usize> RefineContext<'_, N> {
             out.push(link);
             return;
         }
+        let (spread, driver) = self.fr_variation(bsdf, i, j, k);
         let (fji, _) = self.ff_estimates(j, sj, i, si);
         let brdf_err = PI * fji * spread / self.settings.fr_eps;
         let (fjk, fkj) = self.ff_estimates(j, sj, k, sk);
@@ -394,7 +438,20 @@ impl<const N: usize> RefineContext<'_, N> {
             return;
         }
         if straddle_i && brdf_err <= 1.0 && ff_err <= 1.0 && !partial {
-            if self.split_triple(Driver::I, sender, si, h, h_index, i, j, n, group, lost, out) {
+            if self.split_triple(
+                Driver::I,
+                sender,
+                si,
+                h,
+                h_index,
+                i,
+                j,
+                n,
+                (tij, unshot),
+                group,
+                lost,
+                out,
+            ) {
                 return;
             }
             out.push(link);
@@ -403,20 +460,36 @@ impl<const N: usize> RefineContext<'_, N> {
         // The element to split: the BRDF's driver when the BRDF error
         // dominates, otherwise the larger of J and K.
         let (ej, ek) = (self.geom.element(j), self.geom.element(k));
-        let mut order: Vec<Driver> = if brdf_err >= ff_err.max(if partial { 1.0 } else { 0.0 }) {
-            vec![driver]
+        let first = if brdf_err >= ff_err.max(if partial { 1.0 } else { 0.0 }) {
+            driver
         } else if ej.area >= ek.area {
-            vec![Driver::J, Driver::K]
+            Driver::J
         } else {
-            vec![Driver::K, Driver::J]
+            Driver::K
         };
-        for d in [Driver::I, Driver::J, Driver::K] {
-            if !order.contains(&d) {
-                order.push(d);
-            }
-        }
+        // The preferred element first, then the others: no allocation on
+        // this hot path.
+        let rest = match first {
+            Driver::I => [Driver::J, Driver::K],
+            Driver::J => [Driver::K, Driver::I],
+            Driver::K => [Driver::J, Driver::I],
+        };
+        let order = [first, rest[0], rest[1]];
         for d in order {
-            if self.split_triple(d, sender, si, h, h_index, i, j, n, group, lost, out) {
+            if self.split_triple(
+                d,
+                sender,
+                si,
+                h,
+                h_index,
+                i,
+                j,
+                n,
+                (tij, unshot),
+                group,
+                lost,
+                out,
+            ) {
                 return;
             }
         }
@@ -437,6 +510,7 @@ impl<const N: usize> RefineContext<'_, N> {
         i: ElementId,
         j: ElementId,
         n: u32,
+        known: (Throughput, Spectrum<N>),
         group: (u32, f64),
         lost: &mut Spectrum<N>,
         out: &mut Vec<NodeLink<N>>,
@@ -454,7 +528,7 @@ impl<const N: usize> RefineContext<'_, N> {
                     return false;
                 };
                 for c in children {
-                    self.refine_triple(sender, si, h, h_index, c, j, n, group, lost, out);
+                    self.refine_triple(sender, si, h, h_index, c, j, n, None, group, lost, out);
                 }
                 true
             }
@@ -463,7 +537,19 @@ impl<const N: usize> RefineContext<'_, N> {
                     return false;
                 };
                 for c in nodes {
-                    self.refine_triple(sender, si, h, h_index, i, j, c, group, lost, out);
+                    self.refine_triple(
+                        sender,
+                        si,
+                        h,
+                        h_index,
+                        i,
+                        j,
+                        c,
+                        Some(known),
+                        group,
+                        lost,
+                        out,
+                    );
                 }
                 true
             }
@@ -473,7 +559,7 @@ impl<const N: usize> RefineContext<'_, N> {
                 };
                 for c in nodes {
                     let jm = h.nodes[c as usize].from;
-                    self.refine_triple(sender, si, h, h_index, i, jm, c, group, lost, out);
+                    self.refine_triple(sender, si, h, h_index, i, jm, c, None, group, lost, out);
                 }
                 true
             }

@@ -86,6 +86,8 @@ pub struct Solver<const N: usize> {
     pub(crate) depth_of: Vec<u32>,
     pub(crate) stats: SolveStats,
     used: Vec<bool>,
+    /// `element_points` of every element (refinement reads them often).
+    points: Vec<[glam::DVec3; 5]>,
 }
 
 /// Per-surface depth limits from the global limit and MinArea.
@@ -261,6 +263,9 @@ impl<const N: usize> Solver<N> {
             ..SolveStats::default()
         };
         let used = vec![false; geom.element_count()];
+        let points = (0..geom.element_count() as u32)
+            .map(|e| geom.element_points(ElementId(e)))
+            .collect();
         Ok(Solver {
             geom,
             settings,
@@ -276,6 +281,7 @@ impl<const N: usize> Solver<N> {
             depth_of,
             stats,
             used,
+            points,
         })
     }
 
@@ -373,6 +379,7 @@ impl<const N: usize> Solver<N> {
             cache: &self.cache,
             ff_options: FormFactorOptions::default(),
             flux_threshold: self.settings.flux_eps * emitted_sum,
+            points: &self.points,
         };
         let sender = match &src_hierarchy {
             None => Sender::Radiosity {
@@ -445,6 +452,7 @@ impl<const N: usize> Solver<N> {
                             l.i,
                             l.j,
                             n,
+                            None,
                             (g, l.t_scale),
                             &mut lost,
                             &mut out,

@@ -11,8 +11,7 @@
 use std::collections::HashMap;
 use std::sync::RwLock;
 
-use glam::{DVec2, DVec3};
-use trilux_geometry::{ElementId, FormFactorOptions, SceneGeometry};
+use trilux_geometry::{ElementId, FormFactorOptions, SceneGeometry, Side};
 
 /// One element seen from one of its sides.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -24,6 +23,10 @@ pub(crate) struct SidedElement {
 }
 
 impl SidedElement {
+    fn side(self) -> Side {
+        if self.back { Side::Back } else { Side::Front }
+    }
+
     fn key(self) -> u64 {
         (u64::from(self.element.0) << 1) | u64::from(self.back)
     }
@@ -47,9 +50,38 @@ pub(crate) struct Throughput {
 
 const SHARDS: usize = 64;
 
+/// A hasher for the cache's u64 keys: a few multiplications instead of
+/// SipHash, which dominated the solve's profile.
+#[derive(Clone, Copy, Default)]
+struct KeyHasher(u64);
+
+impl std::hash::Hasher for KeyHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.0 = (self.0.rotate_left(8) ^ u64::from(b)).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+        }
+    }
+    fn write_u64(&mut self, k: u64) {
+        // MurmurHash3's 64-bit finaliser: every bit of the key reaches the
+        // top bits (which the table uses), independently of the shard index.
+        let mut h = k ^ 0x5851_F42D_4C95_7F2D;
+        h ^= h >> 33;
+        h = h.wrapping_mul(0xFF51_AFD7_ED55_8CCD);
+        h ^= h >> 33;
+        h = h.wrapping_mul(0xC4CE_B9FE_1A85_EC53);
+        h ^= h >> 33;
+        self.0 = h;
+    }
+}
+
+type KeyMap = HashMap<u64, Throughput, std::hash::BuildHasherDefault<KeyHasher>>;
+
 /// A bounded, thread-safe cache of throughputs keyed by ordered sided pairs.
 pub(crate) struct ThroughputCache {
-    shards: Vec<RwLock<HashMap<u64, Throughput>>>,
+    shards: Vec<RwLock<KeyMap>>,
     per_shard_cap: usize,
 }
 
@@ -57,7 +89,9 @@ impl ThroughputCache {
     /// A cache holding at most about `capacity` pairs.
     pub fn new(capacity: usize) -> Self {
         ThroughputCache {
-            shards: (0..SHARDS).map(|_| RwLock::new(HashMap::new())).collect(),
+            shards: (0..SHARDS)
+                .map(|_| RwLock::new(KeyMap::default()))
+                .collect(),
             per_shard_cap: (capacity / SHARDS).max(16),
         }
     }
@@ -92,73 +126,6 @@ impl ThroughputCache {
     }
 }
 
-/// F_{i→j} between the given faces of two elements, unoccluded.
-///
-/// Front to front is the geometry layer's accurate estimate (Lambert's
-/// closed form with adaptive cubature). When a back face is involved (a
-/// `twosided` material) the kernel cos θ_i cos θ_j / (π r²) is integrated with
-/// the faces' normals on a stratified 8×8 × 8×8 grid of point pairs: a
-/// deterministic estimate good to about a percent away from shared edges.
-pub(crate) fn sided_form_factor(
-    geom: &SceneGeometry,
-    i: SidedElement,
-    j: SidedElement,
-    ff_options: &FormFactorOptions,
-) -> (f64, f64) {
-    if !i.back && !j.back {
-        let ff = geom.form_factor_with(i.element, j.element, ff_options);
-        return (ff.value, ff.spread);
-    }
-    const G: usize = 8;
-    let grid = |e: ElementId, back: bool| -> Vec<(DVec3, DVec3, f64)> {
-        let mut pts = Vec::with_capacity(G * G);
-        for a in 0..G {
-            for b in 0..G {
-                let u = DVec2::new((a as f64 + 0.5) / G as f64, (b as f64 + 0.5) / G as f64);
-                let s = geom.sample_element(e, u);
-                let n = if back { -s.normal } else { s.normal };
-                pts.push((s.point, n, 1.0 / s.pdf_area.max(1e-300)));
-            }
-        }
-        pts
-    };
-    let (pi, pj) = (grid(i.element, i.back), grid(j.element, j.back));
-    let mut sum = 0.0;
-    let mut weight_i = 0.0;
-    let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
-    for &(x, nx, wx) in &pi {
-        weight_i += wx;
-        let mut inner = 0.0;
-        for &(y, ny, wy) in &pj {
-            let d = y - x;
-            let r2 = d.length_squared();
-            if r2 <= 0.0 {
-                continue;
-            }
-            let c1 = nx.dot(d);
-            let c2 = -ny.dot(d);
-            if c1 > 0.0 && c2 > 0.0 {
-                inner += wy * c1 * c2 / (std::f64::consts::PI * r2 * r2);
-            }
-        }
-        let point = (inner / pj.len() as f64).min(1.0);
-        lo = lo.min(point);
-        hi = hi.max(point);
-        sum += wx * point;
-    }
-    let spread = if hi >= lo { hi - lo } else { 0.0 };
-    if weight_i > 0.0 {
-        let f = sum / weight_i;
-        if f.is_finite() {
-            (f.clamp(0.0, 1.0), spread)
-        } else {
-            (0.0, 0.0)
-        }
-    } else {
-        (0.0, 0.0)
-    }
-}
-
 /// Computes T_ij = A_i F_{i→j} V_ij for the given faces, without the cache
 /// (`i` is the receiver: the spread is measured over it).
 pub(crate) fn compute_throughput(
@@ -168,7 +135,8 @@ pub(crate) fn compute_throughput(
     visibility_samples: u32,
     ff_options: &FormFactorOptions,
 ) -> Throughput {
-    let (f, spread) = sided_form_factor(geom, i, j, ff_options);
+    let ff = geom.form_factor_sided(i.element, i.side(), j.element, j.side(), ff_options);
+    let (f, spread) = (ff.value, ff.spread);
     if !(f.is_finite() && f > 0.0) {
         return Throughput::default();
     }
@@ -181,7 +149,7 @@ pub(crate) fn compute_throughput(
         2 | 3 => visibility_samples * 4,
         _ => visibility_samples,
     };
-    let v = geom.visibility(i.element, j.element, samples);
+    let v = geom.visibility_sided(i.element, i.side(), j.element, j.side(), samples);
     let area = geom.element(i.element).area;
     let t = area * f * v;
     if t.is_finite() && t > 0.0 {

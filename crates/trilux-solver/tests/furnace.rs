@@ -84,6 +84,12 @@ fn check<const N: usize>(solution: &Solution<N>) {
             }
         }
     }
+    eprintln!(
+        "furnace N={N}: worst relative error {worst:.5}, escaped {:.5} of emitted, CR {:.5}, shots {}",
+        stats.escaped_flux[0] / stats.emitted_flux[0],
+        stats.convergence_ratio,
+        stats.shots
+    );
     assert!(worst <= 0.005, "worst relative error {worst}");
     // The ledger: emitted = absorbed + escaped + residual, escaped small.
     for band in 0..N {

@@ -86,6 +86,7 @@ fn diffuse_receiver_one_bounce() {
     }
     let mean = sum / (g * g) as f64;
     let expected = rho_le * 0.199825;
+    eprintln!("diffuse plate: mean {mean:.6} vs closed form {expected:.6}");
     assert!(
         (mean - expected).abs() <= 0.01 * expected,
         "mean {mean} vs {expected}"
@@ -178,6 +179,7 @@ fn glossy_receiver_one_bounce() {
     }
     let reference = sum / samples as f64; // areas are 1, Le = 1
     let got = flux[0];
+    eprintln!("glossy plate: flux towards K {got:.6} vs brute force {reference:.6}");
     assert!(
         (got - reference).abs() <= 0.01 * reference,
         "solver flux {got} vs brute force {reference}"

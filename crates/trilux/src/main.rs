@@ -10,6 +10,7 @@
 
 mod info;
 mod power;
+mod render;
 mod solve;
 
 use std::path::PathBuf;
@@ -32,6 +33,9 @@ enum Command {
     Info(info::InfoArgs),
     /// Solve the light of a scene once and save the solution.
     Solve(solve::SolveArgs),
+    /// Render a view of a scene by final gathering (solving first, or from
+    /// a saved solution).
+    Render(render::RenderArgs),
 }
 
 /// How light is carried: 3 RGB bands or spectral bands.
@@ -68,12 +72,37 @@ fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Some(Command::Info(args)) => info::run(&args),
         Some(Command::Solve(args)) => solve::run(&args),
-        // Until the renderer lands, the main job describes the default scene.
-        None => info::run(&info::InfoArgs {
-            scene: default_scene(),
-            json: false,
-            mode: None,
-        }),
+        Some(Command::Render(args)) => render::run(&args),
+        // The main job: render the bundled default scene into out/.
+        None => {
+            let scene = default_scene();
+            std::fs::create_dir_all("out")
+                .map_err(|e| anyhow::anyhow!("out: cannot create the folder: {e}"))?;
+            let exr = render::default_output(&scene);
+            let png = exr.with_extension("png");
+            let args = render::RenderArgs {
+                scene,
+                output: Some(exr.clone()),
+                png: Some(png.clone()),
+                stats: Some(exr.with_extension("json")),
+                spp: None,
+                width: None,
+                height: None,
+                threads: None,
+                seed: 0,
+                solution: None,
+                lookat: None,
+                fov: None,
+                options: solve::SolveOptions {
+                    quality: "default".into(),
+                    convergence: None,
+                    mode: None,
+                },
+            };
+            render::run(&args)?;
+            println!("wrote {} and {}", exr.display(), png.display());
+            Ok(())
+        }
     }
 }
 

@@ -332,9 +332,10 @@ fn info_json_for_the_furnace() {
 }
 
 #[test]
-fn no_arguments_describes_the_default_scene() {
+fn no_arguments_renders_the_default_scene_into_out() {
+    let dir = folder("no-arguments");
     let out = Command::new(env!("CARGO_BIN_EXE_trilux"))
-        .current_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join("../.."))
+        .current_dir(&dir)
         .output()
         .expect("runs");
     assert!(
@@ -342,5 +343,8 @@ fn no_arguments_describes_the_default_scene() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    assert!(String::from_utf8_lossy(&out.stdout).contains("cornell-box.xml"));
+    for file in ["cornell-box.exr", "cornell-box.png", "cornell-box.json"] {
+        assert!(dir.join("out").join(file).exists(), "out/{file} written");
+    }
+    assert!(String::from_utf8_lossy(&out.stdout).contains("out/cornell-box.exr"));
 }

@@ -1,0 +1,160 @@
+//! `trilux solve` and `trilux render` through the binary: a render from a
+//! saved solution does no solving, a solution made for another scene is
+//! refused, bad outputs and bad options fail cleanly (design.md §3).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn trilux(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_trilux"))
+        .args(args)
+        .output()
+        .expect("the trilux binary runs")
+}
+
+fn folder(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("render-cli-{name}"));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("temp folder");
+    dir
+}
+
+fn scene(name: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../scenes")
+        .join(name)
+        .to_string_lossy()
+        .into_owned()
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().expect("utf-8 path")
+}
+
+const SMALL: [&str; 8] = [
+    "--width",
+    "24",
+    "--height",
+    "24",
+    "--spp",
+    "2",
+    "--quality",
+    "draft",
+];
+
+fn assert_one_error_line(out: &Output, what: &str) {
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(
+        out.status.code(),
+        Some(1),
+        "{what}: status; stderr {stderr}"
+    );
+    assert_eq!(stderr.lines().count(), 1, "{what}: one line: {stderr}");
+    assert!(stderr.starts_with("error: "), "{what}: {stderr}");
+}
+
+#[test]
+fn render_from_a_saved_solution_does_not_solve() {
+    let dir = folder("saved");
+    let sol = dir.join("furnace.sol");
+    let out = trilux(&[
+        "solve",
+        &scene("furnace.xml"),
+        "-o",
+        s(&sol),
+        "--quality",
+        "draft",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let exr = dir.join("a.exr");
+    let stats = dir.join("a.json");
+    let furnace = scene("furnace.xml");
+    let mut args = vec!["render", &furnace[..]];
+    let (sol_s, exr_s, stats_s) = (s(&sol).to_owned(), s(&exr).to_owned(), s(&stats).to_owned());
+    args.extend(["--solution", &sol_s, "-o", &exr_s, "--stats", &stats_s]);
+    args.extend(SMALL);
+    let out = trilux(&args);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&stats).expect("stats written"))
+            .expect("stats are JSON");
+    assert_eq!(json["solve_seconds"], serde_json::json!(0.0));
+    assert!(json["render_seconds"].as_f64().is_some_and(|t| t > 0.0));
+    assert!(exr.exists());
+    // Another view of the same solution, with a hyphenated --lookat.
+    let exr2 = dir.join("b.exr");
+    let exr2_s = s(&exr2).to_owned();
+    let mut args = vec!["render", &furnace[..], "--solution", &sol_s, "-o", &exr2_s];
+    args.extend(["--lookat", "-0.5,0.2,0.3,0,0,-1", "--fov", "60"]);
+    args.extend(SMALL);
+    let out = trilux(&args);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(exr2.exists());
+}
+
+#[test]
+fn a_solution_for_another_scene_is_refused() {
+    let dir = folder("other");
+    let sol = dir.join("furnace.sol");
+    let out = trilux(&[
+        "solve",
+        &scene("furnace.xml"),
+        "-o",
+        s(&sol),
+        "--quality",
+        "draft",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let exr = dir.join("x.exr");
+    let cornell = scene("cornell-box.xml");
+    let mut args = vec!["render", &cornell[..], "--solution", s(&sol), "-o", s(&exr)];
+    args.extend(SMALL);
+    let out = trilux(&args);
+    assert_one_error_line(&out, "foreign solution");
+    assert!(!exr.exists(), "no output left behind");
+}
+
+#[test]
+fn unwritable_output_and_missing_scene_fail_cleanly() {
+    let dir = folder("bad");
+    let exr = dir.join("no-such-folder").join("x.exr");
+    let furnace = scene("furnace.xml");
+    let mut args = vec!["render", &furnace[..], "-o", s(&exr)];
+    args.extend(SMALL);
+    let out = trilux(&args);
+    assert_one_error_line(&out, "unwritable output");
+    assert!(!exr.exists());
+    let out = trilux(&["render", s(&dir.join("missing.xml"))]);
+    assert_one_error_line(&out, "missing scene");
+    let out = trilux(&[
+        "solve",
+        s(&dir.join("missing.xml")),
+        "-o",
+        s(&dir.join("m.sol")),
+    ]);
+    assert_one_error_line(&out, "missing scene (solve)");
+}
+
+#[test]
+fn unknown_option_is_a_usage_error() {
+    let out = trilux(&["render", &scene("furnace.xml"), "--no-such-option"]);
+    assert_eq!(out.status.code(), Some(2));
+    let out = trilux(&["render", &scene("furnace.xml"), "--lookat", "1,2,3"]);
+    assert_one_error_line(&out, "short --lookat");
+}
