@@ -3,7 +3,8 @@
 //! Run: `cargo run --release -p trilux-render --example render_scene -- SCENE.xml OUT.exr [SIZE] [SPP] [draft|default|high] [never|auto|always]`
 //!
 //! Prints the solve and render times and the image mean. Spectral scenes
-//! solve and render in 10 bands.
+//! solve and render in 10 bands. OUT ending in `.png` writes an 8-bit sRGB
+//! PNG (exposure 0, clamped), anything else a linear EXR.
 
 use std::path::Path;
 use std::time::Instant;
@@ -67,7 +68,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let (i, s) = render(&scene, &sol, &view, &settings, |_, _| {})?;
         (i, s, solve_s)
     };
-    image.write_exr(Path::new(out))?;
+    let out = Path::new(out);
+    if out.extension().is_some_and(|e| e == "png") {
+        image.write_png(out, 0.0)?;
+    } else {
+        image.write_exr(out)?;
+    }
     println!(
         "solve {solve_s:.2} s, render {:.2} s, extra bounces {} of {} gather rays, mean {:?}",
         stats.seconds,
