@@ -118,6 +118,8 @@ pub(crate) struct RefineContext<'a, const N: usize> {
     pub flux_threshold: f64,
     /// `element_points` of every element, computed once.
     pub points: &'a [[DVec3; 5]],
+    /// The centres of every element's 2×2 quadrants (its midpoint rule).
+    pub interior: &'a [[DVec3; 4]],
 }
 
 /// Point-to-disc estimate of F_{a→b} (notes §2, HSA91): b seen from a's
@@ -217,7 +219,11 @@ impl<const N: usize> RefineContext<'_, N> {
             unshot,
         };
         let flux = PI * th.t * unshot.sum();
-        if flux < self.flux_threshold || self.sides[sj as usize].is_absorber() {
+        // A black receiver only absorbs, but it is refined like any other:
+        // a link made high up would send the sender's *average* unshot
+        // radiance, also from the parts that cannot see the receiver (the
+        // floor under a box sending into the box's black inside).
+        if flux < self.flux_threshold {
             out.push(link);
             return;
         }
@@ -272,14 +278,23 @@ impl<const N: usize> RefineContext<'_, N> {
     /// part in two-point mode, the whole BRDF in uniform mode).
     fn fr_centre(&self, bsdf: &Bsdf<N>, i: ElementId, j: ElementId, k: ElementId) -> Spectrum<N> {
         let g = self.geom;
-        let (ei, ej, ek) = (g.element(i), g.element(j), g.element(k));
+        let (ei, ej) = (g.element(i), g.element(j));
         let frame = trilux_brdf::Frame::from_normal(ej.normal);
         let wi = frame.to_local((ei.centre - ej.centre).normalize_or_zero());
-        let wo = frame.to_local((ek.centre - ej.centre).normalize_or_zero());
-        match self.settings.transport {
-            Transport::TwoPoint => bsdf.eval_glossy(wi, wo),
-            Transport::Uniform => bsdf.eval(wi, wo),
+        // The discretised fr over K (paper Eq. 5's fr_KJI): the midpoint rule
+        // on K's 2×2 quadrants rather than its centre alone, so that a glossy
+        // lobe that falls between K's centre and its edges is not missed
+        // by a link made early (photometric criterion) on a large K.
+        let mut sum = Spectrum::zero();
+        let points = &self.interior[k.index()];
+        for &p in points {
+            let wo = frame.to_local((p - ej.centre).normalize_or_zero());
+            sum += match self.settings.transport {
+                Transport::TwoPoint => bsdf.eval_glossy(wi, wo),
+                Transport::Uniform => bsdf.eval(wi, wo),
+            };
         }
+        sum * (1.0 / points.len() as f64)
     }
 
     /// The spread of fr over the three elements and the element driving it

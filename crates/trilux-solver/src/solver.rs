@@ -88,6 +88,8 @@ pub struct Solver<const N: usize> {
     used: Vec<bool>,
     /// `element_points` of every element (refinement reads them often).
     points: Vec<[glam::DVec3; 5]>,
+    /// The centres of every element's 2×2 quadrants.
+    interior: Vec<[glam::DVec3; 4]>,
 }
 
 /// Per-surface depth limits from the global limit and MinArea.
@@ -266,6 +268,14 @@ impl<const N: usize> Solver<N> {
         let points = (0..geom.element_count() as u32)
             .map(|e| geom.element_points(ElementId(e)))
             .collect();
+        let interior = (0..geom.element_count() as u32)
+            .map(|e| {
+                [(0.25, 0.25), (0.75, 0.25), (0.25, 0.75), (0.75, 0.75)].map(|(u, v)| {
+                    geom.sample_element(ElementId(e), glam::DVec2::new(u, v))
+                        .point
+                })
+            })
+            .collect();
         Ok(Solver {
             geom,
             settings,
@@ -282,6 +292,7 @@ impl<const N: usize> Solver<N> {
             stats,
             used,
             points,
+            interior,
         })
     }
 
@@ -380,6 +391,7 @@ impl<const N: usize> Solver<N> {
             ff_options: FormFactorOptions::default(),
             flux_threshold: self.settings.flux_eps * emitted_sum,
             points: &self.points,
+            interior: &self.interior,
         };
         let sender = match &src_hierarchy {
             None => Sender::Radiosity {
