@@ -285,16 +285,26 @@ impl<const N: usize> RefineContext<'_, N> {
         // on K's 2×2 quadrants rather than its centre alone, so that a glossy
         // lobe that falls between K's centre and its edges is not missed
         // by a link made early (photometric criterion) on a large K.
+        // Only the points on wi's side of j count: the throughput of (j, k)
+        // already covers just the part of K in front of j.
         let mut sum = Spectrum::zero();
-        let points = &self.interior[k.index()];
-        for &p in points {
+        let mut count = 0u32;
+        for &p in &self.interior[k.index()] {
             let wo = frame.to_local((p - ej.centre).normalize_or_zero());
+            if wo.z * wi.z <= 0.0 {
+                continue;
+            }
+            count += 1;
             sum += match self.settings.transport {
                 Transport::TwoPoint => bsdf.eval_glossy(wi, wo),
                 Transport::Uniform => bsdf.eval(wi, wo),
             };
         }
-        sum * (1.0 / points.len() as f64)
+        if count == 0 {
+            Spectrum::zero()
+        } else {
+            sum * (1.0 / f64::from(count))
+        }
     }
 
     /// The spread of fr over the three elements and the element driving it
