@@ -28,30 +28,30 @@ pub fn solve_and_render(
     view: &ViewOverrides,
     settings: &RenderSettings,
 ) -> Result<(Image, PipelineStats), RenderError> {
-    let start = Instant::now();
     if scene.mode() == trilux_color::Mode::Spectral {
-        let sol = solve_scene::<10>(scene, solver)?;
-        let solve_seconds = start.elapsed().as_secs_f64();
-        let (image, render) = render(scene, &sol, view, settings, |_, _| {})?;
-        Ok((
-            image,
-            PipelineStats {
-                solve: sol.stats().clone(),
-                render,
-                solve_seconds,
-            },
-        ))
+        solve_and_render_bands::<10>(scene, solver, view, settings)
     } else {
-        let sol = solve_scene::<3>(scene, solver)?;
-        let solve_seconds = start.elapsed().as_secs_f64();
-        let (image, render) = render(scene, &sol, view, settings, |_, _| {})?;
-        Ok((
-            image,
-            PipelineStats {
-                solve: sol.stats().clone(),
-                render,
-                solve_seconds,
-            },
-        ))
+        solve_and_render_bands::<3>(scene, solver, view, settings)
     }
+}
+
+/// [`solve_and_render`] with `N` bands.
+fn solve_and_render_bands<const N: usize>(
+    scene: &trilux_scene::Scene,
+    solver: trilux_solver::SolverSettings,
+    view: &ViewOverrides,
+    settings: &RenderSettings,
+) -> Result<(Image, PipelineStats), RenderError> {
+    let start = Instant::now();
+    let sol = solve_scene::<N>(scene, solver)?;
+    let solve_seconds = start.elapsed().as_secs_f64();
+    let (image, render) = render(scene, &sol, view, settings, |_, _| {})?;
+    Ok((
+        image,
+        PipelineStats {
+            solve: sol.stats().clone(),
+            render,
+            solve_seconds,
+        },
+    ))
 }

@@ -42,15 +42,13 @@ fn assert_one_error_line(out: &Output, what: &str) {
     assert!(stderr.starts_with("error: "), "{what}: {stderr}");
 }
 
-#[test]
-fn render_from_a_saved_solution_does_not_solve() {
-    let dir = folder("saved");
-    let sol = dir.join("furnace.sol");
+/// Saves a draft solve of the furnace to `sol`.
+fn solve_furnace(sol: &Path) {
     let out = trilux(&[
         "solve",
         &scene("furnace.xml"),
         "-o",
-        s(&sol),
+        s(sol),
         "--quality",
         "draft",
     ]);
@@ -59,6 +57,13 @@ fn render_from_a_saved_solution_does_not_solve() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
+}
+
+#[test]
+fn render_from_a_saved_solution_does_not_solve() {
+    let dir = folder("saved");
+    let sol = dir.join("furnace.sol");
+    solve_furnace(&sol);
     let exr = dir.join("a.exr");
     let stats = dir.join("a.json");
     let furnace = scene("furnace.xml");
@@ -97,19 +102,7 @@ fn render_from_a_saved_solution_does_not_solve() {
 fn a_solution_for_another_scene_is_refused() {
     let dir = folder("other");
     let sol = dir.join("furnace.sol");
-    let out = trilux(&[
-        "solve",
-        &scene("furnace.xml"),
-        "-o",
-        s(&sol),
-        "--quality",
-        "draft",
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    solve_furnace(&sol);
     let exr = dir.join("x.exr");
     let cornell = scene("cornell-box.xml");
     let mut args = vec!["render", &cornell[..], "--solution", s(&sol), "-o", s(&exr)];
