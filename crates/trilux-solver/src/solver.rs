@@ -18,7 +18,7 @@ use std::f64::consts::PI;
 use std::time::Instant;
 
 use rayon::prelude::*;
-use trilux_brdf::{Bsdf, BsdfParams};
+use trilux_brdf::{AlbedoTable, Bsdf, BsdfParams, Frame};
 use trilux_color::{ColorParam, Spectrum};
 use trilux_geometry::{ElementId, FormFactorOptions, SceneGeometry, Shape, SurfaceId};
 
@@ -31,7 +31,7 @@ use crate::settings::SolverSettings;
 use crate::sides::{SideId, TransportSide, build_sides, eligible_pairs};
 use crate::solution::Solution;
 use crate::stats::SolveStats;
-use crate::throughput::ThroughputCache;
+use crate::throughput::{SidedElement, ThroughputCache, compute_throughput};
 
 /// What the solver needs of a scene: per shape its geometry, its material
 /// and its area emitter's radiance. (The scene layer builds this; the solver
@@ -75,6 +75,11 @@ pub struct Solver<const N: usize> {
     pub(crate) geom: SceneGeometry,
     pub(crate) settings: SolverSettings,
     pub(crate) materials: Vec<Bsdf<N>>,
+    /// Directional albedo per material (for the renormalisation).
+    albedo: Vec<AlbedoTable<N>>,
+    /// Σ_K T(j, K) / A_j per (side, element): how much of j's hemisphere
+    /// the side's stored receivers cover.
+    coverage: std::sync::Mutex<HashMap<(SideId, ElementId), f64>>,
     pub(crate) sides: Vec<TransportSide<N>>,
     partners: Vec<Vec<SideId>>,
     pub(crate) field: ElementRadiance<N>,
@@ -91,6 +96,16 @@ pub struct Solver<const N: usize> {
     /// The centres of every element's 2×2 quadrants.
     interior: Vec<[glam::DVec3; 4]>,
 }
+
+/// The most a group's area reflectances are scaled up or down to match the
+/// albedo (a guard against estimation noise).
+const MAX_RENORMALISATION: f64 = 1.5;
+
+/// The coverage above which j's hemisphere counts as (nearly) closed: the
+/// target is then the albedo times the covered share, which assumes the
+/// lobe misses the uncovered part in proportion (an error of at most 1 −
+/// coverage of the target).
+const CLOSED_COVERAGE: f64 = 0.9;
 
 /// Per-surface depth limits from the global limit and MinArea.
 fn depth_limits(geom: &SceneGeometry, settings: &SolverSettings) -> Vec<u32> {
@@ -155,6 +170,7 @@ impl<const N: usize> Solver<N> {
             }
             emission.push(le);
         }
+        let albedo = materials.par_iter().map(Bsdf::albedo_table).collect();
         let depth_of = depth_limits(&geom, &settings);
         presubdivide(&mut geom, &depth_of);
         let mut sides = build_sides(&geom, &materials, &emission, settings.transport);
@@ -280,6 +296,8 @@ impl<const N: usize> Solver<N> {
             geom,
             settings,
             materials,
+            albedo,
+            coverage: std::sync::Mutex::new(HashMap::new()),
             sides,
             partners,
             field,
@@ -499,12 +517,38 @@ impl<const N: usize> Solver<N> {
             // What an element reflects may not exceed what arrived there.
             let room = (arrived_g - diffuse_g).max(Spectrum::zero());
             let glossy_g = glossy_flux[g];
+            // Where (nearly) every direction from j reaches a stored
+            // receiver, the discretised area reflectances must reflect the
+            // BRDF's albedo over the covered share (notes §7: renormalise
+            // against the albedo); point samples of a peaked lobe over
+            // coarse K's fall short of it. (Two-point mode only: the
+            // uniform mode stays the paper's, for ablation.)
+            let target = if side.stored
+                && !glossy_g.is_black()
+                && self.settings.transport == crate::settings::Transport::TwoPoint
+            {
+                let covered = self.hemisphere_coverage(l.side, l.j);
+                (covered >= CLOSED_COVERAGE).then(|| {
+                    let (ei, ej) = (geom.element(l.i), geom.element(l.j));
+                    let wi = Frame::from_normal(ej.normal)
+                        .to_local((ei.centre - ej.centre).normalize_or_zero());
+                    let glossy_albedo = self.albedo[side.shape].albedo(wi) - side.rho_d;
+                    (arrived_g * glossy_albedo * covered.min(1.0)).max(Spectrum::zero())
+                })
+            } else {
+                None
+            };
             let scale = Spectrum::<N>::new(std::array::from_fn(|b| {
-                if glossy_g[b] > room[b] && glossy_g[b] > 0.0 {
-                    room[b] / glossy_g[b]
-                } else {
-                    1.0
+                let mut f = 1.0;
+                if let Some(t) = target
+                    && glossy_g[b] > 0.0
+                {
+                    f = (t[b] / glossy_g[b]).clamp(1.0 / MAX_RENORMALISATION, MAX_RENORMALISATION);
                 }
+                if glossy_g[b] * f > room[b] && glossy_g[b] > 0.0 {
+                    f = room[b] / glossy_g[b];
+                }
+                f
             }));
             group_scale[g] = scale;
             let absorbed_g = arrived_g - diffuse_g - glossy_g * scale;
@@ -524,18 +568,15 @@ impl<const N: usize> Solver<N> {
             self.used[l.i.index()] = true;
             self.used[l.j.index()] = true;
         }
-        // The radiance increments are kept as computed; only the flux they
-        // add to the residual is bounded. Where the bound bites (estimated
-        // throughputs that sum to more than the element's area), the
-        // hierarchy holds more π T L than its key, and its own shot is
-        // normalised to the key (shot_scale above).
+        // The group's renormalisation applies to the radiance it gathers
+        // and to the flux it adds to the residual alike.
         for nl in &node_links {
             let hier = &mut self.hierarchies[nl.hierarchy as usize];
             let node = &mut hier.nodes[nl.node as usize];
-            let dl = nl.gathered * shot_scale;
+            let dl = nl.gathered * shot_scale * group_scale[nl.group as usize];
             node.gathered += dl;
             let t = node.t;
-            hier.unshot_flux += dl * group_scale[nl.group as usize] * (PI * t);
+            hier.unshot_flux += dl * (PI * t);
         }
         let escaped = phi - total_arrived;
         for b in 0..N {
@@ -562,6 +603,44 @@ impl<const N: usize> Solver<N> {
             (Source::Stored(_), None) => {}
         }
         live
+    }
+
+    /// Σ over the side's stored hierarchies of T(j, K) / A_j: the
+    /// cosine-weighted share of j's hemisphere that stored receivers cover
+    /// (1 in a closed room).
+    fn hemisphere_coverage(&self, side: SideId, j: ElementId) -> f64 {
+        if let Ok(cache) = self.coverage.lock()
+            && let Some(&c) = cache.get(&(side, j))
+        {
+            return c;
+        }
+        let a = self.geom.element(j).area;
+        let this = SidedElement {
+            element: j,
+            back: self.sides[side as usize].back,
+        };
+        let ff = FormFactorOptions::default();
+        let mut t = 0.0;
+        for h in self.hierarchies.iter().filter(|h| h.from == side) {
+            let k = h.nodes[0].to;
+            let other = SidedElement {
+                element: k,
+                back: self.sides[h.to as usize].back,
+            };
+            t += compute_throughput(
+                &self.geom,
+                other,
+                this,
+                self.settings.visibility_samples,
+                &ff,
+            )
+            .t;
+        }
+        let c = t / a;
+        if let Ok(mut cache) = self.coverage.lock() {
+            cache.insert((side, j), c);
+        }
+        c
     }
 
     /// Final push-pull of everything, statistics, and the solution.
