@@ -212,38 +212,41 @@ impl LitFloor {
     }
 }
 
+/// Closest hit of a ray with the floor z = 0 (facing +z, locator 0) and a
+/// square light of half-size `s` at height `h` facing down (locator 1): the
+/// geometry of the analytic lit-floor scenes.
+pub fn floor_and_square_light(o: DVec3, d: DVec3, h: f64, s: f64) -> Option<SurfacePoint<u8>> {
+    let mut best: Option<SurfacePoint<u8>> = None;
+    if d.z != 0.0 {
+        let t = -o.z / d.z;
+        if t > 1e-9 {
+            best = Some(SurfacePoint {
+                point: o + d * t,
+                normal: DVec3::Z,
+                t,
+                locator: 0,
+            });
+        }
+        let t = (h - o.z) / d.z;
+        let p = o + d * t;
+        if t > 1e-9 && p.x.abs() <= s && p.y.abs() <= s && best.is_none_or(|b| t < b.t) {
+            best = Some(SurfacePoint {
+                point: p,
+                normal: -DVec3::Z,
+                t,
+                locator: 1,
+            });
+        }
+    }
+    best
+}
+
 impl<const N: usize> GatherScene<N> for LitFloor {
     /// 0 = floor, 1 = emitter.
     type Locator = u8;
 
     fn intersect(&self, o: DVec3, d: DVec3) -> Option<SurfacePoint<u8>> {
-        let mut best: Option<SurfacePoint<u8>> = None;
-        if d.z != 0.0 {
-            let t = -o.z / d.z;
-            if t > 1e-9 {
-                best = Some(SurfacePoint {
-                    point: o + d * t,
-                    normal: DVec3::Z,
-                    t,
-                    locator: 0,
-                });
-            }
-            let t = (self.h - o.z) / d.z;
-            let p = o + d * t;
-            if t > 1e-9
-                && p.x.abs() <= self.s
-                && p.y.abs() <= self.s
-                && best.is_none_or(|b| t < b.t)
-            {
-                best = Some(SurfacePoint {
-                    point: p,
-                    normal: -DVec3::Z,
-                    t,
-                    locator: 1,
-                });
-            }
-        }
-        best
+        floor_and_square_light(o, d, self.h, self.s)
     }
     fn unoccluded(&self, _from: &SurfacePoint<u8>, _to: DVec3) -> bool {
         true

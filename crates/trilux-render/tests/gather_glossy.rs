@@ -51,33 +51,7 @@ impl GlossyFloor {
 impl GatherScene<3> for GlossyFloor {
     type Locator = u8;
     fn intersect(&self, o: DVec3, d: DVec3) -> Option<SurfacePoint<u8>> {
-        let mut best: Option<SurfacePoint<u8>> = None;
-        if d.z != 0.0 {
-            let t = -o.z / d.z;
-            if t > 1e-9 {
-                best = Some(SurfacePoint {
-                    point: o + d * t,
-                    normal: DVec3::Z,
-                    t,
-                    locator: 0,
-                });
-            }
-            let t = (self.h - o.z) / d.z;
-            let p = o + d * t;
-            if t > 1e-9
-                && p.x.abs() <= self.s
-                && p.y.abs() <= self.s
-                && best.is_none_or(|b| t < b.t)
-            {
-                best = Some(SurfacePoint {
-                    point: p,
-                    normal: -DVec3::Z,
-                    t,
-                    locator: 1,
-                });
-            }
-        }
-        best
+        trilux_render::analytic::floor_and_square_light(o, d, self.h, self.s)
     }
     fn unoccluded(&self, _: &SurfacePoint<u8>, _: DVec3) -> bool {
         true
