@@ -336,3 +336,17 @@ fn no_arguments_renders_the_default_scene_into_out() {
     }
     assert!(String::from_utf8_lossy(&out.stdout).contains("out/cornell-box.exr"));
 }
+
+/// The README's main command is a plain `cargo run --release`: in a
+/// workspace with two binaries (trilux, xtask) that only works when the
+/// `trilux` crate is the workspace's default member.
+#[test]
+fn cargo_run_means_the_trilux_command() {
+    let manifest =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../../Cargo.toml"))
+            .expect("workspace manifest");
+    assert!(
+        manifest.contains("default-members = [\"crates/trilux\"]"),
+        "the workspace must name crates/trilux as its default member"
+    );
+}
