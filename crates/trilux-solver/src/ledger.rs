@@ -35,22 +35,10 @@ impl Ledger {
             emitted,
             absorbed: vec![0.0; n],
             escaped: vec![0.0; n],
-            min_shot_escaped: 0.0,
-            min_element_absorbed: 0.0,
+            // Fractions are at most 1: start there so that the minima
+            // report what the shots did, not a clamp at zero.
+            min_shot_escaped: 1.0,
+            min_element_absorbed: 1.0,
         }
-    }
-
-    /// Relative imbalance |emitted − absorbed − escaped − residual| / emitted,
-    /// the largest over bands.
-    pub fn imbalance(&self, residual: &[f64]) -> f64 {
-        let mut worst: f64 = 0.0;
-        for b in 0..self.emitted.len() {
-            let e = self.emitted[b];
-            if e > 0.0 {
-                let d = e - self.absorbed[b] - self.escaped[b] - residual[b];
-                worst = worst.max(d.abs() / e);
-            }
-        }
-        worst
     }
 }

@@ -148,21 +148,6 @@ impl<const N: usize> Solution<N> {
         min
     }
 
-    /// Root radiance and throughput of the stored interaction between two
-    /// faces, if it exists (diagnostics).
-    pub fn interaction_root(
-        &self,
-        from: (SurfaceId, bool),
-        to: (SurfaceId, bool),
-    ) -> Option<(Spectrum<N>, f64, usize)> {
-        let key = (
-            from.0.0 * 2 + u32::from(from.1),
-            to.0.0 * 2 + u32::from(to.1),
-        );
-        let h = &self.hierarchies[*self.by_sides.get(&key)? as usize];
-        Some((h.nodes[0].radiance, h.nodes[0].t, h.nodes.len()))
-    }
-
     /// Number of stored interaction hierarchies and of their nodes.
     pub fn interaction_counts(&self) -> (usize, usize) {
         (

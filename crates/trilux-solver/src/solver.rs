@@ -20,7 +20,7 @@ use std::time::Instant;
 use rayon::prelude::*;
 use trilux_brdf::{AlbedoTable, Bsdf, BsdfParams, Frame};
 use trilux_color::{ColorParam, Spectrum};
-use trilux_geometry::{ElementId, FormFactorOptions, SceneGeometry, Shape, SurfaceId};
+use trilux_geometry::{ElementId, FormFactorOptions, SceneGeometry, Shape};
 
 use crate::error::SolverError;
 use crate::interaction::Hierarchy;
@@ -681,11 +681,5 @@ impl<const N: usize> Solver<N> {
     /// The geometry (with its pre-subdivided element trees).
     pub fn geometry(&self) -> &SceneGeometry {
         &self.geom
-    }
-
-    /// The input surface ids of a side table entry (front, back).
-    pub fn surface_sides(&self, surface: SurfaceId) -> [SideId; 2] {
-        let s = surface.0 * 2;
-        [s, s + 1]
     }
 }
