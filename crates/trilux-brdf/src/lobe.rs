@@ -55,7 +55,10 @@ impl<const N: usize> Conductor<N> {
         if !(s.is_finite() && s > 0.0) {
             return Spectrum::zero();
         }
-        self.fresnel(wi.dot(h)) * s
+        // wi·h = wo·h in exact arithmetic; their mean is symmetric in (wi, wo)
+        // bit for bit, so reciprocity holds exactly even where F is steep
+        // (k ≈ 0 near total internal reflection).
+        self.fresnel(0.5 * (wi.dot(h) + wo.dot(h))) * s
     }
 
     /// Samples wi from the microfacet normal distribution (see
