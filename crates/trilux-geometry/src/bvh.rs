@@ -488,6 +488,49 @@ impl SceneGeometry {
         best
     }
 
+    /// The shape a primitive belongs to.
+    fn prim_shape(&self, id: usize) -> u32 {
+        match self.bvh.prims[id] {
+            Prim::Tri {
+                owner: TriOwner::Mesh { mesh, .. },
+                ..
+            } => self.mesh_shape[mesh as usize],
+            Prim::Tri {
+                owner: TriOwner::Quad { surface },
+                ..
+            } => self.surfaces[surface as usize].shape,
+            Prim::Analytic(a) => {
+                self.surfaces[self.analytic[a as usize].first_surface as usize].shape
+            }
+        }
+    }
+
+    /// [`SceneGeometry::intersect`] that ignores one shape's primitives
+    /// (probes that start on a surface and must see what lies on it, even
+    /// coincident with it).
+    pub fn intersect_ignoring(&self, ray: &Ray, t_max: f64, shape: u32) -> Option<Hit> {
+        let tmin = self.ray_epsilon(ray.origin) / ray.dir.length();
+        let cw = self.bvh.cw.as_ref()?;
+        let (ray32, start, len) = self.traversal_ray(ray.origin, ray.dir, tmin, t_max)?;
+        let pre = RayPre::new(ray.origin, ray.dir);
+        let mut best: Option<PrimHit> = None;
+        let mut best_t = t_max;
+        let mut rh = RayHit::none();
+        cw.ray_traverse(ray32, &mut rh, |_, id| {
+            if self.prim_shape(id) == shape {
+                return f32::INFINITY;
+            }
+            if let Some((t, bary)) = self.test_prim(&self.bvh.prims[id], &pre, tmin, best_t) {
+                best_t = t;
+                best = Some(PrimHit { prim: id, t, bary });
+                (((t - start) * len) as f32).next_up()
+            } else {
+                f32::INFINITY
+            }
+        });
+        best.map(|h| self.make_hit(ray.origin, ray.dir, h))
+    }
+
     fn any_prim(&self, o: DVec3, d: DVec3, tmin: f64, tmax: f64) -> bool {
         self.any_prim_hint(o, d, tmin, tmax, &mut None)
     }

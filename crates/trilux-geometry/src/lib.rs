@@ -70,11 +70,14 @@
 //!   cubature for curved pieces and disks; stratified sampling for large
 //!   clusters), per side for two-sided materials ([`Side`]).
 //! - [`visibility`]: visible fractions from stratified shadow segments.
+//! - [`burial`]: the parts of faces that another shape covers (the floor
+//!   under a box), probed once; visibility treats them as blocked.
 //! - `quadrature` and `transform` (private): integration rules and affine
 //!   maps.
 #![forbid(unsafe_code)]
 
 pub mod bounds;
+pub mod burial;
 pub mod bvh;
 pub mod chart;
 pub mod element;
@@ -91,6 +94,7 @@ mod transform;
 pub mod visibility;
 
 pub use bounds::Bounds;
+pub use burial::{BurialMap, BurialRequest};
 pub use bvh::{Hit, RAY_EPSILON, Ray};
 pub use chart::{CHART_CONE_DEG, CHART_MAX_TRIANGLES, Piece};
 pub use element::{Element, ElementDomain};

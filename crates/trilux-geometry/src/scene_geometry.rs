@@ -30,6 +30,8 @@ pub struct SceneGeometry {
     pub(crate) bounds: Bounds,
     /// Largest absolute coordinate of the scene: the scale of ray epsilons.
     pub(crate) extent: f64,
+    /// Buried parts of faces, when the solver has probed them.
+    pub(crate) burial: Option<crate::burial::BurialMap>,
 }
 
 impl SceneGeometry {
@@ -50,6 +52,7 @@ impl SceneGeometry {
             bvh: Bvh::default(),
             bounds: Bounds::EMPTY,
             extent: 0.0,
+            burial: None,
         };
         let mut prims: Vec<Prim> = Vec::new();
         for (index, shape) in shapes.iter().enumerate() {

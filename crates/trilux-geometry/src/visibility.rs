@@ -7,7 +7,8 @@
 //! (b, a)). Only segments whose end
 //! points face each other (both one-sided cosines positive) carry light and
 //! are counted; if none do, the plain fraction over all segments is
-//! returned (the form factor is then zero anyway).
+//! returned (the form factor is then zero anyway). A segment with an end
+//! on a buried part of its face ([`crate::burial`]) counts as blocked.
 
 use glam::DVec3;
 use rayon::prelude::*;
@@ -45,7 +46,8 @@ impl SceneGeometry {
             let d = y.point - x.point;
             let faces =
                 a_side.sign() * x.normal.dot(d) > 0.0 && b_side.sign() * y.normal.dot(d) < 0.0;
-            let vis = !self.occluded_hint(x.point, y.point, &mut hint);
+            let vis = !self.buried_end(a, a_side, &x, b, b_side, &y)
+                && !self.occluded_hint(x.point, y.point, &mut hint);
             visible += u32::from(vis);
             if faces {
                 facing += 1;
@@ -95,7 +97,9 @@ impl SceneGeometry {
                 continue;
             }
             total += w;
-            if !self.occluded_hint(x.point, y.point, &mut hint) {
+            if !self.buried_end(a, a_side, &x, b, b_side, &y)
+                && !self.occluded_hint(x.point, y.point, &mut hint)
+            {
                 seen += w;
             }
         }
@@ -104,6 +108,24 @@ impl SceneGeometry {
         } else {
             self.visibility_sided(a, a_side, b, b_side, samples)
         }
+    }
+
+    /// True if either end of a segment lies on a buried part of its face
+    /// ([`crate::burial`]): such segments carry no light.
+    #[inline]
+    fn buried_end(
+        &self,
+        a: ElementId,
+        a_side: Side,
+        x: &SurfaceSample,
+        b: ElementId,
+        b_side: Side,
+        y: &SurfaceSample,
+    ) -> bool {
+        self.burial.as_ref().is_some_and(|m| {
+            m.is_buried(self.elements[a.index()].surface, a_side, x.coord)
+                || m.is_buried(self.elements[b.index()].surface, b_side, y.coord)
+        })
     }
 
     /// The ends of shadow segment `k` between `a` and `b`. The lower element

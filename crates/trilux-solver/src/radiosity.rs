@@ -34,13 +34,20 @@ impl<const N: usize> ElementRadiance<N> {
 
     /// Push-pull of one side's tree under `root` (HSA91; paper §3.2.4 and
     /// §4.4): gathered radiance goes down unchanged and lands in L and δL at
-    /// the leaves; parents become the area-weighted average of their
-    /// children. For Lambertian radiance the area weight *is* the flux weight
-    /// (flux = π A L whatever the orientation), so pulling over curved,
-    /// non-coplanar children conserves flux exactly.
-    pub fn push_pull(&mut self, geom: &SceneGeometry, root: ElementId, back: bool) {
+    /// the leaves; parents become the average of their children weighted by
+    /// their exposed areas `exposed_area` (element area × exposed share, see
+    /// `trilux_geometry::burial`). For Lambertian radiance that area weight
+    /// *is* the flux weight (flux = π A L whatever the orientation), so
+    /// pulling over curved, non-coplanar children conserves flux exactly.
+    pub fn push_pull(
+        &mut self,
+        geom: &SceneGeometry,
+        root: ElementId,
+        back: bool,
+        exposed_area: &[f64],
+    ) {
         let s = usize::from(back);
-        self.push_pull_rec(geom, root, s, Spectrum::zero());
+        self.push_pull_rec(geom, root, s, Spectrum::zero(), exposed_area);
     }
 
     fn push_pull_rec(
@@ -49,6 +56,7 @@ impl<const N: usize> ElementRadiance<N> {
         e: ElementId,
         s: usize,
         from_above: Spectrum<N>,
+        exposed_area: &[f64],
     ) -> (Spectrum<N>, Spectrum<N>) {
         let i = e.index();
         let down = from_above + self.gathered[s][i];
@@ -60,12 +68,16 @@ impl<const N: usize> ElementRadiance<N> {
                 (self.radiance[s][i], self.unshot[s][i])
             }
             Some(children) => {
-                let area = geom.element(e).area;
+                let area = exposed_area[i];
                 let mut l = Spectrum::zero();
                 let mut dl = Spectrum::zero();
                 for c in children {
-                    let w = geom.element(c).area / area;
-                    let (cl, cdl) = self.push_pull_rec(geom, c, s, down);
+                    let w = if area > 0.0 {
+                        exposed_area[c.index()] / area
+                    } else {
+                        0.0
+                    };
+                    let (cl, cdl) = self.push_pull_rec(geom, c, s, down, exposed_area);
                     l += cl * w;
                     dl += cdl * w;
                 }

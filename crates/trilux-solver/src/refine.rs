@@ -59,6 +59,10 @@ impl<const N: usize> Sender<'_, N> {
     }
 }
 
+/// Largest relative error, from the sender's unshot radiance varying over
+/// it, that a pair link may carry (see `RefineContext::sender_varies`).
+const SENDER_VARIATION: f64 = 0.01;
+
 /// A transient link of stage 1.
 #[derive(Clone, Debug)]
 pub(crate) struct PairLink<const N: usize> {
@@ -120,6 +124,8 @@ pub(crate) struct RefineContext<'a, const N: usize> {
     pub points: &'a [[DVec3; 5]],
     /// The centres of every element's 2×2 quadrants (its midpoint rule).
     pub interior: &'a [[DVec3; 4]],
+    /// Exposed area of every element's faces, `[back][element]`.
+    pub exposed_area: &'a [Vec<f64>; 2],
 }
 
 /// Point-to-disc estimate of F_{a→b} (notes §2, HSA91): b seen from a's
@@ -186,7 +192,10 @@ impl<const N: usize> RefineContext<'_, N> {
         )
     }
 
-    /// Stage 1: refines the pair (i, j) and appends pair links.
+    /// Stage 1: refines the pair (i, j) and appends pair links. `budget`
+    /// is the form-factor spread over j this link may have: FFErr for a
+    /// root pair, shared among the children when the sender is split (the
+    /// receiver-side errors of sibling senders add up on j).
     #[allow(clippy::too_many_arguments)]
     pub fn refine_pair(
         &self,
@@ -195,6 +204,7 @@ impl<const N: usize> RefineContext<'_, N> {
         sj: SideId,
         i: ElementId,
         j: ElementId,
+        budget: f64,
         out: &mut Vec<PairLink<N>>,
     ) {
         let th = self.throughput(j, sj, i, si);
@@ -203,7 +213,7 @@ impl<const N: usize> RefineContext<'_, N> {
             // Fully occluded or facing away. Near the roots a handful of
             // shadow rays may miss a gap: look one level further there.
             if ei.depth + ej.depth < 2 && th.v == 0.0 && self.unoccluded_positive(i, si, j, sj) {
-                self.split_pair(sender, si, sj, i, j, out);
+                self.split_pair(sender, si, sj, i, j, budget, out);
             }
             return;
         }
@@ -227,24 +237,99 @@ impl<const N: usize> RefineContext<'_, N> {
             out.push(link);
             return;
         }
+        // A link sends the sender's *average* unshot radiance; where that
+        // radiance varies over the sender in step with the form factor to
+        // j (the bright middle of a floor sees more of the ceiling than its
+        // corners), the average is biased. Compare the transfer resolved
+        // over the sender's children with the averaged one (point-to-disc
+        // estimates) and split the sender when they differ.
+        if self.sender_varies(sender, si, i, sj, j) {
+            self.split_sender(sender, si, sj, i, j, budget, out);
+            return;
+        }
         // The transfer is accurate when the point form factor varies little
         // over the receiver (so that pushing it down unchanged is right).
         let partial = th.v > 0.0 && th.v < 1.0;
-        if th.spread <= self.settings.ff_eps && !partial {
+        if th.spread <= budget && !partial {
             out.push(link);
             return;
         }
-        if !self.split_pair(sender, si, sj, i, j, out) {
+        if !self.split_pair(sender, si, sj, i, j, budget, out) {
             out.push(link);
         }
+    }
+
+    /// True when the transfer i → j resolved over i's children differs
+    /// from the one made with i's average unshot radiance by more than
+    /// [`SENDER_VARIATION`] (relative): Σ_c a_c δL_c F̂_cj against
+    /// δL̄_i Σ_c a_c F̂_cj, with a_c the children's exposed areas (so that
+    /// δL̄_i = Σ a_c δL_c / Σ a_c) and F̂ point-to-disc estimates.
+    fn sender_varies(
+        &self,
+        sender: &Sender<'_, N>,
+        si: SideId,
+        i: ElementId,
+        sj: SideId,
+        j: ElementId,
+    ) -> bool {
+        let Sender::Radiosity { field, back } = sender else {
+            return false;
+        };
+        let Some(children) = self.geom.element(i).children() else {
+            return false;
+        };
+        let s = usize::from(*back);
+        let ej = self.geom.element(j);
+        let nj = ej.normal * self.sides[sj as usize].sign();
+        let ni = self.sides[si as usize].sign();
+        let (mut resolved, mut weight, mut mean) = (0.0, 0.0, 0.0);
+        for c in children {
+            let ec = self.geom.element(c);
+            let a = self.exposed_area[s][c.index()];
+            let f = a * disc_estimate(ec.centre, ec.normal * ni, ej.centre, nj, ej.area);
+            let dl = field.unshot[s][c.index()].sum();
+            resolved += f * dl;
+            weight += f;
+            mean += a * dl;
+        }
+        let total_area: f64 = children
+            .iter()
+            .map(|c| self.exposed_area[s][c.index()])
+            .sum();
+        if total_area <= 0.0 || weight <= 0.0 {
+            return false;
+        }
+        let averaged = weight * mean / total_area;
+        (resolved - averaged).abs() > SENDER_VARIATION * averaged
     }
 
     fn unoccluded_positive(&self, i: ElementId, si: SideId, j: ElementId, sj: SideId) -> bool {
         self.throughput(j, sj, i, si).f > 0.0
     }
 
+    /// Refines the sender's children against j, each with its area's
+    /// share of the spread budget.
+    #[allow(clippy::too_many_arguments)]
+    fn split_sender(
+        &self,
+        sender: &Sender<'_, N>,
+        si: SideId,
+        sj: SideId,
+        i: ElementId,
+        j: ElementId,
+        budget: f64,
+        out: &mut Vec<PairLink<N>>,
+    ) {
+        let area = self.geom.element(i).area;
+        for c in self.geom.element(i).children().into_iter().flatten() {
+            let share = self.geom.element(c).area / area;
+            self.refine_pair(sender, si, sj, c, j, budget * share, out);
+        }
+    }
+
     /// Splits the larger splittable element of the pair; false if neither
     /// can be split.
+    #[allow(clippy::too_many_arguments)]
     fn split_pair(
         &self,
         sender: &Sender<'_, N>,
@@ -252,6 +337,7 @@ impl<const N: usize> RefineContext<'_, N> {
         sj: SideId,
         i: ElementId,
         j: ElementId,
+        budget: f64,
         out: &mut Vec<PairLink<N>>,
     ) -> bool {
         let (ei, ej) = (self.geom.element(i), self.geom.element(j));
@@ -263,12 +349,14 @@ impl<const N: usize> RefineContext<'_, N> {
             (None, None) => return false,
         };
         if split_i {
+            // A sender much larger than its receiver: split by size (the
+            // budget stays, as before any sender-variation split).
             for c in ei.children().into_iter().flatten() {
-                self.refine_pair(sender, si, sj, c, j, out);
+                self.refine_pair(sender, si, sj, c, j, budget, out);
             }
         } else {
             for c in ej.children().into_iter().flatten() {
-                self.refine_pair(sender, si, sj, i, c, out);
+                self.refine_pair(sender, si, sj, i, c, budget, out);
             }
         }
         true
@@ -396,7 +484,12 @@ impl<const N: usize> RefineContext<'_, N> {
         }
         let bsdf = &self.materials[self.sides[sj as usize].shape];
         let fr = self.fr_centre(bsdf, i, j, k);
-        let aj = self.geom.element(j).area;
+        // R(i→j→k) = π F_{j→i} fr with F_{j→i} = T_ij / A_j over j's
+        // exposed area (light arrives and leaves there only).
+        let aj = self.exposed_area[usize::from(self.sides[sj as usize].back)][j.index()];
+        if aj <= 0.0 {
+            return;
+        }
         let r = fr * (PI * tij.t / aj);
         let gathered = unshot * r;
         // An element that lies partly behind j's tangent plane gets a

@@ -113,8 +113,9 @@ fn probe_points(geom: &SceneGeometry, surface: SurfaceId, sign: f64) -> Vec<(DVe
     out
 }
 
-/// Which pairs of sides can exchange light: sender side `a` and receiver side
-/// `b` of different input surfaces such that some point of `b` lies in front
+/// Which pairs of sides can exchange light: a Lambertian side that sees
+/// itself with itself, and sender side `a` and receiver side `b` of
+/// different input surfaces such that some point of `b` lies in front
 /// of `a` and some point of `a` in front of `b`, both as seen by the same pair
 /// of points. Exact for planar surfaces (probing the corners and interior
 /// suffices: the conditions are linear), a dense probe for curved ones.
@@ -149,6 +150,21 @@ pub(crate) fn eligible_pairs<const N: usize>(
                 if faces {
                     out.push(b as SideId);
                 }
+            }
+            // A Lambertian face of a concave surface (a pleated curtain's
+            // chart, the inside of a tube) also lights itself: the links
+            // between its own non-coplanar elements are the secondary
+            // interactions of paper §5.2 (coplanar pairs get a zero form
+            // factor). Glossy faces that see themselves are left out (the
+            // solver warns).
+            let s = geom.surface(sides[a].surface);
+            let sees_itself = if sides[a].back {
+                s.back_can_see_itself()
+            } else {
+                s.can_see_itself()
+            };
+            if sees_itself && !sides[a].stored {
+                out.push(a as SideId);
             }
             out
         })

@@ -19,6 +19,9 @@ pub struct Solution<const N: usize> {
     geom: SceneGeometry,
     settings: SolverSettings,
     depth_of: Vec<u32>,
+    /// Exposed area of every element's faces, `[back][element]`
+    /// (`trilux_geometry::burial`).
+    exposed_area: [Vec<f64>; 2],
     /// Two-point (Lambertian) reflected radiance, `[back][element]`.
     radiance: [Vec<Spectrum<N>>; 2],
     hierarchies: Vec<Hierarchy<N>>,
@@ -59,6 +62,7 @@ impl<const N: usize> Solution<N> {
             geom: solver.geom,
             settings: solver.settings,
             depth_of: solver.depth_of,
+            exposed_area: solver.exposed_area,
             radiance: solver.field.radiance,
             hierarchies: solver.hierarchies,
             by_sides,
@@ -107,6 +111,29 @@ impl<const N: usize> Solution<N> {
     pub fn lambertian_radiance(&self, from: &SurfaceSite) -> Spectrum<N> {
         let leaf = self.geom.locate(from.surface, from.coord);
         self.radiance[usize::from(from.back)][leaf.index()]
+    }
+
+    /// Area mean of the Lambertian (two-point) reflected radiance over one
+    /// face of an input surface: its leaf elements' radiance weighted by
+    /// their exposed areas, over the face's whole area (buried parts send
+    /// nothing). For a diffuse scene solved in two-point mode this is
+    /// the face's mean exitant radiance less emission, which a path tracer's
+    /// irradiance meter gives independently as ρ Ē / π.
+    pub fn surface_mean_radiance(&self, surface: SurfaceId, back: bool) -> Spectrum<N> {
+        let mut sum = Spectrum::<N>::zero();
+        let mut area = 0.0;
+        let mut stack = vec![self.geom.surface(surface).root];
+        while let Some(id) = stack.pop() {
+            let e = self.geom.element(id);
+            if let Some(children) = e.children() {
+                stack.extend(children);
+            } else {
+                sum += self.radiance[usize::from(back)][id.index()]
+                    * self.exposed_area[usize::from(back)][id.index()];
+                area += e.area;
+            }
+        }
+        if area > 0.0 { sum * (1.0 / area) } else { sum }
     }
 
     /// Flux π Σ T L carried by the stored interaction from one face to
@@ -170,7 +197,7 @@ impl<const N: usize> Solution<N> {
 
 const MAGIC: &[u8; 8] = b"TRILUXS\0";
 /// Version of the solution file format.
-pub const FORMAT_VERSION: u32 = 1;
+pub const FORMAT_VERSION: u32 = 2;
 
 /// FNV-1a, 64 bits: stable across platforms and Rust versions.
 fn fnv1a(bytes: &[u8]) -> u64 {
@@ -283,6 +310,11 @@ impl<const N: usize> Solution<N> {
                 w.spectrum(s)?;
             }
         }
+        for side in &self.exposed_area {
+            for &a in side {
+                w.f64(a)?;
+            }
+        }
         w.u32(self.hierarchies.len() as u32)?;
         for h in &self.hierarchies {
             w.u32(h.from)?;
@@ -374,6 +406,16 @@ impl<const N: usize> Solution<N> {
                 side.push(r.spectrum().map_err(truncated)?);
             }
         }
+        let mut exposed_area = [Vec::with_capacity(elements), Vec::with_capacity(elements)];
+        for side in &mut exposed_area {
+            for _ in 0..elements {
+                let a = r.f64().map_err(truncated)?;
+                if !(a.is_finite() && a >= 0.0) {
+                    return Err(bad("corrupt exposed area".into()));
+                }
+                side.push(a);
+            }
+        }
         let count = r.u32().map_err(truncated)? as usize;
         let sides = 2 * surfaces as u32;
         let mut hierarchies = Vec::with_capacity(count.min(1 << 24));
@@ -437,6 +479,7 @@ impl<const N: usize> Solution<N> {
             geom,
             settings: settings.clone(),
             depth_of,
+            exposed_area,
             radiance,
             hierarchies,
             by_sides,

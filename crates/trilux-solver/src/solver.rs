@@ -20,7 +20,7 @@ use std::time::Instant;
 use rayon::prelude::*;
 use trilux_brdf::{AlbedoTable, Bsdf, BsdfParams, Frame};
 use trilux_color::{ColorParam, Spectrum};
-use trilux_geometry::{ElementId, FormFactorOptions, SceneGeometry, Shape};
+use trilux_geometry::{BurialRequest, ElementId, FormFactorOptions, SceneGeometry, Shape, Side};
 
 use crate::error::SolverError;
 use crate::interaction::Hierarchy;
@@ -89,6 +89,8 @@ pub struct Solver<const N: usize> {
     pub(crate) ledger: Ledger,
     emitted: Spectrum<N>,
     pub(crate) depth_of: Vec<u32>,
+    /// Exposed area of every element's faces, `[back][element]`.
+    pub(crate) exposed_area: [Vec<f64>; 2],
     pub(crate) stats: SolveStats,
     used: Vec<bool>,
     /// `element_points` of every element (refinement reads them often).
@@ -106,6 +108,34 @@ const MAX_RENORMALISATION: f64 = 1.5;
 /// lobe misses the uncovered part in proportion (an error of at most 1 −
 /// coverage of the target).
 const CLOSED_COVERAGE: f64 = 0.9;
+
+/// Exposed area A × (exposed share) of every element's two faces,
+/// `[back][element]`: leaves from the burial map, parents the sum of their
+/// children (so that flux pulls stay exact).
+fn exposed_areas(geom: &SceneGeometry) -> [Vec<f64>; 2] {
+    let mut out = [
+        vec![0.0; geom.element_count()],
+        vec![0.0; geom.element_count()],
+    ];
+    for (s, face) in [Side::Front, Side::Back].into_iter().enumerate() {
+        for surface in geom.surfaces() {
+            exposed_rec(geom, surface.root, face, &mut out[s]);
+        }
+    }
+    out
+}
+
+fn exposed_rec(geom: &SceneGeometry, e: ElementId, face: Side, out: &mut [f64]) -> f64 {
+    let a = match geom.element(e).children() {
+        None => geom.element(e).area * geom.exposed_fraction(e, face),
+        Some(children) => children
+            .into_iter()
+            .map(|c| exposed_rec(geom, c, face, out))
+            .sum(),
+    };
+    out[e.index()] = a;
+    a
+}
 
 /// Per-surface depth limits from the global limit and MinArea.
 fn depth_limits(geom: &SceneGeometry, settings: &SolverSettings) -> Vec<u32> {
@@ -185,17 +215,33 @@ impl<const N: usize> Solver<N> {
             }
         }
         for (index, s) in geom.surfaces().iter().enumerate() {
-            let reflects = |back: bool| !sides[2 * index + usize::from(back)].is_absorber();
-            if (s.can_see_itself() && reflects(false))
-                || (s.back_can_see_itself() && reflects(true))
-            {
+            // Lambertian faces exchange light with themselves through
+            // two-point links (sides::eligible_pairs); glossy ones would
+            // need self-interactions, which are not built yet.
+            let glossy = |back: bool| sides[2 * index + usize::from(back)].stored;
+            if (s.can_see_itself() && glossy(false)) || (s.back_can_see_itself() && glossy(true)) {
                 warnings.push(format!(
-                    "shape {}: a curved surface that sees itself; its self-exchange (paper §5 secondary interactions) is left out",
+                    "shape {}: a glossy curved surface that sees itself; its glossy self-exchange (paper §5 secondary interactions) is left out",
                     s.shape
                 ));
             }
         }
         warnings.dedup();
+        // Buried parts of every face that sends light (the floor under a
+        // box): visibility treats them as blocked, and radiance is spread
+        // over the exposed area only (trilux_geometry::burial).
+        let requests: Vec<BurialRequest> = sides
+            .iter()
+            .filter(|s| !s.is_absorber())
+            .map(|s| BurialRequest {
+                surface: s.surface,
+                side: if s.back { Side::Back } else { Side::Front },
+                resolution: 2u32.pow(depth_of[s.surface.index()] + 1).min(256),
+            })
+            .collect();
+        let burial = geom.compute_burial(&requests);
+        geom.set_burial(burial);
+        let exposed_area = exposed_areas(&geom);
         let partners = eligible_pairs(&geom, &sides);
         let cache = ThroughputCache::new(1 << 22);
         let ff_options = FormFactorOptions::default();
@@ -255,7 +301,8 @@ impl<const N: usize> Solver<N> {
                 continue;
             }
             let surface = &geom.surfaces()[side.surface.index()];
-            let flux = side.emission * (PI * surface.area());
+            let flux =
+                side.emission * (PI * exposed_area[usize::from(side.back)][surface.root.index()]);
             emitted += flux;
             {
                 let mut stack = vec![surface.root];
@@ -307,6 +354,7 @@ impl<const N: usize> Solver<N> {
             ledger,
             emitted,
             depth_of,
+            exposed_area,
             stats,
             used,
             points,
@@ -387,7 +435,12 @@ impl<const N: usize> Solver<N> {
             Source::Radiosity(s) => {
                 let side = &self.sides[s as usize];
                 let root = geom.surfaces()[side.surface.index()].root;
-                self.field.push_pull(geom, root, side.back);
+                self.field.push_pull(
+                    geom,
+                    root,
+                    side.back,
+                    &self.exposed_area[usize::from(side.back)],
+                );
                 (s, None)
             }
             Source::Stored(h) => {
@@ -410,6 +463,7 @@ impl<const N: usize> Solver<N> {
             flux_threshold: self.settings.flux_eps * emitted_sum,
             points: &self.points,
             interior: &self.interior,
+            exposed_area: &self.exposed_area,
         };
         let sender = match &src_hierarchy {
             None => Sender::Radiosity {
@@ -435,7 +489,7 @@ impl<const N: usize> Solver<N> {
             .par_iter()
             .flat_map_iter(|&(i, r, j)| {
                 let mut out = Vec::new();
-                ctx.refine_pair(&sender, send_side, r, i, j, &mut out);
+                ctx.refine_pair(&sender, send_side, r, i, j, self.settings.ff_eps, &mut out);
                 out
             })
             .collect();
@@ -513,7 +567,15 @@ impl<const N: usize> Solver<N> {
         for (g, l) in pair_links.iter().enumerate() {
             let side = &self.sides[l.side as usize];
             let arrived_g = l.unshot * shot_scale * (PI * l.t);
-            let diffuse_g = arrived_g * side.rho_d;
+            // Light spreads over j's exposed area. (No transfer reaches an
+            // element that is wholly buried, whose segments all count as
+            // blocked; if one did, its light would be absorbed.)
+            let aj = self.exposed_area[usize::from(side.back)][l.j.index()];
+            let diffuse_g = if aj > 0.0 {
+                arrived_g * side.rho_d
+            } else {
+                Spectrum::zero()
+            };
             // What an element reflects may not exceed what arrived there.
             let room = (arrived_g - diffuse_g).max(Spectrum::zero());
             let glossy_g = glossy_flux[g];
@@ -559,8 +621,7 @@ impl<const N: usize> Solver<N> {
             total_arrived += arrived_g;
             absorbed += absorbed_g;
             // The Lambertian share: straight into j's radiance (two-point).
-            if !side.rho_d.is_black() {
-                let aj = geom.element(l.j).area;
+            if !side.rho_d.is_black() && aj > 0.0 {
                 let dl = l.unshot * shot_scale * side.rho_d * (l.t / aj);
                 self.field.gathered[usize::from(side.back)][l.j.index()] += dl;
                 self.side_flux[l.side as usize] += dl * (PI * aj);
@@ -614,7 +675,10 @@ impl<const N: usize> Solver<N> {
         {
             return c;
         }
-        let a = self.geom.element(j).area;
+        let a = self.exposed_area[usize::from(self.sides[side as usize].back)][j.index()];
+        if a <= 0.0 {
+            return 0.0;
+        }
         let this = SidedElement {
             element: j,
             back: self.sides[side as usize].back,
@@ -647,7 +711,12 @@ impl<const N: usize> Solver<N> {
     fn finish(mut self, seconds: f64) -> Solution<N> {
         for side in &self.sides {
             let root = self.geom.surfaces()[side.surface.index()].root;
-            self.field.push_pull(&self.geom, root, side.back);
+            self.field.push_pull(
+                &self.geom,
+                root,
+                side.back,
+                &self.exposed_area[usize::from(side.back)],
+            );
         }
         // Pushing makes pending energy part of δL again; the residual keys
         // already count it.

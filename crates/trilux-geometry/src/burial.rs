@@ -1,0 +1,291 @@
+//! Buried parts of surfaces: where another surface lies on or just in front
+//! of a face, so that the face there neither receives nor sends light (the
+//! floor under a box, a ceiling just above a lamp's back, a wall behind a
+//! cupboard standing against it).
+//!
+//! Piecewise-constant radiance spreads what an element receives over its
+//! whole area and sends it from its whole area. An element that straddles
+//! the edge of a box standing on it receives on its open part only, but
+//! would send a share of that light from its covered part, into the box,
+//! where it is lost: a systematic energy sink at every contact, which
+//! refinement shrinks only linearly. A [`BurialMap`] marks the covered
+//! parts once, so that shadow segments from or to a buried point count as
+//! blocked ([`SceneGeometry::visibility_sided`]) and the solver spreads an
+//! element's light over its exposed area only
+//! ([`BurialMap::exposed_fraction`]).
+//!
+//! **The test.** A point of a face is buried when each of 9 probe rays
+//! into the face's hemisphere (the normal, and 8 directions 60° from it)
+//! meets another shape within `reach`, a distance of the order of the
+//! map's cell size. The probes start a hair behind the face and ignore its
+//! own shape, so a coincident face (a box's bottom on the floor) counts.
+//! A face seen through a gap wider than `reach` stays exposed: the light
+//! that enters the gap is then resolved by visibility, as everywhere else.
+//!
+//! **Resolution.** A parametric surface's face gets an R × R grid of cells
+//! in (u, v); a chart's face one probe per midpoint sub-triangle (4 per
+//! triangle).
+
+use std::collections::HashMap;
+
+use glam::{DVec2, DVec3};
+use rayon::prelude::*;
+
+use crate::bvh::Ray;
+use crate::element::ElementDomain;
+use crate::form_factor::Side;
+use crate::ids::{ElementId, SurfaceId};
+use crate::scene_geometry::SceneGeometry;
+use crate::surface::{SurfaceCoord, SurfaceGeom};
+
+/// Which cells of which faces are buried.
+#[derive(Clone, Debug, Default)]
+pub struct BurialMap {
+    /// Indexed by 2 × surface + back; `None`: not probed (all exposed).
+    faces: Vec<Option<FaceBurial>>,
+}
+
+#[derive(Clone, Debug)]
+enum FaceBurial {
+    /// `res` × `res` cells over (u, v), row-major in v; true = buried.
+    Grid { res: u32, buried: Vec<bool> },
+    /// Per mesh triangle, 4 bits (corner a, corner b, corner c, middle).
+    Triangles { buried: HashMap<u32, u8> },
+}
+
+/// The centroids of the four midpoint sub-triangles, in barycentrics
+/// (b1, b2): corners at vertex 0, 1, 2, then the middle one.
+const SUB_CENTROIDS: [(f64, f64); 4] = [
+    (1.0 / 6.0, 1.0 / 6.0),
+    (2.0 / 3.0, 1.0 / 6.0),
+    (1.0 / 6.0, 2.0 / 3.0),
+    (1.0 / 3.0, 1.0 / 3.0),
+];
+
+/// The midpoint sub-triangle holding barycentrics (b1, b2).
+fn sub_triangle(bary: DVec2) -> usize {
+    let b0 = 1.0 - bary.x - bary.y;
+    if b0 >= 0.5 {
+        0
+    } else if bary.x >= 0.5 {
+        1
+    } else if bary.y >= 0.5 {
+        2
+    } else {
+        3
+    }
+}
+
+/// What to probe: one face of a surface, at a grid resolution (ignored for
+/// charts).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct BurialRequest {
+    /// The surface.
+    pub surface: SurfaceId,
+    /// Its face.
+    pub side: Side,
+    /// Cells per side of the (u, v) grid.
+    pub resolution: u32,
+}
+
+fn side_index(surface: SurfaceId, side: Side) -> usize {
+    2 * surface.index() + usize::from(side == Side::Back)
+}
+
+impl BurialMap {
+    /// True if the point `coord` of `surface`'s face `side` is buried.
+    pub fn is_buried(&self, surface: SurfaceId, side: Side, coord: SurfaceCoord) -> bool {
+        match (self.faces.get(side_index(surface, side)), coord) {
+            (Some(Some(FaceBurial::Grid { res, buried })), SurfaceCoord::Uv(uv)) => {
+                let r = *res as f64;
+                let i = ((uv.x * r) as i64).clamp(0, *res as i64 - 1) as usize;
+                let j = ((uv.y * r) as i64).clamp(0, *res as i64 - 1) as usize;
+                buried[j * *res as usize + i]
+            }
+            (
+                Some(Some(FaceBurial::Triangles { buried })),
+                SurfaceCoord::Triangle { index, bary },
+            ) => buried
+                .get(&index)
+                .is_some_and(|bits| bits & (1 << sub_triangle(bary)) != 0),
+            _ => false,
+        }
+    }
+
+    /// True if no face has a buried cell.
+    pub fn is_empty(&self) -> bool {
+        self.faces.iter().flatten().all(|f| match f {
+            FaceBurial::Grid { buried, .. } => !buried.contains(&true),
+            FaceBurial::Triangles { buried } => buried.values().all(|&b| b == 0),
+        })
+    }
+
+    /// The exposed share of an element's face, in [0, 1] (1 where the face
+    /// was not probed): the fraction of its grid cells (of its pieces'
+    /// area, for chart clusters) that are not buried.
+    pub fn exposed_fraction(&self, geom: &SceneGeometry, id: ElementId, side: Side) -> f64 {
+        let e = geom.element(id);
+        let Some(Some(face)) = self.faces.get(side_index(e.surface, side)) else {
+            return 1.0;
+        };
+        match (face, e.domain) {
+            (FaceBurial::Grid { res, buried }, ElementDomain::Rect { min, max }) => {
+                let r = *res as f64;
+                let cells = |lo: f64, hi: f64| {
+                    let a = ((lo * r).round() as i64).clamp(0, *res as i64 - 1);
+                    let b = ((hi * r).round() as i64).clamp(a + 1, *res as i64);
+                    (a as usize, b as usize)
+                };
+                let (i0, i1) = cells(min.x, max.x);
+                let (j0, j1) = cells(min.y, max.y);
+                let mut open = 0usize;
+                for j in j0..j1 {
+                    for i in i0..i1 {
+                        open += usize::from(!buried[j * *res as usize + i]);
+                    }
+                }
+                open as f64 / ((i1 - i0) * (j1 - j0)) as f64
+            }
+            (FaceBurial::Triangles { buried }, ElementDomain::Cluster { .. }) => {
+                let (mut open, mut total) = (0.0, 0.0);
+                for p in geom.element_pieces(id) {
+                    let [a, b, c] = p.bary;
+                    // Sub-triangle area fraction × the triangle's area.
+                    let w = 0.5 * ((b - a).perp_dot(c - a)).abs() * 2.0;
+                    let area = w * geom.triangle_area(e.surface, p.triangle);
+                    let centre = (a + b + c) / 3.0;
+                    let bits = buried.get(&p.triangle).copied().unwrap_or(0);
+                    total += area;
+                    if bits & (1 << sub_triangle(centre)) == 0 {
+                        open += area;
+                    }
+                }
+                if total > 0.0 { open / total } else { 1.0 }
+            }
+            _ => 1.0,
+        }
+    }
+}
+
+impl SceneGeometry {
+    /// Probes the requested faces for buried parts (module docs), in
+    /// parallel.
+    pub fn compute_burial(&self, requests: &[BurialRequest]) -> BurialMap {
+        let mut faces = vec![None; 2 * self.surfaces.len()];
+        let probed: Vec<(usize, FaceBurial)> = requests
+            .par_iter()
+            .filter(|r| r.surface.index() < self.surfaces.len())
+            .map(|r| (side_index(r.surface, r.side), self.probe_face(r)))
+            .collect();
+        for (i, f) in probed {
+            faces[i] = Some(f);
+        }
+        BurialMap { faces }
+    }
+
+    /// Makes `map` the one [`SceneGeometry::visibility_sided`] consults.
+    pub fn set_burial(&mut self, map: BurialMap) {
+        self.burial = (!map.is_empty()).then_some(map);
+    }
+
+    /// The burial map in use, if any face has buried parts.
+    pub fn burial(&self) -> Option<&BurialMap> {
+        self.burial.as_ref()
+    }
+
+    /// The exposed share of an element's face (1 without a burial map).
+    pub fn exposed_fraction(&self, id: ElementId, side: Side) -> f64 {
+        self.burial
+            .as_ref()
+            .map_or(1.0, |m| m.exposed_fraction(self, id, side))
+    }
+
+    pub(crate) fn triangle_area(&self, surface: SurfaceId, tri: u32) -> f64 {
+        match &self.surfaces[surface.index()].geom {
+            SurfaceGeom::Chart { mesh } => self.meshes[*mesh as usize]
+                .tri_area
+                .get(tri as usize)
+                .copied()
+                .unwrap_or(0.0),
+            SurfaceGeom::Patch(_) => 0.0,
+        }
+    }
+
+    fn probe_face(&self, r: &BurialRequest) -> FaceBurial {
+        let s = &self.surfaces[r.surface.index()];
+        let sign = r.side.sign();
+        match &s.geom {
+            SurfaceGeom::Patch(_) => {
+                let res = r.resolution.clamp(1, 1024);
+                // Cells are about sqrt(area)/res across.
+                let reach = s.area.sqrt() / res as f64;
+                let buried = (0..res * res)
+                    .map(|c| {
+                        let uv = DVec2::new(
+                            ((c % res) as f64 + 0.5) / res as f64,
+                            ((c / res) as f64 + 0.5) / res as f64,
+                        );
+                        self.surface_point(r.surface, SurfaceCoord::Uv(uv))
+                            .is_some_and(|p| self.probe(p.point, p.normal * sign, s.shape, reach))
+                    })
+                    .collect();
+                FaceBurial::Grid { res, buried }
+            }
+            SurfaceGeom::Chart { mesh } => {
+                let m = &self.meshes[*mesh as usize];
+                let mut buried = HashMap::new();
+                for (t, &owner) in m.tri_surface.iter().enumerate() {
+                    if owner != r.surface.0 {
+                        continue;
+                    }
+                    let reach = (0.25 * m.tri_area[t]).sqrt();
+                    let mut bits = 0u8;
+                    for (k, &(b1, b2)) in SUB_CENTROIDS.iter().enumerate() {
+                        let coord = SurfaceCoord::Triangle {
+                            index: t as u32,
+                            bary: DVec2::new(b1, b2),
+                        };
+                        if self
+                            .surface_point(r.surface, coord)
+                            .is_some_and(|p| self.probe(p.point, p.normal * sign, s.shape, reach))
+                        {
+                            bits |= 1 << k;
+                        }
+                    }
+                    if bits != 0 {
+                        buried.insert(t as u32, bits);
+                    }
+                }
+                FaceBurial::Triangles { buried }
+            }
+        }
+    }
+
+    /// True if every probe ray from `p` into the hemisphere of `n` meets
+    /// another shape within `reach`.
+    fn probe(&self, p: DVec3, n: DVec3, own_shape: u32, reach: f64) -> bool {
+        if !(p.is_finite() && n.is_finite() && reach > 0.0) {
+            return false;
+        }
+        // Start a hair behind the face so that a coincident face is met.
+        let behind = 1e-6 * self.extent;
+        let origin = p - n * behind;
+        let (t, b) = n.any_orthonormal_pair();
+        let (sin, cos) = (60f64.to_radians().sin(), 60f64.to_radians().cos());
+        let dirs = std::iter::once(n).chain((0..8).map(|k| {
+            let phi = k as f64 * std::f64::consts::FRAC_PI_4;
+            cos * n + sin * (phi.cos() * t + phi.sin() * b)
+        }));
+        for d in dirs {
+            // Distances count from the face, not from the probe's origin.
+            let t_max = reach + behind / d.dot(n).max(1e-3);
+            if self
+                .intersect_ignoring(&Ray { origin, dir: d }, t_max, own_shape)
+                .is_none()
+            {
+                return false;
+            }
+        }
+        true
+    }
+}

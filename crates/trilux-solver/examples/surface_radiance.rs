@@ -1,0 +1,61 @@
+//! Solves a scene in RGB mode and prints, per shape, its area and the area
+//! mean of the reflected radiance leaving its front face, as JSON: the
+//! numbers `tests/golden/surface_irradiance.py` compares with Mitsuba 3's
+//! irradiance meters (mean exitant radiance of a diffuse face = ρ Ē / π).
+//!
+//! ```text
+//! cargo run --release -p trilux-solver --example surface_radiance -- SCENE [draft|default|high] [CR|-] [MAX_SHOTS]
+//! ```
+
+use std::path::PathBuf;
+
+use trilux_solver::{Quality, SceneInput, Solver, SolverSettings};
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let mut args = std::env::args().skip(1);
+    let path = PathBuf::from(
+        args.next()
+            .ok_or("usage: surface_radiance SCENE [QUALITY] [CR]")?,
+    );
+    let quality = match args.next().as_deref() {
+        None | Some("default") => Quality::Default,
+        Some("draft") => Quality::Draft,
+        Some("high") => Quality::High,
+        Some(q) => return Err(format!("unknown quality {q}").into()),
+    };
+    let scene = trilux_scene::load(&path)?;
+    let input = SceneInput::from_scene(&scene);
+    let mut settings = SolverSettings::preset(quality);
+    if let Some(cr) = args.next().filter(|a| a != "-") {
+        settings.convergence = cr.parse()?;
+    }
+    if let Some(shots) = args.next() {
+        settings.max_shots = shots.parse()?;
+    }
+    let solution = Solver::<3>::new(&input.as_input(), settings)?.solve(|_| {});
+    let geom = solution.geometry();
+    let mut rows = Vec::new();
+    for shape in 0..input.shapes.len() as u32 {
+        let (mut area, mut sum) = (0.0, [0.0; 3]);
+        for s in geom.surfaces_of_shape(shape) {
+            let a = geom.surface(s).area();
+            let l = solution.surface_mean_radiance(s, false);
+            area += a;
+            for (b, v) in sum.iter_mut().enumerate() {
+                *v += l[b] * a;
+            }
+        }
+        let mean = sum.map(|v| if area > 0.0 { v / area } else { 0.0 });
+        rows.push(format!(
+            "{{\"shape\": {shape}, \"area\": {area}, \"radiance\": [{}, {}, {}]}}",
+            mean[0], mean[1], mean[2]
+        ));
+    }
+    let st = solution.stats();
+    println!(
+        "{{\"convergence_ratio\": {}, \"shapes\": [\n  {}\n]}}",
+        st.convergence_ratio,
+        rows.join(",\n  ")
+    );
+    Ok(())
+}
