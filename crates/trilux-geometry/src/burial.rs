@@ -23,8 +23,8 @@
 //! that enters the gap is then resolved by visibility, as everywhere else.
 //!
 //! **Resolution.** A parametric surface's face gets an R × R grid of cells
-//! in (u, v); a chart's face one probe per midpoint sub-triangle (4 per
-//! triangle).
+//! in (u, v), refined 4 × 4 along the outlines of buried regions; a chart's
+//! face one probe per midpoint sub-triangle (4 per triangle).
 
 use std::collections::HashMap;
 
@@ -216,19 +216,59 @@ impl SceneGeometry {
         let sign = r.side.sign();
         match &s.geom {
             SurfaceGeom::Patch(_) => {
-                let res = r.resolution.clamp(1, 1024);
+                let coarse = r.resolution.clamp(1, 256);
                 // Cells are about sqrt(area)/res across.
-                let reach = s.area.sqrt() / res as f64;
-                let buried = (0..res * res)
-                    .map(|c| {
-                        let uv = DVec2::new(
-                            ((c % res) as f64 + 0.5) / res as f64,
-                            ((c / res) as f64 + 0.5) / res as f64,
-                        );
-                        self.surface_point(r.surface, SurfaceCoord::Uv(uv))
-                            .is_some_and(|p| self.probe(p.point, p.normal * sign, s.shape, reach))
-                    })
+                let reach = s.area.sqrt() / coarse as f64;
+                let probe_uv = |uv: DVec2| {
+                    self.surface_point(r.surface, SurfaceCoord::Uv(uv))
+                        .is_some_and(|p| self.probe(p.point, p.normal * sign, s.shape, reach))
+                };
+                let centre = |i: u32, j: u32, res: u32| {
+                    DVec2::new(
+                        (i as f64 + 0.5) / res as f64,
+                        (j as f64 + 0.5) / res as f64,
+                    )
+                };
+                let first: Vec<bool> = (0..coarse * coarse)
+                    .map(|c| probe_uv(centre(c % coarse, c / coarse, coarse)))
                     .collect();
+                if !first.contains(&true) {
+                    return FaceBurial::Grid {
+                        res: coarse,
+                        buried: first,
+                    };
+                }
+                // Where buried and exposed cells meet (a box's outline), probe
+                // again FINE × FINE times finer, so that the cells that
+                // straddle the outline, which send light into the box from
+                // their covered part, are few.
+                const FINE: u32 = 4;
+                let res = coarse * FINE;
+                let at = |i: i64, j: i64| -> Option<bool> {
+                    (i >= 0 && j >= 0 && i < coarse as i64 && j < coarse as i64)
+                        .then(|| first[(j * coarse as i64 + i) as usize])
+                };
+                let mut buried = vec![false; (res * res) as usize];
+                for j in 0..coarse {
+                    for i in 0..coarse {
+                        let here = first[(j * coarse + i) as usize];
+                        let boundary = (-1..=1).any(|dj| {
+                            (-1..=1).any(|di| {
+                                at(i as i64 + di, j as i64 + dj).is_some_and(|b| b != here)
+                            })
+                        });
+                        for sj in 0..FINE {
+                            for si in 0..FINE {
+                                let (fi, fj) = (i * FINE + si, j * FINE + sj);
+                                buried[(fj * res + fi) as usize] = if boundary {
+                                    probe_uv(centre(fi, fj, res))
+                                } else {
+                                    here
+                                };
+                            }
+                        }
+                    }
+                }
                 FaceBurial::Grid { res, buried }
             }
             SurfaceGeom::Chart { mesh } => {

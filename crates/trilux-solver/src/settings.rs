@@ -20,9 +20,9 @@ pub enum Transport {
 pub enum Quality {
     /// Fast previews: CR 0.95, coarse elements.
     Draft,
-    /// CR 0.99.
+    /// CR 0.999 (residual 0.1 % of the emitted flux).
     Default,
-    /// CR 0.999, fine elements.
+    /// CR 0.9999, fine elements.
     High,
 }
 
@@ -86,7 +86,7 @@ impl SolverSettings {
                 transport: Transport::TwoPoint,
             },
             Quality::Default => SolverSettings {
-                convergence: 0.99,
+                convergence: 0.999,
                 max_shots: 100_000,
                 max_depth: 5,
                 min_area_fraction: 1e-6,
@@ -97,7 +97,7 @@ impl SolverSettings {
                 transport: Transport::TwoPoint,
             },
             Quality::High => SolverSettings {
-                convergence: 0.999,
+                convergence: 0.9999,
                 max_shots: 500_000,
                 max_depth: 6,
                 min_area_fraction: 1e-7,

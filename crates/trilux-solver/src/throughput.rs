@@ -149,7 +149,7 @@ pub(crate) fn compute_throughput(
         2 | 3 => visibility_samples * 4,
         _ => visibility_samples,
     };
-    let v = geom.visibility_sided(i.element, i.side(), j.element, j.side(), samples);
+    let v = geom.visibility_weighted(i.element, i.side(), j.element, j.side(), samples);
     let area = geom.element(i.element).area;
     let t = area * f * v;
     if t.is_finite() && t > 0.0 {

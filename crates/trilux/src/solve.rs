@@ -19,7 +19,7 @@ pub struct SolveOptions {
     #[arg(long, value_parser = ["draft", "default", "high"], default_value = "default")]
     pub quality: String,
     /// Target convergence ratio CR = (IF − RF)/IF in [0, 1] (default from
-    /// --quality: 0.95, 0.99, 0.999).
+    /// --quality: 0.95, 0.999, 0.9999).
     #[arg(long)]
     pub convergence: Option<f64>,
     /// Override the scene's colour mode.
