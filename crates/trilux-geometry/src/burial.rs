@@ -224,10 +224,7 @@ impl SceneGeometry {
                         .is_some_and(|p| self.probe(p.point, p.normal * sign, s.shape, reach))
                 };
                 let centre = |i: u32, j: u32, res: u32| {
-                    DVec2::new(
-                        (i as f64 + 0.5) / res as f64,
-                        (j as f64 + 0.5) / res as f64,
-                    )
+                    DVec2::new((i as f64 + 0.5) / res as f64, (j as f64 + 0.5) / res as f64)
                 };
                 let first: Vec<bool> = (0..coarse * coarse)
                     .map(|c| probe_uv(centre(c % coarse, c / coarse, coarse)))

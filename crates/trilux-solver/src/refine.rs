@@ -395,6 +395,32 @@ impl<const N: usize> RefineContext<'_, N> {
         }
     }
 
+    /// fr at the mirror direction of i's centre about j, if that direction
+    /// passes within K's angular radius (plus a margin for the lobe's
+    /// width) of K's centre, as seen from j's centre.
+    fn peak_fr(
+        &self,
+        bsdf: &Bsdf<N>,
+        i: ElementId,
+        j: ElementId,
+        k: ElementId,
+    ) -> Option<Spectrum<N>> {
+        let g = self.geom;
+        let (ei, ej, ek) = (g.element(i), g.element(j), g.element(k));
+        let frame = trilux_brdf::Frame::from_normal(ej.normal);
+        let wi = frame.to_local((ei.centre - ej.centre).normalize_or_zero());
+        let mirror = DVec3::new(-wi.x, -wi.y, wi.z);
+        let to_k = ek.centre - ej.centre;
+        let dist = to_k.length();
+        if dist <= 0.0 || wi.z == 0.0 {
+            return None;
+        }
+        let radius = 0.5 * ek.bounds.diagonal().length();
+        let cone = (radius / dist).atan() + 0.2;
+        let angle = frame.to_world(mirror).angle_between(to_k);
+        (angle <= cone).then(|| bsdf.eval_glossy(wi, mirror))
+    }
+
     /// The spread of fr over the three elements and the element driving it
     /// (notes §2, step 3): only computed when the cheaper tests did not
     /// already decide.
@@ -522,7 +548,16 @@ impl<const N: usize> RefineContext<'_, N> {
             gathered,
         };
         let flux_to_k = PI * tjk * gathered.sum();
-        if flux_to_k < self.flux_threshold {
+        // The photometric criterion trusts the midpoint estimate of fr over
+        // K, which misses a narrow lobe whose peak falls between K's sample
+        // points: such links would stay coarse *because* they were
+        // underestimated. Bound the flux with fr at the mirror direction
+        // when that direction passes near K.
+        if flux_to_k < self.flux_threshold
+            && self.peak_fr(bsdf, i, j, k).is_none_or(|peak| {
+                PI * tjk * (unshot * peak).sum() * (PI * tij.t / aj) < self.flux_threshold
+            })
+        {
             task.out.push(link);
             return;
         }

@@ -82,6 +82,8 @@ pub struct Solver<const N: usize> {
     coverage: std::sync::Mutex<HashMap<(SideId, ElementId), f64>>,
     pub(crate) sides: Vec<TransportSide<N>>,
     partners: Vec<Vec<SideId>>,
+    /// (sender side, receiver side) of every stored interaction.
+    stored_pairs: std::collections::HashSet<(SideId, SideId)>,
     pub(crate) field: ElementRadiance<N>,
     side_flux: Vec<Spectrum<N>>,
     pub(crate) hierarchies: Vec<Hierarchy<N>>,
@@ -101,7 +103,11 @@ pub struct Solver<const N: usize> {
 
 /// The most a group's area reflectances are scaled up or down to match the
 /// albedo (a guard against estimation noise).
-const MAX_RENORMALISATION: f64 = 1.5;
+const MAX_RENORMALISATION: f64 = 50.0;
+
+/// BSDF samples per pair link for the covered share of an open
+/// hemisphere's glossy lobe (a square number: stratified on a grid).
+const LOBE_SAMPLES: u32 = 64;
 
 /// The coverage above which j's hemisphere counts as (nearly) closed: the
 /// target is then the albedo times the covered share, which assumes the
@@ -339,7 +345,9 @@ impl<const N: usize> Solver<N> {
                 })
             })
             .collect();
+        let stored_pairs = hierarchies.iter().map(|h| (h.from, h.to)).collect();
         Ok(Solver {
+            stored_pairs,
             geom,
             settings,
             materials,
@@ -590,13 +598,18 @@ impl<const N: usize> Solver<N> {
                 && self.settings.transport == crate::settings::Transport::TwoPoint
             {
                 let covered = self.hemisphere_coverage(l.side, l.j);
-                (covered >= CLOSED_COVERAGE).then(|| {
+                if covered >= CLOSED_COVERAGE {
                     let (ei, ej) = (geom.element(l.i), geom.element(l.j));
-                    let wi = Frame::from_normal(ej.normal)
+                    let wi = Frame::from_normal(ej.normal * side.sign())
                         .to_local((ei.centre - ej.centre).normalize_or_zero());
                     let glossy_albedo = self.albedo[side.shape].albedo(wi) - side.rho_d;
-                    (arrived_g * glossy_albedo * covered.min(1.0)).max(Spectrum::zero())
-                })
+                    Some((arrived_g * glossy_albedo * covered.min(1.0)).max(Spectrum::zero()))
+                } else {
+                    // An open hemisphere: the share of the lobe that meets a
+                    // stored receiver, by sampling the BRDF (a narrow lobe
+                    // need not miss the open part in proportion).
+                    Some(arrived_g * self.covered_lobe(l.side, l.i, l.j))
+                }
             } else {
                 None
             };
@@ -664,6 +677,54 @@ impl<const N: usize> Solver<N> {
             (Source::Stored(_), None) => {}
         }
         live
+    }
+
+    /// ∫ fr_glossy cos dω over the directions from j's centre that meet a
+    /// face j's side stores an interaction towards, for light from i's
+    /// centre: [`LOBE_SAMPLES`] stratified samples of the BSDF, each traced.
+    fn covered_lobe(&self, side: SideId, i: ElementId, j: ElementId) -> Spectrum<N> {
+        let geom = &self.geom;
+        let ts = &self.sides[side as usize];
+        let (ei, ej) = (geom.element(i), geom.element(j));
+        let normal = ej.normal * ts.sign();
+        let frame = Frame::from_normal(normal);
+        let wi = frame.to_local((ei.centre - ej.centre).normalize_or_zero());
+        let bsdf = &self.materials[ts.shape];
+        // The BSDF's frame is the front's: flip z for a back side.
+        let to_bsdf = |v: glam::DVec3| glam::DVec3::new(v.x, v.y, v.z * ts.sign());
+        let origin = ej.centre + normal * (1e-7 * geom.bounds().diagonal().length());
+        let mut sum = Spectrum::<N>::zero();
+        let n = LOBE_SAMPLES;
+        let grid = (n as f64).sqrt() as u32;
+        for a in 0..grid {
+            for b in 0..grid {
+                let u = glam::DVec2::new(
+                    (f64::from(a) + 0.5) / f64::from(grid),
+                    (f64::from(b) + 0.5) / f64::from(grid),
+                );
+                let Some(smp) = bsdf.sample(to_bsdf(wi), u) else {
+                    continue;
+                };
+                let wo = to_bsdf(smp.wi);
+                if wo.z <= 0.0 {
+                    continue;
+                }
+                let dir = frame.to_world(wo);
+                let Some(hit) =
+                    geom.intersect(&trilux_geometry::Ray { origin, dir }, f64::INFINITY)
+                else {
+                    continue;
+                };
+                let hit_side = 2 * hit.surface.0
+                    + u32::from(!hit.front_facing(&trilux_geometry::Ray { origin, dir }));
+                if !self.stored_pairs.contains(&(side, hit_side)) {
+                    continue;
+                }
+                let f = bsdf.eval_glossy(to_bsdf(wi), smp.wi);
+                sum += f * (wo.z / smp.pdf);
+            }
+        }
+        sum * (1.0 / f64::from(grid * grid))
     }
 
     /// Σ over the side's stored hierarchies of T(j, K) / A_j: the
