@@ -119,6 +119,29 @@ impl SceneGeometry {
         }
     }
 
+    /// Area-weighted sums of the shading normals and of the geometric
+    /// normals over a chart element's pieces, (Σ A n_s, Σ A n_g), when its
+    /// mesh has smooth shading normals; `None` otherwise. The irradiance a
+    /// Lambertian BSDF sees about its shading normals, from a distant
+    /// source in direction d, is (Σ A n_s · d)/(Σ A n_g · d) times the one
+    /// about the geometric normals.
+    pub fn shading_moments(&self, id: ElementId) -> Option<(DVec3, DVec3)> {
+        let e = &self.elements[id.index()];
+        let SurfaceGeom::Chart { mesh } = &self.surfaces[e.surface.index()].geom else {
+            return None;
+        };
+        let m = &self.meshes[*mesh as usize];
+        m.shading_normals.as_ref()?;
+        let (mut s, mut g) = (DVec3::ZERO, DVec3::ZERO);
+        for p in self.element_pieces(id) {
+            let a = m.tri_area[p.triangle as usize] * p.area_fraction();
+            let centre = (p.bary[0] + p.bary[1] + p.bary[2]) / 3.0;
+            s += a * m.shading_normal(p.triangle, centre);
+            g += a * m.tri_normal[p.triangle as usize];
+        }
+        Some((s, g))
+    }
+
     /// Splits an element into its four children (creating them on first
     /// call; later calls return the same ids). Children lie on the true
     /// surface.

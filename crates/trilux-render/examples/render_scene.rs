@@ -41,8 +41,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     let extra = match rest.get(3).map(String::as_str) {
         Some("never") => ExtraBounce::Never,
-        Some("always") => ExtraBounce::Always,
-        _ => ExtraBounce::default(),
+        Some("auto") => ExtraBounce::Auto { close_factor: 1.0 },
+        _ => ExtraBounce::Always,
     };
     let scene = trilux_scene::load(scene)?;
     let camera = scene.camera.as_ref().ok_or("the scene has no camera")?;
@@ -56,7 +56,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     let t = Instant::now();
     let (image, stats, solve_s) = if scene.spectral {
-        let sol = solve_scene::<10>(&scene, SolverSettings::preset(quality))?;
+        let sol = solve_scene::<{ trilux_color::SPECTRAL_BANDS }>(
+            &scene,
+            SolverSettings::preset(quality),
+        )?;
         let solve_s = t.elapsed().as_secs_f64();
         print_stats(sol.stats());
         let (i, s) = render(&scene, &sol, &view, &settings, |_, _| {})?;

@@ -48,7 +48,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let scene = trilux_scene::load(&p)?;
         let t = Instant::now();
         let (bands, r) = if scene.spectral {
-            let sol = solve_scene::<10>(&scene, SolverSettings::preset(Quality::Default))?;
+            let sol = solve_scene::<{ trilux_color::SPECTRAL_BANDS }>(
+                &scene,
+                SolverSettings::preset(Quality::Default),
+            )?;
             let solve = t.elapsed().as_secs_f64();
             (10, (solve, times(&scene, &sol)?))
         } else {

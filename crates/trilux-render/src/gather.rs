@@ -81,25 +81,26 @@ pub struct BsdfSample<const N: usize> {
 }
 
 /// When to continue a gather path one bounce before reading the solution.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub enum ExtraBounce {
     /// Always read the solution at the first gather hit (the paper's §4.5).
     Never,
     /// Where the solution's steps would show (notes §6): the gather hit is
     /// closer than `close_factor` × the linear size of the element it hit,
-    /// or the BSDF lobe at x_s subtends less than the element's solid angle.
+    /// the BSDF lobe at x_s subtends less than the element's solid angle, or
+    /// the hit surface is glossy (its stored radiance is constant over whole
+    /// receiving elements, a lobe there is not) or smooth-shaded (the
+    /// solution reflects about geometric normals, the BSDF about shading
+    /// normals).
     Auto {
         /// Distance threshold in units of the hit element's linear size.
         close_factor: f64,
     },
-    /// At every gather hit (for measuring what the rule buys).
+    /// At every gather hit: the solution is read one bounce later, which
+    /// dilutes its remaining bias (the default; docs/results.md measures
+    /// what it buys and costs).
+    #[default]
     Always,
-}
-
-impl Default for ExtraBounce {
-    fn default() -> Self {
-        Self::Auto { close_factor: 1.0 }
-    }
 }
 
 /// Everything the final gather needs from a scene and its solution.
@@ -166,6 +167,13 @@ pub trait GatherScene<const N: usize>: Sync {
     /// Solid angle (sr) of the BSDF lobe at `at` for viewer direction `wo`;
     /// 2π for a diffuse surface.
     fn lobe_solid_angle(&self, at: &SurfacePoint<Self::Locator>, wo: DVec3) -> f64;
+
+    /// True where the shading normal differs from the geometric one
+    /// (smooth-shaded meshes): the solution's radiance there was computed
+    /// with the geometric normal, the BSDF's with the shading normal.
+    fn shading_differs(&self, _at: &SurfacePoint<Self::Locator>) -> bool {
+        false
+    }
 }
 
 /// The power heuristic (β = 2) weight of a strategy with density `a`
@@ -340,6 +348,15 @@ impl<'a, S> FinalGather<'a, S> {
                     return true;
                 }
                 let dir = (xd.point - xs.point) / xd.t.max(1e-300);
+                // A glossy hit: the solution's radiance towards x_s is
+                // piecewise constant over whole receiving elements, which a
+                // lobe narrower than a hemisphere varies across (the mirror
+                // image of a lamp in a glossy floor, seen from the ceiling).
+                if self.scene.lobe_solid_angle(xd, -dir) < 2.0 * std::f64::consts::PI
+                    || self.scene.shading_differs(xd)
+                {
+                    return true;
+                }
                 let cos_d = xd.normal.dot(dir).abs();
                 let element_sr = size * size * cos_d / (xd.t * xd.t);
                 self.scene.lobe_solid_angle(xs, wo) < element_sr

@@ -29,7 +29,7 @@ pub fn solve_and_render(
     settings: &RenderSettings,
 ) -> Result<(Image, PipelineStats), RenderError> {
     if scene.mode() == trilux_color::Mode::Spectral {
-        solve_and_render_bands::<10>(scene, solver, view, settings)
+        solve_and_render_bands::<{ trilux_color::SPECTRAL_BANDS }>(scene, solver, view, settings)
     } else {
         solve_and_render_bands::<3>(scene, solver, view, settings)
     }

@@ -335,6 +335,11 @@ impl<const N: usize, S: RadianceSolution<N>> GatherScene<N> for SolvedScene<'_, 
         let back = usize::from(at.normal.dot(wo) < 0.0);
         self.shapes[at.locator.shape as usize].lobe_sr[back]
     }
+
+    fn shading_differs(&self, at: &SurfacePoint<HitLocator>) -> bool {
+        // More than about 1° apart.
+        at.locator.shading_normal.dot(at.normal).abs() < 0.9998
+    }
 }
 
 /// The solver's solution answers the renderer's queries directly.

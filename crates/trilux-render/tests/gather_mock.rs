@@ -65,7 +65,7 @@ fn furnace_renders_two_at_64_spp() {
     // rule (the extra bounce changes the estimator, not its expectation).
     for extra in [
         ExtraBounce::Never,
-        ExtraBounce::default(),
+        ExtraBounce::Auto { close_factor: 1.0 },
         ExtraBounce::Always,
     ] {
         let scene = Furnace {

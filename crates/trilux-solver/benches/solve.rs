@@ -45,9 +45,12 @@ fn bench(c: &mut Criterion) {
             }),
             Mode::Spectral => group.bench_function(&name, |b| {
                 b.iter(|| {
-                    Solver::<10>::new(&input.as_input(), settings.clone())
-                        .map(|s| s.solve(|_| {}))
-                        .is_ok()
+                    Solver::<{ trilux_color::SPECTRAL_BANDS }>::new(
+                        &input.as_input(),
+                        settings.clone(),
+                    )
+                    .map(|s| s.solve(|_| {}))
+                    .is_ok()
                 })
             }),
         };

@@ -59,9 +59,10 @@ fn every_bundled_scene_balances() {
                 assert!(s.min_radiance() >= 0.0, "{name}");
             }
             Mode::Spectral => {
-                let s = Solver::<10>::new(&input.as_input(), settings)
-                    .expect("solver builds")
-                    .solve(|_| {});
+                let s =
+                    Solver::<{ trilux_color::SPECTRAL_BANDS }>::new(&input.as_input(), settings)
+                        .expect("solver builds")
+                        .solve(|_| {});
                 check(s.stats(), 10, &name);
                 assert!(s.min_radiance() >= 0.0, "{name}");
             }

@@ -93,6 +93,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 solution: None,
                 lookat: None,
                 fov: None,
+                extra_bounce: "always".into(),
                 options: solve::SolveOptions {
                     quality: "default".into(),
                     convergence: None,

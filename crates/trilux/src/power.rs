@@ -14,7 +14,7 @@ use trilux_color::{ColorParam, Mode, Spectrum};
 use trilux_scene::{Scene, surface_area};
 
 /// Bands of the spectral mode (trilux-color's default for the paper: 10).
-pub const SPECTRAL_BANDS: usize = 10;
+pub use trilux_color::SPECTRAL_BANDS;
 
 /// Total emitted power per band (W): Σ π · L · A over the area emitters.
 pub fn emitted_power(scene: &Scene, mode: Mode) -> Result<Vec<f64>> {

@@ -52,6 +52,13 @@ pub struct RenderArgs {
     /// Field of view in degrees along the scene's fov_axis.
     #[arg(long, allow_hyphen_values = true)]
     pub fov: Option<f64>,
+    /// Where the gather continues one bounce before reading the solution:
+    /// at every hit (`always`, the default: the solution's remaining bias
+    /// is diluted by a bounce), only where its steps would show (`auto`:
+    /// close hits, narrow lobes, glossy or smooth-shaded hits; faster), or
+    /// nowhere (`never`: the paper's §4.5).
+    #[arg(long, value_parser = ["always", "auto", "never"], default_value = "always")]
+    pub extra_bounce: String,
     #[command(flatten)]
     pub options: SolveOptions,
 }
@@ -114,6 +121,11 @@ fn render_mode<const N: usize>(args: &RenderArgs, scene: &Scene, input: &SceneIn
         spp,
         seed: args.seed,
         filter: trilux_render::filter_of(camera),
+        extra_bounce: match args.extra_bounce.as_str() {
+            "auto" => trilux_render::ExtraBounce::Auto { close_factor: 1.0 },
+            "never" => trilux_render::ExtraBounce::Never,
+            _ => trilux_render::ExtraBounce::Always,
+        },
         ..RenderSettings::default()
     };
     let output = args
@@ -170,6 +182,6 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let input = SceneInput::from_scene(&scene);
     match args.options.mode(&scene) {
         Mode::Rgb => render_mode::<3>(args, &scene, &input),
-        Mode::Spectral => render_mode::<10>(args, &scene, &input),
+        Mode::Spectral => render_mode::<{ trilux_color::SPECTRAL_BANDS }>(args, &scene, &input),
     }
 }

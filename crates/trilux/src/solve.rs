@@ -144,6 +144,8 @@ pub fn run(args: &SolveArgs) -> Result<()> {
     let input = SceneInput::from_scene(&scene);
     match args.options.mode(&scene) {
         Mode::Rgb => solve_and_save::<3>(args, &input, settings),
-        Mode::Spectral => solve_and_save::<10>(args, &input, settings),
+        Mode::Spectral => {
+            solve_and_save::<{ trilux_color::SPECTRAL_BANDS }>(args, &input, settings)
+        }
     }
 }
