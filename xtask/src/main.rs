@@ -1,5 +1,9 @@
-//! Project automation: `cargo xtask ci` runs everything the tests need;
-//! `cargo xtask color` checks trilux's colorimetry against colour-science.
+//! Project automation: `cargo xtask ci` runs everything the tests need
+//! (fmt, clippy, the workspace's tests in release mode, the colour check and
+//! the golden images); `cargo xtask color` checks trilux's colorimetry
+//! against colour-science; `cargo xtask golden` compares renders of every
+//! bundled scene with stored Mitsuba 3 references; `cargo xtask sweep`
+//! measures error against time.
 
 mod golden;
 mod sweep;
@@ -37,6 +41,9 @@ fn ci() -> Result<()> {
     )?;
     run("cargo", &["test", "--workspace", "--release"])?;
     color::color()?;
+    // Every bundled scene against its stored Mitsuba 3 reference (issue 5's
+    // golden test: relative RMSE ≤ 0.05, mean within 1 %).
+    golden::main(&["--spp".to_string(), "64".to_string()])?;
     Ok(())
 }
 
