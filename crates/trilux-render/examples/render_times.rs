@@ -53,7 +53,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 SolverSettings::preset(Quality::Default),
             )?;
             let solve = t.elapsed().as_secs_f64();
-            (10, (solve, times(&scene, &sol)?))
+            (trilux_color::SPECTRAL_BANDS, (solve, times(&scene, &sol)?))
         } else {
             let sol = solve_scene::<3>(&scene, SolverSettings::preset(Quality::Default))?;
             let solve = t.elapsed().as_secs_f64();
