@@ -10,7 +10,9 @@ example `surface_radiance`) gives the same number as the area mean of its
 elements' reflected radiance. Their ratio per shape shows where the solver
 gains or loses light.
 
-    python3 tests/golden/surface_irradiance.py scenes/cornell-box.xml [--quality default] [--spp 65536]
+    python3 tests/golden/surface_irradiance.py scenes/cornell-box.xml [--quality default] [--passes 16]
+    python3 tests/golden/surface_irradiance.py scenes/cornell-box.xml --passes 8 \
+        --write tests/golden/cornell-box.surfaces.json     # the reference of surface_means.rs
 
 Needs Mitsuba 3 (`pip install mitsuba`); uses `llvm_ad_rgb` when LLVM is
 available, else `scalar_rgb`.
@@ -85,6 +87,9 @@ def main():
     ap.add_argument("--max-shots", default=None,
                     help="stop trilux after this many shots (1: direct light, with --max-depth 2)")
     ap.add_argument("--max-depth", type=int, default=-1, help="Mitsuba's path depth")
+    ap.add_argument("--write", default=None,
+                    help="also store Mitsuba's values as JSON (the reference of "
+                         "crates/trilux-solver/tests/surface_means.rs)")
     ap.add_argument("--spp", type=int, default=1 << 22, help="samples per pass")
     ap.add_argument("--passes", type=int, default=16,
                     help="independent passes; their spread gives the standard error")
@@ -110,6 +115,7 @@ def main():
           f"trilux {args.quality}, CR {trilux['convergence_ratio']:.4f}")
     print(f"{'shape':>5} {'area':>8} {'mitsuba ρĒ/π (RGB)':>30} {'trilux':>30}  ratio ± 1σ (Mitsuba's noise)")
     tot_m, tot_t = 0.0, 0.0
+    stored = []
     for i in range(count):
         sensor = meters.get(f"meter_{i}")
         if sensor is None:
@@ -124,12 +130,24 @@ def main():
         m = rho * img / np.pi
         t = np.array(trilux["shapes"][i]["radiance"])
         area = trilux["shapes"][i]["area"]
+        stored.append({"shape": i, "radiance": [float(c) for c in m],
+                       "relative_stderr": float(stderr)})
         tot_m += area * m.sum()
         tot_t += area * t.sum()
         ratio = t.sum() / m.sum() if m.sum() > 0 else float("nan")
         print(f"{i:>5} {area:8.4f} {np.array2string(m, precision=5):>30} "
               f"{np.array2string(t, precision=5):>30}  {ratio:.4f} ± {ratio * stderr:.4f}")
     print(f"area-weighted total ratio trilux/mitsuba: {tot_t / tot_m:.4f}")
+    if args.write:
+        with open(args.write, "w", encoding="utf-8") as f:
+            json.dump({"scene": os.path.relpath(os.path.abspath(args.scene), ROOT),
+                       "mitsuba": mi.__version__, "variant": variant,
+                       "samples_per_pass": args.spp, "passes": args.passes,
+                       "max_depth": args.max_depth,
+                       "what": "mean reflected radiance rho*E/pi of each non-emitting "
+                               "shape's front face (RGB)",
+                       "shapes": stored}, f, indent=1)
+            f.write("\n")
 
 
 if __name__ == "__main__":
