@@ -22,7 +22,7 @@ fn cornell_box_faces_match_mitsuba_irradiance_meters() {
     let text = std::fs::read_to_string(root.join("tests/golden/cornell-box.surfaces.json"))
         .expect("reference present");
     let reference: serde_json::Value = serde_json::from_str(&text).expect("valid JSON");
-    let scene = trilux_scene::load(&root.join("scenes/cornell-box.xml")).expect("loads");
+    let scene = trilux_scene::load(root.join("scenes/cornell-box.xml")).expect("loads");
     let input = SceneInput::from_scene(&scene);
     let solution = Solver::<3>::new(&input.as_input(), SolverSettings::preset(Quality::Default))
         .expect("builds")
