@@ -682,8 +682,12 @@ impl SceneGeometry {
                 .abs()
                 .max_element()
                 .max(eb.centre.abs().max_element());
+        // Symmetric in (a, b), so that F_ab and F_ba are both zero or both
+        // computed (reciprocity): each centre lies in the other's plane.
+        let d = eb.centre - ea.centre;
         ea.normal.dot(eb.normal).abs() > 1.0 - 1e-12
-            && ea.normal.dot(eb.centre - ea.centre).abs() <= 1e-12 * scale
+            && ea.normal.dot(d).abs() <= 1e-12 * scale
+            && eb.normal.dot(d).abs() <= 1e-12 * scale
     }
 
     /// The element as polygons (fronts on side `s` = ±1), if it is polygonal.

@@ -93,12 +93,18 @@ proptest! {
             prop_assert!((0.0..=1.0).contains(&v));
             // Reciprocity for elements whose boxes are well apart (smooth
             // kernel): within the stated errors plus 2% for the sampled
-            // estimates' statistical error.
+            // estimates' statistical error, plus an absolute 1e-9 of the
+            // areas: where a piece of a cluster sees the other element only
+            // through a grazing sliver thinner than the adaptive cubature's
+            // finest cell (1/16 of the element), one direction finds F ≈ 1e-9
+            // and the other 0 (a case the regressions file keeps).
             let (ei, ej) = (g.element(i), g.element(j));
             let gap = (ei.bounds.centre() - ej.bounds.centre()).length() - 0.5 * (ei.bounds.diagonal().length() + ej.bounds.diagonal().length());
             if gap > 0.5 * ei.bounds.diagonal().length().max(ej.bounds.diagonal().length()) {
                 let (x, y) = (ei.area * fij.value, ej.area * fji.value);
-                let tol = 4.0 * (ei.area * fij.error + ej.area * fji.error) + 2e-2 * x.max(y) + 1e-12;
+                let tol = 4.0 * (ei.area * fij.error + ej.area * fji.error)
+                    + 2e-2 * x.max(y)
+                    + 1e-9 * (ei.area + ej.area);
                 prop_assert!((x - y).abs() <= tol, "{} vs {} (tol {}) {:?} {:?} {:?} {:?} {:?}", x, y, tol, i, j, side, fij, fji);
             }
         }
