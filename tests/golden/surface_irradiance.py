@@ -12,7 +12,7 @@ gains or loses light.
 
     python3 tests/golden/surface_irradiance.py scenes/cornell-box.xml [--quality default] [--passes 16]
     python3 tests/golden/surface_irradiance.py scenes/cornell-box.xml --passes 8 \
-        --write tests/golden/cornell-box.surfaces.json     # the reference of surface_means.rs
+        --write tests/golden/surfaces/cornell-box.json     # the reference of surface_means.rs
 
 Needs Mitsuba 3 (`pip install mitsuba`); uses `llvm_ad_rgb` when LLVM is
 available, else `scalar_rgb`.

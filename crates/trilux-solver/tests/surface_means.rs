@@ -2,7 +2,7 @@
 //! every non-emitting shape of the Cornell box (RGB mode, default quality),
 //! the area mean of the reflected radiance leaving its front face against
 //! Mitsuba 3's irradiance meters (ρ Ē / π, path tracing with unbounded depth:
-//! tests/golden/cornell-box.surfaces.json, made by
+//! tests/golden/surfaces/cornell-box.json, made by
 //! tests/golden/surface_irradiance.py, which says how).
 //!
 //! Tolerance: 2 % per face (band sum) and 1.5 % for the area-weighted
@@ -19,7 +19,7 @@ use trilux_solver::{Quality, SceneInput, Solver, SolverSettings};
 #[test]
 fn cornell_box_faces_match_mitsuba_irradiance_meters() {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..");
-    let text = std::fs::read_to_string(root.join("tests/golden/cornell-box.surfaces.json"))
+    let text = std::fs::read_to_string(root.join("tests/golden/surfaces/cornell-box.json"))
         .expect("reference present");
     let reference: serde_json::Value = serde_json::from_str(&text).expect("valid JSON");
     let scene = trilux_scene::load(root.join("scenes/cornell-box.xml")).expect("loads");
