@@ -720,14 +720,14 @@ impl<const N: usize> Solver<N> {
                 if wo.z <= 0.0 {
                     continue;
                 }
-                let dir = frame.to_world(wo);
-                let Some(hit) =
-                    geom.intersect(&trilux_geometry::Ray { origin, dir }, f64::INFINITY)
-                else {
+                let ray = trilux_geometry::Ray {
+                    origin,
+                    dir: frame.to_world(wo),
+                };
+                let Some(hit) = geom.intersect(&ray, f64::INFINITY) else {
                     continue;
                 };
-                let hit_side = 2 * hit.surface.0
-                    + u32::from(!hit.front_facing(&trilux_geometry::Ray { origin, dir }));
+                let hit_side = 2 * hit.surface.0 + u32::from(!hit.front_facing(&ray));
                 if !self.stored_pairs.contains(&(side, hit_side)) {
                     continue;
                 }
