@@ -64,14 +64,19 @@ def is_spectral(path):
     return False
 
 
-def prepared_copy(path, res, max_depth):
-    """A copy of the scene with the film size and the integrator replaced."""
-    tree = ET.parse(path)
-    root = tree.getroot()
+def use_path_integrator(root, max_depth):
+    """Replaces the scene's integrators by Mitsuba's `path` with `max_depth`."""
     for integ in root.findall("integrator"):
         root.remove(integ)
     integ = ET.SubElement(root, "integrator", {"type": "path"})
     ET.SubElement(integ, "integer", {"name": "max_depth", "value": str(max_depth)})
+
+
+def prepared_copy(path, res, max_depth):
+    """A copy of the scene with the film size and the integrator replaced."""
+    tree = ET.parse(path)
+    root = tree.getroot()
+    use_path_integrator(root, max_depth)
     sensor = root.find("sensor")
     if sensor is None:
         raise SystemExit(f"{path}: no <sensor>")

@@ -29,6 +29,8 @@ import mitsuba as mi
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
+sys.path.insert(0, HERE)
+from make_references import use_path_integrator  # noqa: E402
 
 
 def set_variant():
@@ -45,10 +47,7 @@ def metered_copy(path, spp, max_depth):
     """The scene with one irradiance meter per top-level shape that does not emit."""
     tree = ET.parse(path)
     root = tree.getroot()
-    for integ in root.findall("integrator"):
-        root.remove(integ)
-    integ = ET.SubElement(root, "integrator", {"type": "path"})
-    ET.SubElement(integ, "integer", {"name": "max_depth", "value": str(max_depth)})
+    use_path_integrator(root, max_depth)
     shapes = [c for c in root if c.tag == "shape"]
     for i, shape in enumerate(shapes):
         if shape.find("emitter") is not None:

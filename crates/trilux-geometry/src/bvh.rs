@@ -470,6 +470,18 @@ impl SceneGeometry {
     }
 
     pub(crate) fn closest_prim(&self, o: DVec3, d: DVec3, tmin: f64, tmax: f64) -> Option<PrimHit> {
+        self.closest_prim_skipping(o, d, tmin, tmax, None)
+    }
+
+    /// The closest primitive hit, ignoring the primitives of shape `skip`.
+    fn closest_prim_skipping(
+        &self,
+        o: DVec3,
+        d: DVec3,
+        tmin: f64,
+        tmax: f64,
+        skip: Option<u32>,
+    ) -> Option<PrimHit> {
         let cw = self.bvh.cw.as_ref()?;
         let (ray32, start, len) = self.traversal_ray(o, d, tmin, tmax)?;
         let pre = RayPre::new(o, d);
@@ -477,6 +489,9 @@ impl SceneGeometry {
         let mut best_t = tmax;
         let mut rh = RayHit::none();
         cw.ray_traverse(ray32, &mut rh, |_, id| {
+            if skip.is_some_and(|shape| self.prim_shape(id) == shape) {
+                return f32::INFINITY;
+            }
             if let Some((t, bary)) = self.test_prim(&self.bvh.prims[id], &pre, tmin, best_t) {
                 best_t = t;
                 best = Some(PrimHit { prim: id, t, bary });
@@ -510,25 +525,8 @@ impl SceneGeometry {
     /// coincident with it).
     pub fn intersect_ignoring(&self, ray: &Ray, t_max: f64, shape: u32) -> Option<Hit> {
         let tmin = self.ray_epsilon(ray.origin) / ray.dir.length();
-        let cw = self.bvh.cw.as_ref()?;
-        let (ray32, start, len) = self.traversal_ray(ray.origin, ray.dir, tmin, t_max)?;
-        let pre = RayPre::new(ray.origin, ray.dir);
-        let mut best: Option<PrimHit> = None;
-        let mut best_t = t_max;
-        let mut rh = RayHit::none();
-        cw.ray_traverse(ray32, &mut rh, |_, id| {
-            if self.prim_shape(id) == shape {
-                return f32::INFINITY;
-            }
-            if let Some((t, bary)) = self.test_prim(&self.bvh.prims[id], &pre, tmin, best_t) {
-                best_t = t;
-                best = Some(PrimHit { prim: id, t, bary });
-                (((t - start) * len) as f32).next_up()
-            } else {
-                f32::INFINITY
-            }
-        });
-        best.map(|h| self.make_hit(ray.origin, ray.dir, h))
+        let h = self.closest_prim_skipping(ray.origin, ray.dir, tmin, t_max, Some(shape))?;
+        Some(self.make_hit(ray.origin, ray.dir, h))
     }
 
     fn any_prim(&self, o: DVec3, d: DVec3, tmin: f64, tmax: f64) -> bool {

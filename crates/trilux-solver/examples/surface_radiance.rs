@@ -54,16 +54,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let geom = solution.geometry();
     let mut rows = Vec::new();
     for shape in 0..input.shapes.len() as u32 {
-        let (mut area, mut sum) = (0.0, [0.0; 3]);
-        for s in geom.surfaces_of_shape(shape) {
-            let a = geom.surface(s).area();
-            let l = solution.surface_mean_radiance(s, false);
-            area += a;
-            for (b, v) in sum.iter_mut().enumerate() {
-                *v += l[b] * a;
-            }
-        }
-        let mean = sum.map(|v| if area > 0.0 { v / area } else { 0.0 });
+        let area: f64 = geom
+            .surfaces_of_shape(shape)
+            .into_iter()
+            .map(|s| geom.surface(s).area())
+            .sum();
+        let mean = solution.shape_mean_radiance(shape, false);
         rows.push(format!(
             "{{\"shape\": {shape}, \"area\": {area}, \"radiance\": [{}, {}, {}]}}",
             mean[0], mean[1], mean[2]

@@ -63,6 +63,18 @@ impl<const N: usize> Sender<'_, N> {
 /// it, that a pair link may carry (see `RefineContext::sender_varies`).
 const SENDER_VARIATION: f64 = 0.01;
 
+/// What every pair link of one stage-1 refinement shares: where the unshot
+/// radiance comes from, the sending side and the receiving side.
+#[derive(Clone, Copy)]
+pub(crate) struct PairShot<'s, const N: usize> {
+    /// Unshot radiance by element pair.
+    pub sender: &'s Sender<'s, N>,
+    /// The sending side.
+    pub si: SideId,
+    /// The receiving side.
+    pub sj: SideId,
+}
+
 /// A transient link of stage 1.
 #[derive(Clone, Debug)]
 pub(crate) struct PairLink<const N: usize> {
@@ -196,24 +208,22 @@ impl<const N: usize> RefineContext<'_, N> {
     /// is the form-factor spread over j this link may have: FFErr for a
     /// root pair, shared among the children when the sender is split (the
     /// receiver-side errors of sibling senders add up on j).
-    #[allow(clippy::too_many_arguments)]
     pub fn refine_pair(
         &self,
-        sender: &Sender<'_, N>,
-        si: SideId,
-        sj: SideId,
+        shot: PairShot<'_, N>,
         i: ElementId,
         j: ElementId,
         budget: f64,
         out: &mut Vec<PairLink<N>>,
     ) {
+        let PairShot { sender, si, sj } = shot;
         let th = self.throughput(j, sj, i, si);
         let (ei, ej) = (self.geom.element(i), self.geom.element(j));
         if th.t <= 0.0 {
             // Fully occluded or facing away. Near the roots a handful of
             // shadow rays may miss a gap: look one level further there.
             if ei.depth + ej.depth < 2 && th.v == 0.0 && self.unoccluded_positive(i, si, j, sj) {
-                self.split_pair(sender, si, sj, i, j, budget, out);
+                self.split_pair(shot, i, j, budget, out);
             }
             return;
         }
@@ -243,8 +253,8 @@ impl<const N: usize> RefineContext<'_, N> {
         // corners), the average is biased. Compare the transfer resolved
         // over the sender's children with the averaged one (point-to-disc
         // estimates) and split the sender when they differ.
-        if self.sender_varies(sender, si, i, sj, j) {
-            self.split_sender(sender, si, sj, i, j, budget, out);
+        if self.sender_varies(shot, i, j) {
+            self.split_sender(shot, i, j, budget, true, out);
             return;
         }
         // The transfer is accurate when the point form factor varies little
@@ -254,7 +264,7 @@ impl<const N: usize> RefineContext<'_, N> {
             out.push(link);
             return;
         }
-        if !self.split_pair(sender, si, sj, i, j, budget, out) {
+        if !self.split_pair(shot, i, j, budget, out) {
             out.push(link);
         }
     }
@@ -264,14 +274,8 @@ impl<const N: usize> RefineContext<'_, N> {
     /// [`SENDER_VARIATION`] (relative): Σ_c a_c δL_c F̂_cj against
     /// δL̄_i Σ_c a_c F̂_cj, with a_c the children's exposed areas (so that
     /// δL̄_i = Σ a_c δL_c / Σ a_c) and F̂ point-to-disc estimates.
-    fn sender_varies(
-        &self,
-        sender: &Sender<'_, N>,
-        si: SideId,
-        i: ElementId,
-        sj: SideId,
-        j: ElementId,
-    ) -> bool {
+    fn sender_varies(&self, shot: PairShot<'_, N>, i: ElementId, j: ElementId) -> bool {
+        let PairShot { sender, si, sj } = shot;
         let Sender::Radiosity { field, back } = sender else {
             return false;
         };
@@ -307,34 +311,33 @@ impl<const N: usize> RefineContext<'_, N> {
         self.throughput(j, sj, i, si).f > 0.0
     }
 
-    /// Refines the sender's children against j, each with its area's
-    /// share of the spread budget.
-    #[allow(clippy::too_many_arguments)]
+    /// Refines the sender's children against j; with `share_budget`, each
+    /// with its area's share of the spread budget.
     fn split_sender(
         &self,
-        sender: &Sender<'_, N>,
-        si: SideId,
-        sj: SideId,
+        shot: PairShot<'_, N>,
         i: ElementId,
         j: ElementId,
         budget: f64,
+        share_budget: bool,
         out: &mut Vec<PairLink<N>>,
     ) {
         let area = self.geom.element(i).area;
         for c in self.geom.element(i).children().into_iter().flatten() {
-            let share = self.geom.element(c).area / area;
-            self.refine_pair(sender, si, sj, c, j, budget * share, out);
+            let share = if share_budget {
+                self.geom.element(c).area / area
+            } else {
+                1.0
+            };
+            self.refine_pair(shot, c, j, budget * share, out);
         }
     }
 
     /// Splits the larger splittable element of the pair; false if neither
     /// can be split.
-    #[allow(clippy::too_many_arguments)]
     fn split_pair(
         &self,
-        sender: &Sender<'_, N>,
-        si: SideId,
-        sj: SideId,
+        shot: PairShot<'_, N>,
         i: ElementId,
         j: ElementId,
         budget: f64,
@@ -351,12 +354,10 @@ impl<const N: usize> RefineContext<'_, N> {
         if split_i {
             // A sender much larger than its receiver: split by size (the
             // budget stays, as before any sender-variation split).
-            for c in ei.children().into_iter().flatten() {
-                self.refine_pair(sender, si, sj, c, j, budget, out);
-            }
+            self.split_sender(shot, i, j, budget, false, out);
         } else {
             for c in ej.children().into_iter().flatten() {
-                self.refine_pair(sender, si, sj, i, c, budget, out);
+                self.refine_pair(shot, i, c, budget, out);
             }
         }
         true

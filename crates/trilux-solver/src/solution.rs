@@ -136,6 +136,19 @@ impl<const N: usize> Solution<N> {
         if area > 0.0 { sum * (1.0 / area) } else { sum }
     }
 
+    /// [`Solution::surface_mean_radiance`] over all the input surfaces of
+    /// one shape (a cube's six faces, a mesh's charts), area-weighted.
+    pub fn shape_mean_radiance(&self, shape: u32, back: bool) -> Spectrum<N> {
+        let mut sum = Spectrum::<N>::zero();
+        let mut area = 0.0;
+        for s in self.geom.surfaces_of_shape(shape) {
+            let a = self.geom.surface(s).area();
+            sum += self.surface_mean_radiance(s, back) * a;
+            area += a;
+        }
+        if area > 0.0 { sum * (1.0 / area) } else { sum }
+    }
+
     /// Flux π Σ T L carried by the stored interaction from one face to
     /// another (flux-weighted over its hierarchy, so it is the root's
     /// π T L), if that interaction exists.

@@ -26,7 +26,7 @@ use crate::error::SolverError;
 use crate::interaction::Hierarchy;
 use crate::ledger::Ledger;
 use crate::radiosity::ElementRadiance;
-use crate::refine::{NodeLink, PairLink, RefineContext, Sender, TripleTask};
+use crate::refine::{NodeLink, PairLink, PairShot, RefineContext, Sender, TripleTask};
 use crate::settings::SolverSettings;
 use crate::sides::{SideId, TransportSide, build_sides, eligible_pairs};
 use crate::solution::Solution;
@@ -504,7 +504,12 @@ impl<const N: usize> Solver<N> {
             .par_iter()
             .flat_map_iter(|&(i, r, j)| {
                 let mut out = Vec::new();
-                ctx.refine_pair(&sender, send_side, r, i, j, self.settings.ff_eps, &mut out);
+                let shot = PairShot {
+                    sender: &sender,
+                    si: send_side,
+                    sj: r,
+                };
+                ctx.refine_pair(shot, i, j, self.settings.ff_eps, &mut out);
                 out
             })
             .collect();
