@@ -161,22 +161,25 @@ impl<const N: usize> Hierarchy<N> {
                 (node.radiance, node.unshot)
             }
             Some(children) => {
+                let pulled = children.map(|c| self.push_pull_rec(c, down));
+                // Children split since this node was may have changed their
+                // T: the node's T is again the sum of its children's.
                 let total: f64 = children.iter().map(|&c| self.nodes[c as usize].t).sum();
                 let mut l = Spectrum::zero();
                 let mut dl = Spectrum::zero();
-                for c in children {
+                for (c, (cl, cdl)) in children.into_iter().zip(pulled) {
                     let w = if total > 0.0 {
                         self.nodes[c as usize].t / total
                     } else {
                         0.25
                     };
-                    let (cl, cdl) = self.push_pull_rec(c, down);
                     l += cl * w;
                     dl += cdl * w;
                 }
                 let node = &mut self.nodes[n as usize];
                 node.radiance = l;
                 node.unshot = dl;
+                node.t = total;
                 (l, dl)
             }
         }

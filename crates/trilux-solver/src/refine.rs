@@ -363,13 +363,54 @@ impl<const N: usize> RefineContext<'_, N> {
         true
     }
 
+    /// The direction of incidence at j's centre from i, in j's (front)
+    /// frame, on the receiving side `sign` (±1): towards i's centre, or,
+    /// when that centre lies behind j's tangent plane although part of i is
+    /// in front (i straddles the plane; T_ij counts only that part), towards
+    /// the mean of i's sample points in front. `None` when none is.
+    fn incident(
+        &self,
+        frame: &trilux_brdf::Frame,
+        i: ElementId,
+        j: ElementId,
+        sign: f64,
+    ) -> Option<DVec3> {
+        let cj = self.geom.element(j).centre;
+        let wi = frame.to_local((self.geom.element(i).centre - cj).normalize_or_zero());
+        if wi.z * sign > 0.0 {
+            return Some(wi);
+        }
+        let (mut sum, mut count) = (DVec3::ZERO, 0u32);
+        for &p in self.points[i.index()]
+            .iter()
+            .chain(&self.interior[i.index()])
+        {
+            let w = frame.to_local(p - cj);
+            if w.z * sign > 0.0 {
+                sum += w.normalize_or_zero();
+                count += 1;
+            }
+        }
+        (count > 0)
+            .then(|| sum.normalize_or_zero())
+            .filter(|w| w.z * sign > 0.0)
+    }
+
     /// fr(i→j→k) at the three centres, for stored transport (the glossy
     /// part in two-point mode, the whole BRDF in uniform mode).
-    fn fr_centre(&self, bsdf: &Bsdf<N>, i: ElementId, j: ElementId, k: ElementId) -> Spectrum<N> {
-        let g = self.geom;
-        let (ei, ej) = (g.element(i), g.element(j));
+    fn fr_centre(
+        &self,
+        bsdf: &Bsdf<N>,
+        i: ElementId,
+        j: ElementId,
+        k: ElementId,
+        sign: f64,
+    ) -> Spectrum<N> {
+        let ej = self.geom.element(j);
         let frame = trilux_brdf::Frame::from_normal(ej.normal);
-        let wi = frame.to_local((ei.centre - ej.centre).normalize_or_zero());
+        let Some(wi) = self.incident(&frame, i, j, sign) else {
+            return Spectrum::zero();
+        };
         // The discretised fr over K (paper Eq. 5's fr_KJI): the midpoint rule
         // on K's 2×2 quadrants rather than its centre alone, so that a glossy
         // lobe that falls between K's centre and its edges is not missed
@@ -405,11 +446,12 @@ impl<const N: usize> RefineContext<'_, N> {
         i: ElementId,
         j: ElementId,
         k: ElementId,
+        sign: f64,
     ) -> Option<Spectrum<N>> {
         let g = self.geom;
-        let (ei, ej, ek) = (g.element(i), g.element(j), g.element(k));
+        let (ej, ek) = (g.element(j), g.element(k));
         let frame = trilux_brdf::Frame::from_normal(ej.normal);
-        let wi = frame.to_local((ei.centre - ej.centre).normalize_or_zero());
+        let wi = self.incident(&frame, i, j, sign)?;
         let mirror = DVec3::new(-wi.x, -wi.y, wi.z);
         let to_k = ek.centre - ej.centre;
         let dist = to_k.length();
@@ -510,7 +552,7 @@ impl<const N: usize> RefineContext<'_, N> {
             return;
         }
         let bsdf = &self.materials[self.sides[sj as usize].shape];
-        let fr = self.fr_centre(bsdf, i, j, k);
+        let fr = self.fr_centre(bsdf, i, j, k, self.sides[sj as usize].sign());
         // R(i→j→k) = π F_{j→i} fr with F_{j→i} = T_ij / A_j over j's
         // exposed area (light arrives and leaves there only).
         let aj = self.exposed_area[usize::from(self.sides[sj as usize].back)][j.index()];
@@ -555,9 +597,11 @@ impl<const N: usize> RefineContext<'_, N> {
         // underestimated. Bound the flux with fr at the mirror direction
         // when that direction passes near K.
         if flux_to_k < self.flux_threshold
-            && self.peak_fr(bsdf, i, j, k).is_none_or(|peak| {
-                PI * tjk * (unshot * peak).sum() * (PI * tij.t / aj) < self.flux_threshold
-            })
+            && self
+                .peak_fr(bsdf, i, j, k, self.sides[sj as usize].sign())
+                .is_none_or(|peak| {
+                    PI * tjk * (unshot * peak).sum() * (PI * tij.t / aj) < self.flux_threshold
+                })
         {
             task.out.push(link);
             return;
