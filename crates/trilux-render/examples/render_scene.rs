@@ -54,18 +54,19 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         height: size,
         ..Default::default()
     };
+    // Single solver settings may be overridden for experiments
+    // (`SolverSettings::override_from`: TRILUX_FF_EPS and the like).
+    let mut solver_settings = SolverSettings::preset(quality);
+    solver_settings.override_from(|name| std::env::var(name).ok())?;
     let t = Instant::now();
     let (image, stats, solve_s) = if scene.spectral {
-        let sol = solve_scene::<{ trilux_color::SPECTRAL_BANDS }>(
-            &scene,
-            SolverSettings::preset(quality),
-        )?;
+        let sol = solve_scene::<{ trilux_color::SPECTRAL_BANDS }>(&scene, solver_settings)?;
         let solve_s = t.elapsed().as_secs_f64();
         print_stats(sol.stats());
         let (i, s) = render(&scene, &sol, &view, &settings, |_, _| {})?;
         (i, s, solve_s)
     } else {
-        let sol = solve_scene::<3>(&scene, SolverSettings::preset(quality))?;
+        let sol = solve_scene::<3>(&scene, solver_settings)?;
         let solve_s = t.elapsed().as_secs_f64();
         print_stats(sol.stats());
         let (i, s) = render(&scene, &sol, &view, &settings, |_, _| {})?;

@@ -8,7 +8,7 @@
 //! ```
 //!
 //! The environment variables `TRILUX_MAX_DEPTH`, `TRILUX_FF_EPS`,
-//! `TRILUX_FLUX_EPS` and `TRILUX_VISIBILITY_SAMPLES` override single
+//! `TRILUX_FR_EPS`, `TRILUX_FLUX_EPS` and `TRILUX_VISIBILITY_SAMPLES` override single
 //! settings of the preset (for experiments).
 
 use std::path::PathBuf;
@@ -37,19 +37,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         settings.max_shots = shots.parse()?;
     }
     // Single settings may be overridden for experiments.
-    let var = |name: &str| std::env::var(name).ok();
-    if let Some(v) = var("TRILUX_MAX_DEPTH") {
-        settings.max_depth = v.parse()?;
-    }
-    if let Some(v) = var("TRILUX_FF_EPS") {
-        settings.ff_eps = v.parse()?;
-    }
-    if let Some(v) = var("TRILUX_FLUX_EPS") {
-        settings.flux_eps = v.parse()?;
-    }
-    if let Some(v) = var("TRILUX_VISIBILITY_SAMPLES") {
-        settings.visibility_samples = v.parse()?;
-    }
+    settings.override_from(|name| std::env::var(name).ok())?;
     let solution = Solver::<3>::new(&input.as_input(), settings)?.solve(|_| {});
     let geom = solution.geometry();
     let mut rows = Vec::new();

@@ -110,6 +110,33 @@ impl SolverSettings {
         }
     }
 
+    /// Overrides single settings from `TRILUX_MAX_DEPTH`, `TRILUX_FF_EPS`,
+    /// `TRILUX_FR_EPS`, `TRILUX_FLUX_EPS` and `TRILUX_VISIBILITY_SAMPLES`
+    /// as `lookup` returns them (the examples pass `std::env::var`): a way
+    /// to run experiments on one parameter at a time. The message names
+    /// the variable that does not parse.
+    pub fn override_from(&mut self, lookup: impl Fn(&str) -> Option<String>) -> Result<(), String> {
+        fn parse<T: std::str::FromStr>(name: &str, v: &str) -> Result<T, String> {
+            v.parse().map_err(|_| format!("{name}: cannot parse '{v}'"))
+        }
+        if let Some(v) = lookup("TRILUX_MAX_DEPTH") {
+            self.max_depth = parse("TRILUX_MAX_DEPTH", &v)?;
+        }
+        if let Some(v) = lookup("TRILUX_FF_EPS") {
+            self.ff_eps = parse("TRILUX_FF_EPS", &v)?;
+        }
+        if let Some(v) = lookup("TRILUX_FR_EPS") {
+            self.fr_eps = parse("TRILUX_FR_EPS", &v)?;
+        }
+        if let Some(v) = lookup("TRILUX_FLUX_EPS") {
+            self.flux_eps = parse("TRILUX_FLUX_EPS", &v)?;
+        }
+        if let Some(v) = lookup("TRILUX_VISIBILITY_SAMPLES") {
+            self.visibility_samples = parse("TRILUX_VISIBILITY_SAMPLES", &v)?;
+        }
+        self.validate()
+    }
+
     /// Checks that every value is usable; the message names the field.
     pub fn validate(&self) -> Result<(), String> {
         let unit = |name: &str, v: f64| {
