@@ -103,6 +103,23 @@ pub(crate) struct NodeLink<const N: usize> {
     pub gathered: Spectrum<N>,
 }
 
+/// What a three-point link (i j) → (j k) takes from its pair (i, j), the
+/// same for every receiver node k: computed once per pair link and handed
+/// down the K-side recursion.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Incidence<const N: usize> {
+    /// T_ij.
+    tij: Throughput,
+    /// δL sent from i towards j.
+    unshot: Spectrum<N>,
+    /// The direction of incidence at j's centre in j's front frame
+    /// (`RefineContext::incident`); `None` when no part of i is on the
+    /// receiving side.
+    wi: Option<DVec3>,
+    /// i has points on both sides of j's tangent plane.
+    straddle_i: bool,
+}
+
 /// One receiving hierarchy refined against the pair links of one shot
 /// (stage 2): what the recursion carries besides the three elements.
 pub(crate) struct TripleTask<'t, const N: usize> {
@@ -120,6 +137,15 @@ pub(crate) struct TripleTask<'t, const N: usize> {
     pub lost: Spectrum<N>,
     /// The links made.
     pub out: Vec<NodeLink<N>>,
+}
+
+impl<const N: usize> TripleTask<'_, N> {
+    /// Keeps a link that carries light (a zero of the BRDF carries none).
+    fn push(&mut self, link: NodeLink<N>) {
+        if !link.gathered.is_black() {
+            self.out.push(link);
+        }
+    }
 }
 
 /// Everything refinement reads, shared by the parallel tasks of a shot.
@@ -396,21 +422,19 @@ impl<const N: usize> RefineContext<'_, N> {
             .filter(|w| w.z * sign > 0.0)
     }
 
-    /// fr(i→j→k) at the three centres, for stored transport (the glossy
-    /// part in two-point mode, the whole BRDF in uniform mode).
+    /// fr(i→j→k) for light arriving at j's centre from `wi` (j's front
+    /// frame), for stored transport (the glossy part in two-point mode, the
+    /// whole BRDF in uniform mode); `None` when none of K's sample points is
+    /// on wi's side of j (a zero of the geometry, not of the BRDF).
     fn fr_centre(
         &self,
         bsdf: &Bsdf<N>,
-        i: ElementId,
+        wi: DVec3,
         j: ElementId,
         k: ElementId,
-        sign: f64,
-    ) -> Spectrum<N> {
+    ) -> Option<Spectrum<N>> {
         let ej = self.geom.element(j);
         let frame = trilux_brdf::Frame::from_normal(ej.normal);
-        let Some(wi) = self.incident(&frame, i, j, sign) else {
-            return Spectrum::zero();
-        };
         // The discretised fr over K (paper Eq. 5's fr_KJI): the midpoint rule
         // on K's 2×2 quadrants rather than its centre alone, so that a glossy
         // lobe that falls between K's centre and its edges is not missed
@@ -430,28 +454,22 @@ impl<const N: usize> RefineContext<'_, N> {
                 Transport::Uniform => bsdf.eval(wi, wo),
             };
         }
-        if count == 0 {
-            Spectrum::zero()
-        } else {
-            sum * (1.0 / f64::from(count))
-        }
+        (count > 0).then(|| sum * (1.0 / f64::from(count)))
     }
 
-    /// fr at the mirror direction of i's centre about j, if that direction
+    /// fr at the mirror direction of `wi` about j, if that direction
     /// passes within K's angular radius (plus a margin for the lobe's
     /// width) of K's centre, as seen from j's centre.
     fn peak_fr(
         &self,
         bsdf: &Bsdf<N>,
-        i: ElementId,
+        wi: DVec3,
         j: ElementId,
         k: ElementId,
-        sign: f64,
     ) -> Option<Spectrum<N>> {
         let g = self.geom;
         let (ej, ek) = (g.element(j), g.element(k));
         let frame = trilux_brdf::Frame::from_normal(ej.normal);
-        let wi = self.incident(&frame, i, j, sign)?;
         let mirror = DVec3::new(-wi.x, -wi.y, wi.z);
         let to_k = ek.centre - ej.centre;
         let dist = to_k.length();
@@ -507,6 +525,33 @@ impl<const N: usize> RefineContext<'_, N> {
         front && back
     }
 
+    /// The pair (i, j)'s part of every three-point link (i j) → (j k):
+    /// `None` when no light passes from i to j.
+    pub fn incidence(
+        &self,
+        sender: &Sender<'_, N>,
+        si: SideId,
+        i: ElementId,
+        sj: SideId,
+        j: ElementId,
+    ) -> Option<Incidence<N>> {
+        let tij = self.throughput(j, sj, i, si);
+        if tij.t <= 0.0 {
+            return None;
+        }
+        let unshot = sender.unshot(self.geom, i, j);
+        if unshot.is_black() {
+            return None;
+        }
+        let frame = trilux_brdf::Frame::from_normal(self.geom.element(j).normal);
+        Some(Incidence {
+            tij,
+            unshot,
+            wi: self.incident(&frame, i, j, self.sides[sj as usize].sign()),
+            straddle_i: self.straddles(i, j),
+        })
+    }
+
     /// Stage 2: refines the three-point link (i j) → node of `h` (whose sender
     /// element is j) and appends node links.
     #[allow(clippy::too_many_arguments)]
@@ -516,24 +561,20 @@ impl<const N: usize> RefineContext<'_, N> {
         i: ElementId,
         j: ElementId,
         n: u32,
-        known: Option<(Throughput, Spectrum<N>)>,
+        known: Option<Incidence<N>>,
     ) {
         let (si, sj, sk, group) = (task.si, task.h.from, task.h.to, task.group);
-        // T_ij and δL_ij are the same for every receiver node of one (i, j):
-        // the K-side recursion hands them down instead of looking them up.
-        let (tij, unshot) = match known {
-            Some(k) => k,
-            None => {
-                let tij = self.throughput(j, sj, i, si);
-                if tij.t <= 0.0 {
-                    return;
-                }
-                (tij, task.sender.unshot(self.geom, i, j))
-            }
-        };
-        if tij.t <= 0.0 || unshot.is_black() {
+        // T_ij, δL_ij and the incidence at j are the same for every receiver
+        // node of one (i, j): the K-side recursion hands them down.
+        let Some(known) = known.or_else(|| self.incidence(task.sender, si, i, sj, j)) else {
             return;
-        }
+        };
+        let Incidence {
+            tij,
+            unshot,
+            wi,
+            straddle_i,
+        } = known;
         let node = &task.h.nodes[n as usize];
         debug_assert_eq!(node.from, j);
         let (k, tjk, vjk) = (node.to, node.t, node.v);
@@ -547,27 +588,24 @@ impl<const N: usize> RefineContext<'_, N> {
                 } else {
                     Driver::K
                 };
-                self.split_triple(side, task, i, j, n, (tij, unshot));
+                self.split_triple(side, task, i, j, n, known);
             }
             return;
         }
         let bsdf = &self.materials[self.sides[sj as usize].shape];
-        let fr = self.fr_centre(bsdf, i, j, k, self.sides[sj as usize].sign());
         // R(i→j→k) = π F_{j→i} fr with F_{j→i} = T_ij / A_j over j's
         // exposed area (light arrives and leaves there only).
         let aj = self.exposed_area[usize::from(self.sides[sj as usize].back)][j.index()];
         if aj <= 0.0 {
             return;
         }
-        let r = fr * (PI * tij.t / aj);
-        let gathered = unshot * r;
-        // An element that lies partly behind j's tangent plane gets a
-        // BRDF value of its centre's side only: refine it like partial
-        // visibility (its part in front may carry light even when the
-        // centre's direction is below the horizon).
-        let straddle_i = self.straddles(i, j);
         let straddle_k = self.straddles(k, j);
-        if gathered.is_black() {
+        // No sample point of i or K on the receiving side of j: an element
+        // that lies partly behind j's tangent plane still carries light
+        // through its part in front, so refine it like partial visibility.
+        // (A zero of the BRDF itself, a lobe far from K, is not refined
+        // for: the peak bound below decides whether the lobe may be near.)
+        let Some(fr) = wi.and_then(|wi| self.fr_centre(bsdf, wi, j, k)) else {
             let order = match (straddle_i, straddle_k) {
                 (true, true) if self.geom.element(i).area >= self.geom.element(k).area => {
                     [Driver::I, Driver::K]
@@ -578,12 +616,13 @@ impl<const N: usize> RefineContext<'_, N> {
                 (false, false) => return,
             };
             for d in order {
-                if self.split_triple(d, task, i, j, n, (tij, unshot)) {
+                if self.split_triple(d, task, i, j, n, known) {
                     return;
                 }
             }
             return;
-        }
+        };
+        let gathered = unshot * fr * (PI * tij.t / aj);
         let link = NodeLink {
             hierarchy: task.h_index,
             node: n,
@@ -597,13 +636,13 @@ impl<const N: usize> RefineContext<'_, N> {
         // underestimated. Bound the flux with fr at the mirror direction
         // when that direction passes near K.
         if flux_to_k < self.flux_threshold
-            && self
-                .peak_fr(bsdf, i, j, k, self.sides[sj as usize].sign())
+            && wi
+                .and_then(|wi| self.peak_fr(bsdf, wi, j, k))
                 .is_none_or(|peak| {
                     PI * tjk * (unshot * peak).sum() * (PI * tij.t / aj) < self.flux_threshold
                 })
         {
-            task.out.push(link);
+            task.push(link);
             return;
         }
         let (spread, driver) = self.fr_variation(bsdf, i, j, k);
@@ -614,14 +653,14 @@ impl<const N: usize> RefineContext<'_, N> {
         let ff_err = self.throughput(k, sk, j, sj).spread / self.settings.ff_eps;
         let partial = (vjk > 0.0 && vjk < 1.0) || straddle_k;
         if brdf_err <= 1.0 && ff_err <= 1.0 && !partial && !straddle_i {
-            task.out.push(link);
+            task.push(link);
             return;
         }
         if straddle_i && brdf_err <= 1.0 && ff_err <= 1.0 && !partial {
-            if self.split_triple(Driver::I, task, i, j, n, (tij, unshot)) {
+            if self.split_triple(Driver::I, task, i, j, n, known) {
                 return;
             }
-            task.out.push(link);
+            task.push(link);
             return;
         }
         // The element to split: the BRDF's driver when the BRDF error
@@ -643,11 +682,11 @@ impl<const N: usize> RefineContext<'_, N> {
         };
         let order = [first, rest[0], rest[1]];
         for d in order {
-            if self.split_triple(d, task, i, j, n, (tij, unshot)) {
+            if self.split_triple(d, task, i, j, n, known) {
                 return;
             }
         }
-        task.out.push(link);
+        task.push(link);
     }
 
     /// Applies one of the three subdivision cases (notes §3), following an
@@ -661,7 +700,7 @@ impl<const N: usize> RefineContext<'_, N> {
         i: ElementId,
         j: ElementId,
         n: u32,
-        known: (Throughput, Spectrum<N>),
+        known: Incidence<N>,
     ) -> bool {
         let node_split = task.h.nodes[n as usize].split;
         let which = match (which, node_split) {

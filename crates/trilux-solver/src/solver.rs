@@ -550,6 +550,17 @@ impl<const N: usize> Solver<N> {
                 groups_of_side.entry(l.side).or_default().push(g as u32);
             }
         }
+        // Each pair link's part of its three-point links, once for all the
+        // hierarchies that leave its receiving side.
+        let incidences: Vec<_> = pair_links
+            .par_iter()
+            .map(|l| {
+                self.sides[l.side as usize]
+                    .stored
+                    .then(|| ctx.incidence(&sender, send_side, l.i, l.side, l.j))
+                    .flatten()
+            })
+            .collect();
         let busy = src_hierarchy.as_ref().map(|(h, _)| *h);
         let results: Vec<(Vec<NodeLink<N>>, u32, Spectrum<N>)> = self
             .hierarchies
@@ -569,9 +580,12 @@ impl<const N: usize> Solver<N> {
                 };
                 for &g in &groups_of_side[&from] {
                     let l = &pair_links[g as usize];
+                    let Some(incidence) = incidences[g as usize] else {
+                        continue;
+                    };
                     task.group = g;
                     for n in ctx.nodes_for(task.h, l.j, &mut task.lost) {
-                        ctx.refine_triple(&mut task, l.i, l.j, n, None);
+                        ctx.refine_triple(&mut task, l.i, l.j, n, Some(incidence));
                     }
                 }
                 (task.out, h as u32, task.lost)
