@@ -20,7 +20,7 @@ use std::time::Instant;
 use rayon::prelude::*;
 use trilux_brdf::{AlbedoTable, Bsdf, BsdfParams, Frame};
 use trilux_color::{ColorParam, Spectrum};
-use trilux_geometry::{BurialRequest, ElementId, FormFactorOptions, SceneGeometry, Shape, Side};
+use trilux_geometry::{BurialRequest, ElementId, SceneGeometry, Shape, Side};
 
 use crate::error::SolverError;
 use crate::interaction::Hierarchy;
@@ -31,7 +31,7 @@ use crate::settings::SolverSettings;
 use crate::sides::{SideId, TransportSide, build_sides, eligible_pairs};
 use crate::solution::Solution;
 use crate::stats::SolveStats;
-use crate::throughput::{SidedElement, ThroughputCache, compute_throughput};
+use crate::throughput::{FORM_FACTOR_OPTIONS, SidedElement, ThroughputCache, compute_throughput};
 
 /// What the solver needs of a scene: per shape its geometry, its material
 /// and its area emitter's radiance. (The scene layer builds this; the solver
@@ -257,7 +257,7 @@ impl<const N: usize> Solver<N> {
         let exposed_area = exposed_areas(&geom);
         let partners = eligible_pairs(&geom, &sides);
         let cache = ThroughputCache::new(1 << 22);
-        let ff_options = FormFactorOptions::default();
+        let ff_options = FORM_FACTOR_OPTIONS;
 
         // Root interactions: every eligible pair whose sender needs stored
         // interactions (a glossy part, or any reflection in uniform mode)
@@ -478,7 +478,7 @@ impl<const N: usize> Solver<N> {
             sides: &self.sides,
             materials: &self.materials,
             cache: &self.cache,
-            ff_options: FormFactorOptions::default(),
+            ff_options: FORM_FACTOR_OPTIONS,
             flux_threshold: self.settings.flux_eps * emitted_sum,
             points: &self.points,
             interior: &self.interior,
@@ -803,7 +803,7 @@ impl<const N: usize> Solver<N> {
             element: j,
             back: self.sides[side as usize].back,
         };
-        let ff = FormFactorOptions::default();
+        let ff = FORM_FACTOR_OPTIONS;
         let mut t = 0.0;
         for h in self.hierarchies.iter().filter(|h| h.from == side) {
             let k = h.nodes[0].to;

@@ -48,6 +48,18 @@ pub(crate) struct Throughput {
     pub spread: f64,
 }
 
+/// The form-factor accuracy the solver asks for: relative tolerance 1e-2
+/// on the adaptive cubature (the geometry crate's default is 1e-3). T also
+/// carries a visible fraction from 16–256 shadow rays, whose noise is
+/// larger; the degree-5 rules' actual error is far below the tolerance
+/// (the furnace, whose visibility is exact, stays at 0.37 %), and the
+/// solve is about a quarter faster (docs/results.md, "Solver").
+pub(crate) const FORM_FACTOR_OPTIONS: FormFactorOptions = FormFactorOptions {
+    rel_tol: 1e-2,
+    max_depth: 4,
+    samples: 64,
+};
+
 const SHARDS: usize = 64;
 
 /// A hasher for the cache's u64 keys: a few multiplications instead of
