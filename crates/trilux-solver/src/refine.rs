@@ -35,7 +35,7 @@ use crate::interaction::{Hierarchy, Split};
 use crate::radiosity::ElementRadiance;
 use crate::settings::{SolverSettings, Transport};
 use crate::sides::{SideId, TransportSide};
-use crate::throughput::{SidedElement, Throughput, ThroughputCache, compute_throughput};
+use crate::throughput::{SidedElement, Throughput, ThroughputCache, compute_throughput_with};
 
 /// What a shot sends from: unshot radiance by element pair.
 pub(crate) enum Sender<'a, const N: usize> {
@@ -208,12 +208,26 @@ impl<const N: usize> RefineContext<'_, N> {
         if let Some(t) = self.cache.get(a, b) {
             return t;
         }
-        let t = compute_throughput(
+        // A pair inside a pair that all its shadow rays (64 or more at the
+        // levels refinement starts from) found unoccluded is unoccluded too:
+        // its sub-segments lie in the parent pair's shaft.
+        let parent_visible =
+            |x: SidedElement, y: SidedElement| self.cache.get(x, y).is_some_and(|t| t.v >= 1.0);
+        let up = |s: SidedElement| {
+            self.geom.element(s.element).parent.map(|p| SidedElement {
+                element: p,
+                back: s.back,
+            })
+        };
+        let visible = up(a).is_some_and(|pa| parent_visible(pa, b))
+            || up(b).is_some_and(|pb| parent_visible(a, pb));
+        let t = compute_throughput_with(
             self.geom,
             a,
             b,
             self.settings.visibility_samples,
             &self.ff_options,
+            visible,
         );
         self.cache.insert(a, b, t);
         t

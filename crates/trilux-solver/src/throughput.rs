@@ -147,6 +147,19 @@ pub(crate) fn compute_throughput(
     visibility_samples: u32,
     ff_options: &FormFactorOptions,
 ) -> Throughput {
+    compute_throughput_with(geom, i, j, visibility_samples, ff_options, false)
+}
+
+/// [`compute_throughput`], taking V = 1 without tracing when `visible`
+/// (a pair inside a pair whose shadow rays all passed).
+pub(crate) fn compute_throughput_with(
+    geom: &SceneGeometry,
+    i: SidedElement,
+    j: SidedElement,
+    visibility_samples: u32,
+    ff_options: &FormFactorOptions,
+    visible: bool,
+) -> Throughput {
     let ff = geom.form_factor_sided(i.element, i.side(), j.element, j.side(), ff_options);
     let (f, spread) = (ff.value, ff.spread);
     if !(f.is_finite() && f > 0.0) {
@@ -161,7 +174,11 @@ pub(crate) fn compute_throughput(
         2 | 3 => visibility_samples * 4,
         _ => visibility_samples,
     };
-    let v = geom.visibility_weighted(i.element, i.side(), j.element, j.side(), samples);
+    let v = if visible {
+        1.0
+    } else {
+        geom.visibility_weighted(i.element, i.side(), j.element, j.side(), samples)
+    };
     let area = geom.element(i.element).area;
     let t = area * f * v;
     if t.is_finite() && t > 0.0 {
