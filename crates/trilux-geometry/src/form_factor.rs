@@ -565,18 +565,7 @@ fn clip_to_plane<'a>(doms: &[QDom<'a>], polys: &[Poly]) -> Vec<QDom<'a>> {
         return Vec::new();
     };
     let (n, p0) = (first.n, first.v[0]);
-    let scale = polys
-        .iter()
-        .flat_map(|p| p.v[..p.len].iter())
-        .map(|v| (*v - p0).length())
-        .fold(0.0, f64::max);
-    let coplanar = polys.iter().all(|p| {
-        p.n.dot(n) > 1.0 - 1e-12
-            && p.v[..p.len]
-                .iter()
-                .all(|v| n.dot(*v - p0).abs() <= 1e-12 * scale.max(1e-300))
-    });
-    if !coplanar {
+    if !coplanar_polys(polys) {
         return doms.to_vec();
     }
     let mut out = Vec::with_capacity(doms.len());
@@ -627,6 +616,79 @@ fn clip_to_plane<'a>(doms: &[QDom<'a>], polys: &[Poly]) -> Vec<QDom<'a>> {
         }
     }
     out
+}
+
+/// True when all the polygons lie in one plane and face the same way.
+fn coplanar_polys(polys: &[Poly]) -> bool {
+    let Some(first) = polys.first() else {
+        return true;
+    };
+    let (n, p0) = (first.n, first.v[0]);
+    let scale = polys
+        .iter()
+        .flat_map(|p| p.v[..p.len].iter())
+        .map(|v| (*v - p0).length())
+        .fold(0.0, f64::max);
+    polys.iter().all(|p| {
+        p.n.dot(n) > 1.0 - 1e-12
+            && p.v[..p.len]
+                .iter()
+                .all(|v| n.dot(*v - p0).abs() <= 1e-12 * scale.max(1e-300))
+    })
+}
+
+/// ∫ over `doms` of Lambert's form factor to `polys` (paper notation:
+/// A_x F(dA_x → polys)), with its error, and the min and max of the point
+/// values F(x → polys) seen. Lambert's integrand vanishes behind each
+/// polygon's plane, with a kink there: the domains are clipped to the
+/// front half-space of each plane before integrating, one polygon at a
+/// time when the polygons are not coplanar (a non-planar cluster), so that
+/// a sliver of a domain in front of one piece is integrated rather than
+/// missed by every rule point.
+fn integrate_lambert(
+    doms: &[QDom<'_>],
+    polys: &[Poly],
+    rel_tol: f64,
+    depth: u32,
+) -> (f64, f64, f64, f64) {
+    let mut lo = f64::INFINITY;
+    let mut hi = f64::NEG_INFINITY;
+    if coplanar_polys(polys) {
+        let mut f = |x: DVec3, n: DVec3| {
+            let g = lambert_sum(x, n, polys);
+            lo = lo.min(g);
+            hi = hi.max(g);
+            (g, 0.0)
+        };
+        let doms = clip_to_plane(doms, polys);
+        if doms.is_empty() {
+            return (0.0, 0.0, lo, hi);
+        }
+        let (v, e) = integrate(&doms, &mut f, rel_tol, depth);
+        return (v, e, lo, hi);
+    }
+    // The spread of the whole cluster's point values, at the rule points
+    // of the unclipped domains.
+    for d in doms {
+        for (x, n, _) in d.points() {
+            let g = lambert_sum(x, n, polys);
+            lo = lo.min(g);
+            hi = hi.max(g);
+        }
+    }
+    let (mut v, mut e) = (0.0, 0.0);
+    for p in polys {
+        let one = std::slice::from_ref(p);
+        let clipped = clip_to_plane(doms, one);
+        if clipped.is_empty() {
+            continue;
+        }
+        let mut f = |x: DVec3, n: DVec3| (lambert_sum(x, n, one), 0.0);
+        let (pv, pe) = integrate(&clipped, &mut f, rel_tol, depth);
+        v += pv;
+        e += pe;
+    }
+    (v, e, lo, hi)
 }
 
 /// The point-to-point kernel cos θ_x cos θ_y / (π r²), one-sided.
@@ -837,35 +899,15 @@ impl SceneGeometry {
             spread: if hi >= lo { hi - lo } else { 0.0 },
         };
         if let (Some(polys), Some(doms)) = (&to_polys, &from_doms) {
-            let mut f = |x: DVec3, n: DVec3| {
-                let g = lambert_sum(x, n, polys);
-                lo = lo.min(g);
-                hi = hi.max(g);
-                (g, 0.0)
-            };
-            let doms = clip_to_plane(doms, polys);
-            if doms.is_empty() {
-                return FormFactor::default();
-            }
-            let (v, e) = integrate(&doms, &mut f, tol, depth);
+            let (v, e, lo, hi) = integrate_lambert(doms, polys, tol, depth);
             return result(v / a_from, e / a_from, lo, hi);
         }
         let from_polys = self.element_polygons(from, sf);
         let to_doms = self.element_domains(to, st);
         let ratio = a_to / a_from;
         if let (Some(polys), Some(doms)) = (&from_polys, &to_doms) {
-            let mut f = |y: DVec3, m: DVec3| {
-                let g = lambert_sum(y, m, polys);
-                lo = lo.min(g * ratio);
-                hi = hi.max(g * ratio);
-                (g, 0.0)
-            };
-            let doms = clip_to_plane(doms, polys);
-            if doms.is_empty() {
-                return FormFactor::default();
-            }
-            let (v, e) = integrate(&doms, &mut f, tol, depth);
-            return result(v / a_from, e / a_from, lo, hi);
+            let (v, e, lo, hi) = integrate_lambert(doms, polys, tol, depth);
+            return result(v / a_from, e / a_from, lo * ratio, hi * ratio);
         }
         if let (Some(fd), Some(td)) = (&from_doms, &to_doms) {
             let (v, e, lo, hi) = integrate_pairs(fd, td, tol, depth + 2);
