@@ -12,8 +12,10 @@
 //!   F(dA_x → P) = (1/2π) |Σ_e β_e n_x · u_e| (notes/validation.md), after
 //!   clipping P to x's tangent plane and dropping pieces whose front does not
 //!   face x. The sender is first clipped to the receiver's front half-space
-//!   when the receiver is planar (the integrand vanishes behind it, with a
-//!   kink along the plane). The outer integral over the sender is adaptive
+//!   (the integrand vanishes behind it, with a kink along the plane); for
+//!   a non-planar cluster, to each piece's half-space in turn, integrating
+//!   piece by piece (otherwise a sliver in front of one piece could hold no
+//!   rule point and be missed). The outer integral over the sender is adaptive
 //!   cubature: a degree-5 rule (3×3 Gauss–Legendre on uv rectangles,
 //!   Dunavant's 7-point rule on triangles) on a domain is accepted at once
 //!   if it agrees with the one-point rule within the domain's share of the
