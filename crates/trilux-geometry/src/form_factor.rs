@@ -343,11 +343,13 @@ fn integrate(
     (v, e)
 }
 
-/// The product rule over two domains: Σ_i Σ_j w_i w_j K(x_i, y_j).
-fn pair_rule(a: &QDom<'_>, b: &QDom<'_>) -> f64 {
-    let pb = b.points();
-    a.points()
-        .iter()
+/// Rule points of a domain: (point, normal, weight).
+type RulePoints = Vec<(DVec3, DVec3, f64)>;
+
+/// The product rule over two domains' rule points:
+/// Σ_i Σ_j w_i w_j K(x_i, y_j).
+fn pair_rule(pa: &[(DVec3, DVec3, f64)], pb: &[(DVec3, DVec3, f64)]) -> f64 {
+    pa.iter()
         .map(|&(x, nx, wx)| {
             wx * pb
                 .iter()
@@ -357,17 +359,29 @@ fn pair_rule(a: &QDom<'_>, b: &QDom<'_>) -> f64 {
         .sum()
 }
 
-/// Adaptive cubature of the kernel over a pair of domains. Both one-sided
+/// Adaptive cubature of the kernel over a pair of domains (with their rule
+/// points `pa`, `pb`, evaluated once per domain). Both one-sided
 /// refinements (split `a`, split `b`) are compared with the parent
 /// estimate: the error is the larger difference (refining one side alone
 /// cannot see the other side's rule error), and the side whose refinement
 /// changed the estimate most is refined further (as hierarchical radiosity
 /// refines the link's worse end).
-fn pair_adaptive(a: &QDom<'_>, b: &QDom<'_>, q0: f64, tol: f64, depth: u32) -> (f64, f64) {
+#[allow(clippy::too_many_arguments)]
+fn pair_adaptive(
+    a: &QDom<'_>,
+    pa: &[(DVec3, DVec3, f64)],
+    b: &QDom<'_>,
+    pb: &[(DVec3, DVec3, f64)],
+    q0: f64,
+    tol: f64,
+    depth: u32,
+) -> (f64, f64) {
     let ca = a.split();
     let cb = b.split();
-    let qa = ca.map(|c| pair_rule(&c, b));
-    let qb = cb.map(|c| pair_rule(a, &c));
+    let pca: [RulePoints; 4] = ca.map(|c| c.points());
+    let pcb: [RulePoints; 4] = cb.map(|c| c.points());
+    let qa: [f64; 4] = std::array::from_fn(|k| pair_rule(&pca[k], pb));
+    let qb: [f64; 4] = std::array::from_fn(|k| pair_rule(pa, &pcb[k]));
     let (sa, sb): (f64, f64) = (qa.iter().sum(), qb.iter().sum());
     let (ea, eb) = ((sa - q0).abs(), (sb - q0).abs());
     let split_a = ea > eb || (ea == eb && a.size() >= b.size());
@@ -379,9 +393,9 @@ fn pair_adaptive(a: &QDom<'_>, b: &QDom<'_>, q0: f64, tol: f64, depth: u32) -> (
     let mut e = 0.0;
     for k in 0..4 {
         let (cv, ce) = if split_a {
-            pair_adaptive(&ca[k], b, qa[k], 0.5 * tol, depth - 1)
+            pair_adaptive(&ca[k], &pca[k], b, pb, qa[k], 0.5 * tol, depth - 1)
         } else {
-            pair_adaptive(a, &cb[k], qb[k], 0.5 * tol, depth - 1)
+            pair_adaptive(a, pa, &cb[k], &pcb[k], qb[k], 0.5 * tol, depth - 1)
         };
         v += cv;
         e += ce;
@@ -397,10 +411,12 @@ fn integrate_pairs(
     rel_tol: f64,
     depth: u32,
 ) -> (f64, f64, f64, f64) {
+    let from_points: Vec<RulePoints> = from.iter().map(QDom::points).collect();
+    let to_points: Vec<RulePoints> = to.iter().map(QDom::points).collect();
     let mut q0 = Vec::with_capacity(from.len() * to.len());
-    for a in from {
-        for b in to {
-            q0.push(pair_rule(a, b));
+    for pa in &from_points {
+        for pb in &to_points {
+            q0.push(pair_rule(pa, pb));
         }
     }
     let total: f64 = q0.iter().sum();
@@ -408,8 +424,8 @@ fn integrate_pairs(
     let mut v = 0.0;
     let mut e = 0.0;
     let mut k = 0;
-    for a in from {
-        for b in to {
+    for (a, pa) in from.iter().zip(&from_points) {
+        for (b, pb) in to.iter().zip(&to_points) {
             let tol = (0.5 * rel_tol * (q0[k].abs() + even)).max(1e-300);
             // Accept at once when the one-point pair rule agrees with the
             // product rule (error: their difference, conservative for
@@ -419,19 +435,19 @@ fn integrate_pairs(
             let (dv, de) = if (c - q0[k]).abs() <= tol {
                 (q0[k], (c - q0[k]).abs())
             } else {
-                pair_adaptive(a, b, q0[k], tol, depth)
+                pair_adaptive(a, pa, b, pb, q0[k], tol, depth)
             };
             v += dv;
             e += de;
             k += 1;
         }
     }
-    let to_points: Vec<(DVec3, DVec3, f64)> = to.iter().flat_map(|b| b.points()).collect();
+    let all_to: RulePoints = to_points.into_iter().flatten().collect();
     let mut lo = f64::INFINITY;
     let mut hi = f64::NEG_INFINITY;
-    for a in from {
-        for (x, nx, _) in a.points() {
-            let g: f64 = to_points
+    for pa in &from_points {
+        for &(x, nx, _) in pa {
+            let g: f64 = all_to
                 .iter()
                 .map(|&(y, ny, wy)| wy * kernel(x, nx, y, ny))
                 .sum::<f64>()

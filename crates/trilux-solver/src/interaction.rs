@@ -94,6 +94,12 @@ impl<const N: usize> Hierarchy<N> {
         }
     }
 
+    /// True for a side's interaction with itself (a concave surface lighting
+    /// itself: paper §5.2's secondary interactions).
+    pub fn is_self(&self) -> bool {
+        self.from == self.to
+    }
+
     /// The four children of node `n`, if split.
     pub fn children(&self, n: u32) -> Option<[u32; 4]> {
         let f = self.nodes[n as usize].first_child;

@@ -113,8 +113,8 @@ fn probe_points(geom: &SceneGeometry, surface: SurfaceId, sign: f64) -> Vec<(DVe
     out
 }
 
-/// Which pairs of sides can exchange light: a Lambertian side that sees
-/// itself with itself, and sender side `a` and receiver side `b` of
+/// Which pairs of sides can exchange light: a side that sees itself with
+/// itself, and sender side `a` and receiver side `b` of
 /// different input surfaces such that some point of `b` lies in front
 /// of `a` and some point of `a` in front of `b`, both as seen by the same pair
 /// of points. Exact for planar surfaces (probing the corners and interior
@@ -151,19 +151,19 @@ pub(crate) fn eligible_pairs<const N: usize>(
                     out.push(b as SideId);
                 }
             }
-            // A Lambertian face of a concave surface (a pleated curtain's
-            // chart, the inside of a tube) also lights itself: the links
-            // between its own non-coplanar elements are the secondary
-            // interactions of paper §5.2 (coplanar pairs get a zero form
-            // factor). Glossy faces that see themselves are left out (the
-            // solver warns).
+            // A face of a concave surface (a pleated curtain's chart, the
+            // inside of a tube) also lights itself: the links between its
+            // own non-coplanar elements are the secondary interactions of
+            // paper §5.2 (coplanar pairs get a zero form factor), two-point
+            // for its Lambertian part and through its interaction with
+            // itself for its glossy part.
             let s = geom.surface(sides[a].surface);
             let sees_itself = if sides[a].back {
                 s.back_can_see_itself()
             } else {
                 s.can_see_itself()
             };
-            if sees_itself && !sides[a].stored {
+            if sees_itself {
                 out.push(a as SideId);
             }
             out

@@ -227,18 +227,6 @@ impl<const N: usize> Solver<N> {
                 side.rho_d = side.rho_d.min(Spectrum::splat(1.0));
             }
         }
-        for (index, s) in geom.surfaces().iter().enumerate() {
-            // Lambertian faces exchange light with themselves through
-            // two-point links (sides::eligible_pairs); glossy ones would
-            // need self-interactions, which are not built yet.
-            let glossy = |back: bool| sides[2 * index + usize::from(back)].stored;
-            if (s.can_see_itself() && glossy(false)) || (s.back_can_see_itself() && glossy(true)) {
-                warnings.push(format!(
-                    "shape {}: a glossy curved surface that sees itself; its glossy self-exchange (paper §5 secondary interactions) is left out",
-                    s.shape
-                ));
-            }
-        }
         warnings.dedup();
         // Buried parts of every face that sends light (the floor under a
         // box): visibility treats them as blocked, and radiance is spread
@@ -462,10 +450,27 @@ impl<const N: usize> Solver<N> {
                 );
                 (s, None)
             }
+            Source::Stored(h) if self.hierarchies[h as usize].is_self() => {
+                // A surface's interaction with itself (paper §5.2's
+                // secondary interactions of a glossy concave surface)
+                // receives from its own shot: it stays in place as a
+                // receiver, and a copy of its unshot radiance sends.
+                let hier = &mut self.hierarchies[h as usize];
+                hier.push_pull();
+                (hier.from, Some((h, hier.clone())))
+            }
             Source::Stored(h) => {
+                // An inert stand-in while it sends: no side has id
+                // SideId::MAX, so nothing looks it up.
                 let mut hier = std::mem::replace(
                     &mut self.hierarchies[h as usize],
-                    Hierarchy::new(0, 0, ElementId(0), ElementId(0), Default::default()),
+                    Hierarchy::new(
+                        SideId::MAX,
+                        SideId::MAX,
+                        ElementId(0),
+                        ElementId(0),
+                        Default::default(),
+                    ),
                 );
                 hier.push_pull();
                 (hier.from, Some((h, hier)))
@@ -561,7 +566,15 @@ impl<const N: usize> Solver<N> {
                     .flatten()
             })
             .collect();
-        let busy = src_hierarchy.as_ref().map(|(h, _)| *h);
+        // The source hierarchy was taken out to send (unless it is a
+        // surface's interaction with itself, which stays to receive).
+        let self_source = src_hierarchy
+            .as_ref()
+            .is_some_and(|(_, hier)| hier.is_self());
+        let busy = src_hierarchy
+            .as_ref()
+            .filter(|_| !self_source)
+            .map(|(h, _)| *h);
         let results: Vec<(Vec<NodeLink<N>>, u32, Spectrum<N>)> = self
             .hierarchies
             .par_iter_mut()
@@ -713,6 +726,9 @@ impl<const N: usize> Solver<N> {
                 let side = &self.sides[s as usize];
                 let root = self.geom.surfaces()[side.surface.index()].root;
                 self.field.clear_unshot(&self.geom, root, side.back);
+            }
+            (Source::Stored(h), Some(_)) if self_source => {
+                self.hierarchies[h as usize].clear_unshot();
             }
             (Source::Stored(h), Some((_, mut hier))) => {
                 hier.clear_unshot();

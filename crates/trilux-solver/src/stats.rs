@@ -48,6 +48,6 @@ pub struct SolveStats {
     /// a fraction of what arrived there (band minimum). Negative would mean
     /// an element reflected more than it received.
     pub min_element_absorbed: f64,
-    /// Warnings (e.g. self-exchange of concave surfaces left out).
+    /// Warnings (e.g. a Lambertian reflectance above 1 clamped).
     pub warnings: Vec<String>,
 }
