@@ -66,6 +66,7 @@ fn scene(
     closed: bool,
     box_material: BsdfParams,
     plates: &[Plate],
+    tube: Option<BsdfParams>,
     le: f64,
 ) -> (Vec<Shape>, Vec<BsdfParams>, Vec<Option<ColorParam>>) {
     let mut shapes = Vec::new();
@@ -92,6 +93,22 @@ fn scene(
         bsdfs.push(box_material);
         emission.push(None);
     }
+    // An open tube seen from inside (flipped normals): a concave surface
+    // whose pieces light themselves (secondary interactions, glossy or
+    // not).
+    if let Some(material) = tube {
+        shapes.push(Shape {
+            kind: ShapeKind::Cylinder {
+                p0: DVec3::new(-0.2, 0.0, -0.5),
+                p1: DVec3::new(0.2, 0.1, 0.3),
+                radius: 0.35,
+            },
+            world_from_object: DMat4::IDENTITY,
+            flip_normals: true,
+        });
+        bsdfs.push(material);
+        emission.push(None);
+    }
     for p in plates {
         shapes.push(Shape {
             kind: ShapeKind::Rectangle,
@@ -114,10 +131,11 @@ proptest! {
         closed in any::<bool>(),
         box_material in material(),
         plates in proptest::collection::vec(plate(), 0..3),
+        tube in proptest::option::of(material()),
         le in 0.5..20.0f64,
         uniform in any::<bool>(),
     ) {
-        let (shapes, bsdfs, emission) = scene(closed, box_material, &plates, le);
+        let (shapes, bsdfs, emission) = scene(closed, box_material, &plates, tube, le);
         let input = SolverInput { shapes: &shapes, bsdfs: &bsdfs, emission: &emission };
         let mut settings = SolverSettings::preset(Quality::Draft);
         settings.max_depth = 3;
