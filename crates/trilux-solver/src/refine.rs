@@ -112,12 +112,21 @@ pub(crate) struct Incidence<const N: usize> {
     tij: Throughput,
     /// δL sent from i towards j.
     unshot: Spectrum<N>,
-    /// The direction of incidence at j's centre in j's front frame
-    /// (`RefineContext::incident`); `None` when no part of i is on the
-    /// receiving side.
-    wi: Option<DVec3>,
+    /// The light's arrival at j's centre (`RefineContext::incident`);
+    /// `None` when no part of i is on the receiving side.
+    incoming: Option<Incoming>,
     /// i has points on both sides of j's tangent plane.
     straddle_i: bool,
+}
+
+/// Where light from i arrives at j: j's front frame, and the direction of
+/// incidence in it.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Incoming {
+    /// j's frame (its front normal as z).
+    frame: trilux_brdf::Frame,
+    /// The direction towards i's part on the receiving side, local.
+    wi: DVec3,
 }
 
 /// One receiving hierarchy refined against the pair links of one shot
@@ -443,12 +452,12 @@ impl<const N: usize> RefineContext<'_, N> {
     fn fr_centre(
         &self,
         bsdf: &Bsdf<N>,
-        wi: DVec3,
+        incoming: &Incoming,
         j: ElementId,
         k: ElementId,
     ) -> Option<Spectrum<N>> {
         let ej = self.geom.element(j);
-        let frame = trilux_brdf::Frame::from_normal(ej.normal);
+        let Incoming { frame, wi } = *incoming;
         // The discretised fr over K (paper Eq. 5's fr_KJI): the midpoint rule
         // on K's 2×2 quadrants rather than its centre alone, so that a glossy
         // lobe that falls between K's centre and its edges is not missed
@@ -477,13 +486,13 @@ impl<const N: usize> RefineContext<'_, N> {
     fn peak_fr(
         &self,
         bsdf: &Bsdf<N>,
-        wi: DVec3,
+        incoming: &Incoming,
         j: ElementId,
         k: ElementId,
     ) -> Option<Spectrum<N>> {
         let g = self.geom;
         let (ej, ek) = (g.element(j), g.element(k));
-        let frame = trilux_brdf::Frame::from_normal(ej.normal);
+        let Incoming { frame, wi } = *incoming;
         let mirror = DVec3::new(-wi.x, -wi.y, wi.z);
         let to_k = ek.centre - ej.centre;
         let dist = to_k.length();
@@ -561,7 +570,9 @@ impl<const N: usize> RefineContext<'_, N> {
         Some(Incidence {
             tij,
             unshot,
-            wi: self.incident(&frame, i, j, self.sides[sj as usize].sign()),
+            incoming: self
+                .incident(&frame, i, j, self.sides[sj as usize].sign())
+                .map(|wi| Incoming { frame, wi }),
             straddle_i: self.straddles(i, j),
         })
     }
@@ -586,7 +597,7 @@ impl<const N: usize> RefineContext<'_, N> {
         let Incidence {
             tij,
             unshot,
-            wi,
+            incoming,
             straddle_i,
         } = known;
         let node = &task.h.nodes[n as usize];
@@ -619,7 +630,7 @@ impl<const N: usize> RefineContext<'_, N> {
         // through its part in front, so refine it like partial visibility.
         // (A zero of the BRDF itself, a lobe far from K, is not refined
         // for: the peak bound below decides whether the lobe may be near.)
-        let Some(fr) = wi.and_then(|wi| self.fr_centre(bsdf, wi, j, k)) else {
+        let Some(fr) = incoming.and_then(|inc| self.fr_centre(bsdf, &inc, j, k)) else {
             let order = match (straddle_i, straddle_k) {
                 (true, true) if self.geom.element(i).area >= self.geom.element(k).area => {
                     [Driver::I, Driver::K]
@@ -650,8 +661,8 @@ impl<const N: usize> RefineContext<'_, N> {
         // underestimated. Bound the flux with fr at the mirror direction
         // when that direction passes near K.
         if flux_to_k < self.flux_threshold
-            && wi
-                .and_then(|wi| self.peak_fr(bsdf, wi, j, k))
+            && incoming
+                .and_then(|inc| self.peak_fr(bsdf, &inc, j, k))
                 .is_none_or(|peak| {
                     PI * tjk * (unshot * peak).sum() * (PI * tij.t / aj) < self.flux_threshold
                 })
