@@ -588,23 +588,9 @@ fn clip_to_plane<'a>(doms: &[QDom<'a>], polys: &[Poly]) -> Vec<QDom<'a>> {
     }
     let mut out = Vec::with_capacity(doms.len());
     for d in doms {
-        let (corners, normal): (Vec<DVec3>, DVec3) = match *d {
-            QDom::Rect { patch, min, max, s }
-                if patch.is_planar() && matches!(patch, Patch::Quad { .. }) =>
-            {
-                (
-                    [min, DVec2::new(max.x, min.y), max, DVec2::new(min.x, max.y)]
-                        .iter()
-                        .map(|&uv| patch.eval(uv).p)
-                        .collect(),
-                    s * patch.eval(min).n,
-                )
-            }
-            QDom::Tri { v, n } => (v.to_vec(), n),
-            _ => {
-                out.push(*d);
-                continue;
-            }
+        let Some((corners, normal)) = planar_corners(d) else {
+            out.push(*d);
+            continue;
         };
         let dist: Vec<f64> = corners.iter().map(|c| n.dot(*c - p0)).collect();
         if dist.iter().all(|&x| x >= 0.0) {
@@ -634,6 +620,47 @@ fn clip_to_plane<'a>(doms: &[QDom<'a>], polys: &[Poly]) -> Vec<QDom<'a>> {
         }
     }
     out
+}
+
+/// The corners and normal of a planar polygonal domain (a uv rectangle of
+/// a planar quad, or a triangle); `None` for curved domains.
+fn planar_corners(d: &QDom<'_>) -> Option<(Vec<DVec3>, DVec3)> {
+    match *d {
+        QDom::Rect { patch, min, max, s }
+            if patch.is_planar() && matches!(patch, Patch::Quad { .. }) =>
+        {
+            Some((
+                [min, DVec2::new(max.x, min.y), max, DVec2::new(min.x, max.y)]
+                    .iter()
+                    .map(|&uv| patch.eval(uv).p)
+                    .collect(),
+                s * patch.eval(min).n,
+            ))
+        }
+        QDom::Tri { v, n } => Some((v.to_vec(), n)),
+        QDom::Rect { .. } => None,
+    }
+}
+
+/// True when some planar domain has corners strictly on both sides of
+/// some polygon's plane (then Lambert's integrand has a kink inside it).
+fn any_domain_straddles(doms: &[QDom<'_>], polys: &[Poly]) -> bool {
+    let corners: Vec<Vec<DVec3>> = doms
+        .iter()
+        .filter_map(|d| planar_corners(d).map(|(c, _)| c))
+        .collect();
+    polys.iter().any(|p| {
+        let (n, p0) = (p.n, p.v[0]);
+        corners.iter().any(|c| {
+            let (mut front, mut back) = (false, false);
+            for x in c {
+                let d = n.dot(*x - p0);
+                front |= d > 0.0;
+                back |= d < 0.0;
+            }
+            front && back
+        })
+    })
 }
 
 /// True when all the polygons lie in one plane and face the same way.
@@ -671,7 +698,10 @@ fn integrate_lambert(
 ) -> (f64, f64, f64, f64) {
     let mut lo = f64::INFINITY;
     let mut hi = f64::NEG_INFINITY;
-    if coplanar_polys(polys) {
+    // One integration of the whole set when no piece's plane cuts a
+    // domain (the integrand is then smooth on every domain, or the pieces
+    // are coplanar and the domains are clipped to their common plane).
+    if coplanar_polys(polys) || !any_domain_straddles(doms, polys) {
         let mut f = |x: DVec3, n: DVec3| {
             let g = lambert_sum(x, n, polys);
             lo = lo.min(g);
