@@ -29,7 +29,7 @@ use glam::DVec3;
 use trilux_brdf::area::Element as Driver;
 use trilux_brdf::{Bsdf, ElementPoints, brdf_variation};
 use trilux_color::Spectrum;
-use trilux_geometry::{ElementId, FormFactorOptions, SceneGeometry};
+use trilux_geometry::{ElementId, SceneGeometry};
 
 use crate::interaction::{Hierarchy, Split};
 use crate::radiosity::ElementRadiance;
@@ -119,6 +119,15 @@ pub(crate) struct Incidence<const N: usize> {
     straddle_i: bool,
 }
 
+impl<const N: usize> Incidence<N> {
+    /// The unit direction (world space) from j's centre towards the part
+    /// of i the light comes from; `None` when no part is on the receiving
+    /// side.
+    pub fn direction(&self) -> Option<DVec3> {
+        self.incoming.map(|inc| inc.frame.to_world(inc.wi))
+    }
+}
+
 /// Where light from i arrives at j: j's front frame, and the direction of
 /// incidence in it.
 #[derive(Clone, Copy, Debug)]
@@ -164,7 +173,6 @@ pub(crate) struct RefineContext<'a, const N: usize> {
     pub sides: &'a [TransportSide<N>],
     pub materials: &'a [Bsdf<N>],
     pub cache: &'a ThroughputCache,
-    pub ff_options: FormFactorOptions,
     /// Photometric threshold in watts (band sum): flux_eps × IF.
     pub flux_threshold: f64,
     /// `element_points` of every element, computed once.
@@ -230,14 +238,7 @@ impl<const N: usize> RefineContext<'_, N> {
         };
         let visible = up(a).is_some_and(|pa| parent_visible(pa, b))
             || up(b).is_some_and(|pb| parent_visible(a, pb));
-        let t = compute_throughput_with(
-            self.geom,
-            a,
-            b,
-            self.settings.visibility_samples,
-            &self.ff_options,
-            visible,
-        );
+        let t = compute_throughput_with(self.geom, a, b, self.settings.visibility_samples, visible);
         self.cache.insert(a, b, t);
         t
     }

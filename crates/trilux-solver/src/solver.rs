@@ -31,7 +31,7 @@ use crate::settings::SolverSettings;
 use crate::sides::{SideId, TransportSide, build_sides, eligible_pairs};
 use crate::solution::Solution;
 use crate::stats::SolveStats;
-use crate::throughput::{FORM_FACTOR_OPTIONS, SidedElement, ThroughputCache, compute_throughput};
+use crate::throughput::{SidedElement, ThroughputCache, compute_throughput};
 
 /// What the solver needs of a scene: per shape its geometry, its material
 /// and its area emitter's radiance. (The scene layer builds this; the solver
@@ -245,7 +245,6 @@ impl<const N: usize> Solver<N> {
         let exposed_area = exposed_areas(&geom);
         let partners = eligible_pairs(&geom, &sides);
         let cache = ThroughputCache::new(1 << 22);
-        let ff_options = FORM_FACTOR_OPTIONS;
 
         // Root interactions: every eligible pair whose sender needs stored
         // interactions (a glossy part, or any reflection in uniform mode)
@@ -277,13 +276,7 @@ impl<const N: usize> Solver<N> {
                     element: eb,
                     back: sides[b as usize].back,
                 };
-                crate::throughput::compute_throughput(
-                    &geom,
-                    sb,
-                    sa,
-                    settings.visibility_samples,
-                    &ff_options,
-                )
+                crate::throughput::compute_throughput(&geom, sb, sa, settings.visibility_samples)
             })
             .collect();
         let mut hierarchies = Vec::with_capacity(roots.len());
@@ -483,7 +476,6 @@ impl<const N: usize> Solver<N> {
             sides: &self.sides,
             materials: &self.materials,
             cache: &self.cache,
-            ff_options: FORM_FACTOR_OPTIONS,
             flux_threshold: self.settings.flux_eps * emitted_sum,
             points: &self.points,
             interior: &self.interior,
@@ -650,25 +642,30 @@ impl<const N: usize> Solver<N> {
             // against the albedo); point samples of a peaked lobe over
             // coarse K's fall short of it. (Two-point mode only: the
             // uniform mode stays the paper's, for ablation.)
-            let target = if side.stored
-                && !glossy_g.is_black()
-                && self.settings.transport == crate::settings::Transport::TwoPoint
-            {
-                let covered = self.hemisphere_coverage(l.side, l.j);
-                if covered >= CLOSED_COVERAGE {
-                    let (ei, ej) = (geom.element(l.i), geom.element(l.j));
-                    let wi = Frame::from_normal(ej.normal * side.sign())
-                        .to_local((ei.centre - ej.centre).normalize_or_zero());
-                    let glossy_albedo = self.albedo[side.shape].albedo(wi) - side.rho_d;
-                    Some((arrived_g * glossy_albedo * covered.min(1.0)).max(Spectrum::zero()))
-                } else {
-                    // An open hemisphere: the share of the lobe that meets a
-                    // stored receiver, by sampling the BRDF (a narrow lobe
-                    // need not miss the open part in proportion).
-                    Some(arrived_g * self.covered_lobe(l.side, l.i, l.j))
+            // The light arrives from the part of i in front of j (the
+            // same direction the group's area reflectances used).
+            let to_light = incidences[g].and_then(|inc| inc.direction());
+            let target = match to_light {
+                Some(to_light)
+                    if side.stored
+                        && !glossy_g.is_black()
+                        && self.settings.transport == crate::settings::Transport::TwoPoint =>
+                {
+                    let covered = self.hemisphere_coverage(l.side, l.j);
+                    if covered >= CLOSED_COVERAGE {
+                        let wi = Frame::from_normal(geom.element(l.j).normal * side.sign())
+                            .to_local(to_light);
+                        let glossy_albedo = self.albedo[side.shape].albedo(wi) - side.rho_d;
+                        Some((arrived_g * glossy_albedo * covered.min(1.0)).max(Spectrum::zero()))
+                    } else {
+                        // An open hemisphere: the share of the lobe that
+                        // meets a stored receiver, by sampling the BRDF (a
+                        // narrow lobe need not miss the open part in
+                        // proportion).
+                        Some(arrived_g * self.covered_lobe(l.side, to_light, l.j))
+                    }
                 }
-            } else {
-                None
+                _ => None,
             };
             let scale = Spectrum::<N>::new(std::array::from_fn(|b| {
                 let mut f = 1.0;
@@ -740,15 +737,16 @@ impl<const N: usize> Solver<N> {
     }
 
     /// ∫ fr_glossy cos dω over the directions from j's centre that meet a
-    /// face j's side stores an interaction towards, for light from i's
-    /// centre: [`LOBE_SAMPLES`] stratified samples of the BSDF, each traced.
-    fn covered_lobe(&self, side: SideId, i: ElementId, j: ElementId) -> Spectrum<N> {
+    /// face j's side stores an interaction towards, for light arriving from
+    /// the unit direction `to_light` (world space): [`LOBE_SAMPLES`]
+    /// stratified samples of the BSDF, each traced.
+    fn covered_lobe(&self, side: SideId, to_light: glam::DVec3, j: ElementId) -> Spectrum<N> {
         let geom = &self.geom;
         let ts = &self.sides[side as usize];
-        let (ei, ej) = (geom.element(i), geom.element(j));
+        let ej = geom.element(j);
         let normal = ej.normal * ts.sign();
         let frame = Frame::from_normal(normal);
-        let wi = frame.to_local((ei.centre - ej.centre).normalize_or_zero());
+        let wi = frame.to_local(to_light);
         let bsdf = &self.materials[ts.shape];
         // The BSDF's frame is the front's: flip z for a back side.
         let to_bsdf = |v: glam::DVec3| glam::DVec3::new(v.x, v.y, v.z * ts.sign());
@@ -819,7 +817,6 @@ impl<const N: usize> Solver<N> {
             element: j,
             back: self.sides[side as usize].back,
         };
-        let ff = FORM_FACTOR_OPTIONS;
         let mut t = 0.0;
         for h in self.hierarchies.iter().filter(|h| h.from == side) {
             let k = h.nodes[0].to;
@@ -827,14 +824,7 @@ impl<const N: usize> Solver<N> {
                 element: k,
                 back: self.sides[h.to as usize].back,
             };
-            t += compute_throughput(
-                &self.geom,
-                other,
-                this,
-                self.settings.visibility_samples,
-                &ff,
-            )
-            .t;
+            t += compute_throughput(&self.geom, other, this, self.settings.visibility_samples).t;
         }
         let c = t / a;
         if let Ok(mut cache) = self.coverage.lock() {

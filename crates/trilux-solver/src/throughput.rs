@@ -54,7 +54,7 @@ pub(crate) struct Throughput {
 /// larger; the degree-5 rules' actual error is far below the tolerance
 /// (the furnace, whose visibility is exact, stays at 0.37 %), and the
 /// solve is about a quarter faster (docs/results.md, "Solver").
-pub(crate) const FORM_FACTOR_OPTIONS: FormFactorOptions = FormFactorOptions {
+const FORM_FACTOR_OPTIONS: FormFactorOptions = FormFactorOptions {
     rel_tol: 1e-2,
     max_depth: 4,
     samples: 64,
@@ -145,9 +145,8 @@ pub(crate) fn compute_throughput(
     i: SidedElement,
     j: SidedElement,
     visibility_samples: u32,
-    ff_options: &FormFactorOptions,
 ) -> Throughput {
-    compute_throughput_with(geom, i, j, visibility_samples, ff_options, false)
+    compute_throughput_with(geom, i, j, visibility_samples, false)
 }
 
 /// [`compute_throughput`], taking V = 1 without tracing when `visible`
@@ -157,10 +156,15 @@ pub(crate) fn compute_throughput_with(
     i: SidedElement,
     j: SidedElement,
     visibility_samples: u32,
-    ff_options: &FormFactorOptions,
     visible: bool,
 ) -> Throughput {
-    let ff = geom.form_factor_sided(i.element, i.side(), j.element, j.side(), ff_options);
+    let ff = geom.form_factor_sided(
+        i.element,
+        i.side(),
+        j.element,
+        j.side(),
+        &FORM_FACTOR_OPTIONS,
+    );
     let (f, spread) = (ff.value, ff.spread);
     if !(f.is_finite() && f > 0.0) {
         return Throughput::default();
