@@ -939,8 +939,6 @@ impl SceneGeometry {
         let tol = opts.rel_tol.max(1e-14);
         let to_polys = self.element_polygons(to, st);
         let from_doms = self.element_domains(from, sf);
-        let mut lo = f64::INFINITY;
-        let mut hi = f64::NEG_INFINITY;
         let result = |v: f64, e: f64, lo: f64, hi: f64| FormFactor {
             value: v.max(0.0),
             error: e,
@@ -961,6 +959,8 @@ impl SceneGeometry {
             let (v, e, lo, hi) = integrate_pairs(fd, td, tol, depth + 2);
             return result(v / a_from, e / a_from, lo, hi);
         }
+        let mut lo = f64::INFINITY;
+        let mut hi = f64::NEG_INFINITY;
         // Sampled estimate (large clusters): stratified points on the
         // integrated side; one point per piece when the cluster has at least
         // `samples` pieces.
