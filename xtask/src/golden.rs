@@ -21,7 +21,8 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 use trilux_render::{
-    Comparison, ExtraBounce, Image, RenderSettings, ViewOverrides, compare, solve_and_render,
+    Comparison, ExtraBounce, Image, Observer, Plan, RenderPlan, RenderSettings, SolutionSource,
+    ViewOverrides, compare,
 };
 use trilux_solver::{Quality, SolverSettings};
 
@@ -93,11 +94,11 @@ pub fn references(only: &[String]) -> Result<Vec<Reference>> {
 
 /// One trilux run: solve plus render of `scenes/NAME.xml` at the given
 /// size, quality preset and samples per pixel, in-process through
-/// `trilux_render::solve_and_render` (the same code the command runs).
+/// `trilux_render::pipeline::run` (the same code the command runs).
 pub struct TriluxRun {
     /// The rendered image.
     pub image: Image,
-    /// Seconds of the solve.
+    /// Seconds of the solve, preparing the scene included.
     pub solve_seconds: f64,
     /// Seconds of the render.
     pub render_seconds: f64,
@@ -134,13 +135,19 @@ pub fn render_trilux(
         height: Some(height),
         ..Default::default()
     };
-    let (image, stats) =
-        solve_and_render(&scene, SolverSettings::preset(quality), &view, &settings)?;
+    let plan = Plan {
+        mode: scene.mode(),
+        solver: SolverSettings::preset(quality),
+        source: SolutionSource::Solve,
+        save: None,
+        render: Some(RenderPlan { view, settings }),
+    };
+    let outcome = Observer::quiet(|o| trilux_render::pipeline::run(&scene, &plan, o))?;
     Ok(TriluxRun {
-        image,
-        solve_seconds: stats.solve_seconds,
-        render_seconds: stats.render.seconds,
-        convergence_ratio: stats.solve.convergence_ratio,
+        image: outcome.image.context("the plan renders")?,
+        solve_seconds: outcome.prepare_seconds + outcome.solve_seconds,
+        render_seconds: outcome.render_seconds,
+        convergence_ratio: outcome.solve.convergence_ratio,
     })
 }
 

@@ -10,7 +10,8 @@
 use glam::DVec3;
 use trilux_color::Spectrum;
 
-use crate::bsdf::{Bsdf, Side};
+use crate::bsdf::Bsdf;
+use trilux_geometry::Side;
 
 /// Samples per side: θ = 0°, 1°, …, 90° (the last one evaluated at 89.95°).
 const STEPS: usize = 91;
@@ -52,7 +53,7 @@ impl<const N: usize> AlbedoTable<N> {
     /// Directional albedo for viewer direction `wo` (local frame), linear in
     /// θ between the tabulated degrees; zero exactly in the tangent plane.
     pub fn albedo(&self, wo: DVec3) -> Spectrum<N> {
-        let Some(side) = Side::of(wo) else {
+        let Some(side) = Side::of_local(wo) else {
             return Spectrum::zero();
         };
         let t = match side {

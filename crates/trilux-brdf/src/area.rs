@@ -19,8 +19,9 @@
 use glam::DVec3;
 use trilux_color::Spectrum;
 
-use crate::bsdf::{Bsdf, Side};
+use crate::bsdf::Bsdf;
 use crate::frame::{Frame, reflect};
+use trilux_geometry::Side;
 
 /// An element seen as points: what the BRDF variation estimate needs.
 #[derive(Clone, Copy, Debug)]

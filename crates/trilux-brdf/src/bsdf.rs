@@ -9,35 +9,13 @@
 //! seen from the back, as in Mitsuba.
 
 use glam::{DVec2, DVec3};
-use serde::{Deserialize, Serialize};
 use trilux_color::{ColorParam, Spectrum};
+use trilux_geometry::Side;
 
 use crate::error::BrdfError;
 use crate::lobe::{Conductor, Lobe};
 use crate::microfacet::Microfacet;
 use crate::params::BsdfParams;
-
-/// Which side of a surface: the front is where its normal points.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
-pub enum Side {
-    /// The side the normal points to.
-    Front,
-    /// The other side.
-    Back,
-}
-
-impl Side {
-    /// The side a local direction lies on (`None` exactly in the plane).
-    pub fn of(w: DVec3) -> Option<Side> {
-        if w.z > 0.0 {
-            Some(Side::Front)
-        } else if w.z < 0.0 {
-            Some(Side::Back)
-        } else {
-            None
-        }
-    }
-}
 
 /// A sampled light direction for a given viewer direction.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -137,6 +115,12 @@ impl<const N: usize> Bsdf<N> {
         }
     }
 
+    /// The smallest roughness α of a conductor part of one side (`None`
+    /// for a side without one, or a black back).
+    pub fn min_alpha(&self, side: Side) -> Option<f64> {
+        self.side(side).and_then(Lobe::min_alpha)
+    }
+
     fn side(&self, side: Side) -> Option<&Lobe<N>> {
         match side {
             Side::Front => self.front.as_ref(),
@@ -148,7 +132,7 @@ impl<const N: usize> Bsdf<N> {
     /// into its upper hemisphere; `None` for opposite sides or a black side.
     fn oriented(&self, wi: DVec3, wo: DVec3) -> Option<(&Lobe<N>, DVec3, DVec3)> {
         let flip = |v: DVec3| DVec3::new(v.x, v.y, -v.z);
-        match Side::of(wo)? {
+        match Side::of_local(wo)? {
             Side::Front if wi.z > 0.0 => self.front.as_ref().map(|l| (l, wi, wo)),
             Side::Back if wi.z < 0.0 => self.back.as_ref().map(|l| (l, flip(wi), flip(wo))),
             _ => None,
@@ -206,7 +190,7 @@ impl<const N: usize> Bsdf<N> {
     /// sample carries nothing (back side of a one-sided material, a
     /// microfacet sample below the horizon).
     pub fn sample(&self, wo: DVec3, u: DVec2) -> Option<BsdfSample<N>> {
-        let side = Side::of(wo)?;
+        let side = Side::of_local(wo)?;
         let l = self.side(side)?;
         let sign = if side == Side::Front { 1.0 } else { -1.0 };
         let wo_l = DVec3::new(wo.x, wo.y, wo.z * sign);
@@ -244,7 +228,7 @@ impl<const N: usize> Bsdf<N> {
     /// fraction of light arriving from all directions (or, by reciprocity,
     /// leaving towards all directions) that is reflected. ≤ 1 per band.
     pub fn albedo(&self, wo: DVec3) -> Spectrum<N> {
-        let Some(side) = Side::of(wo) else {
+        let Some(side) = Side::of_local(wo) else {
             return Spectrum::zero();
         };
         match self.side(side) {

@@ -1,8 +1,9 @@
 //! # trilux-brdf — reflectance
 //!
-//! Layer: depends on `trilux-color` (spectra) and `glam`; nothing here parses
-//! files or knows about elements beyond points and normals (so it can be
-//! used alone). Every model is defined exactly as Mitsuba 3 defines it.
+//! Layer: depends on `trilux-color` (spectra), `trilux-geometry` (only for
+//! [`Side`], the face of a surface) and `glam`; nothing here parses files or
+//! knows about elements beyond points and normals (so it can be used
+//! without the solver). Every model is defined exactly as Mitsuba 3 defines it.
 //!
 //! Contents, in reading order:
 //! - [`params`]: material parameters as plain data ([`BsdfParams`]), the
@@ -21,7 +22,8 @@
 //! - [`albedo`]: [`AlbedoTable`], the directional albedo tabulated per
 //!   degree for frequent use.
 //! - [`area`]: area reflectance R(I→J→K) = π F_JI fr (paper Eq. 5) and the
-//!   BRDF variation estimate over three elements (notes §2).
+//!   BRDF variation estimate over three elements (docs/solver.md,
+//!   "Refinement").
 #![forbid(unsafe_code)]
 // Band loops index several arrays in step; iterators would hide that.
 #![allow(clippy::needless_range_loop)]
@@ -39,7 +41,8 @@ pub mod special;
 
 pub use albedo::AlbedoTable;
 pub use area::{AreaReflectance, BrdfVariation, ElementPoints, area_reflectance, brdf_variation};
-pub use bsdf::{Bsdf, BsdfSample, Side};
+pub use bsdf::{Bsdf, BsdfSample};
 pub use error::BrdfError;
 pub use frame::Frame;
 pub use params::{BsdfParams, Distribution, RoughConductorParams};
+pub use trilux_geometry::Side;

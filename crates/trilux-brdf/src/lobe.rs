@@ -224,6 +224,27 @@ impl<const N: usize> Lobe<N> {
         }
     }
 
+    /// The smallest roughness α of a conductor part with non-zero weight
+    /// (`None` when there is none): the narrowest lobe this side has.
+    pub fn min_alpha(&self) -> Option<f64> {
+        match self {
+            Lobe::Diffuse { .. } => None,
+            Lobe::Conductor(c) => Some(c.microfacet.alpha),
+            Lobe::Blend {
+                weight,
+                first,
+                second,
+            } => {
+                let a = (*weight < 1.0).then(|| first.min_alpha()).flatten();
+                let b = (*weight > 0.0).then(|| second.min_alpha()).flatten();
+                match (a, b) {
+                    (Some(x), Some(y)) => Some(x.min(y)),
+                    (x, y) => x.or(y),
+                }
+            }
+        }
+    }
+
     /// True when this side reflects nothing.
     pub fn is_black(&self) -> bool {
         match self {

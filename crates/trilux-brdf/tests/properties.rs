@@ -102,7 +102,7 @@ proptest! {
         let gl = b3.eval_glossy(wi, wo);
         prop_assert!(gl.is_finite() && gl.is_non_negative());
         // fr = diffuse constant + glossy part, on the reflecting side.
-        if let Some(side) = Side::of(wo).filter(|_| wi.z * wo.z > 0.0) {
+        if let Some(side) = Side::of_local(wo).filter(|_| wi.z * wo.z > 0.0) {
             let sum = b3.diffuse_reflectance(side) + gl;
             for c in 0..3 {
                 prop_assert!((sum[c] - f[c]).abs() <= 1e-9 * f[c].max(1.0));

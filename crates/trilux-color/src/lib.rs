@@ -38,6 +38,6 @@ pub use bands::Bands;
 pub use cie::SampledSpectrum;
 pub use convert::Role;
 pub use error::ColorError;
-pub use mode::{Mode, SPECTRAL_BANDS};
+pub use mode::{Mode, SPECTRAL_BANDS, WithBands};
 pub use param::ColorParam;
-pub use spectrum::{Rgb, Spectrum, Spectrum10};
+pub use spectrum::{Rgb, Spectrum};

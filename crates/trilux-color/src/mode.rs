@@ -1,15 +1,25 @@
-//! RGB or spectral: how one solve carries light (design.md §2).
+//! RGB or spectral: how one solve carries light, and [`WithBands`], the one
+//! place that turns a [`Mode`] into a band count for code generic over it.
 
 use serde::{Deserialize, Serialize};
 
 use crate::param::ColorParam;
 
 /// Bands of spectral mode: 20 of 15 nm over 400–700 nm (the outer ones
-/// reaching 360 and 830 nm). The paper used 10 (design.md's default);
+/// reaching 360 and 830 nm). The paper used 10;
 /// against Mitsuba 3's continuous spectral rendering of the Cornell box,
 /// band averaging alone costs 0.73 % of the image mean with 10 bands and
 /// 0.33 % with 20, at no measurable solve cost (docs/results.md).
 pub const SPECTRAL_BANDS: usize = 20;
+
+/// Code to run with a band count chosen at run time ([`Mode::with_bands`]);
+/// closures cannot be generic over a const, so the code is a type.
+pub trait WithBands {
+    /// What the code returns.
+    type Output;
+    /// Runs with `N` bands.
+    fn run<const N: usize>(self) -> Self::Output;
+}
 
 /// How a solve carries light.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -31,7 +41,17 @@ impl Mode {
         }
     }
 
-    /// The mode a scene is solved in (design.md §2): spectral when some
+    /// Runs code generic over the band count with this mode's band count
+    /// (3 or [`SPECTRAL_BANDS`]): the one `match` from a runtime mode to a
+    /// compile-time `N`.
+    pub fn with_bands<F: WithBands>(self, f: F) -> F::Output {
+        match self {
+            Mode::Rgb => f.run::<3>(),
+            Mode::Spectral => f.run::<SPECTRAL_BANDS>(),
+        }
+    }
+
+    /// The mode a scene is solved in: spectral when some
     /// value is a sampled `<spectrum>` (wavelength:value pairs), RGB
     /// otherwise. A single-value `<spectrum>` does not make a scene spectral.
     pub fn for_values<'a>(values: impl IntoIterator<Item = &'a ColorParam>) -> Mode {

@@ -27,8 +27,6 @@ pub struct Spectrum<const N: usize>(pub [f64; N]);
 
 /// The RGB-mode spectrum (linear sRGB).
 pub type Rgb = Spectrum<3>;
-/// The spectral-mode spectrum of the paper (10 bands).
-pub type Spectrum10 = Spectrum<10>;
 
 impl<const N: usize> Spectrum<N> {
     /// The colour mode this band count stands for: 3 bands are RGB, any

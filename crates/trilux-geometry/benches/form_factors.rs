@@ -10,14 +10,17 @@ use std::hint::black_box;
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::{DMat4, DVec3};
 use scenes::*;
-use trilux_geometry::{ElementId, FormFactorOptions, SceneGeometry, Shape, ShapeKind};
+use trilux_geometry::{
+    ElementForest, ElementId, FaceElement, FormFactorOptions, Geometry, Shape, ShapeKind,
+    SurfaceId, Visibility, form_factor_batch, form_factor_front,
+};
 
 /// All ordered pairs of elements at depth `depth` of different surfaces
 /// whose centres face each other.
-fn facing_pairs(geom: &mut SceneGeometry, depth: u32, limit: usize) -> Vec<(ElementId, ElementId)> {
+fn facing_pairs(geom: &mut ElementForest, depth: u32, limit: usize) -> Vec<(ElementId, ElementId)> {
     let mut elems = Vec::new();
-    for s in 0..geom.surfaces().len() {
-        let mut f = vec![geom.surfaces()[s].root];
+    for s in 0..geom.geometry().surfaces().len() {
+        let mut f = vec![geom.root(SurfaceId(s as u32))];
         for _ in 0..depth {
             f = f.into_iter().flat_map(|e| geom.subdivide(e)).collect();
         }
@@ -40,19 +43,23 @@ fn facing_pairs(geom: &mut SceneGeometry, depth: u32, limit: usize) -> Vec<(Elem
 fn bench_pairs(
     c: &mut Criterion,
     name: &str,
-    geom: &SceneGeometry,
+    geom: &ElementForest,
     pairs: &[(ElementId, ElementId)],
 ) {
     let mut group = c.benchmark_group(name);
     group.sample_size(10);
     group.throughput(Throughput::Elements(pairs.len() as u64));
     let opts = FormFactorOptions::default();
+    let faces: Vec<(FaceElement, FaceElement)> = pairs
+        .iter()
+        .map(|&(a, b)| (FaceElement::front(a), FaceElement::front(b)))
+        .collect();
     group.bench_function("form_factor/1t", |b| {
         b.iter(|| {
             black_box(
                 pairs
                     .iter()
-                    .map(|&(x, y)| geom.form_factor(x, y).value)
+                    .map(|&(x, y)| form_factor_front(geom, x, y).value)
                     .sum::<f64>(),
             )
         })
@@ -62,14 +69,20 @@ fn bench_pairs(
         .build()
         .expect("thread pool");
     group.bench_function("form_factor/2t", |b| {
-        b.iter(|| pool.install(|| black_box(geom.form_factor_batch(pairs, &opts))))
+        b.iter(|| pool.install(|| black_box(form_factor_batch(geom, &faces, &opts))))
     });
     group.bench_function("visibility16/1t", |b| {
         b.iter(|| {
             black_box(
                 pairs
                     .iter()
-                    .map(|&(x, y)| geom.visibility(x, y, 16))
+                    .map(|&(x, y)| {
+                        Visibility::new(geom, None).fraction(
+                            FaceElement::front(x),
+                            FaceElement::front(y),
+                            16,
+                        )
+                    })
                     .sum::<f64>(),
             )
         })
@@ -78,7 +91,7 @@ fn bench_pairs(
 }
 
 fn form_factors(c: &mut Criterion) {
-    let mut geom = SceneGeometry::build(&cornell_box()).expect("valid scene");
+    let mut geom = ElementForest::new(Geometry::build_shared(&cornell_box()).expect("valid scene"));
     let pairs = facing_pairs(&mut geom, 2, 2000);
     eprintln!(
         "cornell box: {} planar element pairs at depth 2",
@@ -110,7 +123,7 @@ fn form_factors(c: &mut Criterion) {
             flip_normals: false,
         },
     ];
-    let mut geom = SceneGeometry::build(&curved).expect("valid scene");
+    let mut geom = ElementForest::new(Geometry::build_shared(&curved).expect("valid scene"));
     let pairs = facing_pairs(&mut geom, 1, 2000);
     eprintln!(
         "sphere, cylinder, disk: {} curved element pairs at depth 1",
@@ -118,7 +131,8 @@ fn form_factors(c: &mut Criterion) {
     );
     bench_pairs(c, "ff_curved", &geom, &pairs);
 
-    let mut geom = SceneGeometry::build(&sphere_in_box(32)).expect("valid scene");
+    let mut geom =
+        ElementForest::new(Geometry::build_shared(&sphere_in_box(32)).expect("valid scene"));
     let pairs = facing_pairs(&mut geom, 2, 2000);
     eprintln!(
         "tessellated sphere (charts) in a box: {} pairs at depth 2",

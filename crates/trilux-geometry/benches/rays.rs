@@ -11,13 +11,13 @@ use std::hint::black_box;
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::{DVec2, DVec3};
 use scenes::*;
-use trilux_geometry::{Ray, SceneGeometry, SurfaceId};
+use trilux_geometry::{ElementForest, Geometry, Ray, SurfaceId};
 
 const RAYS: usize = 200_000;
 
 /// Incoherent rays from random points inside the box in random directions,
 /// and segments between random pairs of such points.
-fn workload(geom: &SceneGeometry, seed: u64) -> (Vec<Ray>, Vec<(DVec3, DVec3)>) {
+fn workload(geom: &Geometry, seed: u64) -> (Vec<Ray>, Vec<(DVec3, DVec3)>) {
     let mut rng = Rng(seed);
     let b = geom.bounds();
     let (lo, hi) = (b.min + 0.05 * b.diagonal(), b.max - 0.05 * b.diagonal());
@@ -35,12 +35,12 @@ fn workload(geom: &SceneGeometry, seed: u64) -> (Vec<Ray>, Vec<(DVec3, DVec3)>) 
 
 /// Gather-like rays: from points sampled on the surfaces, into their front
 /// hemisphere; shadow segments between points on two random surfaces.
-fn surface_workload(geom: &SceneGeometry, seed: u64) -> (Vec<Ray>, Vec<(DVec3, DVec3)>) {
+fn surface_workload(forest: &ElementForest, seed: u64) -> (Vec<Ray>, Vec<(DVec3, DVec3)>) {
     let mut rng = Rng(seed);
-    let n = geom.surfaces().len();
+    let n = forest.geometry().surfaces().len();
     let point = |rng: &mut Rng| {
         let s = SurfaceId(((rng.next_f64() * n as f64) as usize).min(n - 1) as u32);
-        geom.sample_surface(s, DVec2::new(rng.next_f64(), rng.next_f64()))
+        forest.sample_surface(s, DVec2::new(rng.next_f64(), rng.next_f64()))
     };
     let rays = (0..RAYS)
         .map(|_| {
@@ -61,7 +61,7 @@ fn surface_workload(geom: &SceneGeometry, seed: u64) -> (Vec<Ray>, Vec<(DVec3, D
 fn bench_scene(
     c: &mut Criterion,
     name: &str,
-    geom: &SceneGeometry,
+    geom: &Geometry,
     rays: &[Ray],
     segs: &[(DVec3, DVec3)],
 ) {
@@ -85,7 +85,7 @@ fn bench_scene(
 
 fn rays(c: &mut Criterion) {
     let t0 = std::time::Instant::now();
-    let geom = SceneGeometry::build(&sphere_in_box(160)).expect("valid scene");
+    let geom = Geometry::build(&sphere_in_box(160)).expect("valid scene");
     eprintln!(
         "sphere in a box: {} primitives, {} input surfaces, built in {:.2} s",
         geom.primitive_count(),
@@ -100,14 +100,15 @@ fn rays(c: &mut Criterion) {
     eprintln!("  {hits} of {} closest-hit rays hit", r.len());
     bench_scene(c, "sphere_in_box_102k", &geom, &r, &s);
 
-    let geom = SceneGeometry::build(&cornell_box()).expect("valid scene");
+    let forest = ElementForest::new(Geometry::build_shared(&cornell_box()).expect("valid scene"));
+    let geom = forest.geometry();
     eprintln!(
         "cornell box: {} primitives, {} input surfaces",
         geom.primitive_count(),
         geom.surfaces().len()
     );
-    let (r, s) = surface_workload(&geom, 2);
-    bench_scene(c, "cornell_box", &geom, &r, &s);
+    let (r, s) = surface_workload(&forest, 2);
+    bench_scene(c, "cornell_box", geom, &r, &s);
 }
 
 criterion_group!(benches, rays);

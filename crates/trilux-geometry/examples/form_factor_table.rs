@@ -4,7 +4,10 @@
 //! Run: `cargo run -p trilux-geometry --release --example form_factor_table`
 
 use glam::{DMat4, DVec3};
-use trilux_geometry::{FormFactorOptions, SceneGeometry, Shape, ShapeKind};
+use trilux_geometry::{
+    ElementForest, FaceElement, FormFactorOptions, Geometry, Shape, ShapeKind, SurfaceId,
+    form_factor, form_factor_front,
+};
 
 fn rect(c: DVec3, hu: DVec3, hv: DVec3, flip: bool) -> Shape {
     let n = hu.cross(hv).normalize();
@@ -34,14 +37,15 @@ fn disk(c: DVec3, r: f64, flip: bool) -> Shape {
 }
 
 fn row(name: &str, shapes: &[Shape], exact: f64) -> Result<(), trilux_geometry::GeometryError> {
-    let g = SceneGeometry::build(shapes)?;
-    let (a, b) = (g.surfaces()[0].root, g.surfaces()[1].root);
+    let g = ElementForest::new(Geometry::build_shared(shapes)?);
+    let (a, b) = (g.root(SurfaceId(0)), g.root(SurfaceId(1)));
     let t0 = std::time::Instant::now();
-    let f = g.form_factor(a, b);
+    let f = form_factor_front(&g, a, b);
     let dt = t0.elapsed().as_secs_f64() * 1e6;
-    let tight = g.form_factor_with(
-        a,
-        b,
+    let tight = form_factor(
+        &g,
+        FaceElement::front(a),
+        FaceElement::front(b),
         &FormFactorOptions {
             rel_tol: 1e-7,
             max_depth: 12,

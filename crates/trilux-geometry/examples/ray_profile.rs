@@ -4,7 +4,7 @@
 //! Run: `cargo run -p trilux-geometry --release --example ray_profile`
 
 use glam::{DMat4, DVec3};
-use trilux_geometry::{Ray, SceneGeometry, Shape, ShapeKind, TriangleMesh};
+use trilux_geometry::{Geometry, Ray, Shape, ShapeKind, TriangleMesh};
 
 fn main() -> Result<(), trilux_geometry::GeometryError> {
     let n = 160u32;
@@ -47,7 +47,7 @@ fn main() -> Result<(), trilux_geometry::GeometryError> {
         },
     ];
     let t0 = std::time::Instant::now();
-    let g = SceneGeometry::build(&shapes)?;
+    let g = Geometry::build(&shapes)?;
     println!(
         "build: {:.2} s, {} primitives, {} input surfaces",
         t0.elapsed().as_secs_f64(),

@@ -5,7 +5,10 @@
 //! Run: `cargo run -p trilux-geometry --release --example two_squares`
 
 use glam::{DMat4, DVec4};
-use trilux_geometry::{SceneGeometry, Shape, ShapeKind};
+use trilux_geometry::{
+    ElementForest, FaceElement, Geometry, Shape, ShapeKind, SurfaceId, Visibility,
+    form_factor_front,
+};
 
 /// The rectangle [-1,1]² scaled by `half`, at height `z`, facing down if
 /// `flip`.
@@ -23,21 +26,31 @@ fn square(half: f64, z: f64, flip: bool) -> Shape {
 }
 
 fn main() -> Result<(), trilux_geometry::GeometryError> {
-    let geom = SceneGeometry::build(&[square(0.5, 0.0, false), square(0.5, 1.0, true)])?;
-    let (a, b) = (geom.surfaces()[0].root, geom.surfaces()[1].root);
-    let f = geom.form_factor(a, b);
+    let geom = ElementForest::new(Geometry::build_shared(&[
+        square(0.5, 0.0, false),
+        square(0.5, 1.0, true),
+    ])?);
+    let (a, b) = (geom.root(SurfaceId(0)), geom.root(SurfaceId(1)));
+    let f = form_factor_front(&geom, a, b);
     println!(
         "F(square → square) = {:.6} ± {:.1e}   closed form 0.199825",
         f.value, f.error
     );
-    println!("visibility         = {:.3}", geom.visibility(a, b, 64));
+    println!(
+        "visibility         = {:.3}",
+        Visibility::new(&geom, None).fraction(FaceElement::front(a), FaceElement::front(b), 64)
+    );
 
-    let blocked = SceneGeometry::build(&[
+    let blocked = ElementForest::new(Geometry::build_shared(&[
         square(0.5, 0.0, false),
         square(0.5, 1.0, true),
         square(0.25, 0.5, false),
-    ])?;
-    let v = blocked.visibility(a, b, 1024);
+    ])?);
+    let v = Visibility::new(&blocked, None).fraction(
+        FaceElement::front(a),
+        FaceElement::front(b),
+        1024,
+    );
     println!("with a 0.5×0.5 blocker halfway: visibility = {v:.3}");
     Ok(())
 }

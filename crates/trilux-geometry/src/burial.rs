@@ -9,10 +9,10 @@
 //! would send a share of that light from its covered part, into the box,
 //! where it is lost: a systematic energy sink at every contact, which
 //! refinement shrinks only linearly. A [`BurialMap`] marks the covered
-//! parts once, so that shadow segments from or to a buried point count as
-//! blocked ([`SceneGeometry::visibility_sided`]) and the solver spreads an
-//! element's light over its exposed area only
-//! ([`BurialMap::exposed_fraction`]).
+//! parts once ([`BurialMap::probe`]), so that shadow segments from or to a
+//! buried point count as blocked (it is handed to
+//! [`crate::Visibility`]) and the solver spreads an element's light over
+//! its exposed area only ([`BurialMap::exposed_fraction`]).
 //!
 //! **The test.** A point of a face is buried when each of 9 probe rays
 //! into the face's hemisphere (the normal, and 8 directions 60° from it)
@@ -31,18 +31,17 @@ use std::collections::HashMap;
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
-use crate::bvh::Ray;
 use crate::element::ElementDomain;
-use crate::form_factor::Side;
-use crate::ids::{ElementId, SurfaceId};
-use crate::scene_geometry::SceneGeometry;
+use crate::face::{FaceElement, FaceId, PerFace};
+use crate::forest::ElementForest;
+use crate::geometry::{Geometry, Ray};
 use crate::surface::{SurfaceCoord, SurfaceGeom};
 
 /// Which cells of which faces are buried.
 #[derive(Clone, Debug, Default)]
 pub struct BurialMap {
-    /// Indexed by 2 × surface + back; `None`: not probed (all exposed).
-    faces: Vec<Option<FaceBurial>>,
+    /// `None`: not probed (all exposed).
+    faces: PerFace<Option<FaceBurial>>,
 }
 
 #[derive(Clone, Debug)]
@@ -80,22 +79,31 @@ fn sub_triangle(bary: DVec2) -> usize {
 /// charts).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct BurialRequest {
-    /// The surface.
-    pub surface: SurfaceId,
-    /// Its face.
-    pub side: Side,
+    /// The face.
+    pub face: FaceId,
     /// Cells per side of the (u, v) grid.
     pub resolution: u32,
 }
 
-fn side_index(surface: SurfaceId, side: Side) -> usize {
-    2 * surface.index() + usize::from(side == Side::Back)
-}
-
 impl BurialMap {
-    /// True if the point `coord` of `surface`'s face `side` is buried.
-    pub fn is_buried(&self, surface: SurfaceId, side: Side, coord: SurfaceCoord) -> bool {
-        match (self.faces.get(side_index(surface, side)), coord) {
+    /// Probes the requested faces for buried parts (module docs), in
+    /// parallel.
+    pub fn probe(geom: &Geometry, requests: &[BurialRequest]) -> BurialMap {
+        let mut faces = PerFace::from_fn(geom.surfaces().len(), |_| None);
+        let probed: Vec<(FaceId, FaceBurial)> = requests
+            .par_iter()
+            .filter(|r| r.face.surface().index() < geom.surfaces().len())
+            .map(|r| (r.face, probe_face(geom, r)))
+            .collect();
+        for (face, f) in probed {
+            faces[face] = Some(f);
+        }
+        BurialMap { faces }
+    }
+
+    /// True if the point `coord` of face `face` is buried.
+    pub fn is_buried(&self, face: FaceId, coord: SurfaceCoord) -> bool {
+        match (self.faces.get(face), coord) {
             (Some(Some(FaceBurial::Grid { res, buried })), SurfaceCoord::Uv(uv)) => {
                 let r = *res as f64;
                 let i = ((uv.x * r) as i64).clamp(0, *res as i64 - 1) as usize;
@@ -114,7 +122,7 @@ impl BurialMap {
 
     /// True if no face has a buried cell.
     pub fn is_empty(&self) -> bool {
-        self.faces.iter().flatten().all(|f| match f {
+        self.faces.values().flatten().all(|f| match f {
             FaceBurial::Grid { buried, .. } => !buried.contains(&true),
             FaceBurial::Triangles { buried } => buried.values().all(|&b| b == 0),
         })
@@ -123,9 +131,9 @@ impl BurialMap {
     /// The exposed share of an element's face, in [0, 1] (1 where the face
     /// was not probed): the fraction of its grid cells (of its pieces'
     /// area, for chart clusters) that are not buried.
-    pub fn exposed_fraction(&self, geom: &SceneGeometry, id: ElementId, side: Side) -> f64 {
-        let e = geom.element(id);
-        let Some(Some(face)) = self.faces.get(side_index(e.surface, side)) else {
+    pub fn exposed_fraction(&self, forest: &ElementForest, fe: FaceElement) -> f64 {
+        let (id, e) = (fe.element, forest.element(fe.element));
+        let Some(Some(face)) = self.faces.get(FaceId::new(e.surface, fe.side)) else {
             return 1.0;
         };
         match (face, e.domain) {
@@ -148,11 +156,11 @@ impl BurialMap {
             }
             (FaceBurial::Triangles { buried }, ElementDomain::Cluster { .. }) => {
                 let (mut open, mut total) = (0.0, 0.0);
-                for p in geom.element_pieces(id) {
+                for p in forest.element_pieces(id) {
                     let [a, b, c] = p.bary;
                     // Sub-triangle area fraction × the triangle's area.
                     let w = 0.5 * ((b - a).perp_dot(c - a)).abs() * 2.0;
-                    let area = w * geom.triangle_area(e.surface, p.triangle);
+                    let area = w * forest.geometry().triangle_area(e.surface, p.triangle);
                     let centre = (a + b + c) / 3.0;
                     let bits = buried.get(&p.triangle).copied().unwrap_or(0);
                     total += area;
@@ -167,162 +175,128 @@ impl BurialMap {
     }
 }
 
-impl SceneGeometry {
-    /// Probes the requested faces for buried parts (module docs), in
-    /// parallel.
-    pub fn compute_burial(&self, requests: &[BurialRequest]) -> BurialMap {
-        let mut faces = vec![None; 2 * self.surfaces.len()];
-        let probed: Vec<(usize, FaceBurial)> = requests
-            .par_iter()
-            .filter(|r| r.surface.index() < self.surfaces.len())
-            .map(|r| (side_index(r.surface, r.side), self.probe_face(r)))
-            .collect();
-        for (i, f) in probed {
-            faces[i] = Some(f);
-        }
-        BurialMap { faces }
+/// Probes one face: a grid over (u, v) for parametric surfaces, four
+/// probes per triangle for charts.
+fn probe_face(geom: &Geometry, r: &BurialRequest) -> FaceBurial {
+    match &geom.surface(r.face.surface()).geom {
+        SurfaceGeom::Patch(_) => probe_grid(geom, r),
+        SurfaceGeom::Chart { mesh, .. } => probe_triangles(geom, r.face, *mesh),
     }
+}
 
-    /// Makes `map` the one [`SceneGeometry::visibility_sided`] consults.
-    pub fn set_burial(&mut self, map: BurialMap) {
-        self.burial = (!map.is_empty()).then_some(map);
+/// The centre of cell (i, j) of a `res` × `res` grid over (u, v).
+fn cell_centre(i: u32, j: u32, res: u32) -> DVec2 {
+    DVec2::new((i as f64 + 0.5) / res as f64, (j as f64 + 0.5) / res as f64)
+}
+
+/// A parametric face: one probe per coarse cell; where buried and exposed
+/// cells meet (a box's outline), FINE × FINE probes per cell, so that the
+/// cells straddling the outline, which send light into the box from their
+/// covered part, are few.
+fn probe_grid(geom: &Geometry, r: &BurialRequest) -> FaceBurial {
+    const FINE: u32 = 4;
+    let surface = r.face.surface();
+    let s = geom.surface(surface);
+    let sign = r.face.side().sign();
+    let coarse = r.resolution.clamp(1, 256);
+    // Cells are about sqrt(area)/res across.
+    let reach = s.area.sqrt() / coarse as f64;
+    let probe_uv = |uv: DVec2| {
+        geom.surface_point(surface, SurfaceCoord::Uv(uv))
+            .is_some_and(|p| probe(geom, p.point, p.normal * sign, s.shape, reach))
+    };
+    let first: Vec<bool> = (0..coarse * coarse)
+        .map(|c| probe_uv(cell_centre(c % coarse, c / coarse, coarse)))
+        .collect();
+    if !first.contains(&true) {
+        return FaceBurial::Grid {
+            res: coarse,
+            buried: first,
+        };
     }
-
-    /// The burial map in use, if any face has buried parts.
-    pub fn burial(&self) -> Option<&BurialMap> {
-        self.burial.as_ref()
-    }
-
-    /// The exposed share of an element's face (1 without a burial map).
-    pub fn exposed_fraction(&self, id: ElementId, side: Side) -> f64 {
-        self.burial
-            .as_ref()
-            .map_or(1.0, |m| m.exposed_fraction(self, id, side))
-    }
-
-    pub(crate) fn triangle_area(&self, surface: SurfaceId, tri: u32) -> f64 {
-        match &self.surfaces[surface.index()].geom {
-            SurfaceGeom::Chart { mesh } => self.meshes[*mesh as usize]
-                .tri_area
-                .get(tri as usize)
-                .copied()
-                .unwrap_or(0.0),
-            SurfaceGeom::Patch(_) => 0.0,
-        }
-    }
-
-    fn probe_face(&self, r: &BurialRequest) -> FaceBurial {
-        let s = &self.surfaces[r.surface.index()];
-        let sign = r.side.sign();
-        match &s.geom {
-            SurfaceGeom::Patch(_) => {
-                let coarse = r.resolution.clamp(1, 256);
-                // Cells are about sqrt(area)/res across.
-                let reach = s.area.sqrt() / coarse as f64;
-                let probe_uv = |uv: DVec2| {
-                    self.surface_point(r.surface, SurfaceCoord::Uv(uv))
-                        .is_some_and(|p| self.probe(p.point, p.normal * sign, s.shape, reach))
-                };
-                let centre = |i: u32, j: u32, res: u32| {
-                    DVec2::new((i as f64 + 0.5) / res as f64, (j as f64 + 0.5) / res as f64)
-                };
-                let first: Vec<bool> = (0..coarse * coarse)
-                    .map(|c| probe_uv(centre(c % coarse, c / coarse, coarse)))
-                    .collect();
-                if !first.contains(&true) {
-                    return FaceBurial::Grid {
-                        res: coarse,
-                        buried: first,
+    let at = |i: i64, j: i64| -> Option<bool> {
+        (i >= 0 && j >= 0 && i < coarse as i64 && j < coarse as i64)
+            .then(|| first[(j * coarse as i64 + i) as usize])
+    };
+    let res = coarse * FINE;
+    let mut buried = vec![false; (res * res) as usize];
+    for j in 0..coarse {
+        for i in 0..coarse {
+            let here = first[(j * coarse + i) as usize];
+            let boundary = (-1..=1).any(|dj| {
+                (-1..=1).any(|di| at(i as i64 + di, j as i64 + dj).is_some_and(|b| b != here))
+            });
+            for sj in 0..FINE {
+                for si in 0..FINE {
+                    let (fi, fj) = (i * FINE + si, j * FINE + sj);
+                    buried[(fj * res + fi) as usize] = if boundary {
+                        probe_uv(cell_centre(fi, fj, res))
+                    } else {
+                        here
                     };
                 }
-                // Where buried and exposed cells meet (a box's outline), probe
-                // again FINE × FINE times finer, so that the cells that
-                // straddle the outline, which send light into the box from
-                // their covered part, are few.
-                const FINE: u32 = 4;
-                let res = coarse * FINE;
-                let at = |i: i64, j: i64| -> Option<bool> {
-                    (i >= 0 && j >= 0 && i < coarse as i64 && j < coarse as i64)
-                        .then(|| first[(j * coarse as i64 + i) as usize])
-                };
-                let mut buried = vec![false; (res * res) as usize];
-                for j in 0..coarse {
-                    for i in 0..coarse {
-                        let here = first[(j * coarse + i) as usize];
-                        let boundary = (-1..=1).any(|dj| {
-                            (-1..=1).any(|di| {
-                                at(i as i64 + di, j as i64 + dj).is_some_and(|b| b != here)
-                            })
-                        });
-                        for sj in 0..FINE {
-                            for si in 0..FINE {
-                                let (fi, fj) = (i * FINE + si, j * FINE + sj);
-                                buried[(fj * res + fi) as usize] = if boundary {
-                                    probe_uv(centre(fi, fj, res))
-                                } else {
-                                    here
-                                };
-                            }
-                        }
-                    }
-                }
-                FaceBurial::Grid { res, buried }
-            }
-            SurfaceGeom::Chart { mesh } => {
-                let m = &self.meshes[*mesh as usize];
-                let mut buried = HashMap::new();
-                for (t, &owner) in m.tri_surface.iter().enumerate() {
-                    if owner != r.surface.0 {
-                        continue;
-                    }
-                    let reach = (0.25 * m.tri_area[t]).sqrt();
-                    let mut bits = 0u8;
-                    for (k, &(b1, b2)) in SUB_CENTROIDS.iter().enumerate() {
-                        let coord = SurfaceCoord::Triangle {
-                            index: t as u32,
-                            bary: DVec2::new(b1, b2),
-                        };
-                        if self
-                            .surface_point(r.surface, coord)
-                            .is_some_and(|p| self.probe(p.point, p.normal * sign, s.shape, reach))
-                        {
-                            bits |= 1 << k;
-                        }
-                    }
-                    if bits != 0 {
-                        buried.insert(t as u32, bits);
-                    }
-                }
-                FaceBurial::Triangles { buried }
             }
         }
     }
+    FaceBurial::Grid { res, buried }
+}
 
-    /// True if every probe ray from `p` into the hemisphere of `n` meets
-    /// another shape within `reach`.
-    fn probe(&self, p: DVec3, n: DVec3, own_shape: u32, reach: f64) -> bool {
-        if !(p.is_finite() && n.is_finite() && reach > 0.0) {
+/// A chart's face: one probe per midpoint sub-triangle of each triangle.
+fn probe_triangles(geom: &Geometry, face: FaceId, mesh: u32) -> FaceBurial {
+    let surface = face.surface();
+    let shape = geom.surface(surface).shape;
+    let sign = face.side().sign();
+    let m = &geom.meshes[mesh as usize];
+    let mut buried = HashMap::new();
+    for (t, &owner) in m.tri_surface.iter().enumerate() {
+        if owner != surface.0 {
+            continue;
+        }
+        let reach = (0.25 * m.tri_area[t]).sqrt();
+        let mut bits = 0u8;
+        for (k, &(b1, b2)) in SUB_CENTROIDS.iter().enumerate() {
+            let coord = SurfaceCoord::Triangle {
+                index: t as u32,
+                bary: DVec2::new(b1, b2),
+            };
+            if geom
+                .surface_point(surface, coord)
+                .is_some_and(|p| probe(geom, p.point, p.normal * sign, shape, reach))
+            {
+                bits |= 1 << k;
+            }
+        }
+        if bits != 0 {
+            buried.insert(t as u32, bits);
+        }
+    }
+    FaceBurial::Triangles { buried }
+}
+
+/// True if every probe ray from `p` into the hemisphere of `n` meets
+/// another shape within `reach`.
+fn probe(geom: &Geometry, p: DVec3, n: DVec3, own_shape: u32, reach: f64) -> bool {
+    if !(p.is_finite() && n.is_finite() && reach > 0.0) {
+        return false;
+    }
+    // Start a hair behind the face so that a coincident face is met.
+    let behind = 1e-6 * geom.extent();
+    let origin = p - n * behind;
+    let (t, b) = n.any_orthonormal_pair();
+    let (sin, cos) = (60f64.to_radians().sin(), 60f64.to_radians().cos());
+    let dirs = std::iter::once(n).chain((0..8).map(|k| {
+        let phi = k as f64 * std::f64::consts::FRAC_PI_4;
+        cos * n + sin * (phi.cos() * t + phi.sin() * b)
+    }));
+    for d in dirs {
+        // Distances count from the face, not from the probe's origin.
+        let t_max = reach + behind / d.dot(n).max(1e-3);
+        if geom
+            .intersect_ignoring(&Ray { origin, dir: d }, t_max, own_shape)
+            .is_none()
+        {
             return false;
         }
-        // Start a hair behind the face so that a coincident face is met.
-        let behind = 1e-6 * self.extent;
-        let origin = p - n * behind;
-        let (t, b) = n.any_orthonormal_pair();
-        let (sin, cos) = (60f64.to_radians().sin(), 60f64.to_radians().cos());
-        let dirs = std::iter::once(n).chain((0..8).map(|k| {
-            let phi = k as f64 * std::f64::consts::FRAC_PI_4;
-            cos * n + sin * (phi.cos() * t + phi.sin() * b)
-        }));
-        for d in dirs {
-            // Distances count from the face, not from the probe's origin.
-            let t_max = reach + behind / d.dot(n).max(1e-3);
-            if self
-                .intersect_ignoring(&Ray { origin, dir: d }, t_max, own_shape)
-                .is_none()
-            {
-                return false;
-            }
-        }
-        true
     }
+    true
 }

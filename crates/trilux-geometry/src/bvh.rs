@@ -28,62 +28,19 @@
 //!   (discriminant from the perpendicular distance, Haines et al., Ray
 //!   Tracing Gems ch. 7), disk by the plane z = 0. The whole sphere (tube)
 //!   is one primitive, so the seams between its pieces cannot leak.
-//! - **Self-intersection.** A ray ignores hits closer than
-//!   ε = [`RAY_EPSILON`] × (|origin|∞ + scene extent), measured along the
-//!   ray; [`SceneGeometry::occluded`] ignores the same distance at both ends.
-//!   In f64 the re-hit of a ray's own surface lies within ~1e-15 × |origin|
-//!   / cos θ of the origin, so ε = 1e-9 relative absorbs it for any ray more
-//!   than ~1e-6 rad from grazing, while staying far below any real feature.
+//! - **Self-intersection** is the caller's: every query takes the ray
+//!   interval (tmin, tmax), and [`crate::Geometry`] sets tmin from its
+//!   relative epsilon ([`crate::RAY_EPSILON`]).
+//!
+//! This module knows primitives only; [`crate::Geometry`] turns a
+//! [`PrimHit`] into a hit on an input surface.
 
 use glam::{DVec2, DVec3, Vec3A};
 use obvhs::{BvhBuildParams, aabb::Aabb, cwbvh::CwBvh, cwbvh::builder::build_cwbvh, ray::RayHit};
-use rayon::prelude::*;
 
 use crate::bounds::Bounds;
-use crate::ids::SurfaceId;
-use crate::patch::{Patch, angle_2pi, half, inverse_bilinear, quarter};
-use crate::scene_geometry::SceneGeometry;
-use crate::surface::{SurfaceCoord, SurfaceGeom};
+use crate::patch::{angle_2pi, half, quarter};
 use crate::transform::Affine;
-
-/// Relative self-intersection epsilon (see the module docs).
-pub const RAY_EPSILON: f64 = 1e-9;
-
-/// A ray: points `origin + t · dir` for t > 0. `dir` need not be unit
-/// length; `t` is measured in units of `dir`.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Ray {
-    /// Start point.
-    pub origin: DVec3,
-    /// Direction (non-zero).
-    pub dir: DVec3,
-}
-
-/// The closest intersection of a ray with the scene.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Hit {
-    /// The input surface hit.
-    pub surface: SurfaceId,
-    /// Where on that surface.
-    pub coord: SurfaceCoord,
-    /// World-space hit point.
-    pub point: DVec3,
-    /// Front-side unit geometric normal of the surface (after
-    /// `flip_normals`), whichever side the ray arrived from.
-    pub geometric_normal: DVec3,
-    /// Unit shading normal (interpolated vertex normals of meshes, else the
-    /// geometric normal), on the front side.
-    pub shading_normal: DVec3,
-    /// Ray parameter of the hit, in units of `dir`.
-    pub t: f64,
-}
-
-impl Hit {
-    /// True if the ray arrived on the front side (`dir · n < 0`).
-    pub fn front_facing(&self, ray: &Ray) -> bool {
-        ray.dir.dot(self.geometric_normal) < 0.0
-    }
-}
 
 #[derive(Clone, Copy, Debug)]
 pub(crate) enum AnalyticKind {
@@ -110,24 +67,45 @@ pub(crate) struct Analytic {
     pub sign: f64,
 }
 
+/// What a triangle primitive belongs to.
 #[derive(Clone, Copy, Debug)]
 pub(crate) enum TriOwner {
     Mesh { mesh: u32, tri: u32 },
     Quad { surface: u32 },
 }
 
+/// A primitive of the BVH, with the scene shape it belongs to (so that a
+/// query can ignore one shape).
 #[derive(Clone, Copy, Debug)]
 pub(crate) enum Prim {
-    Tri { v: [DVec3; 3], owner: TriOwner },
-    Analytic(u32),
+    /// A triangle of a mesh or half of a planar quad.
+    Tri {
+        v: [DVec3; 3],
+        owner: TriOwner,
+        shape: u32,
+    },
+    /// A disk, sphere or cylinder: an index into the analytic shapes.
+    Analytic { index: u32, shape: u32 },
 }
 
-#[derive(Clone, Debug, Default)]
+impl Prim {
+    fn shape(&self) -> u32 {
+        match *self {
+            Prim::Tri { shape, .. } | Prim::Analytic { shape, .. } => shape,
+        }
+    }
+}
+
+#[derive(Clone, Debug)]
 pub(crate) struct Bvh {
     cw: Option<CwBvh>,
     /// Primitives in BVH order.
     prims: Vec<Prim>,
+    analytic: Vec<Analytic>,
+    /// Box padding: 4e-6 × the scene's extent.
     pad: f64,
+    /// The scene's box, to which rays are clipped before traversal.
+    bounds: Bounds,
 }
 
 struct BoxPrim(Aabb);
@@ -312,7 +290,7 @@ impl Analytic {
     }
 
     /// Surface, coordinate and front normal of the point at ray parameter t.
-    fn surface_at(&self, o: DVec3, d: DVec3, t: f64) -> (u32, DVec2, DVec3) {
+    pub(crate) fn surface_at(&self, o: DVec3, d: DVec3, t: f64) -> (u32, DVec2, DVec3) {
         let p = self.xf.object_from_world.transform_point3(o) + t * (self.xf.linear_inv * d);
         match self.kind {
             AnalyticKind::Disk => {
@@ -355,18 +333,42 @@ impl Analytic {
     }
 }
 
+/// Which primitive a closest-hit search found, and where.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct PrimHit {
+    /// Index of the primitive (BVH order).
+    pub prim: usize,
+    /// Ray parameter, in units of the query's direction.
+    pub t: f64,
+    /// Barycentrics (b1, b2) for triangles, zero for analytic shapes.
+    pub bary: DVec2,
+}
+
 impl Bvh {
-    pub(crate) fn build(prims: Vec<Prim>, analytic: &[Analytic], extent: f64) -> Bvh {
-        if prims.is_empty() {
-            return Bvh::default();
-        }
+    /// Builds the CWBVH over `prims` (PLOC, obvhs's medium preset), with
+    /// boxes padded by 4e-6 × `extent`.
+    pub(crate) fn build(
+        prims: Vec<Prim>,
+        analytic: Vec<Analytic>,
+        bounds: Bounds,
+        extent: f64,
+    ) -> Bvh {
         let pad = 4e-6 * extent;
+        if prims.is_empty() {
+            return Bvh {
+                cw: None,
+                prims,
+                analytic,
+                pad,
+                bounds,
+            };
+        }
         let boxes: Vec<BoxPrim> = prims
             .iter()
             .map(|p| {
                 let b = match p {
                     Prim::Tri { v, .. } => Bounds::from_points(*v),
-                    Prim::Analytic(a) => analytic[*a as usize].bounds(),
+                    Prim::Analytic { index, .. } => analytic[*index as usize].bounds(),
                 }
                 .padded(pad);
                 BoxPrim(Aabb::new(b.min.as_vec3a(), b.max.as_vec3a()))
@@ -385,7 +387,9 @@ impl Bvh {
         Bvh {
             cw: Some(cw),
             prims: ordered,
+            analytic,
             pad,
+            bounds,
         }
     }
 
@@ -393,27 +397,22 @@ impl Bvh {
     pub(crate) fn len(&self) -> usize {
         self.prims.len()
     }
-}
 
-/// Which primitive a closest-hit search found, and where.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct PrimHit {
-    prim: usize,
-    t: f64,
-    bary: DVec2,
-}
+    /// A primitive, by its index in BVH order.
+    pub(crate) fn prim(&self, id: usize) -> &Prim {
+        &self.prims[id]
+    }
 
-impl SceneGeometry {
-    #[inline]
-    fn ray_epsilon(&self, o: DVec3) -> f64 {
-        RAY_EPSILON * (o.abs().max_element() + self.extent)
+    /// An analytic shape.
+    pub(crate) fn analytic(&self, index: u32) -> &Analytic {
+        &self.analytic[index as usize]
     }
 
     #[inline]
     fn test_prim(&self, prim: &Prim, pre: &RayPre, tmin: f64, tmax: f64) -> Option<(f64, DVec2)> {
         match prim {
             Prim::Tri { v, .. } => intersect_triangle(pre, v, tmin, tmax),
-            Prim::Analytic(a) => self.analytic[*a as usize]
+            Prim::Analytic { index, .. } => self.analytic[*index as usize]
                 .intersect(pre.o, pre.d, tmin, tmax)
                 .map(|t| (t, DVec2::ZERO)),
         }
@@ -432,7 +431,7 @@ impl SceneGeometry {
         if len <= 0.0 || !len.is_finite() || !o.is_finite() {
             return None;
         }
-        let b = self.bounds.padded(2.0 * self.bvh.pad + 1e-300);
+        let b = self.bounds.padded(2.0 * self.pad + 1e-300);
         let inv = 1.0 / d;
         let t1 = (b.min - o) * inv;
         let t2 = (b.max - o) * inv;
@@ -454,7 +453,7 @@ impl SceneGeometry {
         // obvhs culls every box whose exit lies within 1e-4 (absolute) of the
         // traversal ray's origin (`EPSILON` in its node test): start the f32
         // ray a little before the first point we care about.
-        let back = 2e-4 + 2.0 * self.bvh.pad;
+        let back = 2e-4 + 2.0 * self.pad;
         let start = tn.max(tmin).max(0.0) - back / len;
         let origin = o + start * d;
         let dn = d / len;
@@ -469,12 +468,9 @@ impl SceneGeometry {
         Some((ray, start, len))
     }
 
-    pub(crate) fn closest_prim(&self, o: DVec3, d: DVec3, tmin: f64, tmax: f64) -> Option<PrimHit> {
-        self.closest_prim_skipping(o, d, tmin, tmax, None)
-    }
-
-    /// The closest primitive hit, ignoring the primitives of shape `skip`.
-    fn closest_prim_skipping(
+    /// The closest primitive hit in (tmin, tmax), ignoring the primitives of
+    /// shape `skip`.
+    pub(crate) fn closest(
         &self,
         o: DVec3,
         d: DVec3,
@@ -482,17 +478,18 @@ impl SceneGeometry {
         tmax: f64,
         skip: Option<u32>,
     ) -> Option<PrimHit> {
-        let cw = self.bvh.cw.as_ref()?;
+        let cw = self.cw.as_ref()?;
         let (ray32, start, len) = self.traversal_ray(o, d, tmin, tmax)?;
         let pre = RayPre::new(o, d);
         let mut best: Option<PrimHit> = None;
         let mut best_t = tmax;
         let mut rh = RayHit::none();
         cw.ray_traverse(ray32, &mut rh, |_, id| {
-            if skip.is_some_and(|shape| self.prim_shape(id) == shape) {
+            let prim = &self.prims[id];
+            if skip == Some(prim.shape()) {
                 return f32::INFINITY;
             }
-            if let Some((t, bary)) = self.test_prim(&self.bvh.prims[id], &pre, tmin, best_t) {
+            if let Some((t, bary)) = self.test_prim(prim, &pre, tmin, best_t) {
                 best_t = t;
                 best = Some(PrimHit { prim: id, t, bary });
                 (((t - start) * len) as f32).next_up()
@@ -503,40 +500,10 @@ impl SceneGeometry {
         best
     }
 
-    /// The shape a primitive belongs to.
-    fn prim_shape(&self, id: usize) -> u32 {
-        match self.bvh.prims[id] {
-            Prim::Tri {
-                owner: TriOwner::Mesh { mesh, .. },
-                ..
-            } => self.mesh_shape[mesh as usize],
-            Prim::Tri {
-                owner: TriOwner::Quad { surface },
-                ..
-            } => self.surfaces[surface as usize].shape,
-            Prim::Analytic(a) => {
-                self.surfaces[self.analytic[a as usize].first_surface as usize].shape
-            }
-        }
-    }
-
-    /// [`SceneGeometry::intersect`] that ignores one shape's primitives
-    /// (probes that start on a surface and must see what lies on it, even
-    /// coincident with it).
-    pub fn intersect_ignoring(&self, ray: &Ray, t_max: f64, shape: u32) -> Option<Hit> {
-        let tmin = self.ray_epsilon(ray.origin) / ray.dir.length();
-        let h = self.closest_prim_skipping(ray.origin, ray.dir, tmin, t_max, Some(shape))?;
-        Some(self.make_hit(ray.origin, ray.dir, h))
-    }
-
-    fn any_prim(&self, o: DVec3, d: DVec3, tmin: f64, tmax: f64) -> bool {
-        self.any_prim_hint(o, d, tmin, tmax, &mut None)
-    }
-
-    /// Occlusion test that first tries the primitive in `hint` (the last
-    /// occluder found, for coherent segments) and stores the occluder it
-    /// finds there.
-    fn any_prim_hint(
+    /// True if any primitive is hit in (tmin, tmax). Tries the primitive in
+    /// `hint` (the last occluder found, for coherent segments) first, and
+    /// stores the occluder it finds there.
+    pub(crate) fn any(
         &self,
         o: DVec3,
         d: DVec3,
@@ -544,13 +511,13 @@ impl SceneGeometry {
         tmax: f64,
         hint: &mut Option<u32>,
     ) -> bool {
-        let Some(cw) = self.bvh.cw.as_ref() else {
+        let Some(cw) = self.cw.as_ref() else {
             return false;
         };
         let pre = RayPre::new(o, d);
         if let Some(h) = *hint
             && self
-                .test_prim(&self.bvh.prims[h as usize], &pre, tmin, tmax)
+                .test_prim(&self.prims[h as usize], &pre, tmin, tmax)
                 .is_some()
         {
             return true;
@@ -560,10 +527,7 @@ impl SceneGeometry {
         };
         let mut found = None;
         let miss = cw.ray_traverse_miss(ray32, |_, id| {
-            if self
-                .test_prim(&self.bvh.prims[id], &pre, tmin, tmax)
-                .is_some()
-            {
+            if self.test_prim(&self.prims[id], &pre, tmin, tmax).is_some() {
                 found = Some(id as u32);
                 0.0
             } else {
@@ -576,132 +540,24 @@ impl SceneGeometry {
         !miss
     }
 
-    pub(crate) fn make_hit(&self, o: DVec3, d: DVec3, h: PrimHit) -> Hit {
-        let point = o + h.t * d;
-        match self.bvh.prims[h.prim] {
-            Prim::Tri {
-                owner: TriOwner::Mesh { mesh, tri },
-                ..
-            } => {
-                let m = &self.meshes[mesh as usize];
-                Hit {
-                    surface: SurfaceId(m.tri_surface[tri as usize]),
-                    coord: SurfaceCoord::Triangle {
-                        index: tri,
-                        bary: h.bary,
-                    },
-                    point,
-                    geometric_normal: m.tri_normal[tri as usize],
-                    shading_normal: m.shading_normal(tri, h.bary),
-                    t: h.t,
-                }
-            }
-            Prim::Tri {
-                owner: TriOwner::Quad { surface, .. },
-                ..
-            } => {
-                let (uv, n) = match &self.surfaces[surface as usize].geom {
-                    SurfaceGeom::Patch(patch) => match patch.as_ref() {
-                        Patch::Quad { p, normal } => (inverse_bilinear(p, *normal, point), *normal),
-                        _ => (DVec2::ZERO, DVec3::Z),
-                    },
-                    _ => (DVec2::ZERO, DVec3::Z),
-                };
-                Hit {
-                    surface: SurfaceId(surface),
-                    coord: SurfaceCoord::Uv(uv),
-                    point,
-                    geometric_normal: n,
-                    shading_normal: n,
-                    t: h.t,
-                }
-            }
-            Prim::Analytic(a) => {
-                let (s, uv, n) = self.analytic[a as usize].surface_at(o, d, h.t);
-                Hit {
-                    surface: SurfaceId(s),
-                    coord: SurfaceCoord::Uv(uv),
-                    point,
-                    geometric_normal: n,
-                    shading_normal: n,
-                    t: h.t,
-                }
-            }
-        }
-    }
-
-    /// The closest hit along `ray` with ε < t < `t_max` (ε: module docs).
-    pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<Hit> {
-        let tmin = self.ray_epsilon(ray.origin) / ray.dir.length();
-        let h = self.closest_prim(ray.origin, ray.dir, tmin, t_max)?;
-        Some(self.make_hit(ray.origin, ray.dir, h))
-    }
-
-    /// True if `ray` hits anything with ε < t < `t_max`.
-    pub fn ray_occluded(&self, ray: &Ray, t_max: f64) -> bool {
-        let tmin = self.ray_epsilon(ray.origin) / ray.dir.length();
-        self.any_prim(ray.origin, ray.dir, tmin, t_max)
-    }
-
-    /// True if something lies strictly between points `p` and `q`. Safe when
-    /// `p` and `q` lie on surfaces: hits within ε of either end are ignored.
-    pub fn occluded(&self, p: DVec3, q: DVec3) -> bool {
-        self.occluded_hint(p, q, &mut None)
-    }
-
-    /// [`SceneGeometry::occluded`] for coherent segments (e.g. between the
-    /// same two elements): `hint` carries the last occluder found from one
-    /// call to the next and is tested first. Start with `None`.
-    pub fn occluded_hint(&self, p: DVec3, q: DVec3, hint: &mut Option<u32>) -> bool {
-        let d = q - p;
-        let len = d.length();
-        if len <= 0.0 || !len.is_finite() {
-            return false;
-        }
-        let tmin = self.ray_epsilon(p) / len;
-        let tmax = 1.0 - self.ray_epsilon(q) / len;
-        if tmin >= tmax {
-            return false;
-        }
-        self.any_prim_hint(p, d, tmin, tmax, hint)
-    }
-
-    /// [`SceneGeometry::intersect`] for many rays, in parallel (rayon).
-    pub fn intersect_batch(&self, rays: &[Ray], t_max: f64) -> Vec<Option<Hit>> {
-        rays.par_iter()
-            .with_min_len(64)
-            .map(|r| self.intersect(r, t_max))
-            .collect()
-    }
-
-    /// [`SceneGeometry::occluded`] for many segments, in parallel (rayon).
-    pub fn occluded_batch(&self, segments: &[(DVec3, DVec3)]) -> Vec<bool> {
-        segments
-            .par_iter()
-            .with_min_len(64)
-            .map(|&(p, q)| self.occluded(p, q))
-            .collect()
-    }
-
-    /// Number of primitives in the BVH (triangles, including two per planar
-    /// quad, and one per disk, sphere and cylinder).
-    pub fn primitive_count(&self) -> usize {
-        self.bvh.len()
-    }
-
-    /// Brute force closest hit over every primitive, without the BVH: the
-    /// reference for tests.
-    pub fn intersect_brute_force(&self, ray: &Ray, t_max: f64) -> Option<Hit> {
-        let tmin = self.ray_epsilon(ray.origin) / ray.dir.length();
-        let pre = RayPre::new(ray.origin, ray.dir);
+    /// The closest hit over every primitive, without the tree (the
+    /// reference for tests).
+    pub(crate) fn closest_brute_force(
+        &self,
+        o: DVec3,
+        d: DVec3,
+        tmin: f64,
+        tmax: f64,
+    ) -> Option<PrimHit> {
+        let pre = RayPre::new(o, d);
         let mut best: Option<PrimHit> = None;
-        let mut best_t = t_max;
-        for (i, p) in self.bvh.prims.iter().enumerate() {
+        let mut best_t = tmax;
+        for (i, p) in self.prims.iter().enumerate() {
             if let Some((t, bary)) = self.test_prim(p, &pre, tmin, best_t) {
                 best_t = t;
                 best = Some(PrimHit { prim: i, t, bary });
             }
         }
-        best.map(|h| self.make_hit(ray.origin, ray.dir, h))
+        best
     }
 }

@@ -4,7 +4,7 @@
 //! # How charts are chosen
 //!
 //! A mesh never becomes one input surface per triangle (k input surfaces
-//! make k² root interactions, notes/algorithm.md §7). Instead its triangles
+//! make k² root interactions; docs/architecture.md, "Meshes"). Instead its triangles
 //! are grouped into **charts**, each one input surface:
 //!
 //! 1. Triangles are connected through shared edges. Vertices are welded by
@@ -48,6 +48,10 @@ use std::collections::{BinaryHeap, HashMap};
 use glam::{DVec2, DVec3};
 use serde::{Deserialize, Serialize};
 
+use crate::bounds::Bounds;
+use crate::element::{Element, ElementDomain, NO_CHILD};
+use crate::ids::{ElementId, SurfaceId};
+
 /// Largest number of triangles in one chart.
 pub const CHART_MAX_TRIANGLES: usize = 512;
 /// Half-angle, in degrees, of the normal cone of a chart around its seed.
@@ -67,9 +71,6 @@ pub(crate) struct MeshData {
     pub tri_area: Vec<f64>,
     /// Input surface of each triangle (`u32::MAX` for degenerate ones).
     pub tri_surface: Vec<u32>,
-    /// The deepest existing element whose pieces include each whole
-    /// triangle (a shortcut for `locate`; `u32::MAX` before the roots exist).
-    pub tri_element: Vec<u32>,
     /// +1 or −1 (flip_normals), applied to shading normals.
     pub sign: f64,
 }
@@ -473,4 +474,96 @@ pub(crate) fn split_cluster(pieces: &[Piece], mesh: &MeshData) -> [Vec<Piece>; 4
     let left_hi = median_cut(&mut all);
     let right_hi = median_cut(&mut right);
     [all, left_hi, right, right_hi]
+}
+
+/// The element of a cluster of pieces of one chart: its pieces ordered along
+/// a Morton curve of their centroids (so that the area-CDF sampling of
+/// [`crate::sampling`] maps stratified u to spatially stratified points),
+/// area, normal (the normalised area-weighted mean), centre (the centroid of
+/// the piece nearest the area centroid), exact normal cone and bounds. The
+/// pieces are to be stored from index `first_piece` of the piece arena;
+/// they are returned in that order.
+pub(crate) fn cluster_element(
+    m: &MeshData,
+    surface: SurfaceId,
+    mut pieces: Vec<Piece>,
+    parent: Option<ElementId>,
+    depth: u32,
+    first_piece: u32,
+) -> (Element, Vec<Piece>) {
+    morton_sort(&mut pieces, m);
+    let mut area = 0.0;
+    let mut sum_n = DVec3::ZERO;
+    let mut sum_c = DVec3::ZERO;
+    let mut bounds = Bounds::EMPTY;
+    let mut largest = (0.0, DVec3::Z);
+    for p in &pieces {
+        let a = m.tri_area[p.triangle as usize] * p.area_fraction();
+        let n = m.tri_normal[p.triangle as usize];
+        let c = p.corners(m);
+        area += a;
+        sum_n += a * n;
+        sum_c += a * (c[0] + c[1] + c[2]) / 3.0;
+        bounds = bounds.with_point(c[0]).with_point(c[1]).with_point(c[2]);
+        if a > largest.0 {
+            largest = (a, n);
+        }
+    }
+    let normal = sum_n.try_normalize().unwrap_or(largest.1);
+    let centroid = if area > 0.0 {
+        sum_c / area
+    } else {
+        bounds.centre()
+    };
+    let (cone, centre, planar) = cluster_shape(m, &pieces, normal, centroid, bounds);
+    let element = Element {
+        surface,
+        parent,
+        depth,
+        area,
+        centre,
+        normal,
+        normal_cone_cos: if planar { 1.0 } else { cone.clamp(-1.0, 1.0) },
+        bounds,
+        domain: ElementDomain::Cluster {
+            first: first_piece,
+            count: pieces.len() as u32,
+        },
+        first_child: NO_CHILD,
+        planar,
+    };
+    (element, pieces)
+}
+
+/// The normal cone's cosine, the centre (the piece centroid nearest
+/// `centroid`) and planarity of a cluster.
+fn cluster_shape(
+    m: &MeshData,
+    pieces: &[Piece],
+    normal: DVec3,
+    centroid: DVec3,
+    bounds: Bounds,
+) -> (f64, DVec3, bool) {
+    let mut cone = 1.0f64;
+    let mut best = (f64::INFINITY, centroid);
+    let mut planar = true;
+    let plane_d = normal.dot(pieces.first().map(|p| p.corners(m)[0]).unwrap_or(centroid));
+    let tol = 1e-9 * bounds.diagonal().length().max(1e-300);
+    for p in pieces {
+        let n = m.tri_normal[p.triangle as usize];
+        cone = cone.min(n.dot(normal));
+        let c = p.corners(m);
+        let pc = (c[0] + c[1] + c[2]) / 3.0;
+        let d = (pc - centroid).length_squared();
+        if d < best.0 {
+            best = (d, pc);
+        }
+        if c.iter().any(|v| (normal.dot(*v) - plane_d).abs() > tol) {
+            planar = false;
+        }
+    }
+    if cone < 1.0 - 1e-12 {
+        planar = false;
+    }
+    (cone, best.1, planar)
 }

@@ -1,7 +1,7 @@
 //! Errors raised while turning shapes into input surfaces.
 //!
 //! Every error names the index of the offending shape in the slice given to
-//! [`crate::SceneGeometry::build`], so that the scene loader can map it back
+//! [`crate::Geometry::build`], so that the scene loader can map it back
 //! to a file location.
 
 use thiserror::Error;
@@ -10,7 +10,7 @@ use thiserror::Error;
 #[derive(Debug, Clone, PartialEq, Error)]
 #[error("shape {shape}: {problem}")]
 pub struct GeometryError {
-    /// Index of the shape in the slice given to `SceneGeometry::build`.
+    /// Index of the shape in the slice given to `Geometry::build`.
     pub shape: usize,
     /// What is wrong with it.
     pub problem: ShapeProblem,

@@ -1,9 +1,9 @@
 //! Identifiers of input surfaces and elements: plain `u32` indices into the
-//! arenas of [`crate::SceneGeometry`].
+//! arenas of [`crate::Geometry`] and [`crate::ElementForest`].
 
 use serde::{Deserialize, Serialize};
 
-/// Index of an input surface in [`crate::SceneGeometry::surfaces`].
+/// Index of an input surface in [`crate::Geometry::surfaces`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
 pub struct SurfaceId(pub u32);
 
@@ -16,7 +16,7 @@ impl SurfaceId {
 }
 
 /// Index of an element (a node of an input surface's element tree) in the
-/// element arena of [`crate::SceneGeometry`].
+/// element arena of an [`crate::ElementForest`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
 pub struct ElementId(pub u32);
 

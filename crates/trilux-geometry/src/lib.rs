@@ -8,8 +8,12 @@
 //! ## In brief
 //!
 //! ```
+//! use std::sync::Arc;
 //! use glam::{DMat4, DVec2, DVec3};
-//! use trilux_geometry::{Ray, SceneGeometry, Shape, ShapeKind};
+//! use trilux_geometry::{
+//!     ElementForest, FaceElement, Geometry, Ray, Shape, ShapeKind, SurfaceId, Visibility,
+//!     form_factor_front,
+//! };
 //!
 //! // Two unit squares facing each other one unit apart (Mitsuba's
 //! // `rectangle` is [-1, 1]² at z = 0 with normal +z).
@@ -22,19 +26,21 @@
 //!         flip_normals: true,
 //!     },
 //! ];
-//! let mut geom = SceneGeometry::build(&shapes)?;
-//! let (a, b) = (geom.surfaces()[0].root, geom.surfaces()[1].root);
-//! let f = geom.form_factor(a, b); // Lambert's formula, adaptive cubature
+//! let geometry = Arc::new(Geometry::build(&shapes)?);
+//! let mut forest = ElementForest::new(geometry.clone());
+//! let (a, b) = (forest.root(SurfaceId(0)), forest.root(SurfaceId(1)));
+//! let f = form_factor_front(&forest, a, b); // Lambert's formula, adaptive cubature
 //! assert!((f.value - 0.199825).abs() < 1e-5 && f.error < 1e-4);
-//! assert_eq!(geom.visibility(a, b, 16), 1.0);
+//! let visibility = Visibility::new(&forest, None);
+//! assert_eq!(visibility.fraction(FaceElement::front(a), FaceElement::front(b), 16), 1.0);
 //!
-//! let children = geom.subdivide(a); // lazily created, idempotent
-//! let s = geom.sample_element(children[3], DVec2::new(0.5, 0.5));
-//! assert_eq!(geom.locate(geom.element(a).surface, s.coord), children[3]);
+//! let children = forest.subdivide(a); // lazily created, idempotent
+//! let s = forest.sample_element(children[3], DVec2::new(0.5, 0.5));
+//! assert_eq!(forest.locate(SurfaceId(0), s.coord), children[3]);
 //!
-//! let hit = geom.intersect(&Ray { origin: s.point, dir: DVec3::Z }, f64::INFINITY).unwrap();
-//! assert_eq!(hit.surface, geom.element(b).surface);
-//! assert!(!geom.occluded(s.point, hit.point));
+//! let hit = geometry.intersect(&Ray { origin: s.point, dir: DVec3::Z }, f64::INFINITY).unwrap();
+//! assert_eq!(hit.surface, SurfaceId(1));
+//! assert!(!geometry.occluded(s.point, hit.point));
 //! # Ok::<(), trilux_geometry::GeometryError>(())
 //! ```
 //!
@@ -43,8 +49,11 @@
 //! - [`shape`]: the shapes a scene is made of, as plain data in Mitsuba 3's
 //!   conventions ([`Shape`], [`ShapeKind`], [`TriangleMesh`]); checked
 //!   against Mitsuba 3.9 ray hits in `tests/mitsuba.rs`.
-//! - [`scene_geometry`]: [`SceneGeometry::build`] turns shapes into input
-//!   surfaces and a BVH; errors in [`error`] name the shape.
+//! - [`build`]: [`Geometry::build`] turns shapes into input surfaces and
+//!   BVH primitives; errors in [`error`] name the shape.
+//! - [`geometry`]: the immutable [`Geometry`] (input surfaces, meshes, BVH)
+//!   and its ray queries ([`Ray`], [`Hit`], `intersect`, `occluded` and
+//!   their rayon batch forms).
 //! - [`surface`]: [`InputSurface`] (planar, curved, chart) and
 //!   [`SurfaceCoord`]. The private `patch` module holds the parametric
 //!   pieces: rectangles and cube faces (planar bilinear quads), disks (polar:
@@ -53,41 +62,49 @@
 //!   scale and shear are supported exactly for every shape (ellipsoids,
 //!   elliptic tubes and disks): shapes are evaluated in object space and
 //!   mapped by the affine transform.
+//! - [`face`]: the two sides of a surface ([`Side`]), faces ([`FaceId`],
+//!   [`PerFace`]), per-side storage ([`Sided`]) and an element seen from
+//!   one side ([`FaceElement`]).
 //! - [`chart`]: triangle meshes as charts (≤ 512 triangles, 60° normal cone,
 //!   grown compactly over shared edges), chart elements as clusters of
 //!   triangle pieces (the rules are documented there).
-//! - [`element`]: the element trees ([`Element`], [`ElementId`]) in one
-//!   arena, lazily subdivided into 4 children on the true surface, with
-//!   `locate`, `element_contains` and `element_points`.
+//! - [`element`] and [`forest`]: the element trees ([`Element`],
+//!   [`ElementId`]) of an [`ElementForest`], lazily subdivided into 4
+//!   children on the true surface, with `locate`, `element_contains` and
+//!   `element_points`.
 //! - [`sampling`]: stratification-friendly point sampling with exact area
 //!   densities ([`SurfaceSample`]).
-//! - [`bvh`]: ray queries ([`Ray`], [`Hit`], `intersect`, `occluded` and
-//!   their rayon batch forms) over one obvhs CWBVH, with f64 watertight
-//!   triangle tests, exact analytic shapes and a relative self-intersection
-//!   epsilon (robustness rules documented there).
+//! - `bvh` (private): one obvhs CWBVH over every primitive, f64 watertight
+//!   triangle tests, exact analytic shapes (robustness rules documented
+//!   there).
 //! - [`form_factor`]: element-to-element form factors with error estimates
 //!   (Lambert's point-to-polygon formula integrated adaptively; pair
 //!   cubature for curved pieces and disks; stratified sampling for large
-//!   clusters), per side for two-sided materials ([`Side`]).
-//! - [`visibility`]: visible fractions from stratified shadow segments.
+//!   clusters), face to face ([`FaceElement`]).
 //! - [`burial`]: the parts of faces that another shape covers (the floor
-//!   under a box), probed once; visibility treats them as blocked.
-//! - `quadrature` and `transform` (private): integration rules and affine
-//!   maps.
+//!   under a box), probed once into a [`BurialMap`].
+//! - [`visibility`]: visible fractions from stratified shadow segments
+//!   ([`Visibility`], which takes the burial map explicitly).
+//! - `quadrature`, `sequence` and `transform` (private): integration rules,
+//!   seeded Sobol points and affine maps.
 #![forbid(unsafe_code)]
 
 pub mod bounds;
+pub mod build;
 pub mod burial;
-pub mod bvh;
+mod bvh;
 pub mod chart;
 pub mod element;
 pub mod error;
+pub mod face;
+pub mod forest;
 pub mod form_factor;
+pub mod geometry;
 pub mod ids;
 mod patch;
 mod quadrature;
 pub mod sampling;
-pub mod scene_geometry;
+mod sequence;
 pub mod shape;
 pub mod surface;
 mod transform;
@@ -95,16 +112,18 @@ pub mod visibility;
 
 pub use bounds::Bounds;
 pub use burial::{BurialMap, BurialRequest};
-pub use bvh::{Hit, RAY_EPSILON, Ray};
 pub use chart::{CHART_CONE_DEG, CHART_MAX_TRIANGLES, Piece};
 pub use element::{Element, ElementDomain};
 pub use error::{GeometryError, ShapeProblem};
+pub use face::{FaceElement, FaceId, PerFace, Side, Sided};
+pub use forest::ElementForest;
 pub use form_factor::{
-    FormFactor, FormFactorOptions, MAX_POLYGON_PIECES, Side, point_to_polygon,
-    point_to_polygon_front,
+    FormFactor, FormFactorOptions, MAX_POLYGON_PIECES, form_factor, form_factor_batch,
+    form_factor_front, point_to_polygon, point_to_polygon_front,
 };
+pub use geometry::{Geometry, Hit, RAY_EPSILON, Ray};
 pub use ids::{ElementId, SurfaceId};
 pub use sampling::SurfaceSample;
-pub use scene_geometry::SceneGeometry;
 pub use shape::{Shape, ShapeKind, TriangleMesh};
 pub use surface::{InputSurface, SurfaceCoord, SurfaceKind, SurfacePoint};
+pub use visibility::Visibility;

@@ -17,11 +17,9 @@
 
 use glam::{DVec2, DVec3};
 
-use crate::element::ElementDomain;
-use crate::ids::{ElementId, SurfaceId};
+use crate::chart::{MeshData, Piece};
 use crate::patch::{PIECE_ANGLE, Patch};
-use crate::scene_geometry::SceneGeometry;
-use crate::surface::{SurfaceCoord, SurfaceGeom};
+use crate::surface::SurfaceCoord;
 
 /// A point sampled on an element or surface.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -44,103 +42,99 @@ pub(crate) fn square_to_triangle(u: DVec2) -> [f64; 3] {
     [1.0 - s, s * (1.0 - u.y), s * u.y]
 }
 
-impl SceneGeometry {
-    /// Samples a point of element `id` from `u` ∈ [0,1)².
-    pub fn sample_element(&self, id: ElementId, u: DVec2) -> SurfaceSample {
-        let u = u.clamp(DVec2::ZERO, DVec2::splat(1.0 - f64::EPSILON));
-        let e = &self.elements[id.index()];
-        match (e.domain, &self.surfaces[e.surface.index()].geom) {
-            (ElementDomain::Rect { min, max }, SurfaceGeom::Patch(patch)) => {
-                // Where the uv map degenerates (disk centres, sphere poles)
-                // sample uniformly in r² or cos θ instead: the density then
-                // stays finite and positive everywhere.
-                let (uv, dens) = match patch.as_ref() {
-                    Patch::Disk { .. } => {
-                        let r2 = min.x * min.x + u.x * (max.x * max.x - min.x * min.x);
-                        let v = min.y + u.y * (max.y - min.y);
-                        (DVec2::new(r2.sqrt(), v), None)
-                    }
-                    Patch::Sphere { theta0, .. } => {
-                        let c0 = (theta0 + min.y * PIECE_ANGLE).cos();
-                        let c1 = (theta0 + max.y * PIECE_ANGLE).cos();
-                        let z = c0 + u.y * (c1 - c0);
-                        let theta = z.clamp(-1.0, 1.0).acos();
-                        let v = ((theta - theta0) / PIECE_ANGLE).clamp(min.y, max.y);
-                        (
-                            DVec2::new(min.x + u.x * (max.x - min.x), v),
-                            Some((c0 - c1).abs()),
-                        )
-                    }
-                    _ => (min + u * (max - min), None),
-                };
-                let pp = patch.eval(uv);
-                let pdf = match (patch.as_ref(), dens) {
-                    // Uniform in area: the exact element area.
-                    (Patch::Disk { .. }, _) => 1.0 / e.area,
-                    // Uniform in (φ, z) on the object sphere: the world area
-                    // element is r² dφ dz times the tangent-plane area scale
-                    // |det L| |L⁻ᵀ n| of the linear map L.
-                    (Patch::Sphere { xf, radius, .. }, Some(dz)) => {
-                        let p_obj = xf.object_from_world.transform_point3(pp.p);
-                        let n_obj = match patch.as_ref() {
-                            Patch::Sphere { centre, .. } => (p_obj - *centre).normalize(),
-                            _ => DVec3::Z,
-                        };
-                        let scale = xf.linear.determinant().abs() * (xf.normal * n_obj).length();
-                        let jac = scale * radius * radius * (max.x - min.x) * PIECE_ANGLE * dz;
-                        if jac > 0.0 { 1.0 / jac } else { 0.0 }
-                    }
-                    _ => {
-                        let jac = pp.jacobian() * (max.x - min.x) * (max.y - min.y);
-                        if jac > 0.0 { 1.0 / jac } else { 0.0 }
-                    }
-                };
-                SurfaceSample {
-                    point: pp.p,
-                    normal: pp.n,
-                    pdf_area: pdf,
-                    coord: SurfaceCoord::Uv(uv),
-                }
-            }
-            (ElementDomain::Cluster { .. }, SurfaceGeom::Chart { mesh }) => {
-                let m = &self.meshes[*mesh as usize];
-                let pieces = self.element_pieces(id);
-                let target = u.x * e.area;
-                let mut acc = 0.0;
-                let mut chosen = (pieces.len() - 1, 0.0, 1.0);
-                for (k, p) in pieces.iter().enumerate() {
-                    let a = m.tri_area[p.triangle as usize] * p.area_fraction();
-                    if target < acc + a || k + 1 == pieces.len() {
-                        chosen = (k, acc, a);
-                        break;
-                    }
-                    acc += a;
-                }
-                let (k, start, a) = chosen;
-                let ux = if a > 0.0 {
-                    ((target - start) / a).clamp(0.0, 1.0 - f64::EPSILON)
-                } else {
-                    0.5
-                };
-                let l = square_to_triangle(DVec2::new(ux, u.y));
-                let p = pieces[k];
-                let bary = l[0] * p.bary[0] + l[1] * p.bary[1] + l[2] * p.bary[2];
-                SurfaceSample {
-                    point: m.point(p.triangle, bary),
-                    normal: m.tri_normal[p.triangle as usize],
-                    pdf_area: 1.0 / e.area,
-                    coord: SurfaceCoord::Triangle {
-                        index: p.triangle,
-                        bary,
-                    },
-                }
-            }
-            _ => unreachable!("element domain does not match its surface"),
+/// Samples the uv rectangle [min, max] of a patch (of area `area`) from
+/// `u` ∈ [0,1)². Where the uv map degenerates (disk centres, sphere poles)
+/// it samples uniformly in r² or cos θ instead, so that the density stays
+/// finite and positive everywhere.
+pub(crate) fn sample_rect(
+    patch: &Patch,
+    min: DVec2,
+    max: DVec2,
+    area: f64,
+    u: DVec2,
+) -> SurfaceSample {
+    let (uv, dens) = match patch {
+        Patch::Disk { .. } => {
+            let r2 = min.x * min.x + u.x * (max.x * max.x - min.x * min.x);
+            let v = min.y + u.y * (max.y - min.y);
+            (DVec2::new(r2.sqrt(), v), None)
         }
+        Patch::Sphere { theta0, .. } => {
+            let c0 = (theta0 + min.y * PIECE_ANGLE).cos();
+            let c1 = (theta0 + max.y * PIECE_ANGLE).cos();
+            let z = c0 + u.y * (c1 - c0);
+            let theta = z.clamp(-1.0, 1.0).acos();
+            let v = ((theta - theta0) / PIECE_ANGLE).clamp(min.y, max.y);
+            (
+                DVec2::new(min.x + u.x * (max.x - min.x), v),
+                Some((c0 - c1).abs()),
+            )
+        }
+        _ => (min + u * (max - min), None),
+    };
+    let pp = patch.eval(uv);
+    let pdf = match (patch, dens) {
+        // Uniform in area: the exact element area.
+        (Patch::Disk { .. }, _) => 1.0 / area,
+        // Uniform in (φ, z) on the object sphere: the world area element is
+        // r² dφ dz times the tangent-plane area scale |det L| |L⁻ᵀ n| of the
+        // linear map L.
+        (
+            Patch::Sphere {
+                xf, radius, centre, ..
+            },
+            Some(dz),
+        ) => {
+            let p_obj = xf.object_from_world.transform_point3(pp.p);
+            let n_obj = (p_obj - *centre).normalize();
+            let scale = xf.linear.determinant().abs() * (xf.normal * n_obj).length();
+            let jac = scale * radius * radius * (max.x - min.x) * PIECE_ANGLE * dz;
+            if jac > 0.0 { 1.0 / jac } else { 0.0 }
+        }
+        _ => {
+            let jac = pp.jacobian() * (max.x - min.x) * (max.y - min.y);
+            if jac > 0.0 { 1.0 / jac } else { 0.0 }
+        }
+    };
+    SurfaceSample {
+        point: pp.p,
+        normal: pp.n,
+        pdf_area: pdf,
+        coord: SurfaceCoord::Uv(uv),
     }
+}
 
-    /// Samples a point of a whole input surface (its root element).
-    pub fn sample_surface(&self, surface: SurfaceId, u: DVec2) -> SurfaceSample {
-        self.sample_element(self.surfaces[surface.index()].root, u)
+/// Samples a cluster of `pieces` (of total area `area`) of a mesh: `u.x`
+/// picks a piece by its area and is rescaled within it, then the
+/// square-root map gives a uniform point of the piece.
+pub(crate) fn sample_cluster(m: &MeshData, pieces: &[Piece], area: f64, u: DVec2) -> SurfaceSample {
+    let target = u.x * area;
+    let mut acc = 0.0;
+    let mut chosen = (pieces.len() - 1, 0.0, 1.0);
+    for (k, p) in pieces.iter().enumerate() {
+        let a = m.tri_area[p.triangle as usize] * p.area_fraction();
+        if target < acc + a || k + 1 == pieces.len() {
+            chosen = (k, acc, a);
+            break;
+        }
+        acc += a;
+    }
+    let (k, start, a) = chosen;
+    let ux = if a > 0.0 {
+        ((target - start) / a).clamp(0.0, 1.0 - f64::EPSILON)
+    } else {
+        0.5
+    };
+    let l = square_to_triangle(DVec2::new(ux, u.y));
+    let p = pieces[k];
+    let bary = l[0] * p.bary[0] + l[1] * p.bary[1] + l[2] * p.bary[2];
+    SurfaceSample {
+        point: m.point(p.triangle, bary),
+        normal: m.tri_normal[p.triangle as usize],
+        pdf_area: 1.0 / area,
+        coord: SurfaceCoord::Triangle {
+            index: p.triangle,
+            bary,
+        },
     }
 }

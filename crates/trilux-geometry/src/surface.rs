@@ -1,11 +1,10 @@
 //! Input surfaces: the patches of the scene as given (paper §3), each the
-//! root of one element tree.
+//! root of one element tree of an [`crate::ElementForest`].
 
 use glam::{DVec2, DVec3};
 use serde::{Deserialize, Serialize};
 
 use crate::bounds::Bounds;
-use crate::ids::ElementId;
 use crate::patch::Patch;
 
 /// What kind of input surface this is.
@@ -39,13 +38,11 @@ pub enum SurfaceCoord {
 /// One input surface: a parametric piece of a shape or a chart of a mesh.
 #[derive(Clone, Debug)]
 pub struct InputSurface {
-    /// Index of the shape (in the slice given to `SceneGeometry::build`)
+    /// Index of the shape (in the slice given to `Geometry::build`)
     /// this surface belongs to.
     pub shape: u32,
     /// Planar, curved or chart.
     pub kind: SurfaceKind,
-    /// The root of this surface's element tree.
-    pub root: ElementId,
     /// World-space bounds.
     pub bounds: Bounds,
     /// Which piece of its shape this is (0 for a lone surface: cube faces
@@ -62,9 +59,11 @@ pub struct InputSurface {
 #[derive(Clone, Debug)]
 pub(crate) enum SurfaceGeom {
     Patch(Box<Patch>),
-    /// A chart of mesh `mesh` (index into the scene's meshes).
+    /// A chart of mesh `mesh` (index into the scene's meshes) made of
+    /// `triangles`, in the order the chart grew.
     Chart {
         mesh: u32,
+        triangles: Vec<u32>,
     },
 }
 

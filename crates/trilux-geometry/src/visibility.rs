@@ -4,50 +4,58 @@
 //! Segment k joins the k-th point of an Owen-scrambled Sobol sequence on
 //! each element (independent scrambles on the two sides, seeded by the
 //! element ids, so results are deterministic, and the same for (a, b) and
-//! (b, a)). Only segments whose end
-//! points face each other (both one-sided cosines positive) carry light and
-//! are counted; if none do, the plain fraction over all segments is
-//! returned (the form factor is then zero anyway). A segment with an end
-//! on a buried part of its face ([`crate::burial`]) counts as blocked.
+//! (b, a)). Only segments whose end points face each other (both one-sided
+//! cosines positive) carry light and are counted; if none do, the plain
+//! fraction over all segments is returned (the form factor is then zero
+//! anyway). A segment with an end on a buried part of its face
+//! ([`crate::burial`]) counts as blocked, when a burial map is given.
 
 use glam::DVec3;
 use rayon::prelude::*;
 
-use crate::form_factor::{Side, seed_of, sobol2};
+use crate::burial::BurialMap;
+use crate::face::{FaceElement, FaceId};
+use crate::forest::ElementForest;
 use crate::ids::ElementId;
 use crate::sampling::SurfaceSample;
-use crate::scene_geometry::SceneGeometry;
+use crate::sequence::{seed_of, sobol2};
 
-impl SceneGeometry {
-    /// Visible fraction between elements `a` and `b` from `samples` shadow
-    /// segments (at most 65 536), counting the segments between their fronts.
-    pub fn visibility(&self, a: ElementId, b: ElementId, samples: u32) -> f64 {
-        self.visibility_sided(a, Side::Front, b, Side::Front, samples)
+/// Shadow-segment visibility over an element forest, optionally with the
+/// buried parts of faces counted as blocked.
+#[derive(Clone, Copy, Debug)]
+pub struct Visibility<'a> {
+    forest: &'a ElementForest,
+    burial: Option<&'a BurialMap>,
+}
+
+impl<'a> Visibility<'a> {
+    /// Visibility between the elements of `forest`; segments ending on a
+    /// buried part of `burial` count as blocked.
+    pub fn new(forest: &'a ElementForest, burial: Option<&'a BurialMap>) -> Self {
+        Visibility { forest, burial }
     }
 
-    /// [`SceneGeometry::visibility`] between given sides of the elements
-    /// (the facing test uses those sides' normals).
-    pub fn visibility_sided(
-        &self,
-        a: ElementId,
-        a_side: Side,
-        b: ElementId,
-        b_side: Side,
-        samples: u32,
-    ) -> f64 {
+    /// The forest whose elements this visibility is between.
+    pub fn forest(&self) -> &'a ElementForest {
+        self.forest
+    }
+
+    /// Visible fraction between `a` and `b` from `samples` shadow segments
+    /// (at most 65 536), counting the segments between the two faces that
+    /// face each other (module docs).
+    pub fn fraction(&self, a: FaceElement, b: FaceElement, samples: u32) -> f64 {
         let n = samples.clamp(1, 1 << 16);
-        let seed = seed_of(a.min(b), a.max(b));
-        let mut facing = 0u32;
-        let mut facing_visible = 0u32;
-        let mut visible = 0u32;
+        let seed = seed_of(a.element.min(b.element), a.element.max(b.element));
+        let geom = self.forest.geometry();
+        let (mut facing, mut facing_visible, mut visible) = (0u32, 0u32, 0u32);
         let mut hint = None;
         for k in 0..n {
-            let (x, y) = self.segment_ends(a, b, k, seed);
+            let (x, y) = self.segment_ends(a.element, b.element, k, seed);
             let d = y.point - x.point;
             let faces =
-                a_side.sign() * x.normal.dot(d) > 0.0 && b_side.sign() * y.normal.dot(d) < 0.0;
-            let vis = !self.buried_end(a, a_side, &x, b, b_side, &y)
-                && !self.occluded_hint(x.point, y.point, &mut hint);
+                a.side.sign() * x.normal.dot(d) > 0.0 && b.side.sign() * y.normal.dot(d) < 0.0;
+            let vis =
+                !self.buried_end(a, &x, b, &y) && !geom.occluded_hint(x.point, y.point, &mut hint);
             visible += u32::from(vis);
             if faces {
                 facing += 1;
@@ -66,24 +74,16 @@ impl SceneGeometry {
     /// kernel): the factor V such that F · V estimates the occluded form
     /// factor ∫∫ K vis / (π A_a) when occlusion and K are correlated (a
     /// blocker near one end, partial occlusion of a large element). Falls
-    /// back to [`SceneGeometry::visibility_sided`] when no segment carries
-    /// light.
-    pub fn visibility_weighted(
-        &self,
-        a: ElementId,
-        a_side: Side,
-        b: ElementId,
-        b_side: Side,
-        samples: u32,
-    ) -> f64 {
+    /// back to [`Visibility::fraction`] when no segment carries light.
+    pub fn weighted(&self, a: FaceElement, b: FaceElement, samples: u32) -> f64 {
         let n = samples.clamp(1, 1 << 16);
-        let seed = seed_of(a.min(b), a.max(b));
-        let (sa, sb) = (a_side.sign(), b_side.sign());
-        let mut total = 0.0;
-        let mut seen = 0.0;
+        let seed = seed_of(a.element.min(b.element), a.element.max(b.element));
+        let geom = self.forest.geometry();
+        let (sa, sb) = (a.side.sign(), b.side.sign());
+        let (mut total, mut seen) = (0.0, 0.0);
         let mut hint = None;
         for k in 0..n {
-            let (x, y) = self.segment_ends(a, b, k, seed);
+            let (x, y) = self.segment_ends(a.element, b.element, k, seed);
             let d = y.point - x.point;
             let r2 = d.length_squared();
             let (ca, cb) = (sa * x.normal.dot(d), -sb * y.normal.dot(d));
@@ -97,17 +97,36 @@ impl SceneGeometry {
                 continue;
             }
             total += w;
-            if !self.buried_end(a, a_side, &x, b, b_side, &y)
-                && !self.occluded_hint(x.point, y.point, &mut hint)
-            {
+            if !self.buried_end(a, &x, b, &y) && !geom.occluded_hint(x.point, y.point, &mut hint) {
                 seen += w;
             }
         }
         if total > 0.0 {
             (seen / total).clamp(0.0, 1.0)
         } else {
-            self.visibility_sided(a, a_side, b, b_side, samples)
+            self.fraction(a, b, samples)
         }
+    }
+
+    /// [`Visibility::fraction`] for many element pairs, in parallel.
+    pub fn fraction_batch(&self, pairs: &[(FaceElement, FaceElement)], samples: u32) -> Vec<f64> {
+        pairs
+            .par_iter()
+            .map(|&(a, b)| self.fraction(a, b, samples))
+            .collect()
+    }
+
+    /// The shadow segments [`Visibility::fraction`] traces between `a` and
+    /// `b` (for callers that batch or trace them their own way).
+    pub fn segments(&self, a: ElementId, b: ElementId, samples: u32) -> Vec<(DVec3, DVec3)> {
+        let n = samples.clamp(1, 1 << 16);
+        let seed = seed_of(a.min(b), a.max(b));
+        (0..n)
+            .map(|k| {
+                let (x, y) = self.segment_ends(a, b, k, seed);
+                (x.point, y.point)
+            })
+            .collect()
     }
 
     /// True if either end of a segment lies on a buried part of its face
@@ -115,16 +134,14 @@ impl SceneGeometry {
     #[inline]
     fn buried_end(
         &self,
-        a: ElementId,
-        a_side: Side,
+        a: FaceElement,
         x: &SurfaceSample,
-        b: ElementId,
-        b_side: Side,
+        b: FaceElement,
         y: &SurfaceSample,
     ) -> bool {
-        self.burial.as_ref().is_some_and(|m| {
-            m.is_buried(self.elements[a.index()].surface, a_side, x.coord)
-                || m.is_buried(self.elements[b.index()].surface, b_side, y.coord)
+        self.burial.is_some_and(|m| {
+            let face = |e: FaceElement| FaceId::new(self.forest.element(e.element).surface, e.side);
+            m.is_buried(face(a), x.coord) || m.is_buried(face(b), y.coord)
         })
     }
 
@@ -138,38 +155,15 @@ impl SceneGeometry {
         k: u32,
         seed: u32,
     ) -> (SurfaceSample, SurfaceSample) {
-        let first = |e: ElementId| self.sample_element(e, sobol2(k, 0, seed));
-        let second = |e: ElementId| self.sample_element(e, sobol2(k, 2, seed ^ 0x5bd1_e995));
+        let first = |e: ElementId| self.forest.sample_element(e, sobol2(k, 0, seed));
+        let second = |e: ElementId| {
+            self.forest
+                .sample_element(e, sobol2(k, 2, seed ^ 0x5bd1_e995))
+        };
         if a <= b {
             (first(a), second(b))
         } else {
             (second(a), first(b))
         }
-    }
-
-    /// [`SceneGeometry::visibility`] for many element pairs, in parallel.
-    pub fn visibility_batch(&self, pairs: &[(ElementId, ElementId)], samples: u32) -> Vec<f64> {
-        pairs
-            .par_iter()
-            .map(|&(a, b)| self.visibility(a, b, samples))
-            .collect()
-    }
-
-    /// The shadow segments [`SceneGeometry::visibility`] would trace
-    /// (for callers that batch or trace them their own way).
-    pub fn visibility_segments(
-        &self,
-        a: ElementId,
-        b: ElementId,
-        samples: u32,
-    ) -> Vec<(DVec3, DVec3)> {
-        let n = samples.clamp(1, 1 << 16);
-        let seed = seed_of(a.min(b), a.max(b));
-        (0..n)
-            .map(|k| {
-                let (x, y) = self.segment_ends(a, b, k, seed);
-                (x.point, y.point)
-            })
-            .collect()
     }
 }

@@ -4,11 +4,11 @@ mod common;
 
 use common::*;
 use glam::{DMat4, DVec2, DVec3};
-use trilux_geometry::{Ray, SceneGeometry, SurfaceCoord, SurfaceKind};
+use trilux_geometry::{ElementForest, Ray, SurfaceCoord, SurfaceId, SurfaceKind};
 
-fn scene() -> SceneGeometry {
+fn scene() -> ElementForest {
     let (p, t) = curved_sheet(4);
-    SceneGeometry::build(&[
+    common::forest(&[
         cube(DMat4::from_scale(DVec3::splat(3.0)), true),
         sphere(DVec3::new(1.0, 0.0, 0.0), 0.5, DMat4::IDENTITY, false),
         cylinder(
@@ -33,25 +33,31 @@ fn scene() -> SceneGeometry {
 #[test]
 fn surfaces_per_shape() {
     let g = scene();
-    let count = |s: u32| g.surfaces().iter().filter(|x| x.shape == s).count();
+    let count = |s: u32| {
+        g.geometry()
+            .surfaces()
+            .iter()
+            .filter(|x| x.shape == s)
+            .count()
+    };
     assert_eq!(count(0), 6);
     assert_eq!(count(1), 8);
     assert_eq!(count(2), 4);
     assert_eq!(count(3), 1);
     assert_eq!(count(4), 1);
     assert_eq!(count(5), 1);
-    assert_eq!(g.surfaces()[0].kind, SurfaceKind::Planar);
-    assert_eq!(g.surfaces()[6].kind, SurfaceKind::Curved);
-    assert!(g.surfaces().last().unwrap().is_chart());
+    assert_eq!(g.geometry().surfaces()[0].kind, SurfaceKind::Planar);
+    assert_eq!(g.geometry().surfaces()[6].kind, SurfaceKind::Curved);
+    assert!(g.geometry().surfaces().last().unwrap().is_chart());
     // Exact areas: cube face 36, sphere 4π r² / 8, tube 2π r h / 4, disk π r².
     let pi = std::f64::consts::PI;
-    assert!((g.surfaces()[0].area() - 36.0).abs() < 1e-12);
-    assert!((g.surfaces()[6].area() - 4.0 * pi * 0.25 / 8.0).abs() < 1e-12);
-    assert!((g.surfaces()[14].area() - 2.0 * pi * 0.3 * 2.0 / 4.0).abs() < 1e-12);
-    assert!((g.surfaces()[18].area() - pi * 0.16).abs() < 1e-12);
+    assert!((g.geometry().surfaces()[0].area() - 36.0).abs() < 1e-12);
+    assert!((g.geometry().surfaces()[6].area() - 4.0 * pi * 0.25 / 8.0).abs() < 1e-12);
+    assert!((g.geometry().surfaces()[14].area() - 2.0 * pi * 0.3 * 2.0 / 4.0).abs() < 1e-12);
+    assert!((g.geometry().surfaces()[18].area() - pi * 0.16).abs() < 1e-12);
     // Flipped cube: normals point inwards.
-    for s in &g.surfaces()[..6] {
-        let e = g.element(s.root);
+    for s in 0..6 {
+        let e = g.element(g.root(SurfaceId(s)));
         assert!(e.normal.dot(e.centre) < 0.0);
     }
 }
@@ -60,6 +66,7 @@ fn surfaces_per_shape() {
 fn rays_hit_the_expected_surfaces() {
     let g = scene();
     let h = g
+        .geometry()
         .intersect(
             &Ray {
                 origin: DVec3::new(2.5, 0.0, 0.0),
@@ -70,8 +77,9 @@ fn rays_hit_the_expected_surfaces() {
         .expect("hits the sphere");
     assert!((h.point - DVec3::new(1.5, 0.0, 0.0)).length() < 1e-12);
     assert!((h.geometric_normal - DVec3::X).length() < 1e-12);
-    assert_eq!(g.surfaces()[h.surface.index()].shape, 1);
+    assert_eq!(g.geometry().surfaces()[h.surface.index()].shape, 1);
     let h = g
+        .geometry()
         .intersect(
             &Ray {
                 origin: DVec3::new(0.0, 0.0, 0.0),
@@ -80,10 +88,11 @@ fn rays_hit_the_expected_surfaces() {
             f64::INFINITY,
         )
         .expect("hits the disk");
-    assert_eq!(g.surfaces()[h.surface.index()].shape, 3);
+    assert_eq!(g.geometry().surfaces()[h.surface.index()].shape, 3);
     assert!((h.t - 1.5).abs() < 1e-12);
     // A ray along +x from the cube's inside hits the cube's +x face.
     let h = g
+        .geometry()
         .intersect(
             &Ray {
                 origin: DVec3::new(0.0, 2.0, 2.0),
@@ -94,15 +103,21 @@ fn rays_hit_the_expected_surfaces() {
         .expect("hits the cube");
     assert_eq!(h.surface.0, 1);
     assert!((h.t - 3.0).abs() < 1e-12);
-    assert!(g.occluded(DVec3::new(2.5, 0.0, 0.0), DVec3::new(0.0, 0.0, 0.0)));
-    assert!(!g.occluded(DVec3::new(2.5, 2.5, 2.5), DVec3::new(-2.5, 2.5, 2.5)));
+    assert!(
+        g.geometry()
+            .occluded(DVec3::new(2.5, 0.0, 0.0), DVec3::new(0.0, 0.0, 0.0))
+    );
+    assert!(
+        !g.geometry()
+            .occluded(DVec3::new(2.5, 2.5, 2.5), DVec3::new(-2.5, 2.5, 2.5))
+    );
 }
 
 #[test]
 fn subdivide_locate_sample() {
     let mut g = scene();
-    for s in 0..g.surfaces().len() {
-        let root = g.surfaces()[s].root;
+    for s in 0..g.geometry().surfaces().len() {
+        let root = g.root(SurfaceId(s as u32));
         let kids = g.subdivide(root);
         assert_eq!(g.subdivide(root), kids);
         let sum: f64 = kids.iter().map(|&k| g.element(k).area).sum();
@@ -117,6 +132,7 @@ fn subdivide_locate_sample() {
             assert!(g.element_contains(k, smp.coord));
             assert_eq!(g.locate(trilux_geometry::SurfaceId(s as u32), smp.coord), k);
             let sp = g
+                .geometry()
                 .surface_point(trilux_geometry::SurfaceId(s as u32), smp.coord)
                 .unwrap();
             assert!((sp.point - smp.point).length() < 1e-12);
@@ -128,7 +144,7 @@ fn subdivide_locate_sample() {
 #[test]
 fn scene_geometry_is_shareable_across_threads() {
     fn check<T: Send + Sync + Clone>() {}
-    check::<SceneGeometry>();
+    check::<ElementForest>();
     // Reading in parallel while elements exist.
     let g = scene();
     let rays: Vec<Ray> = (0..1000)
@@ -137,8 +153,11 @@ fn scene_geometry_is_shareable_across_threads() {
             dir: DVec3::new((k as f64).sin(), (k as f64).cos(), 0.3),
         })
         .collect();
-    let a = g.intersect_batch(&rays, f64::INFINITY);
-    let b: Vec<_> = rays.iter().map(|r| g.intersect(r, f64::INFINITY)).collect();
+    let a = g.geometry().intersect_batch(&rays, f64::INFINITY);
+    let b: Vec<_> = rays
+        .iter()
+        .map(|r| g.geometry().intersect(r, f64::INFINITY))
+        .collect();
     assert_eq!(a, b);
 }
 
@@ -147,14 +166,14 @@ fn sampling_densities_are_finite_and_positive_everywhere() {
     // Including the disk's centre and the sphere's poles (u on the corners
     // and edges of the unit square), under a non-uniform scale too.
     let m = DMat4::from_scale(DVec3::new(1.0, 2.0, 0.5));
-    let mut g = SceneGeometry::build(&[
+    let mut g = common::forest(&[
         sphere(DVec3::ZERO, 1.0, m, false),
         disk(DVec3::ZERO, DVec3::X, DVec3::Y, 1.0, false),
         cylinder(DVec3::ZERO, DVec3::Z, 0.5, m, true),
     ])
     .expect("valid");
-    for s in 0..g.surfaces().len() {
-        let root = g.surfaces()[s].root;
+    for s in 0..g.geometry().surfaces().len() {
+        let root = g.root(SurfaceId(s as u32));
         let kids = g.subdivide(root);
         for e in std::iter::once(root).chain(kids) {
             for u in [

@@ -4,13 +4,14 @@
 
 use glam::{DMat4, DVec2, DVec3};
 use trilux_geometry::{
-    BurialRequest, SceneGeometry, Shape, ShapeKind, Side, SurfaceCoord, SurfaceId,
+    BurialMap, BurialRequest, ElementForest, FaceElement, FaceId, Geometry, Shape, ShapeKind, Side,
+    SurfaceCoord, SurfaceId, Visibility,
 };
 
 /// A 4 × 4 floor (Mitsuba rectangle scaled by 2, normal +z) and a cube of
 /// half-side `h` whose bottom is at height `lift`, rotated by `angle`
 /// degrees about z.
-fn scene(h: f64, lift: f64, angle: f64) -> SceneGeometry {
+fn scene(h: f64, lift: f64, angle: f64) -> ElementForest {
     let floor = Shape {
         kind: ShapeKind::Rectangle,
         world_from_object: DMat4::from_scale(DVec3::new(2.0, 2.0, 1.0)),
@@ -23,16 +24,21 @@ fn scene(h: f64, lift: f64, angle: f64) -> SceneGeometry {
             * DMat4::from_scale(DVec3::splat(h)),
         flip_normals: false,
     };
-    SceneGeometry::build(&[floor, cube]).expect("valid scene")
+    ElementForest::new(Geometry::build_shared(&[floor, cube]).expect("valid scene"))
 }
 
-fn floor_burial(g: &SceneGeometry, resolution: u32) -> trilux_geometry::BurialMap {
-    g.compute_burial(&[BurialRequest {
-        surface: SurfaceId(0),
-        side: Side::Front,
-        resolution,
-    }])
+fn floor_burial(g: &ElementForest, resolution: u32) -> BurialMap {
+    BurialMap::probe(
+        g.geometry(),
+        &[BurialRequest {
+            face: FaceId::new(SurfaceId(0), Side::Front),
+            resolution,
+        }],
+    )
 }
+
+const FLOOR_FRONT: FaceId = FaceId(0);
+const FLOOR_BACK: FaceId = FaceId(1);
 
 #[test]
 fn a_standing_cube_covers_its_footprint() {
@@ -43,8 +49,8 @@ fn a_standing_cube_covers_its_footprint() {
         let h = 0.4;
         let g = scene(h, 0.0, angle);
         let map = floor_burial(&g, 64);
-        let root = g.surfaces()[0].root;
-        let exposed = map.exposed_fraction(&g, root, Side::Front);
+        let root = g.root(SurfaceId(0));
+        let exposed = map.exposed_fraction(&g, FaceElement::front(root));
         let want = 1.0 - (2.0 * h) * (2.0 * h) / 16.0;
         assert!(
             (exposed - want).abs() < 0.006,
@@ -53,9 +59,9 @@ fn a_standing_cube_covers_its_footprint() {
         // The point under the cube's centre is buried, one 0.2 m outside
         // its edge is not; the back face was not probed.
         let uv = |x: f64, y: f64| SurfaceCoord::Uv(DVec2::new((x + 2.0) / 4.0, (y + 2.0) / 4.0));
-        assert!(map.is_buried(SurfaceId(0), Side::Front, uv(0.3, -0.2)));
-        assert!(!map.is_buried(SurfaceId(0), Side::Front, uv(0.3 + 0.8, -0.2)));
-        assert!(!map.is_buried(SurfaceId(0), Side::Back, uv(0.3, -0.2)));
+        assert!(map.is_buried(FLOOR_FRONT, uv(0.3, -0.2)));
+        assert!(!map.is_buried(FLOOR_FRONT, uv(0.3 + 0.8, -0.2)));
+        assert!(!map.is_buried(FLOOR_BACK, uv(0.3, -0.2)));
     }
 }
 
@@ -66,7 +72,7 @@ fn a_lifted_cube_covers_nothing() {
     let map = floor_burial(&g, 64);
     assert!(map.is_empty());
     assert_eq!(
-        map.exposed_fraction(&g, g.surfaces()[0].root, Side::Front),
+        map.exposed_fraction(&g, FaceElement::front(g.root(SurfaceId(0)))),
         1.0
     );
 }
@@ -77,9 +83,8 @@ fn segments_from_the_covered_part_are_blocked() {
     // once the map is set, those segments carry no light.
     let mut g = scene(0.4, 0.0, 0.0);
     let map = floor_burial(&g, 64);
-    g.set_burial(map);
     // Subdivide the floor until an element lies under the cube.
-    let mut e = g.surfaces()[0].root;
+    let mut e = g.root(SurfaceId(0));
     let target = DVec3::new(0.3, -0.2, 0.0);
     for _ in 0..4 {
         let children = g.subdivide(e);
@@ -92,14 +97,16 @@ fn segments_from_the_covered_part_are_blocked() {
             })
             .expect("four children");
     }
-    assert!(g.exposed_fraction(e, Side::Front) == 0.0);
+    assert!(map.exposed_fraction(&g, FaceElement::front(e)) == 0.0);
     // The cube's top face, seen from below (its back).
     let top = g
+        .geometry()
         .surfaces()
         .iter()
         .position(|s| s.shape == 1 && s.bounds.min.z > 0.7)
-        .map(|i| g.surfaces()[i].root)
+        .map(|i| g.root(SurfaceId(i as u32)))
         .expect("top face");
-    let v = g.visibility_sided(e, Side::Front, top, Side::Back, 64);
+    let vis = Visibility::new(&g, Some(&map));
+    let v = vis.fraction(FaceElement::front(e), FaceElement::new(top, Side::Back), 64);
     assert_eq!(v, 0.0, "segments from a buried element must be blocked");
 }

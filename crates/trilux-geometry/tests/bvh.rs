@@ -7,7 +7,7 @@ mod common;
 use common::*;
 use glam::{DMat4, DQuat, DVec2, DVec3};
 use proptest::prelude::*;
-use trilux_geometry::{Ray, SceneGeometry, Shape, SurfaceId};
+use trilux_geometry::{Ray, Shape, SurfaceId};
 
 fn arb_vec(r: f64) -> impl Strategy<Value = DVec3> {
     (-r..r, -r..r, -r..r).prop_map(|(x, y, z)| DVec3::new(x, y, z))
@@ -106,17 +106,17 @@ proptest! {
     /// (non-uniform scales included).
     #[test]
     fn bvh_agrees_with_brute_force(shapes in prop::collection::vec(arb_shape(true), 1..8), rays in prop::collection::vec(arb_ray(), 64), tmax in prop_oneof![Just(f64::INFINITY), 0.5..20.0f64]) {
-        let g = SceneGeometry::build(&shapes).expect("valid shapes");
+        let g = common::forest(&shapes).expect("valid shapes");
         for r in &rays {
-            let a = g.intersect(r, tmax);
-            let b = g.intersect_brute_force(r, tmax);
+            let a = g.geometry().intersect(r, tmax);
+            let b = g.geometry().intersect_brute_force(r, tmax);
             prop_assert!(same_hit(&a, &b), "ray {:?}: bvh {:?} brute {:?}", r, a, b);
-            prop_assert_eq!(g.ray_occluded(r, tmax), b.is_some());
+            prop_assert_eq!(g.geometry().ray_occluded(r, tmax), b.is_some());
             if let Some(h) = a {
                 prop_assert!(h.point.is_finite() && h.geometric_normal.is_finite() && h.shading_normal.is_finite());
                 prop_assert!((h.geometric_normal.length() - 1.0).abs() < 1e-9);
                 // The hit point lies on the surface it names, at its coordinate.
-                let sp = g.surface_point(h.surface, h.coord).expect("coordinate fits surface");
+                let sp = g.geometry().surface_point(h.surface, h.coord).expect("coordinate fits surface");
                 prop_assert!((sp.point - h.point).length() < 1e-6 * (1.0 + h.point.length()), "{:?} vs {:?}", sp.point, h.point);
             }
         }
@@ -126,15 +126,15 @@ proptest! {
     /// closest hit from p lies before q".
     #[test]
     fn occluded_segments_agree_with_brute_force(shapes in prop::collection::vec(arb_shape(true), 1..8), pts in prop::collection::vec((arb_vec(5.0), arb_vec(5.0)), 64)) {
-        let g = SceneGeometry::build(&shapes).expect("valid shapes");
+        let g = common::forest(&shapes).expect("valid shapes");
         // The hinted form (last occluder tested first, carried across
         // unrelated segments here) must give the same answers.
         let mut hint = None;
         for (p, q) in pts {
             let d = q - p;
-            let brute = g.intersect_brute_force(&Ray { origin: p, dir: d }, 1.0 - 1e-9 * (q.abs().max_element() + 10.0) / d.length()).is_some();
-            prop_assert_eq!(g.occluded(p, q), brute);
-            prop_assert_eq!(g.occluded_hint(p, q, &mut hint), brute);
+            let brute = g.geometry().intersect_brute_force(&Ray { origin: p, dir: d }, 1.0 - 1e-9 * (q.abs().max_element() + 10.0) / d.length()).is_some();
+            prop_assert_eq!(g.geometry().occluded(p, q), brute);
+            prop_assert_eq!(g.geometry().occluded_hint(p, q, &mut hint), brute);
         }
     }
 
@@ -142,7 +142,7 @@ proptest! {
     /// scale): distance and normal.
     #[test]
     fn spheres_match_world_space_reference(c in arb_vec(2.0), r in 0.1..2.0f64, m in arb_transform(false), rays in prop::collection::vec(arb_ray(), 64)) {
-        let g = SceneGeometry::build(&[sphere(c, r, m, false)]).expect("valid sphere");
+        let g = common::forest(&[sphere(c, r, m, false)]).expect("valid sphere");
         let (s, _, _) = m.to_scale_rotation_translation();
         let wc = m.transform_point3(c);
         let wr = r * s.x;
@@ -156,7 +156,7 @@ proptest! {
                 let sq = disc.sqrt();
                 [(-b - sq) / a, (-b + sq) / a].into_iter().find(|&t| t > 1e-6)
             };
-            let hit = g.intersect(&ray, f64::INFINITY);
+            let hit = g.geometry().intersect(&ray, f64::INFINITY);
             // Skip rays that graze the silhouette (ill-conditioned).
             if disc.abs() < 1e-6 * b * b { continue; }
             match (reference, hit) {
@@ -175,12 +175,12 @@ proptest! {
     /// hit it at the far end of the chord, t = −2 (p − c)·d / |d|².
     #[test]
     fn rays_from_sphere_surface(c in arb_vec(2.0), r in 0.1..3.0f64, u in prop::collection::vec((0.0..1.0f64, 0.0..1.0f64, arb_vec(1.0)), 64)) {
-        let g = SceneGeometry::build(&[sphere(c, r, DMat4::IDENTITY, false)]).expect("valid sphere");
+        let g = common::forest(&[sphere(c, r, DMat4::IDENTITY, false)]).expect("valid sphere");
         for (i, (u0, u1, d)) in u.into_iter().enumerate() {
             if d.length() < 1e-3 { continue; }
             let smp = g.sample_surface(SurfaceId((i % 8) as u32), DVec2::new(u0, u1));
             let ray = Ray { origin: smp.point, dir: d };
-            let hit = g.intersect(&ray, f64::INFINITY);
+            let hit = g.geometry().intersect(&ray, f64::INFINITY);
             let cosine = d.normalize().dot(smp.normal);
             if cosine > 1e-6 {
                 prop_assert!(hit.is_none(), "outward ray re-hit {:?}", hit);
@@ -197,7 +197,7 @@ proptest! {
     /// starting on a face hit another face, never their own.
     #[test]
     fn closed_cube_has_no_leaks(m in arb_transform(true), targets in prop::collection::vec((0usize..8, 0usize..8, 0.0..1.0f64, arb_vec(0.99)), 200)) {
-        let g = SceneGeometry::build(&[cube(m, true)]).expect("valid cube");
+        let g = common::forest(&[cube(m, true)]).expect("valid cube");
         let corner = |i: usize| m.transform_point3(DVec3::new(if i & 1 != 0 { 1.0 } else { -1.0 }, if i & 2 != 0 { 1.0 } else { -1.0 }, if i & 4 != 0 { 1.0 } else { -1.0 }));
         for (a, b, s, o) in targets {
             // A point on an edge, a face diagonal or a corner of the cube
@@ -207,13 +207,13 @@ proptest! {
             let origin = m.transform_point3(o);
             let d = target - origin;
             if d.length() < 1e-9 { continue; }
-            let h = g.intersect(&Ray { origin, dir: d }, f64::INFINITY);
+            let h = g.geometry().intersect(&Ray { origin, dir: d }, f64::INFINITY);
             prop_assert!(h.is_some(), "leak: ray from {:?} to {:?}", origin, target);
             let h = h.unwrap();
             prop_assert!(h.t <= 1.0 + 1e-9, "t = {}", h.t);
             // From the hit point on a face onwards, the ray must not stop on
             // that face again, and going back it must reach another face.
-            let back = g.intersect(&Ray { origin: h.point, dir: -d }, f64::INFINITY);
+            let back = g.geometry().intersect(&Ray { origin: h.point, dir: -d }, f64::INFINITY);
             prop_assert!(back.is_some(), "leak on the way back");
             prop_assert!(back.unwrap().t > 1e-6);
         }
@@ -224,7 +224,7 @@ proptest! {
     /// (or, by rounding, a hair after) the aimed point; none leaks through.
     #[test]
     fn grazing_rays_hit_cube_edges(m in arb_transform(true), targets in prop::collection::vec((0usize..12, 0.01..0.99f64, -1e-3..1e-3f64, 1e-9..1e-3f64, any::<bool>()), 200)) {
-        let g = SceneGeometry::build(&[cube(m, false)]).expect("valid cube");
+        let g = common::forest(&[cube(m, false)]).expect("valid cube");
         // Edges as (corner a, corner b, the two axes whose faces meet there).
         let corner = |i: usize| m.transform_point3(DVec3::new(if i & 1 != 0 { 1.0 } else { -1.0 }, if i & 2 != 0 { 1.0 } else { -1.0 }, if i & 4 != 0 { 1.0 } else { -1.0 }));
         let nm = m.inverse().transpose();
@@ -248,7 +248,7 @@ proptest! {
             let along = (corner(b) - corner(a)).normalize();
             let dir = (-delta * na - nb + along_amount * along).normalize();
             let origin = target - 5.0 * dir;
-            let h = g.intersect(&Ray { origin, dir }, f64::INFINITY);
+            let h = g.geometry().intersect(&Ray { origin, dir }, f64::INFINITY);
             prop_assert!(h.is_some(), "leak through an edge: origin {:?} dir {:?}", origin, dir);
             let t = h.unwrap().t;
             prop_assert!(t <= 5.0 + 1e-6 + 1e-13 / delta, "passed through the edge: t = {}", t);
@@ -265,20 +265,20 @@ proptest! {
             let m = DMat4::from_scale_rotation_translation(s.abs() + DVec3::splat(0.05), DQuat::IDENTITY, c);
             if is_cube { cube(m, flip) } else { Shape { kind: trilux_geometry::ShapeKind::Rectangle, world_from_object: m, flip_normals: flip } }
         }).collect();
-        let g = SceneGeometry::build(&shapes).expect("valid shapes");
+        let g = common::forest(&shapes).expect("valid shapes");
         for (r, s, u0, u1) in rays {
-            let a = g.intersect(&r, f64::INFINITY);
-            let b = g.intersect_brute_force(&r, f64::INFINITY);
+            let a = g.geometry().intersect(&r, f64::INFINITY);
+            let b = g.geometry().intersect_brute_force(&r, f64::INFINITY);
             prop_assert!(same_hit(&a, &b), "ray {:?}: bvh {:?} brute {:?}", r, a, b);
             // From a point on a surface.
-            let sid = SurfaceId((s % g.surfaces().len()) as u32);
+            let sid = SurfaceId((s % g.geometry().surfaces().len()) as u32);
             let start = g.sample_surface(sid, DVec2::new(u0, u1)).point;
             let r2 = Ray { origin: start, dir: r.dir };
-            let a = g.intersect(&r2, f64::INFINITY);
-            let b = g.intersect_brute_force(&r2, f64::INFINITY);
+            let a = g.geometry().intersect(&r2, f64::INFINITY);
+            let b = g.geometry().intersect_brute_force(&r2, f64::INFINITY);
             prop_assert!(same_hit(&a, &b), "ray {:?}: bvh {:?} brute {:?}", r2, a, b);
             let far = start + 1e-5 * r.dir;
-            prop_assert_eq!(g.occluded(start, far), g.intersect_brute_force(&Ray { origin: start, dir: far - start }, 1.0 - 1e-9 * (far.abs().max_element() + 10.0) / (far - start).length()).is_some());
+            prop_assert_eq!(g.geometry().occluded(start, far), g.geometry().intersect_brute_force(&Ray { origin: start, dir: far - start }, 1.0 - 1e-9 * (far.abs().max_element() + 10.0) / (far - start).length()).is_some());
         }
     }
 
@@ -287,15 +287,15 @@ proptest! {
     /// a curved one only far away.
     #[test]
     fn rays_from_surfaces_do_not_self_intersect(shapes in prop::collection::vec(arb_shape(true), 1..6), starts in prop::collection::vec((0usize..1000, 0.0..1.0f64, 0.0..1.0f64, arb_vec(1.0)), 64)) {
-        let g = SceneGeometry::build(&shapes).expect("valid shapes");
+        let g = common::forest(&shapes).expect("valid shapes");
         for (s, u0, u1, d) in starts {
             if d.length() < 1e-3 { continue; }
-            let sid = SurfaceId((s % g.surfaces().len()) as u32);
+            let sid = SurfaceId((s % g.geometry().surfaces().len()) as u32);
             let smp = g.sample_surface(sid, DVec2::new(u0, u1));
-            if let Some(h) = g.intersect(&Ray { origin: smp.point, dir: d }, f64::INFINITY) {
+            if let Some(h) = g.geometry().intersect(&Ray { origin: smp.point, dir: d }, f64::INFINITY) {
                 let dist = h.t * d.length();
                 prop_assert!(dist > 1e-7 * (1.0 + smp.point.length()), "re-hit at distance {}", dist);
-                if g.surface(sid).is_planar() {
+                if g.geometry().surface(sid).is_planar() {
                     prop_assert!(h.surface != sid, "planar surface hit itself");
                 }
             }
@@ -307,7 +307,7 @@ proptest! {
     #[test]
     fn disks_and_cylinders_match_world_space_reference(p0 in arb_vec(1.0), p1 in arb_vec(1.0), r in 0.1..1.5f64, m in arb_transform(false), rays in prop::collection::vec(arb_ray(), 64)) {
         prop_assume!((p1 - p0).length() > 0.1);
-        let g = SceneGeometry::build(&[cylinder(p0, p1, r, m, false), Shape { kind: trilux_geometry::ShapeKind::Disk, world_from_object: m, flip_normals: false }]).expect("valid shapes");
+        let g = common::forest(&[cylinder(p0, p1, r, m, false), Shape { kind: trilux_geometry::ShapeKind::Disk, world_from_object: m, flip_normals: false }]).expect("valid shapes");
         let (s, _, _) = m.to_scale_rotation_translation();
         let (a, b) = (m.transform_point3(p0), m.transform_point3(p1));
         let wr = r * s.x;
@@ -345,7 +345,7 @@ proptest! {
                 }
             }
             if margin < 1e-6 { continue; }
-            let hit = g.intersect(&ray, f64::INFINITY);
+            let hit = g.geometry().intersect(&ray, f64::INFINITY);
             match (best, hit) {
                 (None, None) => {}
                 (Some((t, cyl)), Some(h)) => {
@@ -360,7 +360,7 @@ proptest! {
 
 #[test]
 fn segments_between_faces_of_a_closed_room_are_unoccluded() {
-    let g = SceneGeometry::build(&[cube(DMat4::from_scale(DVec3::new(2.0, 1.0, 3.0)), true)])
+    let g = common::forest(&[cube(DMat4::from_scale(DVec3::new(2.0, 1.0, 3.0)), true)])
         .expect("valid cube");
     let mut n = 0;
     for a in 0..6u32 {
@@ -372,7 +372,7 @@ fn segments_between_faces_of_a_closed_room_are_unoccluded() {
                 let u = DVec2::new((k % 8) as f64 / 8.0 + 0.01, (k / 8) as f64 / 8.0 + 0.02);
                 let p = g.sample_surface(SurfaceId(a), u).point;
                 let q = g.sample_surface(SurfaceId(b), DVec2::ONE - u).point;
-                assert!(!g.occluded(p, q), "{p:?} {q:?}");
+                assert!(!g.geometry().occluded(p, q), "{p:?} {q:?}");
                 n += 1;
             }
         }
@@ -408,7 +408,7 @@ fn shared_edges_of_a_triangulated_cube_do_not_leak() {
         DQuat::from_euler(glam::EulerRot::XYZ, 0.3, 1.1, -0.4),
         DVec3::new(0.1, 0.2, 0.3),
     );
-    let g = SceneGeometry::build(&[mesh(p.clone(), t, m)]).expect("valid mesh");
+    let g = common::forest(&[mesh(p.clone(), t, m)]).expect("valid mesh");
     let o = m.transform_point3(DVec3::new(0.1, -0.2, 0.05));
     let mut rays = 0;
     for a in 0..8usize {
@@ -418,7 +418,7 @@ fn shared_edges_of_a_triangulated_cube_do_not_leak() {
             }
             for k in 0..=100 {
                 let target = m.transform_point3(p[a].lerp(p[b], k as f64 / 100.0));
-                let h = g.intersect(
+                let h = g.geometry().intersect(
                     &Ray {
                         origin: o,
                         dir: target - o,

@@ -6,26 +6,35 @@ mod common;
 use common::*;
 use glam::{DMat4, DVec2, DVec3};
 use trilux_geometry::{
-    CHART_MAX_TRIANGLES, ElementId, Ray, SceneGeometry, SurfaceCoord, SurfaceKind,
+    CHART_MAX_TRIANGLES, ElementForest, ElementId, Ray, SurfaceCoord, SurfaceId, SurfaceKind,
 };
 
 #[test]
 fn an_8192_triangle_sheet_becomes_a_handful_of_charts_covering_every_triangle_once() {
     let (p, t) = curved_sheet(64);
     assert_eq!(t.len(), 8192);
-    let mut g =
-        SceneGeometry::build(&[mesh(p.clone(), t.clone(), DMat4::IDENTITY)]).expect("valid mesh");
-    let charts = g.surfaces().len();
+    let mut g = common::forest(&[mesh(p.clone(), t.clone(), DMat4::IDENTITY)]).expect("valid mesh");
+    let charts = g.geometry().surfaces().len();
     println!("{charts} charts");
     assert!(
         (8192 / CHART_MAX_TRIANGLES..=24).contains(&charts),
         "{charts} charts"
     );
-    assert!(g.surfaces().iter().all(|s| s.kind == SurfaceKind::Chart));
+    assert!(
+        g.geometry()
+            .surfaces()
+            .iter()
+            .all(|s| s.kind == SurfaceKind::Chart)
+    );
     // The sheet is a dome in the middle (its back sees itself there) and a
     // saddle near the corners.
-    assert!(g.surfaces().iter().any(|s| s.back_can_see_itself()));
-    let total: f64 = g.surfaces().iter().map(|s| s.area()).sum();
+    assert!(
+        g.geometry()
+            .surfaces()
+            .iter()
+            .any(|s| s.back_can_see_itself())
+    );
+    let total: f64 = g.geometry().surfaces().iter().map(|s| s.area()).sum();
     let exact: f64 = t
         .iter()
         .map(|tri| {
@@ -39,7 +48,9 @@ fn an_8192_triangle_sheet_becomes_a_handful_of_charts_covering_every_triangle_on
     // Subdivide every tree until each leaf is a single piece.
     let mut covered = vec![0.0f64; t.len()];
     let mut leaves_per_triangle = vec![0u32; t.len()];
-    let mut stack: Vec<ElementId> = g.surfaces().iter().map(|s| s.root).collect();
+    let mut stack: Vec<ElementId> = (0..g.geometry().surfaces().len() as u32)
+        .map(|s| g.root(SurfaceId(s)))
+        .collect();
     let mut max_depth = 0;
     while let Some(e) = stack.pop() {
         let pieces = g.element_pieces(e).to_vec();
@@ -77,9 +88,11 @@ fn an_8192_triangle_sheet_becomes_a_handful_of_charts_covering_every_triangle_on
 #[test]
 fn hits_on_a_chart_locate_the_triangle_they_hit() {
     let (p, t) = curved_sheet(32);
-    let mut g = SceneGeometry::build(&[mesh(p, t, DMat4::IDENTITY)]).expect("valid mesh");
+    let mut g = common::forest(&[mesh(p, t, DMat4::IDENTITY)]).expect("valid mesh");
     // Subdivide every chart three levels.
-    let mut frontier: Vec<ElementId> = g.surfaces().iter().map(|s| s.root).collect();
+    let mut frontier: Vec<ElementId> = (0..g.geometry().surfaces().len() as u32)
+        .map(|s| g.root(SurfaceId(s)))
+        .collect();
     for _ in 0..3 {
         frontier = frontier.into_iter().flat_map(|e| g.subdivide(e)).collect();
     }
@@ -87,6 +100,7 @@ fn hits_on_a_chart_locate_the_triangle_they_hit() {
         for j in 0..50 {
             let o = DVec3::new((i as f64 + 0.5) / 50.0, (j as f64 + 0.5) / 50.0, 1.0);
             let h = g
+                .geometry()
                 .intersect(
                     &Ray {
                         origin: o,
@@ -134,10 +148,10 @@ fn concave_and_convex_charts() {
         DVec3::new(0.0, -1.0, 0.3),
     ];
     let t = vec![[0, 1, 2], [0, 2, 3], [1, 0, 5], [1, 5, 4]];
-    let g = SceneGeometry::build(&[mesh(p, t, DMat4::IDENTITY)]).expect("valid mesh");
-    assert_eq!(g.surfaces().len(), 1);
-    let s = &g.surfaces()[0];
-    assert!(g.element(s.root).normal.z > 0.9);
+    let g = common::forest(&[mesh(p, t, DMat4::IDENTITY)]).expect("valid mesh");
+    assert_eq!(g.geometry().surfaces().len(), 1);
+    let s = &g.geometry().surfaces()[0];
+    assert!(g.element(g.root(SurfaceId(0))).normal.z > 0.9);
     assert!(s.can_see_itself());
     assert!(!s.back_can_see_itself());
     assert!(!s.is_planar());
@@ -168,13 +182,20 @@ fn concave_and_convex_charts() {
             t.push([a, b + n as u32, b]);
         }
     }
-    let g = SceneGeometry::build(&[mesh(p, t, DMat4::IDENTITY)]).expect("valid mesh");
-    assert!(g.surfaces().iter().all(|s| !s.can_see_itself()));
-    assert!(g.surfaces().iter().all(|s| s.back_can_see_itself()));
+    let g = common::forest(&[mesh(p, t, DMat4::IDENTITY)]).expect("valid mesh");
+    assert!(g.geometry().surfaces().iter().all(|s| !s.can_see_itself()));
     assert!(
-        g.surfaces()
+        g.geometry()
+            .surfaces()
             .iter()
-            .all(|s| g.element(s.root).normal.z > 0.0)
+            .all(|s| s.back_can_see_itself())
+    );
+    assert!(
+        g.geometry().surfaces().iter().enumerate().all(|(k, _)| g
+            .element(g.root(SurfaceId(k as u32)))
+            .normal
+            .z
+            > 0.0)
     );
 }
 
@@ -185,8 +206,10 @@ fn locate_agrees_with_a_descent_from_the_root() {
     // triangle) and by descending from the root through the children that
     // contain it.
     let (p, t) = curved_sheet(24);
-    let mut g = SceneGeometry::build(&[mesh(p, t, DMat4::IDENTITY)]).expect("valid mesh");
-    let mut frontier: Vec<ElementId> = g.surfaces().iter().map(|s| s.root).collect();
+    let mut g = common::forest(&[mesh(p, t, DMat4::IDENTITY)]).expect("valid mesh");
+    let mut frontier: Vec<ElementId> = (0..g.geometry().surfaces().len() as u32)
+        .map(|s| g.root(SurfaceId(s)))
+        .collect();
     for level in 0..7 {
         let next: Vec<ElementId> = frontier
             .iter()
@@ -196,8 +219,8 @@ fn locate_agrees_with_a_descent_from_the_root() {
             .collect();
         frontier = next;
     }
-    let reference = |g: &SceneGeometry, s: trilux_geometry::SurfaceId, c: SurfaceCoord| {
-        let mut id = g.surface(s).root;
+    let reference = |g: &ElementForest, s: trilux_geometry::SurfaceId, c: SurfaceCoord| {
+        let mut id = g.root(s);
         while let Some(kids) = g.element(id).children() {
             match kids.iter().find(|&&k| g.element_contains(k, c)) {
                 Some(&k) => id = k,
@@ -236,15 +259,14 @@ fn a_triangle_soup_becomes_a_handful_of_charts() {
         }
         triangles.push([k, k + 1, k + 2]);
     }
-    let mut g =
-        SceneGeometry::build(&[mesh(positions, triangles, DMat4::IDENTITY)]).expect("valid mesh");
-    let charts = g.surfaces().len();
+    let mut g = common::forest(&[mesh(positions, triangles, DMat4::IDENTITY)]).expect("valid mesh");
+    let charts = g.geometry().surfaces().len();
     println!("{charts} charts for a soup of 8192 triangles");
     assert!((16..=32).contains(&charts), "{charts} charts");
     // Every triangle is in exactly one chart and reachable by locate.
     let mut seen = vec![0u32; 8192];
     for s in 0..charts {
-        let root = g.surfaces()[s].root;
+        let root = g.root(SurfaceId(s as u32));
         for p in g.element_pieces(root) {
             seen[p.triangle as usize] += 1;
         }

@@ -6,11 +6,11 @@ mod common;
 use common::*;
 use glam::{DMat4, DQuat, DVec2, DVec3};
 use trilux_geometry::{
-    ElementId, SceneGeometry, Shape, ShapeKind, ShapeProblem, SurfaceId, TriangleMesh,
+    ElementForest, ElementId, Shape, ShapeKind, ShapeProblem, SurfaceId, TriangleMesh,
 };
 
 /// Subdivides every element `levels` times and returns the leaves.
-fn refine(g: &mut SceneGeometry, root: ElementId, levels: u32) -> Vec<ElementId> {
+fn refine(g: &mut ElementForest, root: ElementId, levels: u32) -> Vec<ElementId> {
     let mut f = vec![root];
     for _ in 0..levels {
         f = f.into_iter().flat_map(|e| g.subdivide(e)).collect();
@@ -26,10 +26,10 @@ fn ellipsoid_area_is_exact() {
     let m =
         DMat4::from_scale_rotation_translation(DVec3::new(a, a, c), DQuat::IDENTITY, DVec3::ONE);
     let m = DMat4::from_quat(DQuat::from_euler(glam::EulerRot::XYZ, 0.3, 0.2, 0.1)) * m;
-    let g = SceneGeometry::build(&[sphere(DVec3::ZERO, 1.0, m, false)]).expect("valid");
+    let g = common::forest(&[sphere(DVec3::ZERO, 1.0, m, false)]).expect("valid");
     let e = (1.0 - a * a / (c * c)).sqrt();
     let exact = 2.0 * std::f64::consts::PI * a * a * (1.0 + c / (a * e) * e.asin());
-    let total: f64 = g.surfaces().iter().map(|s| s.area()).sum();
+    let total: f64 = g.geometry().surfaces().iter().map(|s| s.area()).sum();
     assert!((total - exact).abs() < 1e-9 * exact, "{total} vs {exact}");
 }
 
@@ -38,7 +38,7 @@ fn elliptic_cylinder_area_is_exact() {
     // Semi-axes 0.5 and 1.2, height 2: perimeter by the trapezoid rule on
     // the periodic integrand (exponentially accurate).
     let m = DMat4::from_scale(DVec3::new(0.5, 1.2, 1.0));
-    let g = SceneGeometry::build(&[cylinder(
+    let g = common::forest(&[cylinder(
         DVec3::new(0.0, 0.0, -1.0),
         DVec3::new(0.0, 0.0, 1.0),
         1.0,
@@ -55,7 +55,7 @@ fn elliptic_cylinder_area_is_exact() {
         .sum::<f64>()
         * std::f64::consts::TAU
         / n as f64;
-    let total: f64 = g.surfaces().iter().map(|s| s.area()).sum();
+    let total: f64 = g.geometry().surfaces().iter().map(|s| s.area()).sum();
     assert!(
         (total - 2.0 * perimeter).abs() < 1e-9 * total,
         "{total} vs {}",
@@ -68,7 +68,7 @@ fn children_areas_sum_to_the_parent_and_densities_integrate_to_the_area() {
     let shear = DMat4::from_cols_array(&[
         1.0, 0.0, 0.0, 0.0, 0.4, 1.0, 0.0, 0.0, 0.0, 0.3, 0.8, 0.0, 0.1, 0.2, 0.3, 1.0,
     ]);
-    let mut g = SceneGeometry::build(&[
+    let mut g = common::forest(&[
         sphere(DVec3::new(0.2, 0.0, 0.0), 0.8, shear, true),
         cylinder(DVec3::ZERO, DVec3::new(0.0, 1.0, 1.0), 0.3, shear, false),
         Shape {
@@ -84,8 +84,8 @@ fn children_areas_sum_to_the_parent_and_densities_integrate_to_the_area() {
         },
     ])
     .expect("valid");
-    for s in 0..g.surfaces().len() {
-        let root = g.surfaces()[s].root;
+    for s in 0..g.geometry().surfaces().len() {
+        let root = g.root(SurfaceId(s as u32));
         let leaves = refine(&mut g, root, 3);
         let sum: f64 = leaves.iter().map(|&l| g.element(l).area).sum();
         assert!(
@@ -249,44 +249,46 @@ fn bad_shapes_are_errors_naming_the_shape() {
         ),
     ];
     for (k, (bad, check)) in cases.into_iter().enumerate() {
-        let err = SceneGeometry::build(&[ok.clone(), bad]).expect_err("bad shape accepted");
+        let err = common::forest(&[ok.clone(), bad]).expect_err("bad shape accepted");
         assert_eq!(err.shape, 1, "case {k}");
         assert!(check(&err.problem), "case {k}: {err}");
         assert!(err.to_string().starts_with("shape 1: "));
     }
     // Degenerate triangles inside a valid mesh are skipped, not errors.
-    let g = SceneGeometry::build(&[mesh(
+    let g = common::forest(&[mesh(
         vec![DVec3::ZERO, DVec3::X, DVec3::Y, 2.0 * DVec3::X],
         vec![[0, 1, 2], [0, 1, 3]],
         DMat4::IDENTITY,
     )])
     .expect("valid");
-    assert_eq!(g.primitive_count(), 1);
+    assert_eq!(g.geometry().primitive_count(), 1);
     // An empty scene is fine and every ray misses.
-    let g = SceneGeometry::build(&[]).expect("empty scene");
+    let g = common::forest(&[]).expect("empty scene");
     assert!(
-        g.intersect(
-            &trilux_geometry::Ray {
-                origin: DVec3::ZERO,
-                dir: DVec3::X
-            },
-            f64::INFINITY
-        )
-        .is_none()
+        g.geometry()
+            .intersect(
+                &trilux_geometry::Ray {
+                    origin: DVec3::ZERO,
+                    dir: DVec3::X
+                },
+                f64::INFINITY
+            )
+            .is_none()
     );
-    assert!(!g.occluded(DVec3::ZERO, DVec3::ONE));
+    assert!(!g.geometry().occluded(DVec3::ZERO, DVec3::ONE));
 }
 
 #[test]
 fn mitsuba_conventions() {
     // Rectangle: [-1,1]², normal +z, u along x.
-    let g = SceneGeometry::build(&[Shape {
+    let g = common::forest(&[Shape {
         kind: ShapeKind::Rectangle,
         world_from_object: DMat4::IDENTITY,
         flip_normals: false,
     }])
     .expect("valid");
     let p = g
+        .geometry()
         .surface_point(
             SurfaceId(0),
             trilux_geometry::SurfaceCoord::Uv(DVec2::new(0.75, 0.25)),
@@ -295,15 +297,15 @@ fn mitsuba_conventions() {
     assert!((p.point - DVec3::new(0.5, -0.5, 0.0)).length() < 1e-15);
     assert_eq!(p.normal, DVec3::Z);
     // flip_normals flips the front.
-    let g = SceneGeometry::build(&[Shape {
+    let g = common::forest(&[Shape {
         kind: ShapeKind::Disk,
         world_from_object: DMat4::IDENTITY,
         flip_normals: true,
     }])
     .expect("valid");
-    assert_eq!(g.element(g.surfaces()[0].root).normal, -DVec3::Z);
+    assert_eq!(g.element(g.root(SurfaceId(0))).normal, -DVec3::Z);
     // Cylinder: an open tube from p0 to p1, outward normals; area 2π r h.
-    let g = SceneGeometry::build(&[cylinder(
+    let g = common::forest(&[cylinder(
         DVec3::ZERO,
         DVec3::new(0.0, 0.0, 2.0),
         0.5,
@@ -311,29 +313,30 @@ fn mitsuba_conventions() {
         false,
     )])
     .expect("valid");
-    let total: f64 = g.surfaces().iter().map(|s| s.area()).sum();
+    let total: f64 = g.geometry().surfaces().iter().map(|s| s.area()).sum();
     assert!((total - std::f64::consts::TAU).abs() < 1e-12);
-    for s in g.surfaces() {
-        let e = g.element(s.root);
+    for (k, s) in g.geometry().surfaces().iter().enumerate() {
+        let e = g.element(g.root(SurfaceId(k as u32)));
         let radial = DVec3::new(e.centre.x, e.centre.y, 0.0).normalize();
         assert!((e.normal - radial).length() < 1e-12);
         assert!(!s.can_see_itself() && s.back_can_see_itself());
     }
     // The tube is open: a ray along its axis passes through.
     assert!(
-        g.intersect(
-            &trilux_geometry::Ray {
-                origin: DVec3::new(0.0, 0.0, -1.0),
-                dir: DVec3::Z
-            },
-            f64::INFINITY
-        )
-        .is_none()
+        g.geometry()
+            .intersect(
+                &trilux_geometry::Ray {
+                    origin: DVec3::new(0.0, 0.0, -1.0),
+                    dir: DVec3::Z
+                },
+                f64::INFINITY
+            )
+            .is_none()
     );
     // Cube: outward normals, 6 faces of area 4.
-    let g = SceneGeometry::build(&[cube(DMat4::IDENTITY, false)]).expect("valid");
-    for s in g.surfaces() {
-        let e = g.element(s.root);
+    let g = common::forest(&[cube(DMat4::IDENTITY, false)]).expect("valid");
+    for (k, s) in g.geometry().surfaces().iter().enumerate() {
+        let e = g.element(g.root(SurfaceId(k as u32)));
         assert!((e.normal - e.centre).length() < 1e-12);
         assert!((s.area() - 4.0).abs() < 1e-12);
     }

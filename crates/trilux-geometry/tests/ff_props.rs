@@ -7,7 +7,9 @@ mod common;
 use common::*;
 use glam::{DMat4, DQuat, DVec3};
 use proptest::prelude::*;
-use trilux_geometry::{ElementId, SceneGeometry, Shape, ShapeKind, Side};
+use trilux_geometry::{
+    ElementId, FaceElement, Shape, ShapeKind, Side, SurfaceId, Visibility, form_factor,
+};
 
 fn arb_vec(r: f64) -> impl Strategy<Value = DVec3> {
     (-r..r, -r..r, -r..r).prop_map(|(x, y, z)| DVec3::new(x, y, z))
@@ -69,11 +71,11 @@ proptest! {
 
     #[test]
     fn form_factors_are_finite_bounded_and_reciprocal(shapes in prop::collection::vec(arb_shape(), 2..5), picks in prop::collection::vec((0usize..1000, 0usize..1000, 0u32..3, 0u32..3, any::<bool>()), 12)) {
-        let mut g = SceneGeometry::build(&shapes).expect("valid shapes");
-        let n = g.surfaces().len();
+        let mut g = common::forest(&shapes).expect("valid shapes");
+        let n = g.geometry().surfaces().len();
         for (a, b, da, db, back) in picks {
             let mut pick = |s: usize, depth: u32| {
-                let mut e = g.surfaces()[s % n].root;
+                let mut e = g.root(SurfaceId((s % n) as u32));
                 for k in 0..depth {
                     e = g.subdivide(e)[(s + k as usize) % 4];
                 }
@@ -82,14 +84,14 @@ proptest! {
             let (i, j): (ElementId, ElementId) = (pick(a, da), pick(b, db));
             let side = if back { Side::Back } else { Side::Front };
             let o = trilux_geometry::FormFactorOptions::default();
-            let fij = g.form_factor_sided(i, Side::Front, j, side, &o);
-            let fji = g.form_factor_sided(j, side, i, Side::Front, &o);
+            let fij = form_factor(&g, FaceElement::new(i, Side::Front), FaceElement::new(j, side), &o);
+            let fji = form_factor(&g, FaceElement::new(j, side), FaceElement::new(i, Side::Front), &o);
             for f in [fij, fji] {
                 prop_assert!(f.value.is_finite() && f.error.is_finite() && f.spread.is_finite(), "{:?}", f);
                 prop_assert!(f.value >= 0.0 && f.error >= 0.0 && f.spread >= 0.0);
                 prop_assert!(f.value <= 1.0 + 1e-2 + f.error, "{:?}", f);
             }
-            let v = g.visibility_sided(i, Side::Front, j, side, 16);
+            let v = Visibility::new(&g, None).fraction(FaceElement::new(i, Side::Front), FaceElement::new(j, side), 16);
             prop_assert!((0.0..=1.0).contains(&v));
             // Reciprocity for elements whose boxes are well apart (smooth
             // kernel): within the stated errors plus 2% for the sampled

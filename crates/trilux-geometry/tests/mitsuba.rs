@@ -4,7 +4,7 @@
 //! cylinders and OBJ meshes (one mirrored) with transforms and `flip_normals`.
 
 use glam::{DMat4, DVec3};
-use trilux_geometry::{Ray, SceneGeometry, Shape, ShapeKind};
+use trilux_geometry::{Geometry, Ray, Shape, ShapeKind};
 
 fn parse(s: &str) -> f64 {
     s.trim().parse().expect("number")
@@ -13,7 +13,7 @@ fn parse(s: &str) -> f64 {
 #[test]
 fn hits_match_mitsuba() {
     let text = include_str!("data/mitsuba_hits.csv");
-    let mut shapes: Vec<SceneGeometry> = Vec::new();
+    let mut shapes: Vec<Geometry> = Vec::new();
     let mut checked = 0;
     let mut hits = 0;
     for line in text
@@ -66,7 +66,7 @@ fn hits_match_mitsuba() {
                     world_from_object,
                     flip_normals: f[2] == "1",
                 };
-                shapes.push(SceneGeometry::build(&[shape]).expect("valid shape"));
+                shapes.push(Geometry::build(&[shape]).expect("valid shape"));
             }
             "ray" => {
                 let k: usize = f[1].parse().expect("index");

@@ -4,7 +4,7 @@ mod common;
 
 use common::*;
 use glam::DVec3;
-use trilux_geometry::SceneGeometry;
+use trilux_geometry::{FaceElement, SurfaceId, Visibility};
 
 /// Exact visible fraction of segments between uniform points of the unit
 /// squares at z = 0 and z = 1 (centred on the z axis) past the blocker
@@ -53,8 +53,8 @@ fn blocker_plate_halfway_matches_brute_force() {
             rect(DVec3::Z, 0.5 * DVec3::X, 0.5 * DVec3::Y, true),
             rect(DVec3::new(cx, cy, 0.5), h * DVec3::X, h * DVec3::Y, false),
         ];
-        let g = SceneGeometry::build(&shapes).expect("valid shapes");
-        let (a, b) = (g.surfaces()[0].root, g.surfaces()[1].root);
+        let g = common::forest(&shapes).expect("valid shapes");
+        let (a, b) = (g.root(SurfaceId(0)), g.root(SurfaceId(1)));
         let reference = exact(cx, cy, h);
         let brute = brute_force(3001, cx, cy, h);
         assert!(
@@ -62,7 +62,11 @@ fn blocker_plate_halfway_matches_brute_force() {
             "brute force {brute} vs exact {reference}"
         );
         let samples = 4096;
-        let v = g.visibility(a, b, samples);
+        let v = Visibility::new(&g, None).fraction(
+            FaceElement::front(a),
+            FaceElement::front(b),
+            samples,
+        );
         // 3σ of a binomial estimate with independent samples (stratified
         // samples do better): 3 √(1/4 / 4096) ≈ 0.023.
         assert!(
@@ -72,8 +76,19 @@ fn blocker_plate_halfway_matches_brute_force() {
         // Symmetric in its arguments up to sampling noise, and the batch
         // form agrees with the single form exactly.
         // (a, b) and (b, a) trace the same segments: exactly symmetric.
-        assert_eq!(g.visibility(b, a, samples), v);
-        assert_eq!(g.visibility_batch(&[(a, b)], samples)[0], v);
+        assert_eq!(
+            Visibility::new(&g, None).fraction(
+                FaceElement::front(b),
+                FaceElement::front(a),
+                samples
+            ),
+            v
+        );
+        assert_eq!(
+            Visibility::new(&g, None)
+                .fraction_batch(&[(FaceElement::front(a), FaceElement::front(b))], samples)[0],
+            v
+        );
         println!(
             "blocker ({cx}, {cy}, {h}): visibility {v:.4} (exact {reference:.4}, brute force {brute:.4})"
         );
@@ -82,23 +97,31 @@ fn blocker_plate_halfway_matches_brute_force() {
 
 #[test]
 fn unblocked_and_fully_blocked() {
-    let open = SceneGeometry::build(&[
+    let open = common::forest(&[
         rect(DVec3::ZERO, 0.5 * DVec3::X, 0.5 * DVec3::Y, false),
         rect(DVec3::Z, 0.5 * DVec3::X, 0.5 * DVec3::Y, true),
     ])
     .expect("valid");
     assert_eq!(
-        open.visibility(open.surfaces()[0].root, open.surfaces()[1].root, 256),
+        Visibility::new(&open, None).fraction(
+            FaceElement::front(open.root(SurfaceId(0))),
+            FaceElement::front(open.root(SurfaceId(1))),
+            256
+        ),
         1.0
     );
-    let closed = SceneGeometry::build(&[
+    let closed = common::forest(&[
         rect(DVec3::ZERO, 0.5 * DVec3::X, 0.5 * DVec3::Y, false),
         rect(DVec3::Z, 0.5 * DVec3::X, 0.5 * DVec3::Y, true),
         rect(0.5 * DVec3::Z, 0.6 * DVec3::X, 0.6 * DVec3::Y, false),
     ])
     .expect("valid");
     assert_eq!(
-        closed.visibility(closed.surfaces()[0].root, closed.surfaces()[1].root, 256),
+        Visibility::new(&closed, None).fraction(
+            FaceElement::front(closed.root(SurfaceId(0))),
+            FaceElement::front(closed.root(SurfaceId(1))),
+            256
+        ),
         0.0
     );
 }
@@ -110,7 +133,7 @@ fn concave_surfaces_see_their_own_pieces() {
     // Inside a sphere (flipped) and inside a tube (back sides), every pair
     // of pieces, including a piece with itself, is fully visible: the
     // chords touch the surface only at their ends.
-    let g = SceneGeometry::build(&[
+    let g = common::forest(&[
         sphere(DVec3::new(0.1, 0.2, 0.3), 1.3, DMat4::IDENTITY, true),
         cylinder(
             DVec3::new(5.0, 0.0, 0.0),
@@ -123,17 +146,19 @@ fn concave_surfaces_see_their_own_pieces() {
     .expect("valid");
     for i in 0..8 {
         for j in 0..8 {
-            let v = g.visibility(g.surfaces()[i].root, g.surfaces()[j].root, 256);
+            let v = Visibility::new(&g, None).fraction(
+                FaceElement::front(g.root(SurfaceId(i as u32))),
+                FaceElement::front(g.root(SurfaceId(j as u32))),
+                256,
+            );
             assert_eq!(v, 1.0, "sphere pieces {i} {j}");
         }
     }
     for i in 8..12 {
         for j in 8..12 {
-            let v = g.visibility_sided(
-                g.surfaces()[i].root,
-                Side::Back,
-                g.surfaces()[j].root,
-                Side::Back,
+            let v = Visibility::new(&g, None).fraction(
+                FaceElement::new(g.root(SurfaceId(i as u32)), Side::Back),
+                FaceElement::new(g.root(SurfaceId(j as u32)), Side::Back),
                 256,
             );
             assert_eq!(v, 1.0, "tube pieces {i} {j}");
@@ -170,14 +195,18 @@ fn weighted_brute_force(n: usize, cx: f64, cy: f64, h: f64) -> f64 {
 fn kernel_weighted_visibility_matches_brute_force() {
     use trilux_geometry::Side;
     for (cx, cy, h) in [(0.0, 0.0, 0.25), (0.3, 0.3, 0.35)] {
-        let g = SceneGeometry::build(&[
+        let g = common::forest(&[
             rect(DVec3::ZERO, 0.5 * DVec3::X, 0.5 * DVec3::Y, false),
             rect(DVec3::Z, 0.5 * DVec3::X, 0.5 * DVec3::Y, true),
             rect(DVec3::new(cx, cy, 0.5), h * DVec3::X, h * DVec3::Y, false),
         ])
         .expect("valid");
-        let (a, b) = (g.surfaces()[0].root, g.surfaces()[1].root);
-        let v = g.visibility_weighted(a, Side::Front, b, Side::Front, 4096);
+        let (a, b) = (g.root(SurfaceId(0)), g.root(SurfaceId(1)));
+        let v = Visibility::new(&g, None).weighted(
+            FaceElement::new(a, Side::Front),
+            FaceElement::new(b, Side::Front),
+            4096,
+        );
         // An odd grid keeps pair midpoints off the blocker's edges (an even
         // one puts many exactly on them and biases the count by ~0.02).
         let reference = weighted_brute_force(37, cx, cy, h);
@@ -188,7 +217,7 @@ fn kernel_weighted_visibility_matches_brute_force() {
         );
         println!(
             "weighted visibility ({cx}, {cy}, {h}): {v:.4} (brute force {reference:.4}, unweighted {:.4})",
-            g.visibility(a, b, 4096)
+            Visibility::new(&g, None).fraction(FaceElement::front(a), FaceElement::front(b), 4096)
         );
     }
 }

@@ -1,14 +1,32 @@
 //! Renders a scene file with direct light only (a stand-in solution that
 //! knows no indirect light), e.g. to compare with Mitsuba 3's path tracer at
-//! `max_depth` 2 before a solve is available.
+//! `max_depth` 2.
 //!
 //! Run: `cargo run --release -p trilux-render --example direct_light -- SCENE.xml OUT.exr [SIZE] [SPP] [rgb|spectral]`
 
 use std::path::Path;
 
-use trilux_color::Spectrum;
-use trilux_geometry::SceneGeometry;
-use trilux_render::{DirectOnly, ExtraBounce, RenderSettings, ViewOverrides, render};
+use trilux_color::{Mode, WithBands};
+use trilux_render::{
+    DirectOnly, ExtraBounce, Image, RenderError, RenderSettings, RenderStats, ViewOverrides,
+    prepare, render, scene_camera,
+};
+
+/// The render, once the band count is known.
+struct Direct<'a> {
+    scene: &'a trilux_scene::Scene,
+    view: ViewOverrides,
+    settings: RenderSettings,
+}
+
+impl WithBands for Direct<'_> {
+    type Output = Result<(Image, RenderStats), RenderError>;
+    fn run<const N: usize>(self) -> Self::Output {
+        let camera = scene_camera(self.scene, &self.view)?;
+        let solution = DirectOnly::<N>::new(prepare::<N>(self.scene)?);
+        render(&solution, &camera, &self.settings, |_, _| {})
+    }
+}
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -17,7 +35,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     let size: Option<u32> = rest.first().map(|s| s.parse()).transpose()?;
     let spp: Option<u32> = rest.get(1).map(|s| s.parse()).transpose()?;
-    let spectral = rest.get(2).map(String::as_str) == Some("spectral");
+    let mode = match rest.get(2).map(String::as_str) {
+        Some("spectral") => Mode::Spectral,
+        _ => Mode::Rgb,
+    };
     let scene = trilux_scene::load(scene)?;
     let camera = scene.camera.as_ref().ok_or("the scene has no camera")?;
     let mut settings = RenderSettings::for_scene(camera);
@@ -28,20 +49,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         height: size,
         ..Default::default()
     };
-    let geometry = SceneGeometry::build(&scene.geometry_shapes())?;
-    let (image, stats) = if spectral {
-        let sol = DirectOnly::<10> {
-            geometry,
-            constant: Spectrum::splat(0.0),
-        };
-        render(&scene, &sol, &view, &settings, |_, _| {})?
-    } else {
-        let sol = DirectOnly::<3> {
-            geometry,
-            constant: Spectrum::splat(0.0),
-        };
-        render(&scene, &sol, &view, &settings, |_, _| {})?
-    };
+    let (image, stats) = mode.with_bands(Direct {
+        scene: &scene,
+        view,
+        settings,
+    })?;
     image.write_exr(Path::new(out))?;
     println!("{:.2} s, mean {:?}", stats.seconds, image.mean());
     Ok(())

@@ -3,13 +3,14 @@
 //! Run: `cargo run --release -p trilux-render --example render_scene -- SCENE.xml OUT.exr [SIZE] [SPP] [draft|default|high] [never|auto|always]`
 //!
 //! Prints the solve and render times and the image mean. Spectral scenes
-//! solve and render in 10 bands. OUT ending in `.png` writes an 8-bit sRGB
-//! PNG (exposure 0, clamped), anything else a linear EXR.
+//! solve and render in their spectral bands. OUT ending in `.png` writes an
+//! 8-bit sRGB PNG (exposure 0, clamped), anything else a linear EXR.
 
 use std::path::Path;
-use std::time::Instant;
 
-use trilux_render::{ExtraBounce, RenderSettings, ViewOverrides, render, solve_scene};
+use trilux_render::{
+    ExtraBounce, Observer, Plan, RenderPlan, RenderSettings, SolutionSource, ViewOverrides,
+};
 use trilux_solver::{Quality, SolverSettings};
 
 fn print_stats(s: &trilux_solver::SolveStats) {
@@ -49,28 +50,28 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut settings = RenderSettings::for_scene(camera);
     settings.spp = spp.unwrap_or(settings.spp);
     settings.extra_bounce = extra;
-    let view = ViewOverrides {
-        width: size,
-        height: size,
-        ..Default::default()
-    };
     // Single solver settings may be overridden for experiments
     // (`SolverSettings::override_from`: TRILUX_FF_EPS and the like).
-    let mut solver_settings = SolverSettings::preset(quality);
-    solver_settings.override_from(|name| std::env::var(name).ok())?;
-    let t = Instant::now();
-    let (image, stats, solve_s) = if scene.spectral {
-        let sol = solve_scene::<{ trilux_color::SPECTRAL_BANDS }>(&scene, solver_settings)?;
-        let solve_s = t.elapsed().as_secs_f64();
-        print_stats(sol.stats());
-        let (i, s) = render(&scene, &sol, &view, &settings, |_, _| {})?;
-        (i, s, solve_s)
-    } else {
-        let sol = solve_scene::<3>(&scene, solver_settings)?;
-        let solve_s = t.elapsed().as_secs_f64();
-        print_stats(sol.stats());
-        let (i, s) = render(&scene, &sol, &view, &settings, |_, _| {})?;
-        (i, s, solve_s)
+    let mut solver = SolverSettings::preset(quality);
+    solver.override_from(|name| std::env::var(name).ok())?;
+    let plan = Plan {
+        mode: scene.mode(),
+        solver,
+        source: SolutionSource::Solve,
+        save: None,
+        render: Some(RenderPlan {
+            view: ViewOverrides {
+                width: size,
+                height: size,
+                ..Default::default()
+            },
+            settings,
+        }),
+    };
+    let outcome = Observer::quiet(|o| trilux_render::pipeline::run(&scene, &plan, o))?;
+    print_stats(&outcome.solve);
+    let (Some(image), Some(stats)) = (&outcome.image, &outcome.render) else {
+        return Err("the plan renders an image".into());
     };
     let out = Path::new(out);
     if out.extension().is_some_and(|e| e == "png") {
@@ -79,7 +80,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         image.write_exr(out)?;
     }
     println!(
-        "solve {solve_s:.2} s, render {:.2} s, extra bounces {} of {} gather rays, mean {:?}",
+        "solve {:.2} s, render {:.2} s, extra bounces {} of {} gather rays, mean {:?}",
+        outcome.solve_seconds,
         stats.seconds,
         stats.gather.extra_bounces,
         stats.gather.gather_rays,

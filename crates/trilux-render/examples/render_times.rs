@@ -1,36 +1,14 @@
 //! Render time per scene at 256×256 for 16 and 64 samples per pixel, from
-//! one default-quality solve per scene (the render alone is timed: the
-//! view-independent solve is shared by every view). Prints a Markdown table
-//! for docs/results.md.
+//! one default-quality solve per scene saved to a file (the render alone is
+//! timed: the view-independent solve is shared by every view). Prints a
+//! Markdown table for docs/results.md.
 //!
 //! Run: `cargo run --release -p trilux-render --example render_times [-- SCENE.xml ...]`
 
 use std::path::PathBuf;
-use std::time::Instant;
 
-use trilux_render::{RadianceSolution, RenderSettings, ViewOverrides, render, solve_scene};
+use trilux_render::{Observer, Plan, RenderPlan, RenderSettings, SolutionSource, ViewOverrides};
 use trilux_solver::{Quality, SolverSettings};
-
-fn times<const N: usize, S: RadianceSolution<N>>(
-    scene: &trilux_scene::Scene,
-    sol: &S,
-) -> Result<Vec<f64>, Box<dyn std::error::Error>> {
-    let view = ViewOverrides {
-        width: Some(256),
-        height: Some(256),
-        ..Default::default()
-    };
-    let mut out = Vec::new();
-    for spp in [16, 64] {
-        let settings = RenderSettings {
-            spp,
-            ..RenderSettings::for_scene(scene.camera.as_ref().ok_or("no camera")?)
-        };
-        let (_, stats) = render(scene, sol, &view, &settings, |_, _| {})?;
-        out.push(stats.seconds);
-    }
-    Ok(out)
-}
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut paths: Vec<PathBuf> = std::env::args().skip(1).map(PathBuf::from).collect();
@@ -42,31 +20,47 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .collect();
         paths.sort();
     }
+    let file = std::env::temp_dir().join(format!("trilux-times-{}.sol", std::process::id()));
     println!("| scene | bands | solve s | render 16 spp s | render 64 spp s |");
     println!("|---|---|---|---|---|");
     for p in paths {
         let scene = trilux_scene::load(&p)?;
-        let t = Instant::now();
-        let (bands, r) = if scene.spectral {
-            let sol = solve_scene::<{ trilux_color::SPECTRAL_BANDS }>(
-                &scene,
-                SolverSettings::preset(Quality::Default),
-            )?;
-            let solve = t.elapsed().as_secs_f64();
-            (trilux_color::SPECTRAL_BANDS, (solve, times(&scene, &sol)?))
-        } else {
-            let sol = solve_scene::<3>(&scene, SolverSettings::preset(Quality::Default))?;
-            let solve = t.elapsed().as_secs_f64();
-            (3, (solve, times(&scene, &sol)?))
+        let camera = scene.camera.as_ref().ok_or("no camera")?;
+        let mut plan = Plan {
+            mode: scene.mode(),
+            solver: SolverSettings::preset(Quality::Default),
+            source: SolutionSource::Solve,
+            save: Some(&file),
+            render: None,
         };
+        let solved = Observer::quiet(|o| trilux_render::pipeline::run(&scene, &plan, o))?;
+        plan.source = SolutionSource::Load(&file);
+        plan.save = None;
+        let mut times = Vec::new();
+        for spp in [16, 64] {
+            plan.render = Some(RenderPlan {
+                view: ViewOverrides {
+                    width: Some(256),
+                    height: Some(256),
+                    ..Default::default()
+                },
+                settings: RenderSettings {
+                    spp,
+                    ..RenderSettings::for_scene(camera)
+                },
+            });
+            let r = Observer::quiet(|o| trilux_render::pipeline::run(&scene, &plan, o))?;
+            times.push(r.render_seconds);
+        }
         let name = p
             .file_stem()
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_default();
         println!(
-            "| {name} | {bands} | {:.2} | {:.2} | {:.2} |",
-            r.0, r.1[0], r.1[1]
+            "| {name} | {} | {:.2} | {:.2} | {:.2} |",
+            solved.solve.bands, solved.solve_seconds, times[0], times[1]
         );
     }
+    let _ = std::fs::remove_file(&file);
     Ok(())
 }

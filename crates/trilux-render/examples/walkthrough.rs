@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use glam::DVec3;
-use trilux_render::{RenderSettings, ViewOverrides, render, solve_scene};
+use trilux_render::{Observer, Plan, RenderPlan, RenderSettings, SolutionSource, ViewOverrides};
 use trilux_solver::{Quality, SolverSettings};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -27,12 +27,19 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let spp: u32 = args.get(3).map(|s| s.parse()).transpose()?.unwrap_or(32);
     let scene = trilux_scene::load(&path)?;
     let camera = scene.camera.clone().ok_or("the scene has no camera")?;
-    if scene.spectral {
-        return Err("this example renders RGB scenes; spectral scenes solve in 10 bands".into());
-    }
+    let file = std::env::temp_dir().join(format!("trilux-walk-{}.sol", std::process::id()));
+    let mut plan = Plan {
+        mode: scene.mode(),
+        solver: SolverSettings::preset(Quality::Default),
+        source: SolutionSource::Solve,
+        save: Some(&file),
+        render: None,
+    };
     let t = Instant::now();
-    let solution = solve_scene::<3>(&scene, SolverSettings::preset(Quality::Default))?;
+    Observer::quiet(|o| trilux_render::pipeline::run(&scene, &plan, o))?;
     println!("solved once in {:.2} s", t.elapsed().as_secs_f64());
+    plan.source = SolutionSource::Load(&file);
+    plan.save = None;
 
     // Walk sideways across the view and a little forward, looking at the
     // scene camera's target.
@@ -51,19 +58,24 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             0.5
         };
         let eye: DVec3 = camera.origin + side * reach * (s - 0.5) + forward * reach * 0.3 * s;
-        let view = ViewOverrides {
-            lookat: Some((eye, camera.target, Some(camera.up))),
-            width: Some(size),
-            height: Some(size),
-            ..Default::default()
-        };
-        let (image, stats) = render(&scene, &solution, &view, &settings, |_, _| {})?;
+        plan.render = Some(RenderPlan {
+            view: ViewOverrides {
+                lookat: Some((eye, camera.target, Some(camera.up))),
+                width: Some(size),
+                height: Some(size),
+                ..Default::default()
+            },
+            settings,
+        });
+        let frame = Observer::quiet(|o| trilux_render::pipeline::run(&scene, &plan, o))?;
+        let image = frame.image.ok_or("the plan renders")?;
         image.write_png(Path::new(&format!("out/walkthrough-{k:02}.png")), 0.0)?;
         image.write_exr(Path::new(&format!("out/walkthrough-{k:02}.exr")))?;
         println!(
-            "frame {k}: eye {eye:.3}, rendered in {:.2} s (no solve)",
-            stats.seconds
+            "frame {k}: eye {eye:.3}, loaded in {:.3} s, rendered in {:.2} s (no solve)",
+            frame.solve_seconds, frame.render_seconds
         );
     }
+    let _ = std::fs::remove_file(&file);
     Ok(())
 }

@@ -24,13 +24,13 @@ use crate::sampler::{MAX_SAMPLES, PixelSampler, dims};
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RenderSettings {
     /// Camera samples per pixel; each traces one light sample and one gather
-    /// ray at the first hit (design.md §3, `--spp`).
+    /// ray at the first hit (`--spp`).
     pub spp: u32,
     /// Seed of the sample sequences.
     pub seed: u32,
     /// Reconstruction filter (Mitsuba's Gaussian by default).
     pub filter: ReconstructionFilter,
-    /// When to continue a gather path one bounce (notes §6).
+    /// When to continue a gather path one bounce ([`ExtraBounce`]).
     pub extra_bounce: ExtraBounce,
     /// Tile edge in pixels.
     pub tile_size: u32,
@@ -157,38 +157,19 @@ where
     Ok((image.develop(), stats))
 }
 
-impl RenderSettings {
-    /// The scene's own sample count and film filter, other settings default.
-    pub fn for_scene(camera: &trilux_scene::Camera) -> Self {
-        Self {
-            spp: camera.sample_count.max(1),
-            filter: crate::view::filter_of(camera),
-            ..Self::default()
-        }
-    }
-}
-
-/// Renders a loaded scene from its solution: the scene's camera (with
-/// `view`'s overrides) and `settings`. Spectral solutions (N ≠ 3) are
-/// converted per sample to linear sRGB through CIE XYZ.
+/// Renders the scene of `solution` through `camera` with `settings`.
+/// Spectral solutions (N ≠ 3) are converted per sample to linear sRGB
+/// through CIE XYZ.
 pub fn render<const N: usize, S: crate::solved::RadianceSolution<N>>(
-    scene: &trilux_scene::Scene,
     solution: &S,
-    view: &crate::view::ViewOverrides,
+    camera: &Camera,
     settings: &RenderSettings,
     progress: impl Fn(usize, usize) + Sync,
 ) -> Result<(Image, RenderStats), RenderError> {
-    let cam = scene.camera.as_ref().ok_or_else(|| {
-        RenderError::Scene(format!(
-            "{}: the scene has no <sensor> to render from",
-            scene.path.display()
-        ))
-    })?;
-    let camera = crate::view::camera_of(cam, view)?;
-    let solved = crate::solved::SolvedScene::new(scene, solution)?;
+    let solved = crate::solved::SolvedScene::new(solution);
     render_image::<_, N>(
         &solved,
-        &camera,
+        camera,
         settings,
         |l| trilux_color::Spectrum::<N>(*l).to_linear_srgb(),
         progress,

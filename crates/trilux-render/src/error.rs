@@ -11,10 +11,20 @@ pub enum RenderError {
     /// A render setting is out of range (samples per pixel, tile size).
     #[error("invalid render setting: {0}")]
     Settings(String),
-    /// The scene cannot be rendered as given (a material or emitter that
-    /// does not convert, a shape the geometry does not know).
-    #[error("{0}")]
-    Scene(String),
+    /// The scene cannot be prepared as written (a material or emitter that
+    /// does not convert, a shape the geometry refuses), at its place in the
+    /// file.
+    #[error(transparent)]
+    Scene(#[from] trilux_scene::SceneError),
+    /// The scene has no camera to render from.
+    #[error("{}: the scene has no <sensor> to render from", path.display())]
+    NoCamera {
+        /// The scene file.
+        path: PathBuf,
+    },
+    /// Solving, or saving or loading a solution, failed.
+    #[error(transparent)]
+    Solver(#[from] trilux_solver::SolverError),
     /// An image could not be written; nothing is left at `path`.
     #[error("cannot write {path}: {reason}")]
     Write {

@@ -9,9 +9,10 @@
 //! element towards every other; this crate turns it into a picture as the
 //! paper's §4.5 describes ("Final Gathering", Fig. 11): a ray from the eye
 //! meets the scene at x_s, gather rays from x_s meet it at x_d, and the
-//! radiance leaving x_d towards x_s is read from the solution. The notes'
-//! §6 adds light sampling with multiple importance sampling, and one extra
-//! bounce where the solution's piecewise-constant steps would show.
+//! radiance leaving x_d towards x_s is read from the solution. The gather
+//! adds light sampling with multiple importance sampling, and one extra
+//! bounce where the solution's piecewise-constant steps would show
+//! ([`gather`]).
 //!
 //! Contents, in the order an image is made:
 //! - [`camera`]: Mitsuba 3's `perspective` sensor (fov, `fov_axis`, `lookat`).
@@ -23,7 +24,8 @@
 //!   ([`GatherScene`]) and the final-gather estimator itself.
 //! - [`solved`]: [`GatherScene`] for trilux's geometry, BRDFs and a
 //!   solution ([`RadianceSolution`]).
-//! - [`pipeline`]: solve and render in the scene's mode, in one call.
+//! - [`pipeline`]: the one orchestration — prepare a loaded scene in its
+//!   mode, solve it or load a saved solution, save it, render a view.
 //! - [`filter`]: reconstruction filters (Mitsuba's Gaussian, box).
 //! - [`film`]: splatting samples through the filter, per-pixel normalisation.
 //! - [`driver`]: tiles rendered in parallel (rayon), merged deterministically.
@@ -59,7 +61,7 @@ pub use gather::{
     BsdfSample, ExtraBounce, GatherScene, GatherStats, LightSample, SurfacePoint, power_heuristic,
 };
 pub use image::Image;
-pub use pipeline::{PipelineStats, solve_and_render};
+pub use pipeline::{Observer, Outcome, Plan, RenderPlan, SolutionSource, prepare, scene_camera};
 pub use sampler::PixelSampler;
-pub use solved::{DirectOnly, RadianceSolution, Site, SolvedScene, solve_scene};
+pub use solved::{DirectOnly, RadianceSolution, SolvedScene};
 pub use view::{ViewOverrides, camera_of, filter_of};

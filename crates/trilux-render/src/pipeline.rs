@@ -1,57 +1,206 @@
-//! Solve and render in one call, in the scene's own mode: 3 bands for RGB
-//! scenes, 10 spectral bands for spectral ones (design.md §2).
+//! The one orchestration from a loaded scene to a solution and an image,
+//! shared by the `trilux` command, the examples and the xtask tools:
+//! prepare the scene in its mode's band count ([`prepare`]), solve it or
+//! load a saved solution, optionally save it, optionally render a view.
+//!
+//! Everything that can be checked before the long work is checked first:
+//! the camera and its overrides and the render settings are validated
+//! before the scene is prepared or solved.
 
+use std::path::Path;
+use std::sync::Arc;
 use std::time::Instant;
 
+use trilux_color::{Mode, WithBands};
+use trilux_scene::{Scene, SceneError};
+use trilux_solver::{
+    PrepareError, PreparedScene, Progress, SceneDescription, Solution, SolveStats, Solver,
+    SolverSettings,
+};
+
+use crate::camera::Camera;
 use crate::driver::{RenderSettings, RenderStats, render};
 use crate::error::RenderError;
 use crate::image::Image;
-use crate::solved::solve_scene;
-use crate::view::ViewOverrides;
+use crate::view::{ViewOverrides, camera_of};
 
-/// What [`solve_and_render`] did.
-#[derive(Clone, Debug)]
-pub struct PipelineStats {
-    /// The solve's statistics.
-    pub solve: trilux_solver::SolveStats,
-    /// The render's statistics.
-    pub render: RenderStats,
-    /// Wall-clock seconds of the solve.
-    pub solve_seconds: f64,
+/// Where the solution comes from.
+#[derive(Clone, Copy, Debug)]
+pub enum SolutionSource<'p> {
+    /// Solve the scene.
+    Solve,
+    /// Load a solution saved for this scene, mode and settings.
+    Load(&'p Path),
 }
 
-/// Solves `scene` with `solver` settings and renders it from its camera,
-/// in the scene's own colour mode (`Scene::mode`).
-pub fn solve_and_render(
-    scene: &trilux_scene::Scene,
-    solver: trilux_solver::SolverSettings,
-    view: &ViewOverrides,
-    settings: &RenderSettings,
-) -> Result<(Image, PipelineStats), RenderError> {
-    if scene.mode() == trilux_color::Mode::Spectral {
-        solve_and_render_bands::<{ trilux_color::SPECTRAL_BANDS }>(scene, solver, view, settings)
-    } else {
-        solve_and_render_bands::<3>(scene, solver, view, settings)
+/// A view to render.
+#[derive(Clone, Copy, Debug)]
+pub struct RenderPlan {
+    /// Changes to the scene's camera.
+    pub view: ViewOverrides,
+    /// Samples, seed, filter, extra-bounce rule.
+    pub settings: RenderSettings,
+}
+
+/// What to do with a scene.
+#[derive(Clone, Debug)]
+pub struct Plan<'p> {
+    /// RGB or spectral.
+    pub mode: Mode,
+    /// The solve's settings (also those a loaded solution must have).
+    pub solver: SolverSettings,
+    /// Solve, or load.
+    pub source: SolutionSource<'p>,
+    /// Save the solution there.
+    pub save: Option<&'p Path>,
+    /// Render a view.
+    pub render: Option<RenderPlan>,
+}
+
+/// What a plan did.
+#[derive(Clone, Debug)]
+pub struct Outcome {
+    /// The rendered image, when the plan renders.
+    pub image: Option<Image>,
+    /// The solve's statistics (`solve_seconds` 0 for a loaded solution).
+    pub solve: SolveStats,
+    /// The render's statistics, when the plan renders.
+    pub render: Option<RenderStats>,
+    /// Wall-clock seconds spent preparing the scene (geometry, BVH,
+    /// materials).
+    pub prepare_seconds: f64,
+    /// Wall-clock seconds of the solve (or of loading the solution).
+    pub solve_seconds: f64,
+    /// Wall-clock seconds of the render.
+    pub render_seconds: f64,
+}
+
+/// Progress reports during a plan (the library never prints).
+pub struct Observer<'o> {
+    /// Called after every shot of a solve.
+    pub solve: &'o mut dyn FnMut(&Progress),
+    /// Called after every rendered tile, with (done, total), from worker
+    /// threads.
+    pub render: &'o (dyn Fn(usize, usize) + Sync),
+}
+
+impl Observer<'_> {
+    /// Runs `f` with an observer that ignores everything.
+    pub fn quiet<T>(f: impl FnOnce(Observer<'_>) -> T) -> T {
+        let mut solve = |_: &Progress| {};
+        f(Observer {
+            solve: &mut solve,
+            render: &|_, _| {},
+        })
     }
 }
 
-/// [`solve_and_render`] with `N` bands.
-fn solve_and_render_bands<const N: usize>(
-    scene: &trilux_scene::Scene,
-    solver: trilux_solver::SolverSettings,
-    view: &ViewOverrides,
-    settings: &RenderSettings,
-) -> Result<(Image, PipelineStats), RenderError> {
-    let start = Instant::now();
-    let sol = solve_scene::<N>(scene, solver)?;
-    let solve_seconds = start.elapsed().as_secs_f64();
-    let (image, render) = render(scene, &sol, view, settings, |_, _| {})?;
-    Ok((
-        image,
-        PipelineStats {
-            solve: sol.stats().clone(),
+/// The scene's camera with `view`'s overrides (an error when the scene has
+/// no sensor or the view is invalid).
+pub fn scene_camera(scene: &Scene, view: &ViewOverrides) -> Result<Camera, RenderError> {
+    let cam = scene.camera.as_ref().ok_or_else(|| RenderError::NoCamera {
+        path: scene.path.clone(),
+    })?;
+    camera_of(cam, view)
+}
+
+/// The scene prepared for `N` bands; errors point at the shape (or its
+/// emitter) in the file.
+pub fn prepare<const N: usize>(scene: &Scene) -> Result<Arc<PreparedScene<N>>, RenderError> {
+    let (shapes, bsdfs, emission) = (
+        scene.geometry_shapes(),
+        scene.bsdf_params(),
+        scene.emitter_radiance(),
+    );
+    let desc = SceneDescription {
+        shapes: &shapes,
+        bsdfs: &bsdfs,
+        emission: &emission,
+    };
+    PreparedScene::new(&desc)
+        .map(Arc::new)
+        .map_err(|e| located(scene, &e).into())
+}
+
+/// A preparation error at its place in the scene file.
+fn located(scene: &Scene, e: &PrepareError) -> SceneError {
+    let location = match e.shape() {
+        Some(i) if e.is_emitter() => scene.shapes[i]
+            .emitter
+            .as_ref()
+            .map_or_else(|| scene.shape_location(i), |em| em.location.clone()),
+        Some(i) => scene.shape_location(i),
+        None => scene.shape_location(usize::MAX),
+    };
+    SceneError::at(&location, e.problem())
+}
+
+/// Carries out `plan` on `scene` (module docs).
+pub fn run(scene: &Scene, plan: &Plan<'_>, observer: Observer<'_>) -> Result<Outcome, RenderError> {
+    let view = match &plan.render {
+        Some(r) => {
+            r.settings.validate()?;
+            Some((scene_camera(scene, &r.view)?, r.settings))
+        }
+        None => None,
+    };
+    plan.solver
+        .validate()
+        .map_err(trilux_solver::SolverError::Settings)?;
+    plan.mode.with_bands(Run {
+        scene,
+        plan,
+        view,
+        observer,
+    })
+}
+
+/// [`run`] once the band count is known.
+struct Run<'a, 'o> {
+    scene: &'a Scene,
+    plan: &'a Plan<'a>,
+    view: Option<(Camera, RenderSettings)>,
+    observer: Observer<'o>,
+}
+
+impl WithBands for Run<'_, '_> {
+    type Output = Result<Outcome, RenderError>;
+
+    fn run<const N: usize>(self) -> Self::Output {
+        let start = Instant::now();
+        let prepared = prepare::<N>(self.scene)?;
+        let prepare_seconds = start.elapsed().as_secs_f64();
+        let start = Instant::now();
+        let mut solution = match self.plan.source {
+            SolutionSource::Solve => {
+                Solver::new(prepared, self.plan.solver.clone())?.solve(|p| (self.observer.solve)(p))
+            }
+            SolutionSource::Load(path) => {
+                let mut s = Solution::load(path, prepared, &self.plan.solver)?;
+                s.stats_mut().solve_seconds = 0.0;
+                s
+            }
+        };
+        let solve_seconds = start.elapsed().as_secs_f64();
+        if let Some(path) = self.plan.save {
+            solution.save(path)?;
+        }
+        let start = Instant::now();
+        let rendered = match &self.view {
+            Some((camera, settings)) => {
+                Some(render(&solution, camera, settings, self.observer.render)?)
+            }
+            None => None,
+        };
+        let render_seconds = start.elapsed().as_secs_f64();
+        let (image, render) = rendered.map_or((None, None), |(i, s)| (Some(i), Some(s)));
+        Ok(Outcome {
+            image,
+            solve: std::mem::take(solution.stats_mut()),
             render,
+            prepare_seconds,
             solve_seconds,
-        },
-    ))
+            render_seconds,
+        })
+    }
 }

@@ -1,17 +1,17 @@
 //! The final gather wired to trilux's own layers: [`SolvedScene`]
-//! implements [`GatherScene`] with trilux-geometry (rays, surface sampling,
-//! element lookup), trilux-brdf (materials), trilux-color (emission) and a
-//! solution ([`RadianceSolution`]: the solver's, or a stand-in).
+//! implements [`GatherScene`] with a prepared scene (geometry, materials,
+//! emitters: `trilux_solver::PreparedScene`) and a solution
+//! ([`RadianceSolution`]: the solver's, or a stand-in).
 //!
-//! - Rays: `SceneGeometry::intersect` (exact for analytic shapes, its own
-//!   self-intersection epsilon), shadow rays `SceneGeometry::occluded`.
+//! - Rays: `Geometry::intersect` (exact for analytic shapes, its own
+//!   self-intersection epsilon), shadow rays `Geometry::occluded`.
 //! - Materials: `Bsdf<N>` in the shading frame of the hit (z = shading
 //!   normal on the front side); it reflects on the viewer's side (black from
 //!   the back unless `twosided`), as in Mitsuba.
 //! - Emitters: one-sided Lambertian area emitters on the front side. Light
 //!   sampling picks an emitting input surface with probability ∝ its area ×
 //!   the luminance of its radiance, then a point uniformly by area
-//!   (`SceneGeometry::sample_surface`; the MIS weight at a gather hit on an
+//!   (`ElementForest::sample_surface`; the MIS weight at a gather hit on an
 //!   emitter uses the same density, 1/area × pick probability).
 //! - Solution lookup: the face a light path leaves from and the face it
 //!   arrives on are passed with the points (the solver keeps both faces of
@@ -22,49 +22,60 @@
 //!   roughness α is taken as 4πα² (its lobe in ω_i is about 2α wide), 2π for
 //!   a diffuse-only side.
 
+use std::sync::Arc;
+
 use glam::{DVec2, DVec3};
-use trilux_brdf::{Bsdf, BsdfParams, Frame};
+use trilux_brdf::{Bsdf, Frame};
 use trilux_color::Spectrum;
-use trilux_geometry::{Ray, SceneGeometry, SurfaceCoord, SurfaceId};
+use trilux_geometry::{ElementForest, FaceId, Geometry, Ray, Side, SurfaceCoord, SurfaceId};
+use trilux_solver::{PreparedScene, SurfaceSite};
 
-use crate::error::RenderError;
 use crate::gather::{BsdfSample, GatherScene, LightSample, SurfacePoint};
-
-/// One end of a solution query: a point of an input surface and the face
-/// light leaves from (or arrives on).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Site {
-    /// The input surface.
-    pub surface: SurfaceId,
-    /// The point in the surface's coordinates.
-    pub coord: SurfaceCoord,
-    /// True for the back face (against the geometric normal).
-    pub back: bool,
-}
 
 /// What the renderer needs of a view-independent solution.
 pub trait RadianceSolution<const N: usize>: Sync {
-    /// The geometry the solution refers to (with the solve's subdivisions).
-    fn geometry(&self) -> &SceneGeometry;
+    /// The scene the solution is of (geometry, materials, emitters).
+    fn scene(&self) -> &PreparedScene<N>;
+    /// The element trees the solution refers to (with the solve's
+    /// subdivisions), over the scene's geometry.
+    fn forest(&self) -> &ElementForest;
     /// Reflected radiance (emission excluded) leaving `from` towards `to`.
-    fn reflected(&self, from: &Site, to: &Site) -> Spectrum<N>;
+    fn reflected(&self, from: &SurfaceSite, to: &SurfaceSite) -> Spectrum<N>;
 }
 
 /// A stand-in solution that knows no indirect light (every reflected
 /// radiance is zero): the final gather then renders direct lighting only.
 /// Also answers a constant, for tests (`constant`).
 pub struct DirectOnly<const N: usize> {
-    /// The scene's geometry.
-    pub geometry: SceneGeometry,
-    /// The reflected radiance it answers everywhere (zero: direct only).
-    pub constant: Spectrum<N>,
+    scene: Arc<PreparedScene<N>>,
+    forest: ElementForest,
+    constant: Spectrum<N>,
+}
+
+impl<const N: usize> DirectOnly<N> {
+    /// Direct light only: every reflected radiance is zero.
+    pub fn new(scene: Arc<PreparedScene<N>>) -> Self {
+        Self::constant(scene, Spectrum::zero())
+    }
+
+    /// A solution that answers `constant` everywhere (for tests).
+    pub fn constant(scene: Arc<PreparedScene<N>>, constant: Spectrum<N>) -> Self {
+        DirectOnly {
+            forest: ElementForest::new(Arc::clone(scene.geometry())),
+            scene,
+            constant,
+        }
+    }
 }
 
 impl<const N: usize> RadianceSolution<N> for DirectOnly<N> {
-    fn geometry(&self) -> &SceneGeometry {
-        &self.geometry
+    fn scene(&self) -> &PreparedScene<N> {
+        &self.scene
     }
-    fn reflected(&self, _from: &Site, _to: &Site) -> Spectrum<N> {
+    fn forest(&self) -> &ElementForest {
+        &self.forest
+    }
+    fn reflected(&self, _from: &SurfaceSite, _to: &SurfaceSite) -> Spectrum<N> {
         self.constant
     }
 }
@@ -82,102 +93,47 @@ pub struct HitLocator {
     pub shape: u32,
 }
 
-/// Per-shape data prepared once.
-struct ShapeData<const N: usize> {
-    bsdf: Bsdf<N>,
-    emission: Option<Spectrum<N>>,
-    /// Lobe solid angle per side [front, back].
-    lobe_sr: [f64; 2],
+/// The lobe solid angle of one side of a material: 4πα² for a
+/// roughconductor part of roughness α (its lobe in ω_i is about 2α wide),
+/// 2π for a diffuse-only side.
+fn lobe_sr<const N: usize>(bsdf: &Bsdf<N>, side: Side) -> f64 {
+    match bsdf.min_alpha(side) {
+        Some(a) => (4.0 * std::f64::consts::PI * a * a).min(2.0 * std::f64::consts::PI),
+        None => 2.0 * std::f64::consts::PI,
+    }
 }
 
 /// A scene and its solution, ready for the final gather.
 pub struct SolvedScene<'a, const N: usize, S> {
+    scene: &'a PreparedScene<N>,
     solution: &'a S,
-    shapes: Vec<ShapeData<N>>,
+    /// Lobe solid angle per shape and side [front, back].
+    lobe_sr: Vec<[f64; 2]>,
     /// Emitting input surfaces with their cumulative pick probabilities.
     emitters: Vec<(SurfaceId, f64)>,
     /// Pick probability / area, by surface index (0 when not emitting).
     light_density: Vec<f64>,
 }
 
-/// Smallest roughconductor α on `back` (false: front) of `p`, if any.
-fn min_alpha(p: &BsdfParams, back: bool) -> Option<f64> {
-    match p {
-        BsdfParams::Diffuse { .. } => None,
-        BsdfParams::RoughConductor(rc) => (!back).then_some(rc.alpha),
-        BsdfParams::Blend {
-            first,
-            second,
-            weight,
-        } => {
-            let a = if *weight < 1.0 {
-                min_alpha(first, back)
-            } else {
-                None
-            };
-            let b = if *weight > 0.0 {
-                min_alpha(second, back)
-            } else {
-                None
-            };
-            match (a, b) {
-                (Some(x), Some(y)) => Some(x.min(y)),
-                (x, y) => x.or(y),
-            }
-        }
-        BsdfParams::TwoSided { front, back: b } => {
-            if back {
-                min_alpha(b.as_deref().unwrap_or(front), false)
-            } else {
-                min_alpha(front, false)
-            }
-        }
-    }
-}
-
-fn lobe_sr(p: &BsdfParams, back: bool) -> f64 {
-    match min_alpha(p, back) {
-        Some(a) => (4.0 * std::f64::consts::PI * a * a).min(2.0 * std::f64::consts::PI),
-        None => 2.0 * std::f64::consts::PI,
-    }
-}
-
 impl<'a, const N: usize, S: RadianceSolution<N>> SolvedScene<'a, N, S> {
-    /// Prepares materials and emitters of `scene` for the geometry and
-    /// light of `solution`.
-    pub fn new(scene: &trilux_scene::Scene, solution: &'a S) -> Result<Self, RenderError> {
-        let geom = solution.geometry();
-        let mut shapes = Vec::with_capacity(scene.shapes.len());
-        for (i, s) in scene.shapes.iter().enumerate() {
-            let bsdf = Bsdf::new(&s.bsdf)
-                .map_err(|e| RenderError::Scene(format!("shape {i} ({}): {e}", s.location)))?;
-            let emission = match &s.emitter {
-                Some(em) => Some(em.radiance.emission::<N>().map_err(|e| {
-                    RenderError::Scene(format!("emitter of shape {i} ({}): {e}", em.location))
-                })?),
-                None => None,
-            };
-            shapes.push(ShapeData {
-                bsdf,
-                emission,
-                lobe_sr: [lobe_sr(&s.bsdf, false), lobe_sr(&s.bsdf, true)],
-            });
-        }
-        let surfaces = geom.surfaces();
+    /// The gather over the scene of `solution`, with its light.
+    pub fn new(solution: &'a S) -> Self {
+        let scene = solution.scene();
+        let lobe_sr = scene
+            .materials()
+            .iter()
+            .map(|b| [lobe_sr(b, Side::Front), lobe_sr(b, Side::Back)])
+            .collect();
+        let surfaces = scene.geometry().surfaces();
         let mut weights = Vec::new();
         for (k, surf) in surfaces.iter().enumerate() {
-            let Some(data) = shapes.get(surf.shape as usize) else {
-                return Err(RenderError::Scene(format!(
-                    "input surface {k} names shape {} of {}",
-                    surf.shape,
-                    shapes.len()
-                )));
-            };
-            if let Some(le) = data.emission {
-                let w = surf.area() * le.luminance().max(le.max_value() * 1e-3);
-                if w > 0.0 && w.is_finite() {
-                    weights.push((SurfaceId(k as u32), w));
-                }
+            let le = scene.emission()[surf.shape as usize];
+            if le.is_black() {
+                continue;
+            }
+            let w = surf.area() * le.luminance().max(le.max_value() * 1e-3);
+            if w > 0.0 && w.is_finite() {
+                weights.push((SurfaceId(k as u32), w));
             }
         }
         let total: f64 = weights.iter().map(|(_, w)| w).sum();
@@ -193,23 +149,27 @@ impl<'a, const N: usize, S: RadianceSolution<N>> SolvedScene<'a, N, S> {
         if let Some(last) = emitters.last_mut() {
             last.1 = 1.0;
         }
-        Ok(Self {
+        Self {
+            scene,
             solution,
-            shapes,
+            lobe_sr,
             emitters,
             light_density,
-        })
+        }
     }
 
-    fn geom(&self) -> &SceneGeometry {
-        self.solution.geometry()
+    fn geom(&self) -> &Geometry {
+        self.scene.geometry()
     }
 
-    fn site(p: &SurfacePoint<HitLocator>, back: bool) -> Site {
-        Site {
-            surface: p.locator.surface,
+    fn bsdf(&self, at: &SurfacePoint<HitLocator>) -> &Bsdf<N> {
+        self.scene.material(at.locator.shape as usize)
+    }
+
+    fn site(p: &SurfacePoint<HitLocator>, side: Side) -> SurfaceSite {
+        SurfaceSite {
+            face: FaceId::new(p.locator.surface, side),
             coord: p.locator.coord,
-            back,
         }
     }
 }
@@ -239,9 +199,10 @@ impl<const N: usize, S: RadianceSolution<N>> GatherScene<N> for SolvedScene<'_, 
     }
 
     fn emitted(&self, at: &SurfacePoint<HitLocator>, wo: DVec3) -> [f64; N] {
-        match self.shapes[at.locator.shape as usize].emission {
-            Some(le) if at.normal.dot(wo) > 0.0 => le.0,
-            _ => [0.0; N],
+        if at.normal.dot(wo) > 0.0 {
+            self.scene.emission()[at.locator.shape as usize].0
+        } else {
+            [0.0; N]
         }
     }
 
@@ -259,10 +220,9 @@ impl<const N: usize, S: RadianceSolution<N>> GatherScene<N> for SolvedScene<'_, 
             .partition_point(|&(_, c)| c <= pick)
             .min(self.emitters.len() - 1);
         let surface = self.emitters[k].0;
-        let geom = self.geom();
-        let s = geom.sample_surface(surface, u);
-        let shape = geom.surface(surface).shape as usize;
-        let le = self.shapes[shape].emission?;
+        let s = self.solution.forest().sample_surface(surface, u);
+        let shape = self.geom().surface(surface).shape as usize;
+        let le = self.scene.emission()[shape];
         let front = s.normal.dot(reference.point - s.point) > 0.0;
         Some(LightSample {
             point: s.point,
@@ -279,7 +239,7 @@ impl<const N: usize, S: RadianceSolution<N>> GatherScene<N> for SolvedScene<'_, 
     fn bsdf_cos(&self, at: &SurfacePoint<HitLocator>, wi: DVec3, wo: DVec3) -> [f64; N] {
         let frame = Frame::from_normal(at.locator.shading_normal);
         let (wi, wo) = (frame.to_local(wi), frame.to_local(wo));
-        (self.shapes[at.locator.shape as usize].bsdf.eval(wi, wo) * wi.z.abs()).0
+        (self.bsdf(at).eval(wi, wo) * wi.z.abs()).0
     }
 
     fn sample_bsdf(
@@ -289,9 +249,7 @@ impl<const N: usize, S: RadianceSolution<N>> GatherScene<N> for SolvedScene<'_, 
         u: DVec2,
     ) -> Option<BsdfSample<N>> {
         let frame = Frame::from_normal(at.locator.shading_normal);
-        let s = self.shapes[at.locator.shape as usize]
-            .bsdf
-            .sample(frame.to_local(wo), u)?;
+        let s = self.bsdf(at).sample(frame.to_local(wo), u)?;
         let wi = frame.to_world(s.wi);
         // A direction on the other side of the true surface than the
         // viewer would pass through it (possible with shading normals).
@@ -307,9 +265,7 @@ impl<const N: usize, S: RadianceSolution<N>> GatherScene<N> for SolvedScene<'_, 
 
     fn bsdf_pdf(&self, at: &SurfacePoint<HitLocator>, wo: DVec3, wi: DVec3) -> f64 {
         let frame = Frame::from_normal(at.locator.shading_normal);
-        self.shapes[at.locator.shape as usize]
-            .bsdf
-            .pdf(frame.to_local(wo), frame.to_local(wi))
+        self.bsdf(at).pdf(frame.to_local(wo), frame.to_local(wi))
     }
 
     fn reflected(
@@ -318,22 +274,22 @@ impl<const N: usize, S: RadianceSolution<N>> GatherScene<N> for SolvedScene<'_, 
         towards: &SurfacePoint<HitLocator>,
     ) -> [f64; N] {
         let d = towards.point - from.point;
-        let from_back = from.normal.dot(d) < 0.0;
-        let to_back = towards.normal.dot(-d) < 0.0;
+        let from_side = Side::from_back(from.normal.dot(d) < 0.0);
+        let to_side = Side::from_back(towards.normal.dot(-d) < 0.0);
         self.solution
-            .reflected(&Self::site(from, from_back), &Self::site(towards, to_back))
+            .reflected(&Self::site(from, from_side), &Self::site(towards, to_side))
             .0
     }
 
     fn element_size(&self, at: &SurfacePoint<HitLocator>) -> f64 {
-        let geom = self.geom();
-        let e = geom.locate(at.locator.surface, at.locator.coord);
-        geom.element(e).area.sqrt()
+        let forest = self.solution.forest();
+        let e = forest.locate(at.locator.surface, at.locator.coord);
+        forest.element(e).area.sqrt()
     }
 
     fn lobe_solid_angle(&self, at: &SurfacePoint<HitLocator>, wo: DVec3) -> f64 {
         let back = usize::from(at.normal.dot(wo) < 0.0);
-        self.shapes[at.locator.shape as usize].lobe_sr[back]
+        self.lobe_sr[at.locator.shape as usize][back]
     }
 
     fn shading_differs(&self, at: &SurfacePoint<HitLocator>) -> bool {
@@ -344,27 +300,13 @@ impl<const N: usize, S: RadianceSolution<N>> GatherScene<N> for SolvedScene<'_, 
 
 /// The solver's solution answers the renderer's queries directly.
 impl<const N: usize> RadianceSolution<N> for trilux_solver::Solution<N> {
-    fn geometry(&self) -> &SceneGeometry {
-        trilux_solver::Solution::geometry(self)
+    fn scene(&self) -> &PreparedScene<N> {
+        trilux_solver::Solution::scene(self)
     }
-    fn reflected(&self, from: &Site, to: &Site) -> Spectrum<N> {
-        let site = |s: &Site| trilux_solver::SurfaceSite {
-            surface: s.surface,
-            coord: s.coord,
-            back: s.back,
-        };
-        self.radiance(&site(from), &site(to))
+    fn forest(&self) -> &ElementForest {
+        trilux_solver::Solution::forest(self)
     }
-}
-
-/// Solves a loaded scene with the solver (a convenience for tests, examples
-/// and tools; the `trilux` command drives the solver itself).
-pub fn solve_scene<const N: usize>(
-    scene: &trilux_scene::Scene,
-    settings: trilux_solver::SolverSettings,
-) -> Result<trilux_solver::Solution<N>, RenderError> {
-    let input = trilux_solver::SceneInput::from_scene(scene);
-    let solver = trilux_solver::Solver::<N>::new(&input.as_input(), settings)
-        .map_err(|e| RenderError::Scene(format!("{}: {e}", scene.path.display())))?;
-    Ok(solver.solve(|_| {}))
+    fn reflected(&self, from: &SurfaceSite, to: &SurfaceSite) -> Spectrum<N> {
+        self.radiance(from, to)
+    }
 }

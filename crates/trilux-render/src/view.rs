@@ -5,6 +5,7 @@
 use glam::DVec3;
 
 use crate::camera::{Camera, FovAxis, look_at};
+use crate::driver::RenderSettings;
 use crate::error::RenderError;
 use crate::filter::ReconstructionFilter;
 
@@ -37,6 +38,17 @@ pub fn filter_of(c: &trilux_scene::Camera) -> ReconstructionFilter {
     match c.rfilter {
         trilux_scene::camera::ReconstructionFilter::Gaussian => ReconstructionFilter::default(),
         trilux_scene::camera::ReconstructionFilter::Box => ReconstructionFilter::Box,
+    }
+}
+
+impl RenderSettings {
+    /// The scene's own sample count and film filter, other settings default.
+    pub fn for_scene(camera: &trilux_scene::Camera) -> Self {
+        Self {
+            spp: camera.sample_count.max(1),
+            filter: filter_of(camera),
+            ..Self::default()
+        }
     }
 }
 

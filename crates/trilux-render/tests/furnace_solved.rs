@@ -8,7 +8,7 @@
 
 use std::path::PathBuf;
 
-use trilux_render::{RenderSettings, ViewOverrides, solve_and_render};
+use trilux_render::{Observer, Plan, RenderPlan, RenderSettings, SolutionSource, ViewOverrides};
 use trilux_solver::{Quality, SolverSettings};
 
 #[test]
@@ -24,14 +24,16 @@ fn solved_furnace_renders_two() {
         height: Some(64),
         ..Default::default()
     };
-    let (img, stats) = solve_and_render(
-        &scene,
-        SolverSettings::preset(Quality::Default),
-        &view,
-        &settings,
-    )
-    .unwrap();
-    assert!(stats.solve.convergence_ratio >= 0.99);
+    let plan = Plan {
+        mode: scene.mode(),
+        solver: SolverSettings::preset(Quality::Default),
+        source: SolutionSource::Solve,
+        save: None,
+        render: Some(RenderPlan { view, settings }),
+    };
+    let outcome = Observer::quiet(|o| trilux_render::pipeline::run(&scene, &plan, o)).unwrap();
+    assert!(outcome.solve.convergence_ratio >= 0.99);
+    let img = outcome.image.unwrap();
     let mean = img.mean();
     for m in mean {
         assert!((m - 2.0).abs() <= 0.005 * 2.0, "mean {mean:?}");

@@ -19,10 +19,9 @@
 
 use std::path::PathBuf;
 
-use trilux_color::Spectrum;
-use trilux_geometry::SceneGeometry;
 use trilux_render::{
-    DirectOnly, ExtraBounce, Image, RenderSettings, ViewOverrides, compare, render,
+    DirectOnly, ExtraBounce, Image, RenderSettings, ViewOverrides, compare, prepare, render,
+    scene_camera,
 };
 
 fn root() -> PathBuf {
@@ -44,7 +43,6 @@ fn direct_light_matches_mitsuba_max_depth_2() {
         let reference = Image::read_exr(&dir.join(format!("{name}.exr"))).unwrap();
         let mask = Image::read_exr(&dir.join(format!("{name}.mask.exr"))).unwrap();
         let scene = trilux_scene::load(root().join(format!("scenes/{name}.xml"))).unwrap();
-        let geometry = SceneGeometry::build(&scene.geometry_shapes()).unwrap();
         let settings = RenderSettings {
             spp: 256,
             extra_bounce: ExtraBounce::Never,
@@ -55,18 +53,13 @@ fn direct_light_matches_mitsuba_max_depth_2() {
             height: Some(reference.height()),
             ..Default::default()
         };
+        let camera = scene_camera(&scene, &view).unwrap();
         let image = if scene.spectral {
-            let sol = DirectOnly::<10> {
-                geometry,
-                constant: Spectrum::splat(0.0),
-            };
-            render(&scene, &sol, &view, &settings, |_, _| {}).unwrap().0
+            let sol = DirectOnly::<10>::new(prepare(&scene).unwrap());
+            render(&sol, &camera, &settings, |_, _| {}).unwrap().0
         } else {
-            let sol = DirectOnly::<3> {
-                geometry,
-                constant: Spectrum::splat(0.0),
-            };
-            render(&scene, &sol, &view, &settings, |_, _| {}).unwrap().0
+            let sol = DirectOnly::<3>::new(prepare(&scene).unwrap());
+            render(&sol, &camera, &settings, |_, _| {}).unwrap().0
         };
         let c = compare(&image, &reference, Some(&mask)).unwrap();
         report.push(format!(

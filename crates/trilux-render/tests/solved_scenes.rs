@@ -4,8 +4,7 @@
 use std::path::PathBuf;
 
 use trilux_color::Spectrum;
-use trilux_geometry::SceneGeometry;
-use trilux_render::{DirectOnly, RenderSettings, ViewOverrides, render};
+use trilux_render::{DirectOnly, RenderSettings, ViewOverrides, prepare, render, scene_camera};
 
 fn scene(name: &str) -> trilux_scene::Scene {
     let p = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -28,16 +27,13 @@ fn furnace_file_renders_two_with_a_solution_that_knows_the_answer() {
     // exact reflected radiance 1 everywhere: image 2.0 (issue 5's furnace
     // criterion: mean within 0.5 %, 99 % of pixels within 2 %, 64 spp).
     let s = scene("furnace.xml");
-    let geometry = SceneGeometry::build(&s.geometry_shapes()).unwrap();
-    let sol = DirectOnly::<3> {
-        geometry,
-        constant: Spectrum::splat(1.0),
-    };
+    let sol = DirectOnly::<3>::constant(prepare(&s).unwrap(), Spectrum::splat(1.0));
     let settings = RenderSettings {
         spp: 64,
         ..RenderSettings::for_scene(s.camera.as_ref().unwrap())
     };
-    let (img, stats) = render(&s, &sol, &small(64), &settings, |_, _| {}).unwrap();
+    let camera = scene_camera(&s, &small(64)).unwrap();
+    let (img, stats) = render(&sol, &camera, &settings, |_, _| {}).unwrap();
     for m in img.mean() {
         assert!((m - 2.0).abs() < 0.01, "mean {m}");
     }
@@ -67,23 +63,17 @@ fn every_scene_renders_direct_light_without_nan_in_both_modes() {
             spp: 4,
             ..RenderSettings::for_scene(s.camera.as_ref().unwrap())
         };
-        let g = SceneGeometry::build(&s.geometry_shapes()).unwrap();
-        let rgb = DirectOnly::<3> {
-            geometry: g.clone(),
-            constant: Spectrum::splat(0.0),
-        };
-        let (img, stats) = render(&s, &rgb, &small(24), &settings, |_, _| {}).unwrap();
+        let camera = scene_camera(&s, &small(24)).unwrap();
+        let rgb = DirectOnly::<3>::new(prepare(&s).unwrap());
+        let (img, stats) = render(&rgb, &camera, &settings, |_, _| {}).unwrap();
         assert_eq!(stats.gather.dropped, 0, "{name}");
         let mean = img.mean();
         assert!(
             mean.iter().all(|m| m.is_finite() && *m > 0.0),
             "{name}: mean {mean:?}"
         );
-        let spectral = DirectOnly::<10> {
-            geometry: g,
-            constant: Spectrum::splat(0.0),
-        };
-        let (img, stats) = render(&s, &spectral, &small(24), &settings, |_, _| {}).unwrap();
+        let spectral = DirectOnly::<10>::new(prepare(&s).unwrap());
+        let (img, stats) = render(&spectral, &camera, &settings, |_, _| {}).unwrap();
         assert_eq!(stats.gather.dropped, 0, "{name} spectral");
         assert!(
             img.pixels().iter().flatten().all(|v| v.is_finite()),

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use serde::Serialize;
 use trilux_brdf::BsdfParams;
 use trilux_color::{ColorParam, Mode};
-use trilux_geometry::{SceneGeometry, Shape};
+use trilux_geometry::{Geometry, Shape};
 
 use crate::camera::Camera;
 use crate::error::{SceneError, SourceLocation};
@@ -71,30 +71,44 @@ impl Scene {
         }
     }
 
-    /// The shapes as the geometry layer takes them (`SceneGeometry::build`).
+    /// The shapes as the geometry layer takes them (`Geometry::build`).
     pub fn geometry_shapes(&self) -> Vec<Shape> {
         self.shapes.iter().map(|s| s.shape.clone()).collect()
     }
 
-    /// The geometry layer's view of the shapes (input surfaces, elements,
-    /// BVH). What the geometry layer refuses is reported at the `<shape>`
-    /// that causes it, as `FILE:LINE:COL: ...`.
-    pub fn build_geometry(&self) -> Result<SceneGeometry, SceneError> {
-        SceneGeometry::build(&self.geometry_shapes()).map_err(|e| match self.shapes.get(e.shape) {
-            Some(s) => SceneError::at(&s.location, e.problem.to_string()),
-            None => SceneError::at(
-                &self
-                    .shapes
-                    .first()
-                    .map(|s| s.location.clone())
-                    .unwrap_or_else(|| SourceLocation {
-                        file: self.path.as_path().into(),
-                        line: 1,
-                        col: 1,
-                    }),
-                e.to_string(),
-            ),
-        })
+    /// Every shape's BSDF parameters, in shape order.
+    pub fn bsdf_params(&self) -> Vec<BsdfParams> {
+        self.shapes.iter().map(|s| s.bsdf.clone()).collect()
+    }
+
+    /// Every shape's emitted radiance (`None` without an emitter), in shape
+    /// order.
+    pub fn emitter_radiance(&self) -> Vec<Option<ColorParam>> {
+        self.shapes
+            .iter()
+            .map(|s| s.emitter.as_ref().map(|e| e.radiance.clone()))
+            .collect()
+    }
+
+    /// Where shape `index` is written (the file's start when there is no
+    /// such shape), for errors found after loading.
+    pub fn shape_location(&self, index: usize) -> SourceLocation {
+        match self.shapes.get(index) {
+            Some(s) => s.location.clone(),
+            None => SourceLocation {
+                file: self.path.as_path().into(),
+                line: 1,
+                col: 1,
+            },
+        }
+    }
+
+    /// The geometry layer's view of the shapes (input surfaces, BVH). What
+    /// the geometry layer refuses is reported at the `<shape>` that causes
+    /// it, as `FILE:LINE:COL: ...`.
+    pub fn build_geometry(&self) -> Result<Geometry, SceneError> {
+        Geometry::build(&self.geometry_shapes())
+            .map_err(|e| SceneError::at(&self.shape_location(e.shape), e.problem.to_string()))
     }
 
     /// Indices and shapes of the emitting shapes.

@@ -1,4 +1,4 @@
-//! Solve time per bundled scene (design.md §5): `cargo bench -p
+//! Solve time per bundled scene (geometry, materials and the solve): `cargo bench -p
 //! trilux-solver --bench solve`. Draft quality keeps a full sweep short;
 //! `TRILUX_BENCH_QUALITY=default` measures the default preset.
 
@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use trilux_color::Mode;
-use trilux_solver::{Quality, SceneInput, Solver, SolverSettings};
+use trilux_solver::{Quality, SceneDescription, Solver, SolverSettings};
 
 fn scenes() -> Vec<PathBuf> {
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
@@ -29,7 +29,16 @@ fn bench(c: &mut Criterion) {
         let Ok(scene) = trilux_scene::load(&path) else {
             continue;
         };
-        let input = SceneInput::from_scene(&scene);
+        let (shapes, bsdfs, emission) = (
+            scene.geometry_shapes(),
+            scene.bsdf_params(),
+            scene.emitter_radiance(),
+        );
+        let input = SceneDescription {
+            shapes: &shapes,
+            bsdfs: &bsdfs,
+            emission: &emission,
+        };
         let settings = SolverSettings::preset(quality);
         let name = path
             .file_stem()
@@ -38,15 +47,15 @@ fn bench(c: &mut Criterion) {
         match scene.mode() {
             Mode::Rgb => group.bench_function(&name, |b| {
                 b.iter(|| {
-                    Solver::<3>::new(&input.as_input(), settings.clone())
+                    Solver::<3>::from_description(&input, settings.clone())
                         .map(|s| s.solve(|_| {}))
                         .is_ok()
                 })
             }),
             Mode::Spectral => group.bench_function(&name, |b| {
                 b.iter(|| {
-                    Solver::<{ trilux_color::SPECTRAL_BANDS }>::new(
-                        &input.as_input(),
+                    Solver::<{ trilux_color::SPECTRAL_BANDS }>::from_description(
+                        &input,
                         settings.clone(),
                     )
                     .map(|s| s.solve(|_| {}))

@@ -4,8 +4,8 @@
 use glam::{DMat4, DVec2};
 use trilux_brdf::BsdfParams;
 use trilux_color::ColorParam;
-use trilux_geometry::{Shape, ShapeKind, SurfaceCoord, SurfaceId};
-use trilux_solver::{Quality, Solver, SolverInput, SolverSettings, SurfaceSite};
+use trilux_geometry::{Shape, ShapeKind, Side, SurfaceCoord, SurfaceId};
+use trilux_solver::{Quality, SceneDescription, Solver, SolverSettings, SurfaceSite};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let shapes = vec![Shape {
@@ -17,7 +17,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         reflectance: ColorParam::Float(0.5),
     }];
     let emission = vec![Some(ColorParam::Float(1.0))];
-    let input = SolverInput {
+    let input = SceneDescription {
         shapes: &shapes,
         bsdfs: &bsdfs,
         emission: &emission,
@@ -25,7 +25,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut settings = SolverSettings::preset(Quality::Default);
     settings.convergence = 0.999;
     settings.max_depth = 3;
-    let solution = Solver::<3>::new(&input, settings)?.solve(|p| {
+    let solution = Solver::<3>::from_description(&input, settings)?.solve(|p| {
         if p.shots % 10 == 0 {
             println!(
                 "shot {:4}  CR {:.5}  links {}",
@@ -37,11 +37,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let mut row = String::new();
         for a in 0..5 {
             let uv = DVec2::new((a as f64 + 0.5) / 5.0, 0.5);
-            let site = SurfaceSite {
-                surface: SurfaceId(f),
-                coord: SurfaceCoord::Uv(uv),
-                back: false,
-            };
+            let site = SurfaceSite::new(SurfaceId(f), Side::Front, SurfaceCoord::Uv(uv));
             row += &format!(" {:.4}", solution.lambertian_radiance(&site)[0] + 1.0);
         }
         println!("face {f}:{row}");

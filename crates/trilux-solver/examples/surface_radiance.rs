@@ -13,7 +13,8 @@
 
 use std::path::PathBuf;
 
-use trilux_solver::{Quality, SceneInput, Solver, SolverSettings};
+use trilux_geometry::Side;
+use trilux_solver::{Quality, SceneDescription, Solver, SolverSettings};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1);
@@ -28,7 +29,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         Some(q) => return Err(format!("unknown quality {q}").into()),
     };
     let scene = trilux_scene::load(&path)?;
-    let input = SceneInput::from_scene(&scene);
+    let (shapes, bsdfs, emission) = (
+        scene.geometry_shapes(),
+        scene.bsdf_params(),
+        scene.emitter_radiance(),
+    );
+    let input = SceneDescription {
+        shapes: &shapes,
+        bsdfs: &bsdfs,
+        emission: &emission,
+    };
     let mut settings = SolverSettings::preset(quality);
     if let Some(cr) = args.next().filter(|a| a != "-") {
         settings.convergence = cr.parse()?;
@@ -38,8 +48,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     // Single settings may be overridden for experiments.
     settings.override_from(|name| std::env::var(name).ok())?;
-    let solution = Solver::<3>::new(&input.as_input(), settings)?.solve(|_| {});
-    let geom = solution.geometry();
+    let solution = Solver::<3>::from_description(&input, settings)?.solve(|_| {});
+    let geom = solution.forest().geometry();
     let mut rows = Vec::new();
     for shape in 0..input.shapes.len() as u32 {
         let area: f64 = geom
@@ -47,7 +57,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .into_iter()
             .map(|s| geom.surface(s).area())
             .sum();
-        let mean = solution.shape_mean_radiance(shape, false);
+        let mean = solution.shape_mean_radiance(shape, Side::Front);
         rows.push(format!(
             "{{\"shape\": {shape}, \"area\": {area}, \"radiance\": [{}, {}, {}]}}",
             mean[0], mean[1], mean[2]

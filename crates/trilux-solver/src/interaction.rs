@@ -5,21 +5,20 @@
 //! interaction (a pair of input-surface sides that exchange light) owns a
 //! hierarchy of nodes in one arena. A node has at most one set of four
 //! children, made by splitting its sender element (`From`) or its receiver
-//! element (`To`) — notes §7's proposal: when refinement later asks for the
-//! other side, it descends through the existing children first, so a point
-//! pair always has exactly one path down (which keeps push-pull and the
-//! renderer's lookup exact).
+//! element (`To`): when refinement later asks for the other side, it
+//! descends through the existing children first, so a point pair always has
+//! exactly one path down (which keeps push-pull and the renderer's lookup
+//! exact; docs/solver.md, "One split side per node").
 //!
 //! Every node caches its throughput T = A_I F_{I→J} V (paper §4.6). A split
 //! node's T is redefined as the sum of its children's, so that pulling with
-//! flux weights T_c / Σ T_c conserves flux exactly (paper §5.6, corrected in
-//! notes §5: area weights are only the far-field limit).
+//! flux weights T_c / Σ T_c conserves flux exactly (paper §5.6 prints area
+//! weights, which are only the far-field limit; docs/solver.md).
 
 use serde::{Deserialize, Serialize};
 use trilux_color::Spectrum;
-use trilux_geometry::{ElementId, SceneGeometry, SurfaceCoord};
+use trilux_geometry::{ElementForest, ElementId, FaceId, SurfaceCoord};
 
-use crate::sides::SideId;
 use crate::throughput::Throughput;
 
 /// Marks "no children".
@@ -62,20 +61,20 @@ pub(crate) struct Node<const N: usize> {
 /// The hierarchy of one root interaction between two sides.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub(crate) struct Hierarchy<const N: usize> {
-    /// The sending side.
-    pub from: SideId,
-    /// The receiving side.
-    pub to: SideId,
+    /// The sending face.
+    pub from: FaceId,
+    /// The receiving face.
+    pub to: FaceId,
     /// Node arena; node 0 is the root.
     pub nodes: Vec<Node<N>>,
     /// Unshot flux of the whole hierarchy (the selection key δΦ, kept current
-    /// as energy arrives: paper Eq. 6 in its exact flux form, notes §4).
+    /// as energy arrives: paper Eq. 6 in its exact flux form).
     pub unshot_flux: Spectrum<N>,
 }
 
 impl<const N: usize> Hierarchy<N> {
     /// A hierarchy with only its root node.
-    pub fn new(from: SideId, to: SideId, i: ElementId, j: ElementId, t: Throughput) -> Self {
+    pub fn new(from: FaceId, to: FaceId, i: ElementId, j: ElementId, t: Throughput) -> Self {
         Hierarchy {
             from,
             to,
@@ -201,7 +200,7 @@ impl<const N: usize> Hierarchy<N> {
     /// Unshot radiance for the element pair (i, j): that of the deepest node
     /// whose elements contain i and j (after push-pull every node's δL is
     /// the flux-weighted average of its subtree).
-    pub fn unshot_for(&self, geom: &SceneGeometry, i: ElementId, j: ElementId) -> Spectrum<N> {
+    pub fn unshot_for(&self, forest: &ElementForest, i: ElementId, j: ElementId) -> Spectrum<N> {
         let mut n = 0u32;
         loop {
             let node = &self.nodes[n as usize];
@@ -211,8 +210,8 @@ impl<const N: usize> Hierarchy<N> {
             let next = children.into_iter().find(|&c| {
                 let child = &self.nodes[c as usize];
                 match node.split {
-                    Split::From => is_within(geom, i, child.from),
-                    Split::To => is_within(geom, j, child.to),
+                    Split::From => is_within(forest, i, child.from),
+                    Split::To => is_within(forest, j, child.to),
                     Split::None => false,
                 }
             });
@@ -228,7 +227,7 @@ impl<const N: usize> Hierarchy<N> {
     /// contain both (paper §4.5, Fig. 11c).
     pub fn radiance_at(
         &self,
-        geom: &SceneGeometry,
+        forest: &ElementForest,
         x: SurfaceCoord,
         y: SurfaceCoord,
     ) -> Spectrum<N> {
@@ -241,8 +240,8 @@ impl<const N: usize> Hierarchy<N> {
             let next = children.into_iter().find(|&c| {
                 let child = &self.nodes[c as usize];
                 match node.split {
-                    Split::From => geom.element_contains(child.from, x),
-                    Split::To => geom.element_contains(child.to, y),
+                    Split::From => forest.element_contains(child.from, x),
+                    Split::To => forest.element_contains(child.to, y),
                     Split::None => false,
                 }
             });
@@ -259,14 +258,14 @@ impl<const N: usize> Hierarchy<N> {
 }
 
 /// True when element `e` is `ancestor` or lies below it.
-pub(crate) fn is_within(geom: &SceneGeometry, e: ElementId, ancestor: ElementId) -> bool {
-    let target = geom.element(ancestor).depth;
+pub(crate) fn is_within(forest: &ElementForest, e: ElementId, ancestor: ElementId) -> bool {
+    let target = forest.element(ancestor).depth;
     let mut cur = e;
     loop {
         if cur == ancestor {
             return true;
         }
-        let el = geom.element(cur);
+        let el = forest.element(cur);
         if el.depth <= target {
             return false;
         }
@@ -312,7 +311,7 @@ mod tests {
             split_from in any::<bool>(),
         ) {
             let e = ElementId(0);
-            let mut h = Hierarchy::<3>::new(0, 1, e, e, Throughput { t: t_root, v: 1.0, f: 0.1, spread: 0.0 });
+            let mut h = Hierarchy::<3>::new(FaceId(0), FaceId(1), e, e, Throughput { t: t_root, v: 1.0, f: 0.1, spread: 0.0 });
             h.nodes[0].gathered = spectrum(pending);
             let before = std::f64::consts::PI * t_root * pending;
             let th: Vec<Throughput> = t_children.iter().map(|&t| Throughput { t, v: 1.0, f: 0.1, spread: 0.0 }).collect();

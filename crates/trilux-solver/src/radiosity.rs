@@ -1,4 +1,5 @@
-//! Two-point radiance of Lambertian parts (design.md §2, notes §7).
+//! Two-point radiance of Lambertian parts (docs/architecture.md, "Two-point
+//! and stored transport").
 //!
 //! A Lambertian surface sends the same radiance in every direction, so its
 //! outgoing light is one spectrum per element and side, exactly as in
@@ -8,27 +9,27 @@
 //! is about to shoot (paper §4.4).
 
 use trilux_color::Spectrum;
-use trilux_geometry::{ElementId, SceneGeometry};
+use trilux_geometry::{ElementForest, ElementId, Side, Sided};
 
 /// Per-element radiance of the two faces of every element.
 #[derive(Clone, Debug)]
 pub(crate) struct ElementRadiance<const N: usize> {
-    /// Reflected outgoing radiance L, indexed `[back][element]`.
-    pub radiance: [Vec<Spectrum<N>>; 2],
+    /// Reflected outgoing radiance L, per side and element.
+    pub radiance: Sided<Vec<Spectrum<N>>>,
     /// Unshot radiance δL.
-    pub unshot: [Vec<Spectrum<N>>; 2],
+    pub unshot: Sided<Vec<Spectrum<N>>>,
     /// Gathered radiance L^G waiting to be pushed.
-    pub gathered: [Vec<Spectrum<N>>; 2],
+    pub gathered: Sided<Vec<Spectrum<N>>>,
 }
 
 impl<const N: usize> ElementRadiance<N> {
     /// All zero for `elements` elements.
     pub fn new(elements: usize) -> Self {
-        let z = || vec![Spectrum::zero(); elements];
+        let z = |_| vec![Spectrum::zero(); elements];
         ElementRadiance {
-            radiance: [z(), z()],
-            unshot: [z(), z()],
-            gathered: [z(), z()],
+            radiance: Sided::from_fn(z),
+            unshot: Sided::from_fn(z),
+            gathered: Sided::from_fn(z),
         }
     }
 
@@ -41,27 +42,26 @@ impl<const N: usize> ElementRadiance<N> {
     /// pulling over curved, non-coplanar children conserves flux exactly.
     pub fn push_pull(
         &mut self,
-        geom: &SceneGeometry,
+        forest: &ElementForest,
         root: ElementId,
-        back: bool,
+        side: Side,
         exposed_area: &[f64],
     ) {
-        let s = usize::from(back);
-        self.push_pull_rec(geom, root, s, Spectrum::zero(), exposed_area);
+        self.push_pull_rec(forest, root, side, Spectrum::zero(), exposed_area);
     }
 
     fn push_pull_rec(
         &mut self,
-        geom: &SceneGeometry,
+        forest: &ElementForest,
         e: ElementId,
-        s: usize,
+        s: Side,
         from_above: Spectrum<N>,
         exposed_area: &[f64],
     ) -> (Spectrum<N>, Spectrum<N>) {
         let i = e.index();
         let down = from_above + self.gathered[s][i];
         self.gathered[s][i] = Spectrum::zero();
-        match geom.element(e).children() {
+        match forest.element(e).children() {
             None => {
                 self.radiance[s][i] += down;
                 self.unshot[s][i] += down;
@@ -77,7 +77,7 @@ impl<const N: usize> ElementRadiance<N> {
                     } else {
                         0.0
                     };
-                    let (cl, cdl) = self.push_pull_rec(geom, c, s, down, exposed_area);
+                    let (cl, cdl) = self.push_pull_rec(forest, c, s, down, exposed_area);
                     l += cl * w;
                     dl += cdl * w;
                 }
@@ -89,12 +89,11 @@ impl<const N: usize> ElementRadiance<N> {
     }
 
     /// Sets δL to zero over one side's tree (the side has just shot).
-    pub fn clear_unshot(&mut self, geom: &SceneGeometry, root: ElementId, back: bool) {
-        let s = usize::from(back);
+    pub fn clear_unshot(&mut self, forest: &ElementForest, root: ElementId, side: Side) {
         let mut stack = vec![root];
         while let Some(e) = stack.pop() {
-            self.unshot[s][e.index()] = Spectrum::zero();
-            if let Some(children) = geom.element(e).children() {
+            self.unshot[side][e.index()] = Spectrum::zero();
+            if let Some(children) = forest.element(e).children() {
                 stack.extend(children);
             }
         }

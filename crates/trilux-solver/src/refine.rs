@@ -1,4 +1,4 @@
-//! RefineAndLink (paper §3.2.2, Fig. 4–5, §4.3; notes §2–3).
+//! RefineAndLink (paper §3.2.2, Fig. 4–5, §4.3; docs/solver.md).
 //!
 //! A shot refines in two stages, both creating links that live only for
 //! this shot (paper §4.2):
@@ -13,9 +13,9 @@
 //!    stored interaction hierarchy leaving j's side (its glossy part):
 //!    refined by the BRDF error FrErr, the form factor and visibility of
 //!    (j, k), and the photometric criterion on the flux that would go on
-//!    towards k. The three subdivision cases of notes §3 apply: split I
+//!    towards k. The three subdivision cases apply: split I
 //!    (sender sub-pairs i_m j), split K (receiver nodes j k_m), or split J
-//!    (matched pairs i j_m → j_m k only).
+//!    (matched pairs i j_m → j_m k only; docs/solver.md, "RefineAndLink").
 //!
 //! Senders are never stored in the sender's hierarchy by refinement: a
 //! finer sender pair than the stored nodes is *virtual*, with the unshot
@@ -29,32 +29,34 @@ use glam::DVec3;
 use trilux_brdf::area::Element as Driver;
 use trilux_brdf::{Bsdf, ElementPoints, brdf_variation};
 use trilux_color::Spectrum;
-use trilux_geometry::{ElementId, SceneGeometry};
+use trilux_geometry::{
+    ElementForest, ElementId, FaceElement, FaceId, PerFace, Side, Sided, Visibility,
+};
 
-use crate::interaction::{Hierarchy, Split};
+use crate::faces::TransportFace;
+use crate::interaction::{Hierarchy, Node, Split};
 use crate::radiosity::ElementRadiance;
 use crate::settings::{SolverSettings, Transport};
-use crate::sides::{SideId, TransportSide};
-use crate::throughput::{SidedElement, Throughput, ThroughputCache, compute_throughput_with};
+use crate::throughput::{Throughput, ThroughputCache, compute_throughput};
 
 /// What a shot sends from: unshot radiance by element pair.
 pub(crate) enum Sender<'a, const N: usize> {
     /// A Lambertian side: δL of its element tree, the same towards every j.
     Radiosity {
-        /// The side's per-element radiance.
+        /// The face's per-element radiance.
         field: &'a ElementRadiance<N>,
-        /// Back face.
-        back: bool,
+        /// The side it sends from.
+        side: Side,
     },
     /// A stored interaction hierarchy.
     Stored(&'a Hierarchy<N>),
 }
 
 impl<const N: usize> Sender<'_, N> {
-    fn unshot(&self, geom: &SceneGeometry, i: ElementId, j: ElementId) -> Spectrum<N> {
+    fn unshot(&self, forest: &ElementForest, i: ElementId, j: ElementId) -> Spectrum<N> {
         match self {
-            Sender::Radiosity { field, back } => field.unshot[usize::from(*back)][i.index()],
-            Sender::Stored(h) => h.unshot_for(geom, i, j),
+            Sender::Radiosity { field, side } => field.unshot[*side][i.index()],
+            Sender::Stored(h) => h.unshot_for(forest, i, j),
         }
     }
 }
@@ -64,15 +66,15 @@ impl<const N: usize> Sender<'_, N> {
 const SENDER_VARIATION: f64 = 0.01;
 
 /// What every pair link of one stage-1 refinement shares: where the unshot
-/// radiance comes from, the sending side and the receiving side.
+/// radiance comes from, the sending face and the receiving face.
 #[derive(Clone, Copy)]
 pub(crate) struct PairShot<'s, const N: usize> {
     /// Unshot radiance by element pair.
     pub sender: &'s Sender<'s, N>,
-    /// The sending side.
-    pub si: SideId,
-    /// The receiving side.
-    pub sj: SideId,
+    /// The sending face.
+    pub si: FaceId,
+    /// The receiving face.
+    pub sj: FaceId,
 }
 
 /// A transient link of stage 1.
@@ -82,8 +84,8 @@ pub(crate) struct PairLink<const N: usize> {
     pub i: ElementId,
     /// Receiving element.
     pub j: ElementId,
-    /// Receiving side.
-    pub side: SideId,
+    /// Receiving face.
+    pub face: FaceId,
     /// T_ij.
     pub t: f64,
     /// δL_i sent along the link.
@@ -138,13 +140,27 @@ pub(crate) struct Incoming {
     wi: DVec3,
 }
 
+/// The refinement oracle's errors for one three-point link, each relative
+/// to its bound (≤ 1 is accurate enough).
+#[derive(Clone, Copy, Debug)]
+struct TripleErrors {
+    /// π F̂_ji (fr_max − fr_min) / FrErr.
+    brdf: f64,
+    /// The spread of F(y → j) over y in K, / FFErr.
+    ff: f64,
+    /// (j, k) partly visible, or K straddling j's tangent plane.
+    partial: bool,
+    /// The element whose variation drives the BRDF error.
+    driver: Driver,
+}
+
 /// One receiving hierarchy refined against the pair links of one shot
 /// (stage 2): what the recursion carries besides the three elements.
 pub(crate) struct TripleTask<'t, const N: usize> {
     /// Where the shot's unshot radiance comes from.
     pub sender: &'t Sender<'t, N>,
     /// The sending side.
-    pub si: SideId,
+    pub si: FaceId,
     /// The receiving hierarchy (this task owns it for the shot).
     pub h: &'t mut Hierarchy<N>,
     /// Its index among the solver's hierarchies.
@@ -168,9 +184,11 @@ impl<const N: usize> TripleTask<'_, N> {
 
 /// Everything refinement reads, shared by the parallel tasks of a shot.
 pub(crate) struct RefineContext<'a, const N: usize> {
-    pub geom: &'a SceneGeometry,
+    pub forest: &'a ElementForest,
+    /// Shadow-ray visibility, with the scene's buried parts.
+    pub visibility: Visibility<'a>,
     pub settings: &'a SolverSettings,
-    pub sides: &'a [TransportSide<N>],
+    pub faces: &'a PerFace<TransportFace<N>>,
     pub materials: &'a [Bsdf<N>],
     pub cache: &'a ThroughputCache,
     /// Photometric threshold in watts (band sum): flux_eps × IF.
@@ -180,10 +198,10 @@ pub(crate) struct RefineContext<'a, const N: usize> {
     /// The centres of every element's 2×2 quadrants (its midpoint rule).
     pub interior: &'a [[DVec3; 4]],
     /// Exposed area of every element's faces, `[back][element]`.
-    pub exposed_area: &'a [Vec<f64>; 2],
+    pub exposed_area: &'a Sided<Vec<f64>>,
 }
 
-/// Point-to-disc estimate of F_{a→b} (notes §2, HSA91): b seen from a's
+/// Point-to-disc estimate of F_{a→b} (Hanrahan, Salzman & Aupperle 1991): b seen from a's
 /// centre as a disc of the same area.
 fn disc_estimate(pa: DVec3, na: DVec3, pb: DVec3, nb: DVec3, area_b: f64) -> f64 {
     let d = pb - pa;
@@ -205,23 +223,10 @@ fn disc_estimate(pa: DVec3, na: DVec3, pb: DVec3, nb: DVec3, area_b: f64) -> f64
 }
 
 impl<const N: usize> RefineContext<'_, N> {
-    fn sided(&self, e: ElementId, side: SideId) -> SidedElement {
-        SidedElement {
-            element: e,
-            back: self.sides[side as usize].back,
-        }
-    }
-
     /// T through the cache, for `recv` receiving from `send` (T is
     /// symmetric; the spread is over the receiver).
-    pub fn throughput(
-        &self,
-        recv: ElementId,
-        sr: SideId,
-        send: ElementId,
-        ss: SideId,
-    ) -> Throughput {
-        let (a, b) = (self.sided(recv, sr), self.sided(send, ss));
+    pub fn throughput(&self, recv: FaceElement, send: FaceElement) -> Throughput {
+        let (a, b) = (recv, send);
         if let Some(t) = self.cache.get(a, b) {
             return t;
         }
@@ -229,25 +234,29 @@ impl<const N: usize> RefineContext<'_, N> {
         // levels refinement starts from) found unoccluded is unoccluded too:
         // its sub-segments lie in the parent pair's shaft.
         let parent_visible =
-            |x: SidedElement, y: SidedElement| self.cache.get(x, y).is_some_and(|t| t.v >= 1.0);
-        let up = |s: SidedElement| {
-            self.geom.element(s.element).parent.map(|p| SidedElement {
-                element: p,
-                back: s.back,
-            })
-        };
+            |x: FaceElement, y: FaceElement| self.cache.get(x, y).is_some_and(|t| t.v >= 1.0);
+        let up = |s: FaceElement| self.forest.element(s.element).parent.map(|p| s.with(p));
         let visible = up(a).is_some_and(|pa| parent_visible(pa, b))
             || up(b).is_some_and(|pb| parent_visible(a, pb));
-        let t = compute_throughput_with(self.geom, a, b, self.settings.visibility_samples, visible);
+        let t = compute_throughput(
+            &self.visibility,
+            a,
+            b,
+            self.settings.visibility_samples,
+            visible,
+        );
         self.cache.insert(a, b, t);
         t
     }
 
     /// Both point-to-disc estimates F̂_{a→b} and F̂_{b→a}.
-    fn ff_estimates(&self, a: ElementId, sa: SideId, b: ElementId, sb: SideId) -> (f64, f64) {
-        let (ea, eb) = (self.geom.element(a), self.geom.element(b));
-        let na = ea.normal * self.sides[sa as usize].sign();
-        let nb = eb.normal * self.sides[sb as usize].sign();
+    fn ff_estimates(&self, a: FaceElement, b: FaceElement) -> (f64, f64) {
+        let (ea, eb) = (
+            self.forest.element(a.element),
+            self.forest.element(b.element),
+        );
+        let na = ea.normal * a.side.sign();
+        let nb = eb.normal * b.side.sign();
         (
             disc_estimate(ea.centre, na, eb.centre, nb, eb.area),
             disc_estimate(eb.centre, nb, ea.centre, na, ea.area),
@@ -267,24 +276,27 @@ impl<const N: usize> RefineContext<'_, N> {
         out: &mut Vec<PairLink<N>>,
     ) {
         let PairShot { sender, si, sj } = shot;
-        let th = self.throughput(j, sj, i, si);
-        let (ei, ej) = (self.geom.element(i), self.geom.element(j));
+        let th = self.throughput(sj.of(j), si.of(i));
+        let (ei, ej) = (self.forest.element(i), self.forest.element(j));
         if th.t <= 0.0 {
             // Fully occluded or facing away. Near the roots a handful of
             // shadow rays may miss a gap: look one level further there.
-            if ei.depth + ej.depth < 2 && th.v == 0.0 && self.unoccluded_positive(i, si, j, sj) {
+            if ei.depth + ej.depth < 2
+                && th.v == 0.0
+                && self.unoccluded_positive(si.of(i), sj.of(j))
+            {
                 self.split_pair(shot, i, j, budget, out);
             }
             return;
         }
-        let unshot = sender.unshot(self.geom, i, j);
+        let unshot = sender.unshot(self.forest, i, j);
         if unshot.is_black() {
             return;
         }
         let link = PairLink {
             i,
             j,
-            side: sj,
+            face: sj,
             t: th.t,
             unshot,
         };
@@ -326,19 +338,19 @@ impl<const N: usize> RefineContext<'_, N> {
     /// δL̄_i = Σ a_c δL_c / Σ a_c) and F̂ point-to-disc estimates.
     fn sender_varies(&self, shot: PairShot<'_, N>, i: ElementId, j: ElementId) -> bool {
         let PairShot { sender, si, sj } = shot;
-        let Sender::Radiosity { field, back } = sender else {
+        let Sender::Radiosity { field, side } = sender else {
             return false;
         };
-        let Some(children) = self.geom.element(i).children() else {
+        let Some(children) = self.forest.element(i).children() else {
             return false;
         };
-        let s = usize::from(*back);
-        let ej = self.geom.element(j);
-        let nj = ej.normal * self.sides[sj as usize].sign();
-        let ni = self.sides[si as usize].sign();
+        let s = *side;
+        let ej = self.forest.element(j);
+        let nj = ej.normal * sj.side().sign();
+        let ni = si.side().sign();
         let (mut resolved, mut weight, mut mean) = (0.0, 0.0, 0.0);
         for c in children {
-            let ec = self.geom.element(c);
+            let ec = self.forest.element(c);
             let a = self.exposed_area[s][c.index()];
             let f = a * disc_estimate(ec.centre, ec.normal * ni, ej.centre, nj, ej.area);
             let dl = field.unshot[s][c.index()].sum();
@@ -357,8 +369,8 @@ impl<const N: usize> RefineContext<'_, N> {
         (resolved - averaged).abs() > SENDER_VARIATION * averaged
     }
 
-    fn unoccluded_positive(&self, i: ElementId, si: SideId, j: ElementId, sj: SideId) -> bool {
-        self.throughput(j, sj, i, si).f > 0.0
+    fn unoccluded_positive(&self, i: FaceElement, j: FaceElement) -> bool {
+        self.throughput(j, i).f > 0.0
     }
 
     /// Refines the sender's children against j; with `share_budget`, each
@@ -372,10 +384,10 @@ impl<const N: usize> RefineContext<'_, N> {
         share_budget: bool,
         out: &mut Vec<PairLink<N>>,
     ) {
-        let area = self.geom.element(i).area;
-        for c in self.geom.element(i).children().into_iter().flatten() {
+        let area = self.forest.element(i).area;
+        for c in self.forest.element(i).children().into_iter().flatten() {
             let share = if share_budget {
-                self.geom.element(c).area / area
+                self.forest.element(c).area / area
             } else {
                 1.0
             };
@@ -393,7 +405,7 @@ impl<const N: usize> RefineContext<'_, N> {
         budget: f64,
         out: &mut Vec<PairLink<N>>,
     ) -> bool {
-        let (ei, ej) = (self.geom.element(i), self.geom.element(j));
+        let (ei, ej) = (self.forest.element(i), self.forest.element(j));
         let split_i = match (ei.children(), ej.children()) {
             // Both splittable: the receiver, unless the sender is much larger.
             (Some(_), Some(_)) => ei.area > 4.0 * ej.area,
@@ -425,8 +437,8 @@ impl<const N: usize> RefineContext<'_, N> {
         j: ElementId,
         sign: f64,
     ) -> Option<DVec3> {
-        let cj = self.geom.element(j).centre;
-        let wi = frame.to_local((self.geom.element(i).centre - cj).normalize_or_zero());
+        let cj = self.forest.element(j).centre;
+        let wi = frame.to_local((self.forest.element(i).centre - cj).normalize_or_zero());
         if wi.z * sign > 0.0 {
             return Some(wi);
         }
@@ -457,7 +469,7 @@ impl<const N: usize> RefineContext<'_, N> {
         j: ElementId,
         k: ElementId,
     ) -> Option<Spectrum<N>> {
-        let ej = self.geom.element(j);
+        let ej = self.forest.element(j);
         let Incoming { frame, wi } = *incoming;
         // The discretised fr over K (paper Eq. 5's fr_KJI): the midpoint rule
         // on K's 2×2 quadrants rather than its centre alone, so that a glossy
@@ -491,7 +503,7 @@ impl<const N: usize> RefineContext<'_, N> {
         j: ElementId,
         k: ElementId,
     ) -> Option<Spectrum<N>> {
-        let g = self.geom;
+        let g = self.forest;
         let (ej, ek) = (g.element(j), g.element(k));
         let Incoming { frame, wi } = *incoming;
         let mirror = DVec3::new(-wi.x, -wi.y, wi.z);
@@ -507,8 +519,8 @@ impl<const N: usize> RefineContext<'_, N> {
     }
 
     /// The spread of fr over the three elements and the element driving it
-    /// (notes §2, step 3): only computed when the cheaper tests did not
-    /// already decide.
+    /// (docs/solver.md, "Refinement"): only computed when the cheaper tests
+    /// did not already decide.
     fn fr_variation(
         &self,
         bsdf: &Bsdf<N>,
@@ -516,7 +528,7 @@ impl<const N: usize> RefineContext<'_, N> {
         j: ElementId,
         k: ElementId,
     ) -> (f64, Driver) {
-        let g = self.geom;
+        let g = self.forest;
         let (ei, ej, ek) = (g.element(i), g.element(j), g.element(k));
         fn pts<'p>(e: &trilux_geometry::Element, p: &'p [DVec3; 5]) -> ElementPoints<'p> {
             ElementPoints {
@@ -538,7 +550,7 @@ impl<const N: usize> RefineContext<'_, N> {
     /// True when element `e` has points on both sides of the tangent plane
     /// of `j` at its centre.
     fn straddles(&self, e: ElementId, j: ElementId) -> bool {
-        let ej = self.geom.element(j);
+        let ej = self.forest.element(j);
         let scale = ej.bounds.diagonal().length().max(1e-300);
         let (mut front, mut back) = (false, false);
         for &p in &self.points[e.index()] {
@@ -554,33 +566,30 @@ impl<const N: usize> RefineContext<'_, N> {
     pub fn incidence(
         &self,
         sender: &Sender<'_, N>,
-        si: SideId,
-        i: ElementId,
-        sj: SideId,
-        j: ElementId,
+        i: FaceElement,
+        j: FaceElement,
     ) -> Option<Incidence<N>> {
-        let tij = self.throughput(j, sj, i, si);
+        let tij = self.throughput(j, i);
         if tij.t <= 0.0 {
             return None;
         }
-        let unshot = sender.unshot(self.geom, i, j);
+        let unshot = sender.unshot(self.forest, i.element, j.element);
         if unshot.is_black() {
             return None;
         }
-        let frame = trilux_brdf::Frame::from_normal(self.geom.element(j).normal);
+        let frame = trilux_brdf::Frame::from_normal(self.forest.element(j.element).normal);
         Some(Incidence {
             tij,
             unshot,
             incoming: self
-                .incident(&frame, i, j, self.sides[sj as usize].sign())
+                .incident(&frame, i.element, j.element, j.side.sign())
                 .map(|wi| Incoming { frame, wi }),
-            straddle_i: self.straddles(i, j),
+            straddle_i: self.straddles(i.element, j.element),
         })
     }
 
-    /// Stage 2: refines the three-point link (i j) → node of `h` (whose sender
-    /// element is j) and appends node links.
-    #[allow(clippy::too_many_arguments)]
+    /// Stage 2: refines the three-point link (i j) → node `n` of the task's
+    /// hierarchy (whose sender element is j) and appends node links.
     pub fn refine_triple(
         &self,
         task: &mut TripleTask<'_, N>,
@@ -589,111 +598,171 @@ impl<const N: usize> RefineContext<'_, N> {
         n: u32,
         known: Option<Incidence<N>>,
     ) {
-        let (si, sj, sk, group) = (task.si, task.h.from, task.h.to, task.group);
+        let (si, sj) = (task.si, task.h.from);
         // T_ij, δL_ij and the incidence at j are the same for every receiver
         // node of one (i, j): the K-side recursion hands them down.
-        let Some(known) = known.or_else(|| self.incidence(task.sender, si, i, sj, j)) else {
+        let Some(known) = known.or_else(|| self.incidence(task.sender, si.of(i), sj.of(j))) else {
             return;
         };
-        let Incidence {
-            tij,
-            unshot,
-            incoming,
-            straddle_i,
-        } = known;
         let node = &task.h.nodes[n as usize];
         debug_assert_eq!(node.from, j);
         let (k, tjk, vjk) = (node.to, node.t, node.v);
         if tjk <= 0.0 {
-            // As in stage 1: near the roots a few shadow rays may miss a gap,
-            // so look one level further before giving the pair up.
-            let (dj, dk) = (self.geom.element(j).depth, self.geom.element(k).depth);
-            if dj + dk < 2 && self.throughput(k, sk, j, sj).f > 0.0 {
-                let side = if self.geom.element(j).area >= self.geom.element(k).area {
-                    Driver::J
-                } else {
-                    Driver::K
-                };
-                self.split_triple(side, task, i, j, n, known);
-            }
+            self.retry_unseen_node(task, i, j, n, known);
             return;
         }
-        let bsdf = &self.materials[self.sides[sj as usize].shape];
+        let bsdf = &self.materials[self.faces[sj].shape];
         // R(i→j→k) = π F_{j→i} fr with F_{j→i} = T_ij / A_j over j's
         // exposed area (light arrives and leaves there only).
-        let aj = self.exposed_area[usize::from(self.sides[sj as usize].back)][j.index()];
+        let aj = self.exposed_area[sj.side()][j.index()];
         if aj <= 0.0 {
             return;
         }
         let straddle_k = self.straddles(k, j);
-        // No sample point of i or K on the receiving side of j: an element
-        // that lies partly behind j's tangent plane still carries light
-        // through its part in front, so refine it like partial visibility.
-        // (A zero of the BRDF itself, a lobe far from K, is not refined
-        // for: the peak bound below decides whether the lobe may be near.)
-        let Some(fr) = incoming.and_then(|inc| self.fr_centre(bsdf, &inc, j, k)) else {
-            let order = match (straddle_i, straddle_k) {
-                (true, true) if self.geom.element(i).area >= self.geom.element(k).area => {
-                    [Driver::I, Driver::K]
-                }
-                (true, true) => [Driver::K, Driver::I],
-                (true, false) => [Driver::I, Driver::I],
-                (false, true) => [Driver::K, Driver::K],
-                (false, false) => return,
-            };
-            for d in order {
-                if self.split_triple(d, task, i, j, n, known) {
-                    return;
-                }
-            }
+        let Some(fr) = known
+            .incoming
+            .and_then(|inc| self.fr_centre(bsdf, &inc, j, k))
+        else {
+            self.split_across_plane(task, i, j, n, known, straddle_k);
             return;
         };
-        let gathered = unshot * fr * (PI * tij.t / aj);
+        let gathered = known.unshot * fr * (PI * known.tij.t / aj);
         let link = NodeLink {
             hierarchy: task.h_index,
             node: n,
-            group,
+            group: task.group,
             gathered,
         };
-        let flux_to_k = PI * tjk * gathered.sum();
-        // The photometric criterion trusts the midpoint estimate of fr over
-        // K, which misses a narrow lobe whose peak falls between K's sample
-        // points: such links would stay coarse *because* they were
-        // underestimated. Bound the flux with fr at the mirror direction
-        // when that direction passes near K.
-        if flux_to_k < self.flux_threshold
-            && incoming
-                .and_then(|inc| self.peak_fr(bsdf, &inc, j, k))
-                .is_none_or(|peak| {
-                    PI * tjk * (unshot * peak).sum() * (PI * tij.t / aj) < self.flux_threshold
-                })
-        {
+        if self.below_photometric(bsdf, &known, j, &task.h.nodes[n as usize], aj, gathered) {
             task.push(link);
             return;
         }
         let (spread, driver) = self.fr_variation(bsdf, i, j, k);
-        let (fji, _) = self.ff_estimates(j, sj, i, si);
-        let brdf_err = PI * fji * spread / self.settings.fr_eps;
-        // The same oracle as stage 1, for the flux this node will carry on:
-        // how much the point form factor F(y → j) varies over y in k.
-        let ff_err = self.throughput(k, sk, j, sj).spread / self.settings.ff_eps;
-        let partial = (vjk > 0.0 && vjk < 1.0) || straddle_k;
-        if brdf_err <= 1.0 && ff_err <= 1.0 && !partial && !straddle_i {
-            task.push(link);
-            return;
+        let (fji, _) = self.ff_estimates(sj.of(j), si.of(i));
+        let errors = TripleErrors {
+            brdf: PI * fji * spread / self.settings.fr_eps,
+            // The same oracle as stage 1, for the flux this node will carry
+            // on: how much the point form factor F(y → j) varies over y in k.
+            ff: self.throughput(task.h.to.of(k), sj.of(j)).spread / self.settings.ff_eps,
+            partial: (vjk > 0.0 && vjk < 1.0) || straddle_k,
+            driver,
+        };
+        self.link_or_split(task, i, j, n, known, link, errors);
+    }
+
+    /// A node whose elements were found not to see each other: as in stage
+    /// 1, near the roots a few shadow rays may miss a gap, so look one
+    /// level further (splitting the larger of J and K) before giving the
+    /// pair up.
+    fn retry_unseen_node(
+        &self,
+        task: &mut TripleTask<'_, N>,
+        i: ElementId,
+        j: ElementId,
+        n: u32,
+        known: Incidence<N>,
+    ) {
+        let k = task.h.nodes[n as usize].to;
+        let (ej, ek) = (self.forest.element(j), self.forest.element(k));
+        if ej.depth + ek.depth < 2 && self.throughput(task.h.to.of(k), task.h.from.of(j)).f > 0.0 {
+            let side = if ej.area >= ek.area {
+                Driver::J
+            } else {
+                Driver::K
+            };
+            self.split_triple(side, task, i, j, n, known);
         }
-        if straddle_i && brdf_err <= 1.0 && ff_err <= 1.0 && !partial {
-            if self.split_triple(Driver::I, task, i, j, n, known) {
+    }
+
+    /// No sample point of i or K on the receiving side of j: an element
+    /// that lies partly behind j's tangent plane still carries light
+    /// through its part in front, so refine it like partial visibility. (A
+    /// zero of the BRDF itself, a lobe far from K, is not refined for: the
+    /// peak bound of [`Self::below_photometric`] decides whether the lobe
+    /// may be near.)
+    fn split_across_plane(
+        &self,
+        task: &mut TripleTask<'_, N>,
+        i: ElementId,
+        j: ElementId,
+        n: u32,
+        known: Incidence<N>,
+        straddle_k: bool,
+    ) {
+        let k = task.h.nodes[n as usize].to;
+        let order = match (known.straddle_i, straddle_k) {
+            (true, true) if self.forest.element(i).area >= self.forest.element(k).area => {
+                [Driver::I, Driver::K]
+            }
+            (true, true) => [Driver::K, Driver::I],
+            (true, false) => [Driver::I, Driver::I],
+            (false, true) => [Driver::K, Driver::K],
+            (false, false) => return,
+        };
+        for d in order {
+            if self.split_triple(d, task, i, j, n, known) {
                 return;
             }
+        }
+    }
+
+    /// The photometric criterion (paper §4.3) on the flux π T_jk ΔL^G the
+    /// link would send on towards k. The midpoint estimate of fr over K
+    /// misses a narrow lobe whose peak falls between K's sample points, and
+    /// such links would stay coarse *because* they were underestimated: the
+    /// flux is also bounded with fr at the mirror direction when that
+    /// direction passes near K.
+    fn below_photometric(
+        &self,
+        bsdf: &Bsdf<N>,
+        known: &Incidence<N>,
+        j: ElementId,
+        node: &Node<N>,
+        aj: f64,
+        gathered: Spectrum<N>,
+    ) -> bool {
+        let (k, tjk) = (node.to, node.t);
+        let flux_to_k = PI * tjk * gathered.sum();
+        flux_to_k < self.flux_threshold
+            && known
+                .incoming
+                .and_then(|inc| self.peak_fr(bsdf, &inc, j, k))
+                .is_none_or(|peak| {
+                    PI * tjk * (known.unshot * peak).sum() * (PI * known.tij.t / aj)
+                        < self.flux_threshold
+                })
+    }
+
+    /// Links when every error is within its bound; otherwise splits the
+    /// element that matters most (the BRDF's driver when the BRDF error
+    /// dominates, otherwise the larger of J and K), trying the others when
+    /// it cannot split, and links when none can.
+    #[allow(clippy::too_many_arguments)]
+    fn link_or_split(
+        &self,
+        task: &mut TripleTask<'_, N>,
+        i: ElementId,
+        j: ElementId,
+        n: u32,
+        known: Incidence<N>,
+        link: NodeLink<N>,
+        e: TripleErrors,
+    ) {
+        let accurate = e.brdf <= 1.0 && e.ff <= 1.0 && !e.partial;
+        if accurate && !known.straddle_i {
             task.push(link);
             return;
         }
-        // The element to split: the BRDF's driver when the BRDF error
-        // dominates, otherwise the larger of J and K.
-        let (ej, ek) = (self.geom.element(j), self.geom.element(k));
-        let first = if brdf_err >= ff_err.max(if partial { 1.0 } else { 0.0 }) {
-            driver
+        if accurate {
+            if !self.split_triple(Driver::I, task, i, j, n, known) {
+                task.push(link);
+            }
+            return;
+        }
+        let k = task.h.nodes[n as usize].to;
+        let (ej, ek) = (self.forest.element(j), self.forest.element(k));
+        let first = if e.brdf >= e.ff.max(if e.partial { 1.0 } else { 0.0 }) {
+            e.driver
         } else if ej.area >= ek.area {
             Driver::J
         } else {
@@ -706,8 +775,7 @@ impl<const N: usize> RefineContext<'_, N> {
             Driver::J => [Driver::K, Driver::I],
             Driver::K => [Driver::J, Driver::I],
         };
-        let order = [first, rest[0], rest[1]];
-        for d in order {
+        for d in [first, rest[0], rest[1]] {
             if self.split_triple(d, task, i, j, n, known) {
                 return;
             }
@@ -715,10 +783,10 @@ impl<const N: usize> RefineContext<'_, N> {
         task.push(link);
     }
 
-    /// Applies one of the three subdivision cases (notes §3), following an
-    /// existing split of the receiving node when it is on the other side.
-    /// False when the chosen element cannot be split.
-    #[allow(clippy::too_many_arguments)]
+    /// Applies one of the three subdivision cases (docs/solver.md,
+    /// "RefineAndLink"), following an existing split of the receiving node
+    /// when it is on the other side. False when the chosen element cannot be
+    /// split.
     fn split_triple(
         &self,
         which: Driver,
@@ -737,7 +805,7 @@ impl<const N: usize> RefineContext<'_, N> {
         };
         match which {
             Driver::I => {
-                let Some(children) = self.geom.element(i).children() else {
+                let Some(children) = self.forest.element(i).children() else {
                     return false;
                 };
                 for c in children {
@@ -782,9 +850,9 @@ impl<const N: usize> RefineContext<'_, N> {
         let (a, b) = (h.nodes[n as usize].from, h.nodes[n as usize].to);
         let (sa, sb) = (h.from, h.to);
         let split_elem = if side == Split::From { a } else { b };
-        let children = self.geom.element(split_elem).children()?;
+        let children = self.forest.element(split_elem).children()?;
         let pairs = children.map(|c| if side == Split::From { (c, b) } else { (a, c) });
-        let throughputs = pairs.map(|(x, y)| self.throughput(y, sb, x, sa));
+        let throughputs = pairs.map(|(x, y)| self.throughput(sb.of(y), sa.of(x)));
         *lost += h.split(n, side, pairs, throughputs);
         h.children(n)
     }
@@ -801,7 +869,7 @@ impl<const N: usize> RefineContext<'_, N> {
         // The chain of elements from the surface's root down to j.
         let mut chain = vec![j];
         let mut cur = j;
-        while let Some(p) = self.geom.element(cur).parent {
+        while let Some(p) = self.forest.element(cur).parent {
             chain.push(p);
             cur = p;
         }

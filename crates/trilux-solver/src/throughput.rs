@@ -11,26 +11,7 @@
 use std::collections::HashMap;
 use std::sync::RwLock;
 
-use trilux_geometry::{ElementId, FormFactorOptions, SceneGeometry, Side};
-
-/// One element seen from one of its sides.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub(crate) struct SidedElement {
-    /// The element.
-    pub element: ElementId,
-    /// Its back face rather than its front.
-    pub back: bool,
-}
-
-impl SidedElement {
-    fn side(self) -> Side {
-        if self.back { Side::Back } else { Side::Front }
-    }
-
-    fn key(self) -> u64 {
-        (u64::from(self.element.0) << 1) | u64::from(self.back)
-    }
-}
+use trilux_geometry::{FaceElement, FormFactorOptions, Visibility, form_factor};
 
 /// A throughput with the visible fraction it was made with.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -108,7 +89,7 @@ impl ThroughputCache {
         }
     }
 
-    fn key(a: SidedElement, b: SidedElement) -> u64 {
+    fn key(a: FaceElement, b: FaceElement) -> u64 {
         // Ordered: T is symmetric but the spread belongs to the first.
         (a.key() << 32) | b.key()
     }
@@ -119,7 +100,7 @@ impl ThroughputCache {
     }
 
     /// The cached throughput of a pair, if any.
-    pub fn get(&self, a: SidedElement, b: SidedElement) -> Option<Throughput> {
+    pub fn get(&self, a: FaceElement, b: FaceElement) -> Option<Throughput> {
         let key = Self::key(a, b);
         let shard = self.shards[Self::shard(key)].read().ok()?;
         shard.get(&key).copied()
@@ -127,7 +108,7 @@ impl ThroughputCache {
 
     /// Stores a throughput; clears the shard when it is full (a simple bound
     /// that keeps memory O(capacity) whatever the scene).
-    pub fn insert(&self, a: SidedElement, b: SidedElement, t: Throughput) {
+    pub fn insert(&self, a: FaceElement, b: FaceElement, t: Throughput) {
         let key = Self::key(a, b);
         if let Ok(mut shard) = self.shards[Self::shard(key)].write() {
             if shard.len() >= self.per_shard_cap {
@@ -139,32 +120,18 @@ impl ThroughputCache {
 }
 
 /// Computes T_ij = A_i F_{i→j} V_ij for the given faces, without the cache
-/// (`i` is the receiver: the spread is measured over it).
+/// (`i` is the receiver: the spread is measured over it). With `visible`,
+/// V = 1 without tracing (a pair inside a pair whose shadow rays all
+/// passed).
 pub(crate) fn compute_throughput(
-    geom: &SceneGeometry,
-    i: SidedElement,
-    j: SidedElement,
-    visibility_samples: u32,
-) -> Throughput {
-    compute_throughput_with(geom, i, j, visibility_samples, false)
-}
-
-/// [`compute_throughput`], taking V = 1 without tracing when `visible`
-/// (a pair inside a pair whose shadow rays all passed).
-pub(crate) fn compute_throughput_with(
-    geom: &SceneGeometry,
-    i: SidedElement,
-    j: SidedElement,
+    vis: &Visibility<'_>,
+    i: FaceElement,
+    j: FaceElement,
     visibility_samples: u32,
     visible: bool,
 ) -> Throughput {
-    let ff = geom.form_factor_sided(
-        i.element,
-        i.side(),
-        j.element,
-        j.side(),
-        &FORM_FACTOR_OPTIONS,
-    );
+    let forest = vis.forest();
+    let ff = form_factor(forest, i, j, &FORM_FACTOR_OPTIONS);
     let (f, spread) = (ff.value, ff.spread);
     if !(f.is_finite() && f > 0.0) {
         return Throughput::default();
@@ -172,7 +139,7 @@ pub(crate) fn compute_throughput_with(
     // Coarse pairs decide a lot of transport from one number: give them
     // more shadow rays (×16 for whole input surfaces, ×4 one or two levels
     // down).
-    let depth = geom.element(i.element).depth + geom.element(j.element).depth;
+    let depth = forest.element(i.element).depth + forest.element(j.element).depth;
     let samples = match depth {
         0 | 1 => visibility_samples * 16,
         2 | 3 => visibility_samples * 4,
@@ -181,18 +148,14 @@ pub(crate) fn compute_throughput_with(
     let v = if visible {
         1.0
     } else {
-        geom.visibility_weighted(i.element, i.side(), j.element, j.side(), samples)
+        vis.weighted(i, j, samples)
     };
-    let area = geom.element(i.element).area;
+    let area = forest.element(i.element).area;
     let t = area * f * v;
-    if t.is_finite() && t > 0.0 {
-        Throughput { t, v, f, spread }
-    } else {
-        Throughput {
-            t: 0.0,
-            v,
-            f,
-            spread,
-        }
+    Throughput {
+        t: if t.is_finite() && t > 0.0 { t } else { 0.0 },
+        v,
+        f,
+        spread,
     }
 }

@@ -6,9 +6,9 @@
 use glam::{DMat4, DVec2};
 use trilux_brdf::BsdfParams;
 use trilux_color::ColorParam;
-use trilux_geometry::{Shape, ShapeKind, SurfaceCoord, SurfaceId};
+use trilux_geometry::{Shape, ShapeKind, Side, SurfaceCoord, SurfaceId};
 use trilux_solver::{
-    Quality, Solution, Solver, SolverInput, SolverSettings, SurfaceSite, Transport,
+    Quality, SceneDescription, Solution, Solver, SolverSettings, SurfaceSite, Transport,
 };
 
 fn furnace_input() -> (Vec<Shape>, Vec<BsdfParams>, Vec<Option<ColorParam>>) {
@@ -26,7 +26,7 @@ fn furnace_input() -> (Vec<Shape>, Vec<BsdfParams>, Vec<Option<ColorParam>>) {
 
 fn solve<const N: usize>(transport: Transport) -> Solution<N> {
     let (shapes, bsdfs, emission) = furnace_input();
-    let input = SolverInput {
+    let input = SceneDescription {
         shapes: &shapes,
         bsdfs: &bsdfs,
         emission: &emission,
@@ -35,7 +35,7 @@ fn solve<const N: usize>(transport: Transport) -> Solution<N> {
     settings.convergence = 0.999;
     settings.max_depth = 3;
     settings.transport = transport;
-    Solver::<N>::new(&input, settings)
+    Solver::<N>::from_description(&input, settings)
         .expect("furnace builds")
         .solve(|_| {})
 }
@@ -55,7 +55,7 @@ fn check<const N: usize>(solution: &Solution<N>) {
         "CR {}",
         stats.convergence_ratio
     );
-    let faces = solution.geometry().surfaces().len();
+    let faces = solution.forest().geometry().surfaces().len();
     assert_eq!(faces, 6);
     let mut worst: f64 = 0.0;
     for f in 0..faces as u32 {
@@ -65,16 +65,12 @@ fn check<const N: usize>(solution: &Solution<N>) {
         for a in 0..7 {
             for b in 0..7 {
                 let uv = DVec2::new((a as f64 + 0.5) / 7.0, (b as f64 + 0.5) / 7.0);
-                let from = SurfaceSite {
-                    surface: SurfaceId(f),
-                    coord: SurfaceCoord::Uv(uv),
-                    back: false,
-                };
-                let to = SurfaceSite {
-                    surface: SurfaceId(other),
-                    coord: SurfaceCoord::Uv(DVec2::splat(0.5)),
-                    back: false,
-                };
+                let from = SurfaceSite::new(SurfaceId(f), Side::Front, SurfaceCoord::Uv(uv));
+                let to = SurfaceSite::new(
+                    SurfaceId(other),
+                    Side::Front,
+                    SurfaceCoord::Uv(DVec2::splat(0.5)),
+                );
                 let l = solution.radiance(&from, &to);
                 for band in 0..N {
                     let expected = le[band] / (1.0 - rho[band]);

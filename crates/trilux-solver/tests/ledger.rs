@@ -10,7 +10,7 @@ use proptest::prelude::*;
 use trilux_brdf::{BsdfParams, Distribution, RoughConductorParams};
 use trilux_color::ColorParam;
 use trilux_geometry::{Shape, ShapeKind};
-use trilux_solver::{Quality, Solver, SolverInput, SolverSettings, Transport};
+use trilux_solver::{Quality, SceneDescription, Solver, SolverSettings, Transport};
 
 fn material() -> impl Strategy<Value = BsdfParams> {
     let diffuse = (0.0..0.95f64).prop_map(|r| BsdfParams::Diffuse {
@@ -136,7 +136,7 @@ proptest! {
         uniform in any::<bool>(),
     ) {
         let (shapes, bsdfs, emission) = scene(closed, box_material, &plates, tube, le);
-        let input = SolverInput { shapes: &shapes, bsdfs: &bsdfs, emission: &emission };
+        let input = SceneDescription { shapes: &shapes, bsdfs: &bsdfs, emission: &emission };
         let mut settings = SolverSettings::preset(Quality::Draft);
         settings.max_depth = 3;
         settings.max_shots = 25;
@@ -144,7 +144,7 @@ proptest! {
         settings.transport = if uniform { Transport::Uniform } else { Transport::TwoPoint };
         let mut last_cr = 0.0f64;
         let mut monotone = true;
-        let solution = Solver::<3>::new(&input, settings).expect("builds").solve(|p| {
+        let solution = Solver::<3>::from_description(&input, settings).expect("builds").solve(|p| {
             monotone &= p.convergence_ratio >= last_cr - 1e-12;
             last_cr = p.convergence_ratio;
         });

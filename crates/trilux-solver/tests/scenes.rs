@@ -4,7 +4,9 @@
 use std::path::PathBuf;
 
 use trilux_color::Mode;
-use trilux_solver::{Quality, SceneInput, SolveStats, Solver, SolverSettings};
+mod common;
+
+use trilux_solver::{Quality, SolveStats, Solver, SolverSettings};
 
 fn scenes() -> Vec<PathBuf> {
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
@@ -46,24 +48,24 @@ fn every_bundled_scene_balances() {
     assert!(list.len() >= 2, "scenes/ holds the bundled scenes");
     for path in list {
         let scene = trilux_scene::load(&path).expect("bundled scene loads");
-        let input = SceneInput::from_scene(&scene);
+        let shown = path.display().to_string();
         let mut settings = SolverSettings::preset(Quality::Draft);
         settings.max_shots = 200;
         let name = path.display().to_string();
         match scene.mode() {
             Mode::Rgb => {
-                let s = Solver::<3>::new(&input.as_input(), settings)
+                let s = Solver::<3>::new(common::prepare(&shown), settings)
                     .expect("solver builds")
                     .solve(|_| {});
                 check(s.stats(), 3, &name);
                 assert!(s.min_radiance() >= 0.0, "{name}");
             }
             Mode::Spectral => {
-                let s =
-                    Solver::<{ trilux_color::SPECTRAL_BANDS }>::new(&input.as_input(), settings)
-                        .expect("solver builds")
-                        .solve(|_| {});
-                check(s.stats(), 10, &name);
+                const N: usize = trilux_color::SPECTRAL_BANDS;
+                let s = Solver::<N>::new(common::prepare(&shown), settings)
+                    .expect("solver builds")
+                    .solve(|_| {});
+                check(s.stats(), N, &name);
                 assert!(s.min_radiance() >= 0.0, "{name}");
             }
         }

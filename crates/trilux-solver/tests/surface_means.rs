@@ -14,7 +14,10 @@
 
 use std::path::PathBuf;
 
-use trilux_solver::{Quality, SceneInput, Solver, SolverSettings};
+mod common;
+
+use trilux_geometry::Side;
+use trilux_solver::{Quality, Solver, SolverSettings};
 
 #[test]
 fn cornell_box_faces_match_mitsuba_irradiance_meters() {
@@ -22,12 +25,11 @@ fn cornell_box_faces_match_mitsuba_irradiance_meters() {
     let text = std::fs::read_to_string(root.join("tests/golden/surfaces/cornell-box.json"))
         .expect("reference present");
     let reference: serde_json::Value = serde_json::from_str(&text).expect("valid JSON");
-    let scene = trilux_scene::load(root.join("scenes/cornell-box.xml")).expect("loads");
-    let input = SceneInput::from_scene(&scene);
-    let solution = Solver::<3>::new(&input.as_input(), SolverSettings::preset(Quality::Default))
+    let scene = common::prepare(&root.join("scenes/cornell-box.xml").display().to_string());
+    let solution = Solver::<3>::new(scene, SolverSettings::preset(Quality::Default))
         .expect("builds")
         .solve(|_| {});
-    let geom = solution.geometry();
+    let geom = solution.forest().geometry();
     let (mut total_ref, mut total_got) = (0.0, 0.0);
     let shapes = reference["shapes"].as_array().expect("shapes");
     assert!(shapes.len() >= 7);
@@ -44,7 +46,7 @@ fn cornell_box_faces_match_mitsuba_irradiance_meters() {
             .into_iter()
             .map(|s| geom.surface(s).area())
             .sum();
-        let got = solution.shape_mean_radiance(shape, false).sum();
+        let got = solution.shape_mean_radiance(shape, Side::Front).sum();
         let ratio = got / want;
         eprintln!("shape {shape}: trilux {got:.5} Mitsuba {want:.5} ratio {ratio:.4}");
         assert!((ratio - 1.0).abs() <= 0.02, "shape {shape}: ratio {ratio}");

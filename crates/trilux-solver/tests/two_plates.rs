@@ -7,8 +7,8 @@ use std::f64::consts::PI;
 use glam::{DMat4, DVec2, DVec3};
 use trilux_brdf::{Bsdf, BsdfParams, Distribution, Frame, RoughConductorParams};
 use trilux_color::{ColorParam, Spectrum};
-use trilux_geometry::{Shape, ShapeKind, SurfaceCoord, SurfaceId};
-use trilux_solver::{Quality, Solver, SolverInput, SolverSettings, SurfaceSite};
+use trilux_geometry::{FaceId, Shape, ShapeKind, Side, SurfaceCoord, SurfaceId};
+use trilux_solver::{Quality, SceneDescription, Solver, SolverSettings, SurfaceSite};
 
 /// A unit square centred at `centre`, facing down (−z) or up (+z).
 fn square(centre: DVec3, down: bool) -> Shape {
@@ -58,14 +58,14 @@ fn diffuse_receiver_one_bounce() {
         },
     ];
     let emission = vec![Some(ColorParam::Float(1.0)), None];
-    let input = SolverInput {
+    let input = SceneDescription {
         shapes: &shapes,
         bsdfs: &bsdfs,
         emission: &emission,
     };
     let settings = one_bounce_settings();
     let ff_eps = settings.ff_eps;
-    let solution = Solver::<3>::new(&input, settings)
+    let solution = Solver::<3>::from_description(&input, settings)
         .expect("builds")
         .solve(|_| {});
     let rho_le = 0.5;
@@ -76,11 +76,7 @@ fn diffuse_receiver_one_bounce() {
     for a in 0..g {
         for b in 0..g {
             let uv = DVec2::new((a as f64 + 0.5) / g as f64, (b as f64 + 0.5) / g as f64);
-            let site = SurfaceSite {
-                surface: SurfaceId(1),
-                coord: SurfaceCoord::Uv(uv),
-                back: false,
-            };
+            let site = SurfaceSite::new(SurfaceId(1), Side::Front, SurfaceCoord::Uv(uv));
             sum += solution.lambertian_radiance(&site)[1];
         }
     }
@@ -91,11 +87,11 @@ fn diffuse_receiver_one_bounce() {
         (mean - expected).abs() <= 0.01 * expected,
         "mean {mean} vs {expected}"
     );
-    let centre = SurfaceSite {
-        surface: SurfaceId(1),
-        coord: SurfaceCoord::Uv(DVec2::splat(0.5)),
-        back: false,
-    };
+    let centre = SurfaceSite::new(
+        SurfaceId(1),
+        Side::Front,
+        SurfaceCoord::Uv(DVec2::splat(0.5)),
+    );
     let l = solution.lambertian_radiance(&centre)[1];
     let expected = rho_le * 0.239456;
     assert!(
@@ -142,7 +138,7 @@ fn glossy_receiver_one_bounce() {
         },
     ];
     let emission = vec![Some(ColorParam::Float(1.0)), None, None];
-    let input = SolverInput {
+    let input = SceneDescription {
         shapes: &shapes,
         bsdfs: &bsdfs,
         emission: &emission,
@@ -150,11 +146,14 @@ fn glossy_receiver_one_bounce() {
     let mut settings = one_bounce_settings();
     settings.fr_eps = 0.05;
     settings.max_depth = 4;
-    let solution = Solver::<3>::new(&input, settings)
+    let solution = Solver::<3>::from_description(&input, settings)
         .expect("builds")
         .solve(|_| {});
     let flux = solution
-        .interaction_flux((SurfaceId(1), false), (SurfaceId(2), false))
+        .interaction_flux(
+            FaceId::new(SurfaceId(1), Side::Front),
+            FaceId::new(SurfaceId(2), Side::Front),
+        )
         .expect("the glossy plate stores an interaction towards K");
 
     // Brute force.

@@ -7,21 +7,20 @@
 use std::path::PathBuf;
 
 use glam::DVec2;
-use trilux_geometry::{SurfaceCoord, SurfaceId};
-use trilux_solver::{
-    Quality, SceneInput, Solution, Solver, SolverSettings, SurfaceSite, Transport,
-};
+mod common;
+
+use trilux_geometry::{Side, SurfaceCoord, SurfaceId};
+use trilux_solver::{Quality, Solution, Solver, SolverSettings, SurfaceSite, Transport};
 
 fn solve(transport: Transport) -> Solution<3> {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/cornell-box.xml");
-    let scene = trilux_scene::load(&path).expect("Cornell box loads");
-    let input = SceneInput::from_scene(&scene);
+    let scene = common::prepare(&path.display().to_string());
     let mut settings = SolverSettings::preset(Quality::Default);
     settings.convergence = 0.999;
     settings.transport = transport;
     settings.flux_eps = 1e-7;
     settings.max_depth = DEPTH;
-    Solver::<3>::new(&input.as_input(), settings)
+    Solver::<3>::new(scene, settings)
         .expect("builds")
         .solve(|_| {})
 }
@@ -47,12 +46,9 @@ fn surface_mean(
     a: u32,
     surfaces: u32,
 ) -> Option<[f64; 3]> {
-    let g = reference.geometry();
-    let site = |s: u32, uv: DVec2| SurfaceSite {
-        surface: SurfaceId(s),
-        coord: SurfaceCoord::Uv(uv),
-        back: false,
-    };
+    let g = reference.forest().geometry();
+    let site =
+        |s: u32, uv: DVec2| SurfaceSite::new(SurfaceId(s), Side::Front, SurfaceCoord::Uv(uv));
     let centre = DVec2::splat(0.5);
     let x = g.surface_point(SurfaceId(a), SurfaceCoord::Uv(centre))?;
     let target = (0..surfaces)
@@ -63,7 +59,7 @@ fn surface_mean(
             let r = d.length();
             (d.dot(x.normal) > 0.3 * r && -d.dot(y.normal) > 0.3 * r).then(|| site(b, centre))
         })?;
-    let y = g.surface_point(target.surface, target.coord)?.point;
+    let y = g.surface_point(target.face.surface(), target.coord)?.point;
     let mut mean = [0.0; 3];
     let mut count = 0;
     for i in 0..GRID {
@@ -92,7 +88,7 @@ fn surface_mean(
 fn uniform_and_two_point_agree_on_the_diffuse_cornell_box() {
     let two = solve(Transport::TwoPoint);
     let uni = solve(Transport::Uniform);
-    let surfaces = two.geometry().surfaces().len() as u32;
+    let surfaces = two.forest().geometry().surfaces().len() as u32;
     let mut compared = 0;
     let mut worst: f64 = 0.0;
     let (mut sum_two, mut sum_uni) = (0.0, 0.0);

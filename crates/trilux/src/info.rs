@@ -10,7 +10,7 @@ use trilux_color::Mode;
 use trilux_geometry::ShapeKind;
 use trilux_scene::Scene;
 
-use crate::ModeArg;
+use crate::options::ModeArg;
 use crate::power::emitted_power;
 
 /// Arguments of `trilux info`.
@@ -27,7 +27,7 @@ pub struct InfoArgs {
     pub mode: Option<ModeArg>,
 }
 
-/// The JSON of `info --json` (design.md §3), exactly these keys.
+/// The JSON of `info --json`, exactly these keys (README, "Using it").
 #[derive(Debug, Serialize)]
 struct InfoJson {
     shapes: usize,

@@ -1,24 +1,32 @@
-//! The `trilux` command: solve, render and inspect scenes (design.md §3).
+//! The `trilux` command: solve, render and inspect scenes.
 //!
 //! Runtime errors print one line `error: ...` on stderr and exit with status
-//! 1; command-line usage errors keep clap's message and exit with status 2.
-//! Subcommands live one per module; `render` and `solve` join `info` here
-//! as variants of [`Command`]. Number-list options whose values may begin
+//! 1; command-line usage errors (unknown options, malformed values) keep
+//! clap's message and exit with status 2, before any file is read.
+//! Subcommands live one per module; the work itself is
+//! `trilux_render::pipeline`'s. Number-list options whose values may begin
 //! with '-' (`--lookat -0.5,1,2,...`) need `#[arg(allow_hyphen_values =
 //! true)]` on the argument (`allow_negative_numbers` only covers plain
 //! numbers, not comma lists).
 
 mod info;
+mod options;
+mod output;
 mod power;
+mod progress;
 mod render;
 mod solve;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use clap::{Parser, Subcommand, ValueEnum};
+use clap::{Parser, Subcommand};
 
 /// Progressive hierarchical three-point light transport.
+///
+/// With no command, renders the bundled Cornell box (scenes/cornell-box.xml)
+/// into out/cornell-box.exr, .png and .json; `trilux render` writes to
+/// out/<scene name>.exr unless told otherwise.
 #[derive(Debug, Parser)]
 #[command(name = "trilux", version, about)]
 struct Cli {
@@ -38,15 +46,6 @@ enum Command {
     Render(render::RenderArgs),
 }
 
-/// How light is carried: 3 RGB bands or spectral bands.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum ModeArg {
-    /// Linear sRGB, 3 bands.
-    Rgb,
-    /// Spectral bands (10 by default).
-    Spectral,
-}
-
 /// The bundled default scene (the Cornell box): `scenes/cornell-box.xml`
 /// below the current folder, else in the source tree this binary was built
 /// from.
@@ -58,14 +57,34 @@ pub fn default_scene() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/cornell-box.xml")
 }
 
-/// The statistics JSON of design.md §3: the solver's figures plus the
-/// render time.
-pub fn stats_json(stats: &trilux_solver::SolveStats, render_seconds: f64) -> serde_json::Value {
-    let mut value = serde_json::to_value(stats).unwrap_or(serde_json::Value::Null);
-    if let Some(map) = value.as_object_mut() {
-        map.insert("render_seconds".into(), serde_json::json!(render_seconds));
+/// Sets the size of rayon's global pool (once, before any parallel work).
+pub fn set_threads(threads: Option<u32>) {
+    if let Some(n) = threads {
+        // Fails only if a pool already exists, which cannot happen here.
+        let _ = rayon::ThreadPoolBuilder::new()
+            .num_threads(n as usize)
+            .build_global();
     }
-    value
+}
+
+/// The main job: the bundled default scene rendered into out/.
+fn render_default() -> anyhow::Result<()> {
+    let scene = default_scene();
+    let exr = render::default_output(&scene);
+    let png = exr.with_extension("png");
+    let stats = exr.with_extension("json");
+    let mut argv = vec!["trilux".into(), "render".into(), scene.into_os_string()];
+    argv.extend(["--png".into(), png.clone().into_os_string()]);
+    argv.extend(["--stats".into(), stats.into_os_string()]);
+    let Cli {
+        command: Some(Command::Render(args)),
+    } = Cli::parse_from(argv)
+    else {
+        anyhow::bail!("the default render's arguments do not parse");
+    };
+    render::run(&args)?;
+    println!("wrote {} and {}", exr.display(), png.display());
+    Ok(())
 }
 
 fn run(cli: Cli) -> anyhow::Result<()> {
@@ -73,37 +92,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         Some(Command::Info(args)) => info::run(&args),
         Some(Command::Solve(args)) => solve::run(&args),
         Some(Command::Render(args)) => render::run(&args),
-        // The main job: render the bundled default scene into out/.
-        None => {
-            let scene = default_scene();
-            std::fs::create_dir_all("out")
-                .map_err(|e| anyhow::anyhow!("out: cannot create the folder: {e}"))?;
-            let exr = render::default_output(&scene);
-            let png = exr.with_extension("png");
-            let args = render::RenderArgs {
-                scene,
-                output: Some(exr.clone()),
-                png: Some(png.clone()),
-                stats: Some(exr.with_extension("json")),
-                spp: None,
-                width: None,
-                height: None,
-                threads: None,
-                seed: 0,
-                solution: None,
-                lookat: None,
-                fov: None,
-                extra_bounce: "always".into(),
-                options: solve::SolveOptions {
-                    quality: "default".into(),
-                    convergence: None,
-                    mode: None,
-                },
-            };
-            render::run(&args)?;
-            println!("wrote {} and {}", exr.display(), png.display());
-            Ok(())
-        }
+        None => render_default(),
     }
 }
 

@@ -10,29 +10,29 @@
 //! ([`trilux_scene::surface_area`]).
 
 use anyhow::{Result, anyhow};
-use trilux_color::{ColorParam, Mode, Spectrum};
+use trilux_color::{ColorParam, Mode, Spectrum, WithBands};
 use trilux_scene::{Scene, surface_area};
-
-/// Bands of the spectral mode (trilux-color's default for the paper: 10).
-pub use trilux_color::SPECTRAL_BANDS;
 
 /// Total emitted power per band (W): Σ π · L · A over the area emitters.
 pub fn emitted_power(scene: &Scene, mode: Mode) -> Result<Vec<f64>> {
-    match mode {
-        Mode::Rgb => power::<3>(scene),
-        Mode::Spectral => power::<SPECTRAL_BANDS>(scene),
-    }
+    mode.with_bands(Power(scene))
 }
 
-fn power<const N: usize>(scene: &Scene) -> Result<Vec<f64>> {
-    let mut total = Spectrum::<N>::zero();
-    for (_, s) in scene.emitters() {
-        let Some(emitter) = &s.emitter else { continue };
-        let radiance = radiance::<N>(&emitter.radiance)
-            .map_err(|e| anyhow!("{}: emitted radiance: {e}", emitter.location))?;
-        total += radiance * (std::f64::consts::PI * surface_area(&s.shape));
+/// [`emitted_power`] once the band count is known.
+struct Power<'a>(&'a Scene);
+
+impl WithBands for Power<'_> {
+    type Output = Result<Vec<f64>>;
+    fn run<const N: usize>(self) -> Self::Output {
+        let mut total = Spectrum::<N>::zero();
+        for (_, s) in self.0.emitters() {
+            let Some(emitter) = &s.emitter else { continue };
+            let radiance = radiance::<N>(&emitter.radiance)
+                .map_err(|e| anyhow!("{}: emitted radiance: {e}", emitter.location))?;
+            total += radiance * (std::f64::consts::PI * surface_area(&s.shape));
+        }
+        Ok(total.0.to_vec())
     }
-    Ok(total.0.to_vec())
 }
 
 fn radiance<const N: usize>(c: &ColorParam) -> Result<Spectrum<N>> {
@@ -43,7 +43,7 @@ fn radiance<const N: usize>(c: &ColorParam) -> Result<Spectrum<N>> {
 mod tests {
     use super::*;
 
-    /// design.md §3's check value (Mitsuba 3.9): the classic Cornell light
+    /// The check value of Mitsuba 3.9: the classic Cornell light
     /// in RGB mode is linear sRGB (20.7108, 10.8546, 2.77115). 1e-4 relative:
     /// the check value's six digits.
     #[test]

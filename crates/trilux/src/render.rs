@@ -1,25 +1,39 @@
 //! `trilux render SCENE`: solve (or load a saved solve) and render a view by
-//! final gathering (design.md §3).
+//! final gathering.
 
 use std::path::{Path, PathBuf};
-use std::time::Instant;
 
-use anyhow::{Context, Result, bail};
-use clap::Args;
-use glam::DVec3;
-use trilux_color::Mode;
-use trilux_render::{Image, RenderSettings, ViewOverrides, render};
-use trilux_scene::Scene;
-use trilux_solver::{SceneInput, Solution, solve_hash};
+use anyhow::{Context, Result};
+use clap::{Args, ValueEnum};
+use trilux_render::{
+    ExtraBounce, Observer, Plan, RenderPlan, RenderSettings, SolutionSource, ViewOverrides,
+};
 
-use crate::solve::{SolveOptions, progress_bar, solve_with_progress, write_json};
+use crate::options::{
+    LookAt, SolveOptions, check_distinct, check_output, parse_fov, parse_lookat, parse_positive,
+};
+use crate::output::{stats_json, write_images, write_json};
+use crate::progress::Bars;
+
+/// Where the gather continues one bounce before reading the solution.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum ExtraBounceArg {
+    /// At every hit: the solution's remaining bias is diluted by a bounce.
+    Always,
+    /// Only where its steps would show (close hits, narrow lobes, glossy or
+    /// smooth-shaded hits): faster.
+    Auto,
+    /// Nowhere: the paper's §4.5.
+    Never,
+}
 
 /// Arguments of `trilux render`.
 #[derive(Debug, Args)]
 pub struct RenderArgs {
     /// The scene file (Mitsuba 3 XML subset).
     pub scene: PathBuf,
-    /// Output EXR (linear sRGB). Default: out/<scene name>.exr.
+    /// Output EXR (linear sRGB). Default: out/<scene name>.exr (the folder
+    /// is made when missing).
     #[arg(short = 'o', long = "output")]
     pub output: Option<PathBuf>,
     /// Also write an sRGB-encoded PNG.
@@ -29,56 +43,36 @@ pub struct RenderArgs {
     #[arg(long)]
     pub stats: Option<PathBuf>,
     /// Camera samples per pixel (default: the scene sampler's sample_count).
-    #[arg(long)]
+    #[arg(long, value_parser = parse_positive)]
     pub spp: Option<u32>,
     /// Film width in pixels (default: the scene's).
-    #[arg(long)]
+    #[arg(long, value_parser = parse_positive)]
     pub width: Option<u32>,
     /// Film height in pixels (default: the scene's).
-    #[arg(long)]
+    #[arg(long, value_parser = parse_positive)]
     pub height: Option<u32>,
     /// Worker threads (default: all cores).
-    #[arg(long)]
-    pub threads: Option<usize>,
+    #[arg(long, value_parser = parse_positive)]
+    pub threads: Option<u32>,
     /// Seed of the sample sequences.
     #[arg(long, default_value_t = 0)]
     pub seed: u32,
-    /// Render from a saved solution instead of solving (`trilux solve`).
+    /// Render from a saved solution instead of solving (`trilux solve`; it
+    /// must have been made with the same --quality, --convergence and
+    /// --mode).
     #[arg(long)]
     pub solution: Option<PathBuf>,
     /// Another view: eye and target, optionally up (`ox,oy,oz,tx,ty,tz[,ux,uy,uz]`).
-    #[arg(long, allow_hyphen_values = true)]
-    pub lookat: Option<String>,
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_lookat)]
+    pub lookat: Option<LookAt>,
     /// Field of view in degrees along the scene's fov_axis.
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_fov)]
     pub fov: Option<f64>,
-    /// Where the gather continues one bounce before reading the solution:
-    /// at every hit (`always`, the default: the solution's remaining bias
-    /// is diluted by a bounce), only where its steps would show (`auto`:
-    /// close hits, narrow lobes, glossy or smooth-shaded hits; faster), or
-    /// nowhere (`never`: the paper's §4.5).
-    #[arg(long, value_parser = ["always", "auto", "never"], default_value = "always")]
-    pub extra_bounce: String,
+    /// Where the gather continues one bounce before reading the solution.
+    #[arg(long, value_enum, default_value = "always")]
+    pub extra_bounce: ExtraBounceArg,
     #[command(flatten)]
     pub options: SolveOptions,
-}
-
-/// Parses `--lookat`.
-fn parse_lookat(text: &str) -> Result<(DVec3, DVec3, Option<DVec3>)> {
-    let values: Vec<f64> = text
-        .split(',')
-        .map(|v| v.trim().parse::<f64>())
-        .collect::<Result<_, _>>()
-        .with_context(|| format!("--lookat: '{text}' is not a comma-separated list of numbers"))?;
-    if values.iter().any(|v| !v.is_finite()) {
-        bail!("--lookat: values must be finite");
-    }
-    let v = |i: usize| DVec3::new(values[i], values[i + 1], values[i + 2]);
-    match values.len() {
-        6 => Ok((v(0), v(3), None)),
-        9 => Ok((v(0), v(3), Some(v(6)))),
-        n => bail!("--lookat takes 6 or 9 numbers (eye, target[, up]), got {n}"),
-    }
 }
 
 /// The default output path for a scene: out/<stem>.exr.
@@ -89,99 +83,95 @@ pub fn default_output(scene: &Path) -> PathBuf {
     PathBuf::from("out").join(format!("{stem}.exr"))
 }
 
-fn render_mode<const N: usize>(args: &RenderArgs, scene: &Scene, input: &SceneInput) -> Result<()> {
-    let settings = args.options.settings()?;
-    let solution: Solution<N> = match &args.solution {
-        Some(path) => {
-            let mut s = Solution::<N>::load(path, &input.as_input(), &settings)?;
-            s.stats_mut().solve_seconds = 0.0;
-            s
+impl RenderArgs {
+    /// The EXR path: `-o`, or the default in `out/` (made when missing).
+    fn output(&self) -> Result<PathBuf> {
+        match &self.output {
+            Some(p) => Ok(p.clone()),
+            None => {
+                std::fs::create_dir_all("out").context("out: cannot create the folder")?;
+                Ok(default_output(&self.scene))
+            }
         }
-        None => solve_with_progress::<N>(input, settings.clone())?,
-    };
+    }
+
+    /// Every output checked, and checked against the inputs, before work.
+    fn check_outputs(&self, exr: &Path) -> Result<()> {
+        let mut outputs = vec![(exr, "image")];
+        outputs.extend(self.png.as_deref().map(|p| (p, "PNG")));
+        outputs.extend(self.stats.as_deref().map(|p| (p, "statistics")));
+        for (path, what) in &outputs {
+            check_output(path, what)?;
+        }
+        let mut inputs = vec![self.scene.as_path()];
+        inputs.extend(self.solution.as_deref());
+        check_distinct(&inputs, &outputs)
+    }
+
+    /// Samples, seed, filter and extra-bounce rule of this render.
+    fn render_plan(&self, camera: &trilux_scene::Camera) -> RenderPlan {
+        let mut settings = RenderSettings::for_scene(camera);
+        settings.spp = self.spp.unwrap_or(settings.spp);
+        settings.seed = self.seed;
+        settings.extra_bounce = match self.extra_bounce {
+            ExtraBounceArg::Always => ExtraBounce::Always,
+            ExtraBounceArg::Auto => ExtraBounce::Auto { close_factor: 1.0 },
+            ExtraBounceArg::Never => ExtraBounce::Never,
+        };
+        RenderPlan {
+            view: ViewOverrides {
+                lookat: self.lookat,
+                fov: self.fov,
+                width: self.width,
+                height: self.height,
+            },
+            settings,
+        }
+    }
+}
+
+/// Runs `trilux render`.
+pub fn run(args: &RenderArgs) -> Result<()> {
+    crate::set_threads(args.threads);
+    let exr = args.output()?;
+    args.check_outputs(&exr)?;
+    let scene = trilux_scene::load(&args.scene)?;
     let camera = scene.camera.as_ref().with_context(|| {
         format!(
             "{}: the scene has no <sensor> to render from",
             scene.path.display()
         )
     })?;
-    let view = ViewOverrides {
-        lookat: args.lookat.as_deref().map(parse_lookat).transpose()?,
-        fov: args.fov,
-        width: args.width,
-        height: args.height,
-    };
-    if let Some(fov) = view.fov
-        && !(fov.is_finite() && fov > 0.0 && fov < 180.0)
-    {
-        bail!("--fov must be in (0, 180) degrees, got {fov}");
-    }
-    let spp = args.spp.unwrap_or(camera.sample_count).max(1);
-    let render_settings = RenderSettings {
-        spp,
-        seed: args.seed,
-        filter: trilux_render::filter_of(camera),
-        extra_bounce: match args.extra_bounce.as_str() {
-            "auto" => trilux_render::ExtraBounce::Auto { close_factor: 1.0 },
-            "never" => trilux_render::ExtraBounce::Never,
-            _ => trilux_render::ExtraBounce::Always,
+    let plan = Plan {
+        mode: args.options.mode(&scene),
+        solver: args.options.settings(),
+        source: match &args.solution {
+            Some(path) => SolutionSource::Load(path),
+            None => SolutionSource::Solve,
         },
-        ..RenderSettings::default()
+        save: None,
+        render: Some(args.render_plan(camera)),
     };
-    let output = args
-        .output
-        .clone()
-        .unwrap_or_else(|| default_output(&args.scene));
-    let start = Instant::now();
-    let bar = progress_bar(1, "render");
-    let (image, _stats) = render(scene, &solution, &view, &render_settings, |done, total| {
-        if let Some(bar) = &bar {
-            bar.set_length(total as u64);
-            bar.set_position(done as u64);
-            bar.set_message(format!("{done}/{total} tiles"));
-        }
-    })?;
-    if let Some(bar) = bar {
-        bar.finish_and_clear();
-    }
-    let render_seconds = start.elapsed().as_secs_f64();
-    write_outputs(&image, &output, args.png.as_deref())?;
+    let bars = Bars::new(true);
+    let mut on_shot = |p: &trilux_solver::Progress| bars.solve(p);
+    let on_tile = |done: usize, total: usize| bars.render(done, total);
+    let outcome = trilux_render::pipeline::run(
+        &scene,
+        &plan,
+        Observer {
+            solve: &mut on_shot,
+            render: &on_tile,
+        },
+    );
+    bars.finish();
+    let outcome = outcome?;
+    let image = outcome.image.context("the render produced no image")?;
+    write_images(&image, &exr, args.png.as_deref())?;
     if let Some(path) = &args.stats {
-        write_json(path, &crate::stats_json(solution.stats(), render_seconds))?;
+        write_json(path, &stats_json(&outcome.solve, outcome.render_seconds))?;
     }
-    for w in &solution.stats().warnings {
+    for w in &outcome.solve.warnings {
         eprintln!("warning: {w}");
     }
-    // Keep the hash in use so that a solution written by `solve` for this
-    // scene is the one `--solution` accepts.
-    let _ = solve_hash(&input.as_input(), &settings, N);
     Ok(())
-}
-
-/// Writes the EXR and, if asked, the PNG (exposure 0, clamped).
-pub fn write_outputs(image: &Image, exr: &Path, png: Option<&Path>) -> Result<()> {
-    image.write_exr(exr)?;
-    if let Some(png) = png {
-        image.write_png(png, 0.0)?;
-    }
-    Ok(())
-}
-
-/// Runs `trilux render`.
-pub fn run(args: &RenderArgs) -> Result<()> {
-    if let Some(n) = args.threads {
-        if n == 0 {
-            bail!("--threads must be at least 1");
-        }
-        // Fails only if a pool already exists, which cannot happen here.
-        let _ = rayon::ThreadPoolBuilder::new()
-            .num_threads(n)
-            .build_global();
-    }
-    let scene = trilux_scene::load(&args.scene)?;
-    let input = SceneInput::from_scene(&scene);
-    match args.options.mode(&scene) {
-        Mode::Rgb => render_mode::<3>(args, &scene, &input),
-        Mode::Spectral => render_mode::<{ trilux_color::SPECTRAL_BANDS }>(args, &scene, &input),
-    }
 }

@@ -1,56 +1,15 @@
 //! `trilux solve SCENE -o FILE`: solve the light once and save it, so that
-//! any number of views can be rendered from it (design.md §3).
+//! any number of views can be rendered from it.
 
-use std::io::IsTerminal;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use clap::Args;
-use indicatif::{ProgressBar, ProgressStyle};
-use trilux_color::Mode;
-use trilux_solver::{Quality, SceneInput, Solution, Solver, SolverSettings, solve_hash};
+use trilux_render::{Observer, Plan, SolutionSource};
 
-use crate::ModeArg;
-
-/// Solver options shared by `solve` and `render`.
-#[derive(Debug, Args, Clone)]
-pub struct SolveOptions {
-    /// Quality preset: error bounds, depth limit and default convergence.
-    #[arg(long, value_parser = ["draft", "default", "high"], default_value = "default")]
-    pub quality: String,
-    /// Target convergence ratio CR = (IF − RF)/IF in [0, 1] (default from
-    /// --quality: 0.95, 0.999, 0.9999).
-    #[arg(long)]
-    pub convergence: Option<f64>,
-    /// Override the scene's colour mode.
-    #[arg(long, value_enum)]
-    pub mode: Option<ModeArg>,
-}
-
-impl SolveOptions {
-    /// The solver settings these options ask for.
-    pub fn settings(&self) -> Result<SolverSettings> {
-        let quality: Quality = self.quality.parse().map_err(anyhow::Error::msg)?;
-        let mut settings = SolverSettings::preset(quality);
-        if let Some(cr) = self.convergence {
-            anyhow::ensure!(
-                cr.is_finite() && (0.0..=1.0).contains(&cr),
-                "--convergence must be in [0, 1], got {cr}"
-            );
-            settings.convergence = cr;
-        }
-        Ok(settings)
-    }
-
-    /// The colour mode: the override, else the scene's own.
-    pub fn mode(&self, scene: &trilux_scene::Scene) -> Mode {
-        match self.mode {
-            Some(ModeArg::Rgb) => Mode::Rgb,
-            Some(ModeArg::Spectral) => Mode::Spectral,
-            None => scene.mode(),
-        }
-    }
-}
+use crate::options::{SolveOptions, check_distinct, check_output, parse_positive};
+use crate::output::{stats_json, write_json};
+use crate::progress::Bars;
 
 /// Arguments of `trilux solve`.
 #[derive(Debug, Args)]
@@ -63,89 +22,48 @@ pub struct SolveArgs {
     /// Write solve statistics as JSON.
     #[arg(long)]
     pub stats: Option<PathBuf>,
+    /// Worker threads (default: all cores).
+    #[arg(long, value_parser = parse_positive)]
+    pub threads: Option<u32>,
     #[command(flatten)]
     pub options: SolveOptions,
 }
 
-/// A progress bar on a terminal, nothing otherwise (CI stays quiet).
-pub fn progress_bar(len: u64, what: &str) -> Option<ProgressBar> {
-    if !std::io::stderr().is_terminal() {
-        return None;
+/// Runs `trilux solve`.
+pub fn run(args: &SolveArgs) -> Result<()> {
+    crate::set_threads(args.threads);
+    check_output(&args.output, "solution")?;
+    let mut outputs = vec![(args.output.as_path(), "solution")];
+    if let Some(stats) = &args.stats {
+        check_output(stats, "statistics")?;
+        outputs.push((stats.as_path(), "statistics"));
     }
-    let bar = ProgressBar::new(len);
-    if let Ok(style) = ProgressStyle::with_template("{prefix} [{bar:40}] {msg} ({elapsed})") {
-        bar.set_style(style.progress_chars("=> "));
-    }
-    bar.set_prefix(what.to_string());
-    Some(bar)
-}
-
-/// Solves `input` with `N` bands, reporting convergence on a progress bar.
-pub fn solve_with_progress<const N: usize>(
-    input: &SceneInput,
-    settings: SolverSettings,
-) -> Result<Solution<N>> {
-    let solver = Solver::<N>::new(&input.as_input(), settings)?;
-    let bar = progress_bar(1000, "solve");
-    let solution = solver.solve(|p| {
-        if let Some(bar) = &bar {
-            let frac = if p.target > 0.0 {
-                p.convergence_ratio / p.target
-            } else {
-                1.0
-            };
-            bar.set_position((frac.clamp(0.0, 1.0) * 1000.0) as u64);
-            bar.set_message(format!(
-                "CR {:.4}/{:.4}, shot {}, {} interactions, {} links",
-                p.convergence_ratio, p.target, p.shots, p.interactions, p.live_links
-            ));
-        }
-    });
-    if let Some(bar) = bar {
-        bar.finish_and_clear();
-    }
-    Ok(solution)
-}
-
-/// Writes JSON atomically (temporary file, then rename).
-pub fn write_json(path: &Path, value: &impl serde::Serialize) -> Result<()> {
-    let text = serde_json::to_string_pretty(value)?;
-    let tmp = path.with_extension("tmp-trilux");
-    std::fs::write(&tmp, text).with_context(|| format!("{}: cannot write", path.display()))?;
-    std::fs::rename(&tmp, path).map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        anyhow::anyhow!("{}: cannot write: {e}", path.display())
-    })
-}
-
-fn solve_and_save<const N: usize>(
-    args: &SolveArgs,
-    input: &SceneInput,
-    settings: SolverSettings,
-) -> Result<()> {
-    let hash = solve_hash(&input.as_input(), &settings, N);
-    let solution = solve_with_progress::<N>(input, settings)?;
-    solution.save(&args.output, hash)?;
+    check_distinct(&[args.scene.as_path()], &outputs)?;
+    let scene = trilux_scene::load(&args.scene)?;
+    let plan = Plan {
+        mode: args.options.mode(&scene),
+        solver: args.options.settings(),
+        source: SolutionSource::Solve,
+        save: Some(&args.output),
+        render: None,
+    };
+    let bars = Bars::new(false);
+    let mut on_shot = |p: &trilux_solver::Progress| bars.solve(p);
+    let outcome = trilux_render::pipeline::run(
+        &scene,
+        &plan,
+        Observer {
+            solve: &mut on_shot,
+            render: &|_, _| {},
+        },
+    );
+    bars.finish();
+    let outcome = outcome?;
     if let Some(path) = &args.stats {
-        let mut stats = solution.stats().clone();
-        stats.warnings.clear();
-        write_json(path, &crate::stats_json(solution.stats(), 0.0))?;
+        write_json(path, &stats_json(&outcome.solve, 0.0))?;
     }
-    for w in &solution.stats().warnings {
+    for w in &outcome.solve.warnings {
         eprintln!("warning: {w}");
     }
     Ok(())
-}
-
-/// Runs `trilux solve`.
-pub fn run(args: &SolveArgs) -> Result<()> {
-    let scene = trilux_scene::load(&args.scene)?;
-    let settings = args.options.settings()?;
-    let input = SceneInput::from_scene(&scene);
-    match args.options.mode(&scene) {
-        Mode::Rgb => solve_and_save::<3>(args, &input, settings),
-        Mode::Spectral => {
-            solve_and_save::<{ trilux_color::SPECTRAL_BANDS }>(args, &input, settings)
-        }
-    }
 }

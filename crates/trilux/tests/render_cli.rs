@@ -1,6 +1,6 @@
 //! `trilux solve` and `trilux render` through the binary: a render from a
 //! saved solution does no solving, a solution made for another scene is
-//! refused, bad outputs and bad options fail cleanly (design.md §3).
+//! refused, bad outputs and bad options fail cleanly.
 
 use std::path::Path;
 use std::process::Output;
@@ -137,6 +137,22 @@ fn unwritable_output_and_missing_scene_fail_cleanly() {
 fn unknown_option_is_a_usage_error() {
     let out = trilux(&["render", &scene("furnace.xml"), "--no-such-option"]);
     assert_eq!(out.status.code(), Some(2));
-    let out = trilux(&["render", &scene("furnace.xml"), "--lookat", "1,2,3"]);
-    assert_one_error_line(&out, "short --lookat");
+    // Malformed values are usage errors too, found before the scene is read
+    // (the scene named here does not even exist).
+    for bad in [
+        &["--lookat", "1,2"][..],
+        &["--lookat", "1,2,3,4,5,x"][..],
+        &["--fov", "200"][..],
+        &["--width", "0"][..],
+        &["--spp", "0"][..],
+        &["--threads", "0"][..],
+        &["--convergence", "2"][..],
+    ] {
+        let mut args = vec!["render", "/no/such/scene.xml"];
+        args.extend(bad);
+        let out = trilux(&args);
+        assert_eq!(out.status.code(), Some(2), "{bad:?}");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!stderr.contains("/no/such/scene.xml:"), "{bad:?}: {stderr}");
+    }
 }

@@ -108,3 +108,12 @@ pub fn curved_sheet(n: u32) -> (Vec<DVec3>, Vec<[u32; 3]>) {
     }
     (p, t)
 }
+
+/// The element forest (roots only) of a scene made of `shapes`.
+pub fn forest(
+    shapes: &[Shape],
+) -> Result<trilux_geometry::ElementForest, trilux_geometry::GeometryError> {
+    Ok(trilux_geometry::ElementForest::new(
+        trilux_geometry::Geometry::build_shared(shapes)?,
+    ))
+}

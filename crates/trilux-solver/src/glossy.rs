@@ -1,0 +1,173 @@
+//! The glossy renormalisation (beyond the paper; docs/solver.md, "Glossy
+//! renormalisation"): what a receiving element's glossy part reflects in
+//! one shot is rescaled towards what its BRDF reflects over the receivers
+//! it stores interactions towards.
+//!
+//! Point samples of a peaked lobe over coarse receivers K fall short of
+//! (or overshoot) the lobe's integral. For each pair link i → j (a group)
+//! the node links' glossy flux is scaled towards a target:
+//! - where (nearly) every direction from j reaches a stored receiver
+//!   (cosine-weighted coverage ≥ [`CLOSED_COVERAGE`]), the glossy albedo of
+//!   j's BRDF for light from i times the covered share;
+//! - in an open hemisphere, the share of the lobe that meets a stored
+//!   receiver, by sampling the BRDF ([`LOBE_SAMPLES`] traced samples).
+//!
+//! The scale is bounded by [`MAX_RENORMALISATION`] either way, and never
+//! lets j reflect more than arrived. Two-point transport only: the uniform
+//! mode stays the paper's, for ablation.
+
+use glam::{DVec2, DVec3};
+use trilux_brdf::Frame;
+use trilux_color::Spectrum;
+use trilux_geometry::{ElementId, FaceId, Ray};
+
+use crate::refine::{Incidence, PairLink};
+use crate::settings::Transport;
+use crate::solver::Solver;
+use crate::throughput::compute_throughput;
+
+/// The most a group's area reflectances are scaled up or down to match the
+/// albedo (a guard against estimation noise).
+const MAX_RENORMALISATION: f64 = 50.0;
+
+/// BSDF samples per pair link for the covered share of an open
+/// hemisphere's glossy lobe (a square number: stratified on a grid).
+const LOBE_SAMPLES: u32 = 64;
+
+/// The coverage above which j's hemisphere counts as (nearly) closed: the
+/// target is then the albedo times the covered share, which assumes the
+/// lobe misses the uncovered part in proportion (an error of at most 1 −
+/// coverage of the target).
+const CLOSED_COVERAGE: f64 = 0.9;
+
+/// The per-band scale of a group's glossy flux `glossy`: towards `target`
+/// (within [`MAX_RENORMALISATION`]), and never beyond `room`, what arrived
+/// less the Lambertian share.
+pub(crate) fn group_scale<const N: usize>(
+    target: Option<Spectrum<N>>,
+    glossy: Spectrum<N>,
+    room: Spectrum<N>,
+) -> Spectrum<N> {
+    Spectrum::<N>::new(std::array::from_fn(|b| {
+        let mut f = 1.0;
+        if let Some(t) = target
+            && glossy[b] > 0.0
+        {
+            f = (t[b] / glossy[b]).clamp(1.0 / MAX_RENORMALISATION, MAX_RENORMALISATION);
+        }
+        if glossy[b] * f > room[b] && glossy[b] > 0.0 {
+            f = room[b] / glossy[b];
+        }
+        f
+    }))
+}
+
+impl<const N: usize> Solver<N> {
+    /// The glossy flux a group should reflect (module docs), for the flux
+    /// `arrived` through pair link `l`; `None` where no renormalisation
+    /// applies. The light arrives from the part of i in front of j (the
+    /// same direction the group's area reflectances used).
+    pub(crate) fn glossy_target(
+        &self,
+        l: &PairLink<N>,
+        incidence: Option<&Incidence<N>>,
+        arrived: Spectrum<N>,
+        glossy: Spectrum<N>,
+    ) -> Option<Spectrum<N>> {
+        let face = &self.faces[l.face];
+        if !face.stored || glossy.is_black() || self.settings.transport != Transport::TwoPoint {
+            return None;
+        }
+        let to_light = incidence.and_then(Incidence::direction)?;
+        let covered = self.hemisphere_coverage(l.face, l.j);
+        if covered >= CLOSED_COVERAGE {
+            let normal = self.forest.element(l.j).normal * l.face.side().sign();
+            let wi = Frame::from_normal(normal).to_local(to_light);
+            let glossy_albedo = self.albedo[face.shape].albedo(wi) - face.rho_d;
+            Some((arrived * glossy_albedo * covered.min(1.0)).max(Spectrum::zero()))
+        } else {
+            // An open hemisphere: the share of the lobe that meets a stored
+            // receiver (a narrow lobe need not miss the open part in
+            // proportion).
+            Some(arrived * self.covered_lobe(l.face, to_light, l.j))
+        }
+    }
+
+    /// ∫ fr_glossy cos dω over the directions from j's centre that meet a
+    /// face that `face` stores an interaction towards, for light arriving
+    /// from the unit direction `to_light` (world space): [`LOBE_SAMPLES`]
+    /// stratified samples of the BSDF, each traced.
+    fn covered_lobe(&self, face: FaceId, to_light: DVec3, j: ElementId) -> Spectrum<N> {
+        let geom = self.forest.geometry();
+        let ts = &self.faces[face];
+        let sign = face.side().sign();
+        let ej = self.forest.element(j);
+        let normal = ej.normal * sign;
+        let frame = Frame::from_normal(normal);
+        let wi = frame.to_local(to_light);
+        let bsdf = self.scene.material(ts.shape);
+        // The BSDF's frame is the front's: flip z for a back face.
+        let to_bsdf = |v: DVec3| DVec3::new(v.x, v.y, v.z * sign);
+        let origin = ej.centre + normal * (1e-7 * geom.bounds().diagonal().length());
+        let mut sum = Spectrum::<N>::zero();
+        let grid = (LOBE_SAMPLES as f64).sqrt() as u32;
+        for a in 0..grid {
+            for b in 0..grid {
+                let u = DVec2::new(
+                    (f64::from(a) + 0.5) / f64::from(grid),
+                    (f64::from(b) + 0.5) / f64::from(grid),
+                );
+                let Some(smp) = bsdf.sample(to_bsdf(wi), u) else {
+                    continue;
+                };
+                let wo = to_bsdf(smp.wi);
+                if wo.z <= 0.0 {
+                    continue;
+                }
+                let ray = Ray {
+                    origin,
+                    dir: frame.to_world(wo),
+                };
+                let Some(hit) = geom.intersect(&ray, f64::INFINITY) else {
+                    continue;
+                };
+                let hit_face = FaceId::new(
+                    hit.surface,
+                    trilux_geometry::Side::from_back(!hit.front_facing(&ray)),
+                );
+                if !self.stored_pairs.contains(&(face, hit_face)) {
+                    continue;
+                }
+                let f = bsdf.eval_glossy(to_bsdf(wi), smp.wi);
+                sum += f * (wo.z / smp.pdf);
+            }
+        }
+        sum * (1.0 / f64::from(grid * grid))
+    }
+
+    /// Σ over the face's stored hierarchies of T(j, K) / A_j: the
+    /// cosine-weighted share of j's hemisphere that stored receivers cover
+    /// (1 in a closed room). Cached per (face, element).
+    fn hemisphere_coverage(&self, face: FaceId, j: ElementId) -> f64 {
+        if let Ok(cache) = self.coverage.lock()
+            && let Some(&c) = cache.get(&(face, j))
+        {
+            return c;
+        }
+        let a = self.exposed_area[face.side()][j.index()];
+        if a <= 0.0 {
+            return 0.0;
+        }
+        let vis = trilux_geometry::Visibility::new(&self.forest, self.burial.as_ref());
+        let mut t = 0.0;
+        for h in self.hierarchies.iter().flatten().filter(|h| h.from == face) {
+            let k = h.to.of(h.nodes[0].to);
+            t += compute_throughput(&vis, k, face.of(j), self.settings.visibility_samples, false).t;
+        }
+        let c = t / a;
+        if let Ok(mut cache) = self.coverage.lock() {
+            cache.insert((face, j), c);
+        }
+        c
+    }
+}

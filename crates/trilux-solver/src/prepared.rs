@@ -1,0 +1,226 @@
+//! The prepared scene: geometry, materials and emitters built once for a
+//! band count, and shared (behind an `Arc`) by the solver, its solution
+//! and the renderer.
+//!
+//! The solver never parses: it takes a [`SceneDescription`], the plain data
+//! of a scene (shapes, BSDF parameters, emitted radiance, one of each per
+//! shape), which the scene layer hands over. Errors name the shape by its
+//! index, so that the caller can point at its place in the file.
+
+use std::io::Write;
+use std::sync::Arc;
+
+use thiserror::Error;
+use trilux_brdf::{BrdfError, Bsdf, BsdfParams};
+use trilux_color::{ColorError, ColorParam, Spectrum};
+use trilux_geometry::{Geometry, GeometryError, Shape};
+
+/// What light transport needs of a scene, as plain data: per shape its
+/// geometry, its material and its area emitter's radiance (if any).
+#[derive(Clone, Copy, Debug)]
+pub struct SceneDescription<'a> {
+    /// The shapes, in scene order.
+    pub shapes: &'a [Shape],
+    /// One material per shape.
+    pub bsdfs: &'a [BsdfParams],
+    /// One optional area-emitter radiance per shape.
+    pub emission: &'a [Option<ColorParam>],
+}
+
+/// What is wrong with a scene description.
+#[derive(Debug, Error)]
+pub enum PrepareError {
+    /// A shape's geometry could not be built.
+    #[error(transparent)]
+    Geometry(#[from] GeometryError),
+    /// A material could not be built for this band count.
+    #[error("shape {shape}: {source}")]
+    Material {
+        /// Index of the shape.
+        shape: usize,
+        /// What is wrong.
+        #[source]
+        source: BrdfError,
+    },
+    /// An emitter's radiance could not be converted to this band count.
+    #[error("shape {shape}: emitted radiance: {source}")]
+    Emission {
+        /// Index of the shape.
+        shape: usize,
+        /// What is wrong.
+        #[source]
+        source: ColorError,
+    },
+    /// An emitter's radiance is negative or not finite after conversion.
+    #[error("shape {shape}: emitted radiance must be finite and non-negative")]
+    BadEmission {
+        /// Index of the shape.
+        shape: usize,
+    },
+    /// The three per-shape lists differ in length.
+    #[error("{shapes} shapes but {bsdfs} materials and {emission} emitter entries")]
+    Lengths {
+        /// Number of shapes.
+        shapes: usize,
+        /// Number of materials.
+        bsdfs: usize,
+        /// Number of emitter entries.
+        emission: usize,
+    },
+    /// The description could not be serialised for its hash.
+    #[error("cannot hash the scene description: {0}")]
+    Hash(#[source] serde_json::Error),
+}
+
+impl PrepareError {
+    /// What is wrong, without naming the shape (for a caller that names
+    /// its place in a file instead).
+    pub fn problem(&self) -> String {
+        match self {
+            PrepareError::Geometry(e) => e.problem.to_string(),
+            PrepareError::Material { source, .. } => source.to_string(),
+            PrepareError::Emission { source, .. } => format!("emitted radiance: {source}"),
+            PrepareError::BadEmission { .. } => {
+                "emitted radiance must be finite and non-negative".into()
+            }
+            PrepareError::Lengths { .. } | PrepareError::Hash(_) => self.to_string(),
+        }
+    }
+
+    /// True when the problem is the shape's emitter rather than the shape.
+    pub fn is_emitter(&self) -> bool {
+        matches!(
+            self,
+            PrepareError::Emission { .. } | PrepareError::BadEmission { .. }
+        )
+    }
+
+    /// The index of the shape at fault, when one is.
+    pub fn shape(&self) -> Option<usize> {
+        match self {
+            PrepareError::Geometry(e) => Some(e.shape),
+            PrepareError::Material { shape, .. }
+            | PrepareError::Emission { shape, .. }
+            | PrepareError::BadEmission { shape } => Some(*shape),
+            PrepareError::Lengths { .. } | PrepareError::Hash(_) => None,
+        }
+    }
+}
+
+/// A scene prepared for light transport with `N` bands.
+#[derive(Debug)]
+pub struct PreparedScene<const N: usize> {
+    geometry: Arc<Geometry>,
+    materials: Vec<Bsdf<N>>,
+    emission: Vec<Spectrum<N>>,
+    hash: u64,
+}
+
+impl<const N: usize> PreparedScene<N> {
+    /// Builds the geometry, every material and every emitter.
+    pub fn new(desc: &SceneDescription<'_>) -> Result<Self, PrepareError> {
+        let n = desc.shapes.len();
+        if desc.bsdfs.len() != n || desc.emission.len() != n {
+            return Err(PrepareError::Lengths {
+                shapes: n,
+                bsdfs: desc.bsdfs.len(),
+                emission: desc.emission.len(),
+            });
+        }
+        let geometry = Geometry::build_shared(desc.shapes)?;
+        let materials = desc
+            .bsdfs
+            .iter()
+            .enumerate()
+            .map(|(shape, p)| {
+                Bsdf::new(p).map_err(|source| PrepareError::Material { shape, source })
+            })
+            .collect::<Result<_, _>>()?;
+        let emission = desc
+            .emission
+            .iter()
+            .enumerate()
+            .map(|(shape, e)| emitted(shape, e.as_ref()))
+            .collect::<Result<_, _>>()?;
+        Ok(PreparedScene {
+            geometry,
+            materials,
+            emission,
+            hash: content_hash(desc, N)?,
+        })
+    }
+
+    /// The geometry, shared.
+    pub fn geometry(&self) -> &Arc<Geometry> {
+        &self.geometry
+    }
+
+    /// The material of every shape.
+    pub fn materials(&self) -> &[Bsdf<N>] {
+        &self.materials
+    }
+
+    /// The material of one shape.
+    pub fn material(&self, shape: usize) -> &Bsdf<N> {
+        &self.materials[shape]
+    }
+
+    /// The emitted radiance of every shape (zero where it does not emit).
+    pub fn emission(&self) -> &[Spectrum<N>] {
+        &self.emission
+    }
+
+    /// A hash of everything the description holds and of `N`: the same
+    /// scene file gives the same hash on any machine.
+    pub fn content_hash(&self) -> u64 {
+        self.hash
+    }
+}
+
+/// One shape's emitted radiance as `N` bands (zero without an emitter).
+fn emitted<const N: usize>(
+    shape: usize,
+    radiance: Option<&ColorParam>,
+) -> Result<Spectrum<N>, PrepareError> {
+    let Some(c) = radiance else {
+        return Ok(Spectrum::zero());
+    };
+    let le = c
+        .emission::<N>()
+        .map_err(|source| PrepareError::Emission { shape, source })?;
+    if le.is_finite() && le.is_non_negative() {
+        Ok(le)
+    } else {
+        Err(PrepareError::BadEmission { shape })
+    }
+}
+
+/// FNV-1a (64 bits) as an `io::Write`: stable across platforms and Rust
+/// versions, fed by the serialiser without an intermediate string.
+pub(crate) struct Fnv1a(pub u64);
+
+impl Fnv1a {
+    pub(crate) fn new() -> Self {
+        Fnv1a(0xcbf2_9ce4_8422_2325)
+    }
+}
+
+impl Write for Fnv1a {
+    fn write(&mut self, bytes: &[u8]) -> std::io::Result<usize> {
+        for &b in bytes {
+            self.0 ^= u64::from(b);
+            self.0 = self.0.wrapping_mul(0x0100_0000_01b3);
+        }
+        Ok(bytes.len())
+    }
+    fn flush(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
+}
+
+fn content_hash(desc: &SceneDescription<'_>, bands: usize) -> Result<u64, PrepareError> {
+    let mut h = Fnv1a::new();
+    serde_json::to_writer(&mut h, &(desc.shapes, desc.bsdfs, desc.emission, bands))
+        .map_err(PrepareError::Hash)?;
+    Ok(h.0)
+}

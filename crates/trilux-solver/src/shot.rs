@@ -1,0 +1,464 @@
+//! One shot of the progressive loop, as named phases (paper §4.1–4.4):
+//!
+//! 1. [`Solver::take_source`]: δΦ_S leaves the residual; the source is
+//!    pushed and pulled (lazily, only now: §4.4) and becomes the sender.
+//! 2. [`stage_one`]: pair links from the source to every receiving face
+//!    (the two-point part), in parallel.
+//! 3. [`shot_scale`]: the links may not carry more flux than the source
+//!    had; a stored source is scaled up to carry its whole key.
+//! 4. [`Solver::stage_two`]: three-point links into the stored hierarchies
+//!    of every glossy receiving face, in parallel over those hierarchies.
+//! 5. [`Solver::receive`]: per pair link (a "group"), the Lambertian share
+//!    goes straight into j's radiance, the glossy share is renormalised
+//!    (`glossy`) and the ledger books what was absorbed.
+//! 6. [`Solver::gather_links`] and [`Solver::unlink`]: the node links add
+//!    their (renormalised) radiance, then links die and δL of the source is
+//!    zeroed (links live for one shot: memory O(n + k²), §4.2).
+
+use std::collections::HashMap;
+use std::f64::consts::PI;
+
+use rayon::prelude::*;
+use trilux_color::Spectrum;
+use trilux_geometry::{ElementId, FaceId, Visibility};
+
+use crate::interaction::Hierarchy;
+use crate::refine::{Incidence, NodeLink, PairLink, PairShot, RefineContext, Sender, TripleTask};
+use crate::solver::{Solver, Source};
+
+/// The most a stored interaction's shot is scaled up to carry its whole
+/// unshot flux (see [`shot_scale`]).
+const MAX_STORED_SHOT_SCALE: f64 = 1.25;
+
+/// What sends during a shot.
+pub(crate) enum Sending<const N: usize> {
+    /// A face's two-point tree.
+    Radiosity(FaceId),
+    /// A stored hierarchy, taken out of the solver while it sends — or, for
+    /// a face's interaction with itself (paper §5.2's secondary
+    /// interactions of a glossy concave surface), a copy, the original
+    /// staying in place to receive from its own shot.
+    Stored {
+        index: u32,
+        hierarchy: Hierarchy<N>,
+        is_self: bool,
+    },
+}
+
+impl<const N: usize> Sending<N> {
+    /// The sending face.
+    fn face(&self) -> FaceId {
+        match self {
+            Sending::Radiosity(f) => *f,
+            Sending::Stored { hierarchy, .. } => hierarchy.from,
+        }
+    }
+}
+
+/// The shot-level scale per band (phase 3): links may not carry more flux
+/// than the source had (form-factor error could otherwise create energy).
+/// A stored interaction I→K sends all its unshot flux to K (its key was
+/// summed as π T_IK δL), so its links are also scaled *up* to carry it
+/// when their own throughput estimates, made at other levels, fall short
+/// (up to [`MAX_STORED_SHOT_SCALE`]); without this the shortfall left as
+/// "escaped" light, 0.3 % of every bounce in the uniform Cornell box. A
+/// Lambertian source's shortfall is light that really leaves (an open
+/// scene).
+fn shot_scale<const N: usize>(
+    pair_links: &[PairLink<N>],
+    phi: Spectrum<N>,
+    stored_source: bool,
+) -> Spectrum<N> {
+    let mut arrived = Spectrum::<N>::zero();
+    for l in pair_links {
+        arrived += l.unshot * (PI * l.t);
+    }
+    Spectrum::<N>::new(std::array::from_fn(|b| {
+        if arrived[b] > phi[b] && arrived[b] > 0.0 {
+            phi[b] / arrived[b]
+        } else if stored_source && arrived[b] > 0.0 {
+            (phi[b] / arrived[b]).min(MAX_STORED_SHOT_SCALE)
+        } else {
+            1.0
+        }
+    }))
+}
+
+/// Phase 2: pair links to every receiving face, in parallel: from the
+/// roots of the two surfaces for a Lambertian source, from the root pair
+/// of a stored hierarchy (whose nodes give the unshot radiance of every
+/// sub-pair: `Sender::unshot`).
+fn stage_one<const N: usize>(
+    ctx: &RefineContext<'_, N>,
+    sender: &Sender<'_, N>,
+    send_face: FaceId,
+    pairs: &[(ElementId, FaceId, ElementId)],
+) -> Vec<PairLink<N>> {
+    pairs
+        .par_iter()
+        .flat_map_iter(|&(i, r, j)| {
+            let mut out = Vec::new();
+            let shot = PairShot {
+                sender,
+                si: send_face,
+                sj: r,
+            };
+            ctx.refine_pair(shot, i, j, ctx.settings.ff_eps, &mut out);
+            out
+        })
+        .collect()
+}
+
+/// What stage 2 produced: node links, and per hierarchy the flux that
+/// splits could not keep.
+type StageTwo<const N: usize> = Vec<(Vec<NodeLink<N>>, u32, Spectrum<N>)>;
+
+impl<const N: usize> Solver<N> {
+    /// One shot from `source` (module docs); returns the number of links it
+    /// made.
+    pub(crate) fn shoot(&mut self, source: Source) -> usize {
+        let Some((phi, sending)) = self.take_source(source) else {
+            return 0;
+        };
+        let send_face = sending.face();
+        let root_of = |f: FaceId| self.forest.root(f.surface());
+        let pairs: Vec<(ElementId, FaceId, ElementId)> = match &sending {
+            Sending::Radiosity(f) => self.partners[*f]
+                .iter()
+                .map(|&r| (root_of(*f), r, root_of(r)))
+                .collect(),
+            Sending::Stored { hierarchy, .. } => {
+                vec![(hierarchy.nodes[0].from, hierarchy.to, hierarchy.nodes[0].to)]
+            }
+        };
+        let (pair_links, incidences, stage_two) = {
+            let (ctx, hierarchies) = self.split_for_shot();
+            let sender = match &sending {
+                Sending::Radiosity(f) => Sender::Radiosity {
+                    field: ctx.field,
+                    side: f.side(),
+                },
+                Sending::Stored { hierarchy, .. } => Sender::Stored(hierarchy),
+            };
+            let pair_links = stage_one(&ctx.refine, &sender, send_face, &pairs);
+            let incidences = incidences(&ctx.refine, &sender, send_face, &pair_links);
+            let stage_two = stage_two(
+                &ctx.refine,
+                &sender,
+                send_face,
+                hierarchies,
+                &pair_links,
+                &incidences,
+            );
+            (pair_links, incidences, stage_two)
+        };
+        let scale = shot_scale(&pair_links, phi, matches!(source, Source::Stored(_)));
+        let node_links = self.book_lost(stage_two);
+        let group_scale = self.receive(&pair_links, &incidences, &node_links, scale, phi);
+        self.gather_links(&node_links, scale, &group_scale);
+        let live = pair_links.len() + node_links.len();
+        self.stats.links_peak = self.stats.links_peak.max(live);
+        self.stats.links_total += live as u64;
+        self.unlink(sending);
+        live
+    }
+
+    /// Phase 1: the source's unshot flux leaves the residual, the source is
+    /// pushed and pulled, and its sender is made (`None` for a hierarchy
+    /// that is not in place, which the loop never picks).
+    fn take_source(&mut self, source: Source) -> Option<(Spectrum<N>, Sending<N>)> {
+        match source {
+            Source::Radiosity(face) => {
+                let phi = std::mem::take(&mut self.face_flux[face]);
+                let root = self.forest.root(face.surface());
+                let side = face.side();
+                self.field
+                    .push_pull(&self.forest, root, side, &self.exposed_area[side]);
+                Some((phi, Sending::Radiosity(face)))
+            }
+            Source::Stored(index) => {
+                let slot = &mut self.hierarchies[index as usize];
+                let h = slot.as_mut()?;
+                let phi = std::mem::take(&mut h.unshot_flux);
+                let is_self = h.is_self();
+                let hierarchy = if is_self {
+                    // A face's interaction with itself receives from its own
+                    // shot: it stays in place, a copy sends.
+                    h.push_pull();
+                    h.clone()
+                } else {
+                    let mut h = slot.take()?;
+                    h.push_pull();
+                    h
+                };
+                let sending = Sending::Stored {
+                    index,
+                    hierarchy,
+                    is_self,
+                };
+                Some((phi, sending))
+            }
+        }
+    }
+
+    /// The refinement context (borrowing what refinement reads) beside the
+    /// stored hierarchies that stage 2 refines.
+    fn split_for_shot(&mut self) -> (ShotContext<'_, N>, &mut Vec<Option<Hierarchy<N>>>) {
+        let flux_threshold = self.settings.flux_eps * self.emitted.sum();
+        let refine = RefineContext {
+            forest: &self.forest,
+            visibility: Visibility::new(&self.forest, self.burial.as_ref()),
+            settings: &self.settings,
+            faces: &self.faces,
+            materials: self.scene.materials(),
+            cache: &self.cache,
+            flux_threshold,
+            points: &self.points,
+            interior: &self.interior,
+            exposed_area: &self.exposed_area,
+        };
+        let ctx = ShotContext {
+            refine,
+            field: &self.field,
+        };
+        (ctx, &mut self.hierarchies)
+    }
+
+    /// Flux that a split could not keep leaves the residual (it is booked
+    /// as escaped); the node links of every hierarchy, in order.
+    fn book_lost(&mut self, stage_two: StageTwo<N>) -> Vec<NodeLink<N>> {
+        let mut node_links = Vec::new();
+        for (links, h, lost) in stage_two {
+            if let Some(hier) = self.hierarchies[h as usize].as_mut() {
+                hier.unshot_flux = (hier.unshot_flux - lost).max(Spectrum::zero());
+            }
+            for b in 0..N {
+                self.ledger.escaped[b] += lost[b];
+            }
+            node_links.extend(links);
+        }
+        node_links
+    }
+
+    /// Phase 6a: every node link adds its radiance, scaled by the shot and
+    /// its group, to its node's L^G and the node's flux to its hierarchy's
+    /// key (the renormalisation applies to both alike).
+    fn gather_links(
+        &mut self,
+        node_links: &[NodeLink<N>],
+        shot_scale: Spectrum<N>,
+        group_scale: &[Spectrum<N>],
+    ) {
+        for nl in node_links {
+            let Some(hier) = self.hierarchies[nl.hierarchy as usize].as_mut() else {
+                continue;
+            };
+            let node = &mut hier.nodes[nl.node as usize];
+            let dl = nl.gathered * shot_scale * group_scale[nl.group as usize];
+            node.gathered += dl;
+            let t = node.t;
+            hier.unshot_flux += dl * (PI * t);
+        }
+    }
+
+    /// Phase 6b: δL over the source is zeroed, and a stored source goes
+    /// back in place.
+    fn unlink(&mut self, sending: Sending<N>) {
+        match sending {
+            Sending::Radiosity(face) => {
+                let root = self.forest.root(face.surface());
+                self.field.clear_unshot(&self.forest, root, face.side());
+            }
+            Sending::Stored {
+                index,
+                is_self: true,
+                ..
+            } => {
+                if let Some(h) = self.hierarchies[index as usize].as_mut() {
+                    h.clear_unshot();
+                }
+            }
+            Sending::Stored {
+                index,
+                mut hierarchy,
+                is_self: false,
+            } => {
+                hierarchy.clear_unshot();
+                self.hierarchies[index as usize] = Some(hierarchy);
+            }
+        }
+    }
+}
+
+/// What a shot's refinement reads.
+pub(crate) struct ShotContext<'a, const N: usize> {
+    pub refine: RefineContext<'a, N>,
+    pub field: &'a crate::radiosity::ElementRadiance<N>,
+}
+
+/// Each pair link's part of its three-point links, once for all the
+/// hierarchies that leave its receiving face (`None` for a link into a
+/// face without stored interactions, or one that carries no light).
+fn incidences<const N: usize>(
+    ctx: &RefineContext<'_, N>,
+    sender: &Sender<'_, N>,
+    send_face: FaceId,
+    pair_links: &[PairLink<N>],
+) -> Vec<Option<Incidence<N>>> {
+    pair_links
+        .par_iter()
+        .map(|l| {
+            ctx.faces[l.face]
+                .stored
+                .then(|| ctx.incidence(sender, send_face.of(l.i), l.face.of(l.j)))
+                .flatten()
+        })
+        .collect()
+}
+
+/// Phase 4: three-point links into the stored hierarchies of every glossy
+/// receiving face, in parallel over those hierarchies (each task owns its
+/// hierarchy, so the receiving trees grow without locks).
+fn stage_two<const N: usize>(
+    ctx: &RefineContext<'_, N>,
+    sender: &Sender<'_, N>,
+    send_face: FaceId,
+    hierarchies: &mut [Option<Hierarchy<N>>],
+    pair_links: &[PairLink<N>],
+    incidences: &[Option<Incidence<N>>],
+) -> StageTwo<N> {
+    let mut groups_of_face: HashMap<FaceId, Vec<u32>> = HashMap::new();
+    for (g, l) in pair_links.iter().enumerate() {
+        if ctx.faces[l.face].stored {
+            groups_of_face.entry(l.face).or_default().push(g as u32);
+        }
+    }
+    // The hierarchy sending this shot is out of its slot (unless it is a
+    // face's interaction with itself, which receives).
+    hierarchies
+        .par_iter_mut()
+        .enumerate()
+        .filter_map(|(h, hier)| hier.as_mut().map(|hier| (h, hier)))
+        .filter(|(_, hier)| groups_of_face.contains_key(&hier.from))
+        .map(|(h, hier)| {
+            let from = hier.from;
+            let mut task = TripleTask {
+                sender,
+                si: send_face,
+                h: hier,
+                h_index: h as u32,
+                group: 0,
+                lost: Spectrum::zero(),
+                out: Vec::new(),
+            };
+            for &g in &groups_of_face[&from] {
+                let l = &pair_links[g as usize];
+                let Some(incidence) = incidences[g as usize] else {
+                    continue;
+                };
+                task.group = g;
+                for n in ctx.nodes_for(task.h, l.j, &mut task.lost) {
+                    ctx.refine_triple(&mut task, l.i, l.j, n, Some(incidence));
+                }
+            }
+            (task.out, h as u32, task.lost)
+        })
+        .collect()
+}
+
+impl<const N: usize> Solver<N> {
+    /// Phase 5: what every pair link (a group) delivers to its receiving
+    /// element j. The flux π T_ij δL arrives; its Lambertian share ρ_d goes
+    /// straight into j's two-point radiance; the glossy share is what the
+    /// group's node links gathered, renormalised (`glossy`) so that j never
+    /// reflects more than arrived; the rest is absorbed. Books absorbed and
+    /// escaped flux in the ledger and returns each group's glossy scale.
+    fn receive(
+        &mut self,
+        pair_links: &[PairLink<N>],
+        incidences: &[Option<Incidence<N>>],
+        node_links: &[NodeLink<N>],
+        shot_scale: Spectrum<N>,
+        phi: Spectrum<N>,
+    ) -> Vec<Spectrum<N>> {
+        let mut glossy_flux = vec![Spectrum::<N>::zero(); pair_links.len()];
+        for nl in node_links {
+            if let Some(h) = &self.hierarchies[nl.hierarchy as usize] {
+                let t = h.nodes[nl.node as usize].t;
+                glossy_flux[nl.group as usize] += nl.gathered * shot_scale * (PI * t);
+            }
+        }
+        let mut group_scale = vec![Spectrum::<N>::splat(1.0); pair_links.len()];
+        let mut total_arrived = Spectrum::<N>::zero();
+        let mut absorbed = Spectrum::<N>::zero();
+        for (g, l) in pair_links.iter().enumerate() {
+            let arrived = l.unshot * shot_scale * (PI * l.t);
+            let rho_d = self.receive_lambertian(l, shot_scale);
+            // Light spreads over j's exposed area. (No transfer reaches an
+            // element that is wholly buried, whose segments all count as
+            // blocked; if one did, its light would be absorbed.)
+            let aj = self.exposed_area[l.face.side()][l.j.index()];
+            let diffuse = if aj > 0.0 {
+                arrived * rho_d
+            } else {
+                Spectrum::zero()
+            };
+            // What an element reflects may not exceed what arrived there.
+            let room = (arrived - diffuse).max(Spectrum::zero());
+            let glossy = glossy_flux[g];
+            let target = self.glossy_target(l, incidences[g].as_ref(), arrived, glossy);
+            let scale = crate::glossy::group_scale(target, glossy, room);
+            group_scale[g] = scale;
+            let absorbed_g = arrived - diffuse - glossy * scale;
+            self.ledger.min_element_absorbed = self
+                .ledger
+                .min_element_absorbed
+                .min(absorbed_g.min_value() / arrived.max_value().max(1e-300));
+            total_arrived += arrived;
+            absorbed += absorbed_g;
+            self.used[l.i.index()] = true;
+            self.used[l.j.index()] = true;
+        }
+        let escaped = phi - total_arrived;
+        for b in 0..N {
+            self.ledger.escaped[b] += escaped[b];
+            self.ledger.absorbed[b] += absorbed[b];
+        }
+        let rel = escaped.min_value() / phi.max_value().max(1e-300);
+        self.ledger.min_shot_escaped = self.ledger.min_shot_escaped.min(rel);
+        group_scale
+    }
+
+    /// The Lambertian share of a pair link: ρ_d (T_ij / A_j) δL into j's
+    /// gathered radiance and its flux into the face's key. On
+    /// smooth-shaded meshes the BSDF takes the cosine about the shading
+    /// normal (as Mitsuba does), which changes the irradiance it reflects
+    /// (never beyond what arrived). Returns the ρ_d used.
+    fn receive_lambertian(&mut self, l: &PairLink<N>, shot_scale: Spectrum<N>) -> Spectrum<N> {
+        let face = &self.faces[l.face];
+        let rho_d = (face.rho_d * self.shading_factor(l.i, l.j)).min(Spectrum::splat(1.0));
+        let side = l.face.side();
+        let aj = self.exposed_area[side][l.j.index()];
+        if !rho_d.is_black() && aj > 0.0 {
+            let dl = l.unshot * shot_scale * rho_d * (l.t / aj);
+            self.field.gathered[side][l.j.index()] += dl;
+            self.face_flux[l.face] += dl * (PI * aj);
+        }
+        rho_d
+    }
+
+    /// The irradiance about j's shading normals over the one about its
+    /// geometric normals, for light from i's centre (1 where shading and
+    /// geometric normals agree): (Σ A n_s · d)/(Σ A n_g · d), in [¼, 4].
+    fn shading_factor(&self, i: ElementId, j: ElementId) -> f64 {
+        let Some((s, g)) = self.shading[j.index()] else {
+            return 1.0;
+        };
+        let d = self.forest.element(i).centre - self.forest.element(j).centre;
+        let (ds, dg) = (s.dot(d), g.dot(d));
+        if dg.abs() <= 1e-12 * g.length() * d.length() || ds * dg <= 0.0 {
+            return 1.0;
+        }
+        (ds / dg).clamp(0.25, 4.0)
+    }
+}

@@ -1,0 +1,216 @@
+//! The solution: radiance leaving any point towards any other point, for
+//! final gathering (paper §4.5). Its file format is in [`file`].
+
+mod file;
+
+use std::collections::HashMap;
+use std::sync::Arc;
+
+use trilux_color::Spectrum;
+use trilux_geometry::{ElementForest, FaceId, Side, Sided, SurfaceCoord, SurfaceId};
+
+use crate::interaction::Hierarchy;
+use crate::prepared::PreparedScene;
+use crate::settings::SolverSettings;
+use crate::solver::Solver;
+use crate::stats::SolveStats;
+
+pub use file::{FORMAT_VERSION, solve_hash};
+
+/// A view-independent solution of the scene's light.
+pub struct Solution<const N: usize> {
+    scene: Arc<PreparedScene<N>>,
+    forest: ElementForest,
+    settings: SolverSettings,
+    depth_of: Vec<u32>,
+    /// Exposed area of every element's faces, per side
+    /// (`trilux_geometry::burial`).
+    exposed_area: Sided<Vec<f64>>,
+    /// Two-point (Lambertian) reflected radiance, per side and element.
+    radiance: Sided<Vec<Spectrum<N>>>,
+    hierarchies: Vec<Hierarchy<N>>,
+    by_faces: HashMap<(FaceId, FaceId), u32>,
+    stats: SolveStats,
+}
+
+/// One end of a radiance query: a point of an input surface and the face
+/// the light leaves or arrives on.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SurfaceSite {
+    /// The face (input surface and side).
+    pub face: FaceId,
+    /// The point, in the surface's coordinates.
+    pub coord: SurfaceCoord,
+}
+
+impl SurfaceSite {
+    /// The point `coord` of `surface`, on side `side`.
+    pub fn new(surface: SurfaceId, side: Side, coord: SurfaceCoord) -> Self {
+        SurfaceSite {
+            face: FaceId::new(surface, side),
+            coord,
+        }
+    }
+}
+
+/// The stored hierarchies' index by (sender face, receiver face).
+fn index_by_faces<const N: usize>(hierarchies: &[Hierarchy<N>]) -> HashMap<(FaceId, FaceId), u32> {
+    hierarchies
+        .iter()
+        .enumerate()
+        .map(|(i, h)| ((h.from, h.to), i as u32))
+        .collect()
+}
+
+impl<const N: usize> Solution<N> {
+    pub(crate) fn from_solver(solver: Solver<N>) -> Self {
+        let hierarchies: Vec<Hierarchy<N>> = solver.hierarchies.into_iter().flatten().collect();
+        let mut stats = solver.stats;
+        // The ledger's per-element and per-shot minima are diagnostics worth
+        // keeping beside the stats.
+        if solver.ledger.min_shot_escaped < -1e-9 {
+            stats.warnings.push(format!(
+                "a shot created energy: escaped flux {} of its source",
+                solver.ledger.min_shot_escaped
+            ));
+        }
+        Solution {
+            by_faces: index_by_faces(&hierarchies),
+            scene: solver.scene,
+            forest: solver.forest,
+            settings: solver.settings,
+            depth_of: solver.depth_of,
+            exposed_area: solver.exposed_area,
+            radiance: solver.field.radiance,
+            hierarchies,
+            stats,
+        }
+    }
+
+    /// Statistics of the solve that made this solution.
+    pub fn stats(&self) -> &SolveStats {
+        &self.stats
+    }
+
+    /// Mutable statistics (for the caller's timing of rendering).
+    pub fn stats_mut(&mut self) -> &mut SolveStats {
+        &mut self.stats
+    }
+
+    /// The scene the solution is of.
+    pub fn scene(&self) -> &Arc<PreparedScene<N>> {
+        &self.scene
+    }
+
+    /// The element trees the solution refers to (with the solve's
+    /// subdivisions).
+    pub fn forest(&self) -> &ElementForest {
+        &self.forest
+    }
+
+    /// The settings of the solve.
+    pub fn settings(&self) -> &SolverSettings {
+        &self.settings
+    }
+
+    /// Reflected radiance leaving `from` towards `to` (emission excluded):
+    /// the Lambertian part from the leaf element containing the point, plus
+    /// the stored part from the deepest node of hierarchy (from, to) whose
+    /// elements contain both points (paper Fig. 11c).
+    pub fn radiance(&self, from: &SurfaceSite, to: &SurfaceSite) -> Spectrum<N> {
+        let leaf = self.forest.locate(from.face.surface(), from.coord);
+        let mut l = self.radiance[from.face.side()][leaf.index()];
+        if let Some(&h) = self.by_faces.get(&(from.face, to.face)) {
+            l += self.hierarchies[h as usize].radiance_at(&self.forest, from.coord, to.coord);
+        }
+        l
+    }
+
+    /// The Lambertian (two-point) reflected radiance alone at a point.
+    pub fn lambertian_radiance(&self, from: &SurfaceSite) -> Spectrum<N> {
+        let leaf = self.forest.locate(from.face.surface(), from.coord);
+        self.radiance[from.face.side()][leaf.index()]
+    }
+
+    /// Area mean of the Lambertian (two-point) reflected radiance over one
+    /// face of an input surface: its leaf elements' radiance weighted by
+    /// their exposed areas, over the face's whole area (buried parts send
+    /// nothing). For a diffuse scene solved in two-point mode this is
+    /// the face's mean exitant radiance less emission, which a path tracer's
+    /// irradiance meter gives independently as ρ Ē / π.
+    pub fn surface_mean_radiance(&self, face: FaceId) -> Spectrum<N> {
+        let mut sum = Spectrum::<N>::zero();
+        let mut area = 0.0;
+        let mut stack = vec![self.forest.root(face.surface())];
+        let side = face.side();
+        while let Some(id) = stack.pop() {
+            let e = self.forest.element(id);
+            if let Some(children) = e.children() {
+                stack.extend(children);
+            } else {
+                sum += self.radiance[side][id.index()] * self.exposed_area[side][id.index()];
+                area += e.area;
+            }
+        }
+        if area > 0.0 { sum * (1.0 / area) } else { sum }
+    }
+
+    /// [`Solution::surface_mean_radiance`] over all the input surfaces of
+    /// one shape (a cube's six faces, a mesh's charts), area-weighted.
+    pub fn shape_mean_radiance(&self, shape: u32, side: Side) -> Spectrum<N> {
+        let mut sum = Spectrum::<N>::zero();
+        let mut area = 0.0;
+        let geom = self.forest.geometry();
+        for s in geom.surfaces_of_shape(shape) {
+            let a = geom.surface(s).area();
+            sum += self.surface_mean_radiance(FaceId::new(s, side)) * a;
+            area += a;
+        }
+        if area > 0.0 { sum * (1.0 / area) } else { sum }
+    }
+
+    /// Flux π Σ T L carried by the stored interaction from one face to
+    /// another (flux-weighted over its hierarchy, so it is the root's
+    /// π T L), if that interaction exists.
+    pub fn interaction_flux(&self, from: FaceId, to: FaceId) -> Option<Spectrum<N>> {
+        let h = &self.hierarchies[*self.by_faces.get(&(from, to))? as usize];
+        let root = &h.nodes[0];
+        Some(root.radiance * (std::f64::consts::PI * root.t))
+    }
+
+    /// The smallest radiance value (any band, any element or node) of the
+    /// solution; NaN if any value is not finite.
+    pub fn min_radiance(&self) -> f64 {
+        let mut min = f64::INFINITY;
+        let mut visit = |s: &Spectrum<N>| {
+            for b in 0..N {
+                if !s[b].is_finite() {
+                    min = f64::NAN;
+                } else if !min.is_nan() {
+                    min = min.min(s[b]);
+                }
+            }
+        };
+        for (_, side) in self.radiance.iter() {
+            side.iter().for_each(&mut visit);
+        }
+        for h in &self.hierarchies {
+            h.nodes.iter().for_each(|n| visit(&n.radiance));
+        }
+        min
+    }
+
+    /// Number of stored interaction hierarchies and of their nodes.
+    pub fn interaction_counts(&self) -> (usize, usize) {
+        (
+            self.hierarchies.len(),
+            self.hierarchies.iter().map(|h| h.nodes.len()).sum(),
+        )
+    }
+
+    /// Whether the solution has stored (direction-dependent) radiance from
+    /// `from`'s face towards `to`'s face.
+    pub fn has_stored(&self, from: &SurfaceSite, to: &SurfaceSite) -> bool {
+        self.by_faces.contains_key(&(from.face, to.face))
+    }
+}

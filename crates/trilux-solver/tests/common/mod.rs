@@ -1,0 +1,22 @@
+//! Helpers shared by the solver's integration tests.
+#![allow(dead_code)]
+
+use std::sync::Arc;
+
+use trilux_solver::{PreparedScene, SceneDescription};
+
+/// A bundled scene file, loaded and prepared for `N` bands.
+pub fn prepare<const N: usize>(path: &str) -> Arc<PreparedScene<N>> {
+    let scene = trilux_scene::load(path).unwrap_or_else(|e| panic!("{e}"));
+    let (shapes, bsdfs, emission) = (
+        scene.geometry_shapes(),
+        scene.bsdf_params(),
+        scene.emitter_radiance(),
+    );
+    let desc = SceneDescription {
+        shapes: &shapes,
+        bsdfs: &bsdfs,
+        emission: &emission,
+    };
+    Arc::new(PreparedScene::new(&desc).unwrap_or_else(|e| panic!("{e}")))
+}

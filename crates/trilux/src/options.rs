@@ -1,0 +1,163 @@
+//! Command-line options shared by `solve` and `render`, and the value
+//! parsers that turn a malformed value into a usage error (status 2) before
+//! any file is read.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Result, bail};
+use clap::{Args, ValueEnum};
+use glam::DVec3;
+use trilux_color::Mode;
+use trilux_solver::{Quality, SolverSettings};
+
+/// How light is carried: 3 RGB bands or spectral bands.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum ModeArg {
+    /// Linear sRGB, 3 bands.
+    Rgb,
+    /// Spectral bands (20 of 15 nm over the visible range).
+    Spectral,
+}
+
+/// Solver options shared by `solve` and `render`.
+#[derive(Debug, Args, Clone)]
+pub struct SolveOptions {
+    /// Quality preset: error bounds, depth limit and default convergence.
+    #[arg(long, value_enum, default_value = "default")]
+    pub quality: QualityArg,
+    /// Target convergence ratio CR = (IF − RF)/IF in [0, 1] (default from
+    /// --quality: 0.95, 0.999, 0.9999).
+    #[arg(long, value_parser = parse_unit)]
+    pub convergence: Option<f64>,
+    /// Override the scene's colour mode.
+    #[arg(long, value_enum)]
+    pub mode: Option<ModeArg>,
+}
+
+/// The quality presets.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum QualityArg {
+    /// Fast previews (CR 0.95, coarse elements).
+    Draft,
+    /// CR 0.999.
+    Default,
+    /// CR 0.9999, fine elements.
+    High,
+}
+
+impl SolveOptions {
+    /// The solver settings these options ask for.
+    pub fn settings(&self) -> SolverSettings {
+        let quality = match self.quality {
+            QualityArg::Draft => Quality::Draft,
+            QualityArg::Default => Quality::Default,
+            QualityArg::High => Quality::High,
+        };
+        let mut settings = SolverSettings::preset(quality);
+        if let Some(cr) = self.convergence {
+            settings.convergence = cr;
+        }
+        settings
+    }
+
+    /// The colour mode: the override, else the scene's own.
+    pub fn mode(&self, scene: &trilux_scene::Scene) -> Mode {
+        match self.mode {
+            Some(ModeArg::Rgb) => Mode::Rgb,
+            Some(ModeArg::Spectral) => Mode::Spectral,
+            None => scene.mode(),
+        }
+    }
+}
+
+/// A number in [0, 1].
+fn parse_unit(text: &str) -> Result<f64, String> {
+    let v: f64 = text
+        .parse()
+        .map_err(|_| format!("'{text}' is not a number"))?;
+    if v.is_finite() && (0.0..=1.0).contains(&v) {
+        Ok(v)
+    } else {
+        Err(format!("{v} is not in [0, 1]"))
+    }
+}
+
+/// An integer of at least 1.
+pub fn parse_positive(text: &str) -> Result<u32, String> {
+    match text.parse::<u32>() {
+        Ok(v) if v >= 1 => Ok(v),
+        Ok(_) => Err("must be at least 1".into()),
+        Err(_) => Err(format!("'{text}' is not a positive integer")),
+    }
+}
+
+/// A field of view in (0, 180) degrees.
+pub fn parse_fov(text: &str) -> Result<f64, String> {
+    let v: f64 = text
+        .parse()
+        .map_err(|_| format!("'{text}' is not a number"))?;
+    if v.is_finite() && v > 0.0 && v < 180.0 {
+        Ok(v)
+    } else {
+        Err(format!("{v} is not in (0, 180) degrees"))
+    }
+}
+
+/// Eye, target and optional up of `--lookat`.
+pub type LookAt = (DVec3, DVec3, Option<DVec3>);
+
+/// `ox,oy,oz,tx,ty,tz[,ux,uy,uz]`: 6 or 9 finite numbers.
+pub fn parse_lookat(text: &str) -> Result<LookAt, String> {
+    let values: Vec<f64> = text
+        .split(',')
+        .map(|v| v.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| format!("'{text}' is not a comma-separated list of numbers"))?;
+    if values.iter().any(|v| !v.is_finite()) {
+        return Err("values must be finite".into());
+    }
+    let v = |i: usize| DVec3::new(values[i], values[i + 1], values[i + 2]);
+    match values.len() {
+        6 => Ok((v(0), v(3), None)),
+        9 => Ok((v(0), v(3), Some(v(6)))),
+        n => Err(format!("takes 6 or 9 numbers (eye, target[, up]), got {n}")),
+    }
+}
+
+/// Refuses an output whose folder does not exist, before any work.
+pub fn check_output(path: &Path, what: &str) -> Result<()> {
+    let parent = path.parent().filter(|p| !p.as_os_str().is_empty());
+    if let Some(dir) = parent
+        && !dir.is_dir()
+    {
+        bail!(
+            "{}: cannot write the {what}: the folder {} does not exist",
+            path.display(),
+            dir.display()
+        );
+    }
+    Ok(())
+}
+
+/// Refuses a set of outputs where two are the same file or one is an
+/// input, before any work.
+pub fn check_distinct(inputs: &[&Path], outputs: &[(&Path, &str)]) -> Result<()> {
+    let key =
+        |p: &Path| -> PathBuf { std::fs::canonicalize(p).unwrap_or_else(|_| p.to_path_buf()) };
+    for (k, (out, what)) in outputs.iter().enumerate() {
+        if let Some(input) = inputs.iter().find(|i| key(i) == key(out)) {
+            bail!(
+                "{}: the {what} would overwrite the input {}",
+                out.display(),
+                input.display()
+            );
+        }
+        if let Some((_, other)) = outputs[..k].iter().find(|(o, _)| key(o) == key(out)) {
+            bail!(
+                "{}: the {what} and the {other} are the same file",
+                out.display()
+            );
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,68 @@
+//! Progress bars on a terminal, nothing otherwise (CI stays quiet).
+
+use std::io::IsTerminal;
+
+use indicatif::{ProgressBar, ProgressStyle};
+use trilux_solver::Progress;
+
+/// A progress bar labelled `what` on a terminal, `None` otherwise.
+fn bar(len: u64, what: &str) -> Option<ProgressBar> {
+    if !std::io::stderr().is_terminal() {
+        return None;
+    }
+    let bar = ProgressBar::new(len);
+    if let Ok(style) = ProgressStyle::with_template("{prefix} [{bar:40}] {msg} ({elapsed})") {
+        bar.set_style(style.progress_chars("=> "));
+    }
+    bar.set_prefix(what.to_string());
+    Some(bar)
+}
+
+/// The bars of one command: the solve's convergence and the render's tiles.
+pub struct Bars {
+    solve: Option<ProgressBar>,
+    render: Option<ProgressBar>,
+}
+
+impl Bars {
+    /// Bars for a solve and, with `render`, a render.
+    pub fn new(render: bool) -> Self {
+        Bars {
+            solve: bar(1000, "solve"),
+            render: if render { bar(1, "render") } else { None },
+        }
+    }
+
+    /// Shows the solve's progress after a shot.
+    pub fn solve(&self, p: &Progress) {
+        let Some(bar) = &self.solve else { return };
+        let frac = if p.target > 0.0 {
+            p.convergence_ratio / p.target
+        } else {
+            1.0
+        };
+        bar.set_position((frac.clamp(0.0, 1.0) * 1000.0) as u64);
+        bar.set_message(format!(
+            "CR {:.4}/{:.4}, shot {}, {} interactions, {} links",
+            p.convergence_ratio, p.target, p.shots, p.interactions, p.live_links
+        ));
+    }
+
+    /// Shows the render's progress after a tile.
+    pub fn render(&self, done: usize, total: usize) {
+        if let Some(s) = &self.solve {
+            s.finish_and_clear();
+        }
+        let Some(bar) = &self.render else { return };
+        bar.set_length(total as u64);
+        bar.set_position(done as u64);
+        bar.set_message(format!("{done}/{total} tiles"));
+    }
+
+    /// Clears every bar.
+    pub fn finish(&self) {
+        for b in [&self.solve, &self.render].into_iter().flatten() {
+            b.finish_and_clear();
+        }
+    }
+}
