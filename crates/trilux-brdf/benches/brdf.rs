@@ -3,6 +3,7 @@
 //! Run: `cargo bench -p trilux-brdf --bench brdf -- --warm-up-time 1 --measurement-time 3`
 //! Each iteration processes a batch of 1024 direction pairs (throughput is
 //! reported per element).
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::{DVec2, DVec3};

@@ -1,6 +1,7 @@
 //! Evaluate, sample and integrate a material; one area reflectance.
 //!
 //! Run: `cargo run -p trilux-brdf --example brdf_tour`
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 use glam::{DVec2, DVec3};
 use trilux_brdf::{

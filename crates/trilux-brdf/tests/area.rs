@@ -1,5 +1,6 @@
 //! Area reflectance R(I→J→K) = π F_JI fr (paper Eq. 5, notes §1) and the
 //! BRDF variation estimate (notes §2).
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 mod common;
 

@@ -1,5 +1,6 @@
 //! Energy: directional albedo against validation.md's table (separable
 //! Smith, F = 1) and against an independent Monte Carlo estimate.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 mod common;
 

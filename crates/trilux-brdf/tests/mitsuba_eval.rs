@@ -6,6 +6,7 @@
 //! |cosθ| of the light direction. Tolerance (issue 3): 1e-4 relative or 1e-6
 //! absolute per channel; Mitsuba computes in f32, so agreement to ~1e-6
 //! relative is what exact formulas give.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 use glam::DVec3;
 use serde::Deserialize;

@@ -1,5 +1,6 @@
 //! Sampling: chi-square goodness of fit of sampled directions against the
 //! pdf (as Mitsuba's and pbrt's own tests do), and the pdf's integral.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 mod common;
 

@@ -1,6 +1,7 @@
 //! Spectrum arithmetic and colour conversions per second.
 //!
 //! Run: `cargo bench -p trilux-color --bench color -- --warm-up-time 1 --measurement-time 3`
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::hint::black_box;

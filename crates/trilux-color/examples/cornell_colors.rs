@@ -1,6 +1,7 @@
 //! The classic Cornell box's colours in both modes.
 //!
 //! Run: `cargo run -p trilux-color --example cornell_colors`
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 use trilux_color::{Bands, ColorParam, Spectrum, srgb};
 

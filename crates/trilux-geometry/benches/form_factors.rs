@@ -2,6 +2,7 @@
 //! visibility estimates per second.
 //!
 //! Run: `cargo bench -p trilux-geometry --bench form_factors -- --warm-up-time 1 --measurement-time 3`
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 mod scenes;
 

@@ -3,6 +3,7 @@
 //! Cornell-box-sized scene.
 //!
 //! Run: `cargo bench -p trilux-geometry --bench rays -- --warm-up-time 1 --measurement-time 3`
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 mod scenes;
 

@@ -2,6 +2,7 @@
 //! notes/validation.md, at the default accuracy and at rel_tol 1e-7.
 //!
 //! Run: `cargo run -p trilux-geometry --release --example form_factor_table`
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 use glam::{DMat4, DVec3};
 use trilux_geometry::{

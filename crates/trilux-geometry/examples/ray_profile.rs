@@ -2,6 +2,7 @@
 //! profiling; the criterion bench `rays` is the record).
 //!
 //! Run: `cargo run -p trilux-geometry --release --example ray_profile`
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 use glam::{DMat4, DVec3};
 use trilux_geometry::{Geometry, Ray, Shape, ShapeKind, TriangleMesh};

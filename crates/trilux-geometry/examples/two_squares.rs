@@ -3,6 +3,7 @@
 //! halfway between them.
 //!
 //! Run: `cargo run -p trilux-geometry --release --example two_squares`
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 use glam::{DMat4, DVec4};
 use trilux_geometry::{

@@ -1,4 +1,5 @@
 //! The contract API end to end on a small scene of every shape kind.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 mod common;
 

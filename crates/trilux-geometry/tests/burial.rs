@@ -1,6 +1,7 @@
 //! Buried parts of faces: a cube standing on a floor covers exactly its
 //! footprint (an analytic area), a cube lifted off it covers nothing, and
 //! shadow segments from the covered part count as blocked.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 use glam::{DMat4, DVec2, DVec3};
 use trilux_geometry::{

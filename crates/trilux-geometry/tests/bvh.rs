@@ -1,6 +1,7 @@
 //! Ray queries: the BVH against brute force over every primitive (proptest),
 //! an independent world-space reference for the analytic shapes, closed-cube
 //! watertightness, and rays that start on surfaces.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 mod common;
 

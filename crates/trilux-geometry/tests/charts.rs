@@ -1,5 +1,6 @@
 //! Triangle meshes become a handful of charts whose element trees reach
 //! every triangle exactly once.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 mod common;
 

@@ -1,5 +1,6 @@
 //! Element trees: exact areas, subdivision, sampling densities, bounds,
 //! normal cones, and errors for bad shapes.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 mod common;
 

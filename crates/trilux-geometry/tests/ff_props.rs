@@ -1,6 +1,7 @@
 //! Property tests: form factors and visibility on random scenes of every
 //! shape kind never produce NaN or infinity, stay in [0, 1], and are
 //! reciprocal within their stated errors for well-separated elements.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 mod common;
 

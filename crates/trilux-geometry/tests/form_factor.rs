@@ -1,4 +1,5 @@
 //! Form factors against the closed forms of notes/validation.md.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 mod common;
 
@@ -163,11 +164,7 @@ fn small_patch_to_coaxial_disk() {
             rect(DVec3::ZERO, s * X, s * Y, false),
             disk(h * Z, X, Y, radius, true),
         );
-        let f = form_factor_front(
-            &g,
-            g.root(SurfaceId(0)),
-            g.root(SurfaceId(1)),
-        );
+        let f = form_factor_front(&g, g.root(SurfaceId(0)), g.root(SurfaceId(1)));
         let expected = radius * radius / (radius * radius + h * h);
         assert!(
             rel(f.value, expected) < 5e-3,
@@ -189,11 +186,7 @@ fn disk_to_coaxial_disk() {
             disk(DVec3::ZERO, X, Y, r1, false),
             disk(h * Z, X, Y, r2, true),
         );
-        let f = form_factor_front(
-            &g,
-            g.root(SurfaceId(0)),
-            g.root(SurfaceId(1)),
-        );
+        let f = form_factor_front(&g, g.root(SurfaceId(0)), g.root(SurfaceId(1)));
         let (a, b) = (r1 / h, r2 / h);
         let x = 1.0 + (1.0 + b * b) / (a * a);
         let expected = 0.5 * (x - (x * x - 4.0 * (b / a) * (b / a)).sqrt());

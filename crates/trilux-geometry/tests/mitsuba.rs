@@ -2,6 +2,7 @@
 //! recorded from Mitsuba 3.9 (scalar_rgb, float32) by
 //! `tests/data/mitsuba_hits.py`, for rectangles, cubes, disks, spheres and
 //! cylinders and OBJ meshes (one mirrored) with transforms and `flip_normals`.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 use glam::{DMat4, DVec3};
 use trilux_geometry::{Geometry, Ray, Shape, ShapeKind};

@@ -1,4 +1,5 @@
 //! Visibility fractions against an independent brute-force estimate.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 mod common;
 

@@ -2,6 +2,7 @@
 //! the cost of the estimator, sampler, filter and tiling themselves.
 //!
 //! Run: `cargo bench -p trilux-render --bench gather -- --warm-up-time 1 --measurement-time 3`
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::DVec3;

@@ -5,6 +5,7 @@
 //!
 //! The printed check compares the centre pixel with the closed form
 //! ρ · Le · F(point → square).
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 use std::path::Path;
 

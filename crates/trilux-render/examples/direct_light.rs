@@ -3,6 +3,7 @@
 //! `max_depth` 2.
 //!
 //! Run: `cargo run --release -p trilux-render --example direct_light -- SCENE.xml OUT.exr [SIZE] [SPP] [rgb|spectral]`
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 use std::path::Path;
 

@@ -5,6 +5,7 @@
 //! Prints the solve and render times and the image mean. Spectral scenes
 //! solve and render in their spectral bands. OUT ending in `.png` writes an
 //! 8-bit sRGB PNG (exposure 0, clamped), anything else a linear EXR.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 use std::path::Path;
 

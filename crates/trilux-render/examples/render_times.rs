@@ -4,6 +4,7 @@
 //! Markdown table for docs/results.md.
 //!
 //! Run: `cargo run --release -p trilux-render --example render_times [-- SCENE.xml ...]`
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 use std::path::PathBuf;
 

@@ -6,6 +6,7 @@
 //!
 //! Run: `cargo run --release -p trilux-render --example saved_solution [-- SCENE.xml [SIZE] [SPP]]`
 //! (default scenes/cornell-box.xml in RGB mode, 128×128, 64 spp).
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 use std::path::PathBuf;
 

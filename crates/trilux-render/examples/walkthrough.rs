@@ -4,6 +4,7 @@
 //!
 //! Run: `cargo run --release -p trilux-render --example walkthrough [-- SCENE.xml [FRAMES] [SIZE] [SPP]]`
 //! (default scenes/paper-scene1.xml, 6 frames, 128×128, 32 spp).
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;

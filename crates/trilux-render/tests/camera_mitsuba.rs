@@ -3,6 +3,7 @@
 //! scalar_rgb). Tolerance 1e-5 on each direction component: Mitsuba
 //! computes in f32 (ε ≈ 6e-8, a few operations), while a wrong convention
 //! (flipped axis, wrong fov axis) changes directions by 1e-2 or more.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 use glam::{DVec2, DVec3};
 use trilux_render::camera::look_at;

@@ -5,6 +5,7 @@
 //! so the image mean must be within 0.5 % of 2.0 and 99 % of the pixels
 //! within 2 %. (The 1 % of flux left unshot at CR 0.99 lowers the
 //! reflected half of the radiance by well under 1 %.)
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 use std::path::PathBuf;
 

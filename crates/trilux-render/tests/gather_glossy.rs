@@ -6,6 +6,7 @@
 //! against Mitsuba 3's `bsdf.eval`). The render combines light samples and
 //! BSDF samples by MIS; both strategies matter here (a narrow lobe, a small
 //! light), and a wrong MIS weight or pdf shows as a bias of several percent.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 use glam::{DVec2, DVec3};
 use trilux_brdf::{Bsdf, BsdfParams, Distribution, RoughConductorParams};

@@ -1,4 +1,5 @@
 //! The final gather on analytic mock scenes (trilux_render::analytic).
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 use glam::DVec3;
 use trilux_render::analytic::{Furnace, LitFloor};

@@ -16,6 +16,7 @@
 //! within 1 % (issue 5's energy-bias bound). A wrong convention (camera
 //! axis, fov, filter, BRDF normalisation, a missing MIS weight) moves both
 //! far beyond.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 use std::path::PathBuf;
 

@@ -1,4 +1,5 @@
 //! Property tests of the renderer's building blocks (proptest).
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 use glam::{DMat4, DVec2, DVec3};
 use proptest::prelude::*;

@@ -1,5 +1,6 @@
 //! The final gather on trilux's real layers (scene loader, geometry, BRDFs,
 //! colour) with stand-in solutions, on the scene files in scenes/.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 use std::path::PathBuf;
 

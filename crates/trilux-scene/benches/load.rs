@@ -1,6 +1,7 @@
 //! Loading speed: the bundled scenes (XML parse, resolve, build).
 //!
 //! `cargo bench -p trilux-scene --bench load -- --warm-up-time 1 --measurement-time 3`
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 use std::path::PathBuf;
 

@@ -4,6 +4,7 @@
 //! cargo run -p trilux-scene --example summary -- scenes/cornell-box.xml
 //! ```
 //! Without an argument it loads the bundled Cornell box.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 use std::path::PathBuf;
 use std::process::ExitCode;

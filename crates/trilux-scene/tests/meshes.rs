@@ -1,5 +1,6 @@
 //! A large OBJ through the loader: the 8 192-triangle sheet of the
 //! foundation issue's chart test (64 × 64 quads, each split in two).
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 use std::fmt::Write as _;
 use std::path::Path;

@@ -4,6 +4,7 @@
 //!
 //! Tolerance: Mitsuba's scalar_rgb variant computes in single precision, so
 //! values agree to a few float32 ulps: 2e-6 absolute plus 2e-6 relative.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 use std::path::PathBuf;
 

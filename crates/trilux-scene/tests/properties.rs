@@ -1,5 +1,6 @@
 //! Property tests: bad input is an error value, never a panic; numbers and
 //! transforms survive the trip through XML text.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 use glam::{DMat4, DVec3};
 use proptest::prelude::*;

@@ -1,6 +1,7 @@
 //! The bundled scenes in scenes/ load, with the structure their files state
 //! (areas from Mitsuba 3's `surface_area` of the same shapes: see
 //! scenes/check_mitsuba.py, whose output lists them).
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 use std::path::PathBuf;
 

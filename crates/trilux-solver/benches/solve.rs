@@ -1,6 +1,7 @@
 //! Solve time per bundled scene (geometry, materials and the solve): `cargo bench -p
 //! trilux-solver --bench solve`. Draft quality keeps a full sweep short;
 //! `TRILUX_BENCH_QUALITY=default` measures the default preset.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 use std::path::PathBuf;
 

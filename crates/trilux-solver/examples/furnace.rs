@@ -1,5 +1,6 @@
 //! Solves the furnace (a closed diffuse box that emits everywhere) and
 //! prints the radiance at a few points and the energy ledger.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 use glam::{DMat4, DVec2};
 use trilux_brdf::BsdfParams;

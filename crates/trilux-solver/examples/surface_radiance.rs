@@ -10,6 +10,7 @@
 //! The environment variables `TRILUX_MAX_DEPTH`, `TRILUX_FF_EPS`,
 //! `TRILUX_FR_EPS`, `TRILUX_FLUX_EPS` and `TRILUX_VISIBILITY_SAMPLES` override single
 //! settings of the preset (for experiments).
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 use std::path::PathBuf;
 

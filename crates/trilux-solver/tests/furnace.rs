@@ -2,6 +2,7 @@
 //! whose every face is Lambertian with ρ = 0.5 and emits Le = 1, the radiance
 //! is Le / (1 − ρ) everywhere (2 for Le = 1), for any discretisation, because every
 //! element's form factors sum to 1.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 use glam::{DMat4, DVec2};
 use trilux_brdf::BsdfParams;

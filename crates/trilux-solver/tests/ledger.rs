@@ -2,6 +2,7 @@
 //! escaped + residual, no shot and no receiving element creates energy, the
 //! residual never grows from one shot to the next, and no radiance is
 //! negative or not finite.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 use std::f64::consts::PI;
 

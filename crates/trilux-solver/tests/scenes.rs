@@ -1,5 +1,6 @@
 //! Every bundled scene solves with a balanced ledger: no shot and no
 //! receiving element creates energy, and no radiance is negative.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 use std::path::PathBuf;
 

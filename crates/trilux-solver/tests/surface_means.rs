@@ -11,6 +11,7 @@
 //! threshold 1e-5 of the emitted flux, piecewise-constant radiance near
 //! the boxes' contact with the floor), measured at 0.5–1.6 % per face and
 //! 1.1 % in total (docs/results.md, "The solution surface by surface").
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 use std::path::PathBuf;
 

@@ -1,6 +1,7 @@
 //! Single-bounce checks between plates (validation.md, "Whole-system
 //! checks"): only the emitter shoots (a shot budget of 1), so what the
 //! receivers hold is exactly the first bounce.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 use std::f64::consts::PI;
 

@@ -3,6 +3,7 @@
 //! agree on a diffuse scene (design.md §2): compared on the classic Cornell
 //! box, surface by surface, on a fixed grid of points through the Solution
 //! API.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 use std::path::PathBuf;
 

@@ -1,6 +1,7 @@
 //! The `trilux` binary: scene errors give exactly one line
 //! `error: FILE:LINE:COL: ...` on stderr and exit status 1; usage errors exit
 //! with clap's status 2; `info --json` has exactly design.md §3's keys.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 use std::path::{Path, PathBuf};
 use std::process::Command;

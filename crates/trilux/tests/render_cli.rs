@@ -1,6 +1,7 @@
 //! `trilux solve` and `trilux render` through the binary: a render from a
 //! saved solution does no solving, a solution made for another scene is
 //! refused, bad outputs and bad options fail cleanly.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 use std::path::Path;
 use std::process::Output;
