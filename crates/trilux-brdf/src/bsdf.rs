@@ -180,10 +180,6 @@ impl<const N: usize> Bsdf<N> {
         self.side(side).is_none_or(Lobe::is_black)
     }
 
-    /// True when one side reflects (a `twosided` material).
-    pub fn is_two_sided(&self) -> bool {
-        self.back.is_some()
-    }
 
     /// Samples a light direction wi for the viewer direction `wo` from
     /// (approximately) fr·cos; `u` uniform in [0, 1)². `None` when the

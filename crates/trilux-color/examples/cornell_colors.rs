@@ -24,15 +24,16 @@ fn main() -> Result<(), trilux_color::ColorError> {
     let l3: Spectrum<3> = light.emission()?;
     println!("RGB mode:      white {:?}  light {:?}", w3.0, l3.0);
 
-    // Spectral mode: 10 bands, edges in nm:
-    println!("band edges:    {:?}", Bands::<10>::edges());
-    let w10: Spectrum<10> = white.reflectance()?;
-    let l10: Spectrum<10> = light.emission()?;
-    println!("spectral mode: white {:?}", w10.0);
-    println!("               light {:?}", l10.0);
+    // Spectral mode: SPECTRAL_BANDS (20) bands, edges in nm:
+    const N: usize = trilux_color::SPECTRAL_BANDS;
+    println!("band edges:    {:?}", Bands::<N>::edges());
+    let ws: Spectrum<N> = white.reflectance()?;
+    let ls: Spectrum<N> = light.emission()?;
+    println!("spectral mode: white {:?}", ws.0);
+    println!("               light {:?}", ls.0);
 
     // What the light looks like: XYZ, linear sRGB, 8-bit sRGB (scaled to Y = 1).
-    let xyz = l10.to_xyz();
+    let xyz = ls.to_xyz();
     let scaled = xyz.map(|v| v / xyz[1]);
     println!(
         "light XYZ {:?} → sRGB bytes at Y = 1: {:?}",

@@ -3,7 +3,6 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::param::ColorParam;
 
 /// Bands of spectral mode: 20 of 15 nm over 400–700 nm (the outer ones
 /// reaching 360 and 830 nm). The paper used 10;
@@ -51,16 +50,6 @@ impl Mode {
         }
     }
 
-    /// The mode a scene is solved in: spectral when some
-    /// value is a sampled `<spectrum>` (wavelength:value pairs), RGB
-    /// otherwise. A single-value `<spectrum>` does not make a scene spectral.
-    pub fn for_values<'a>(values: impl IntoIterator<Item = &'a ColorParam>) -> Mode {
-        if values.into_iter().any(ColorParam::is_sampled) {
-            Mode::Spectral
-        } else {
-            Mode::Rgb
-        }
-    }
 
     /// The lower-case name used on the command line and in stats (`rgb`,
     /// `spectral`).

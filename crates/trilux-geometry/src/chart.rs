@@ -217,52 +217,85 @@ impl Piece {
 
 /// Groups the non-degenerate triangles of a mesh into charts (module docs).
 pub(crate) fn build_charts(mesh: &MeshData) -> Vec<Vec<u32>> {
-    let n = mesh.triangles.len();
-    // Weld vertices by exact position.
-    let mut weld: HashMap<[u64; 3], u32> = HashMap::new();
-    let canon: Vec<u32> = mesh
-        .positions
-        .iter()
-        .map(|p| {
-            let key = [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()];
-            let next = weld.len() as u32;
-            *weld.entry(key).or_insert(next)
-        })
-        .collect();
-    // Edge → triangles.
-    let mut edges: HashMap<(u32, u32), Vec<u32>> = HashMap::new();
-    for (t, tri) in mesh.triangles.iter().enumerate() {
-        if mesh.tri_area[t] <= 0.0 {
-            continue;
-        }
-        for k in 0..3 {
-            let a = canon[tri[k] as usize];
-            let b = canon[tri[(k + 1) % 3] as usize];
-            if a != b {
-                edges
-                    .entry((a.min(b), a.max(b)))
-                    .or_default()
-                    .push(t as u32);
+    let adjacency = Adjacency::new(mesh);
+    let cos_cone = CHART_CONE_DEG.to_radians().cos();
+    let (mut charts, mut chart_of) = grow_charts(mesh, &adjacency, cos_cone);
+    merge_small_charts(mesh, &adjacency, cos_cone, &mut charts, &mut chart_of);
+    charts.retain(|c| !c.is_empty());
+    group_small_charts(mesh, charts, cos_cone)
+}
+
+/// Which triangles share an edge, after welding vertices by exact position
+/// (a loader may duplicate vertices for normals or texture coordinates).
+struct Adjacency<'m> {
+    mesh: &'m MeshData,
+    /// The welded index of every vertex.
+    canon: Vec<u32>,
+    /// Welded edge (low, high) → the non-degenerate triangles that have it.
+    edges: HashMap<(u32, u32), Vec<u32>>,
+}
+
+impl<'m> Adjacency<'m> {
+    fn new(mesh: &'m MeshData) -> Self {
+        let mut weld: HashMap<[u64; 3], u32> = HashMap::new();
+        let canon: Vec<u32> = mesh
+            .positions
+            .iter()
+            .map(|p| {
+                let key = [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()];
+                let next = weld.len() as u32;
+                *weld.entry(key).or_insert(next)
+            })
+            .collect();
+        let mut adjacency = Adjacency {
+            mesh,
+            canon,
+            edges: HashMap::new(),
+        };
+        for (t, &area) in mesh.tri_area.iter().enumerate() {
+            if area <= 0.0 {
+                continue;
+            }
+            let edges: Vec<(u32, u32)> = adjacency.edges_of(t as u32).collect();
+            for edge in edges {
+                adjacency.edges.entry(edge).or_default().push(t as u32);
             }
         }
+        adjacency
     }
-    let neighbours = |t: u32| -> Vec<u32> {
-        let tri = mesh.triangles[t as usize];
+
+    /// The welded edges of triangle `t` (degenerate ones left out).
+    fn edges_of(&self, t: u32) -> impl Iterator<Item = (u32, u32)> + '_ {
+        let tri = self.mesh.triangles[t as usize];
+        (0..3).filter_map(move |k| {
+            let a = self.canon[tri[k] as usize];
+            let b = self.canon[tri[(k + 1) % 3] as usize];
+            (a != b).then(|| (a.min(b), a.max(b)))
+        })
+    }
+
+    /// The triangles sharing an edge with `t`.
+    fn neighbours(&self, t: u32) -> Vec<u32> {
         let mut out = Vec::new();
-        for k in 0..3 {
-            let a = canon[tri[k] as usize];
-            let b = canon[tri[(k + 1) % 3] as usize];
-            if let Some(list) = edges.get(&(a.min(b), a.max(b))) {
+        for edge in self.edges_of(t) {
+            if let Some(list) = self.edges.get(&edge) {
                 out.extend(list.iter().copied().filter(|&o| o != t));
             }
         }
         out
-    };
-    let centroid = |t: u32| {
-        let [a, b, c] = mesh.vertices(t);
-        (a + b + c) / 3.0
-    };
-    let cos_cone = CHART_CONE_DEG.to_radians().cos();
+    }
+}
+
+fn centroid(mesh: &MeshData, t: u32) -> DVec3 {
+    let [a, b, c] = mesh.vertices(t);
+    (a + b + c) / 3.0
+}
+
+/// Grows charts from seeds in file order, always adding the connected
+/// candidate nearest the seed's centroid within the normal cone, up to the
+/// cap. Returns the charts and the chart of every triangle.
+fn grow_charts(mesh: &MeshData, adjacency: &Adjacency<'_>, cos_cone: f64) -> (Vec<Vec<u32>>, Vec<u32>) {
+    let n = mesh.triangles.len();
     let mut chart_of = vec![u32::MAX; n];
     let mut charts: Vec<Vec<u32>> = Vec::new();
     for seed in 0..n as u32 {
@@ -271,7 +304,7 @@ pub(crate) fn build_charts(mesh: &MeshData) -> Vec<Vec<u32>> {
         }
         let id = charts.len() as u32;
         let seed_n = mesh.tri_normal[seed as usize];
-        let seed_c = centroid(seed);
+        let seed_c = centroid(mesh, seed);
         let mut members = Vec::new();
         // Max-heap on negated distance (ordered bits of a non-negative f64).
         let mut heap: BinaryHeap<(std::cmp::Reverse<u64>, u32)> = BinaryHeap::new();
@@ -285,42 +318,53 @@ pub(crate) fn build_charts(mesh: &MeshData) -> Vec<Vec<u32>> {
             }
             chart_of[t as usize] = id;
             members.push(t);
-            for o in neighbours(t) {
+            for o in adjacency.neighbours(t) {
                 if chart_of[o as usize] == u32::MAX
                     && mesh.tri_normal[o as usize].dot(seed_n) >= cos_cone
                 {
-                    let d = (centroid(o) - seed_c).length();
+                    let d = (centroid(mesh, o) - seed_c).length();
                     heap.push((std::cmp::Reverse(d.to_bits()), o));
                 }
             }
         }
         charts.push(members);
     }
-    // Merge small charts into a neighbour when both bounds still hold.
+    (charts, chart_of)
+}
+
+/// Merges every chart smaller than an eighth of the cap into a neighbouring
+/// chart when both bounds still hold (the cap allowing 1.5×); merged charts
+/// are left empty.
+fn merge_small_charts(
+    mesh: &MeshData,
+    adjacency: &Adjacency<'_>,
+    cos_cone: f64,
+    charts: &mut [Vec<u32>],
+    chart_of: &mut [u32],
+) {
     let small = CHART_MAX_TRIANGLES / 8;
     for c in 0..charts.len() {
         if charts[c].is_empty() || charts[c].len() >= small {
             continue;
         }
-        let mut target = None;
-        'search: for &t in &charts[c] {
-            for o in neighbours(t) {
-                let oc = chart_of[o as usize] as usize;
-                if oc != c
-                    && !charts[oc].is_empty()
-                    && charts[oc].len() + charts[c].len() <= CHART_MAX_TRIANGLES * 3 / 2
-                {
+        let fits = |oc: usize| {
+            oc != c
+                && !charts[oc].is_empty()
+                && charts[oc].len() + charts[c].len() <= CHART_MAX_TRIANGLES * 3 / 2
+                && {
                     let seed_n = mesh.tri_normal[charts[oc][0] as usize];
-                    if charts[c]
+                    charts[c]
                         .iter()
                         .all(|&m| mesh.tri_normal[m as usize].dot(seed_n) >= cos_cone)
-                    {
-                        target = Some(oc);
-                        break 'search;
-                    }
                 }
-            }
-        }
+        };
+        let target = charts[c].iter().find_map(|&t| {
+            adjacency
+                .neighbours(t)
+                .into_iter()
+                .map(|o| chart_of[o as usize] as usize)
+                .find(|&oc| fits(oc))
+        });
         if let Some(oc) = target {
             let moved = std::mem::take(&mut charts[c]);
             for &m in &moved {
@@ -329,8 +373,6 @@ pub(crate) fn build_charts(mesh: &MeshData) -> Vec<Vec<u32>> {
             charts[oc].extend(moved);
         }
     }
-    charts.retain(|c| !c.is_empty());
-    group_small_charts(mesh, charts, cos_cone)
 }
 
 /// Groups the charts still smaller than an eighth of the cap (disconnected

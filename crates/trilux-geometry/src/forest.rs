@@ -69,10 +69,6 @@ impl ElementForest {
         &self.geometry
     }
 
-    /// The geometry, shared.
-    pub fn shared_geometry(&self) -> &Arc<Geometry> {
-        &self.geometry
-    }
 
     /// The root element of an input surface.
     #[inline]

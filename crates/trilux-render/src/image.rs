@@ -111,10 +111,6 @@ impl Image {
         &self.pixels
     }
 
-    /// Mutable pixels, row-major from the top-left.
-    pub fn pixels_mut(&mut self) -> &mut [[f32; 3]] {
-        &mut self.pixels
-    }
 
     /// Pixel (x, y).
     pub fn get(&self, x: u32, y: u32) -> [f32; 3] {

@@ -108,11 +108,6 @@ impl Camera {
         }
     }
 
-    /// The vertical field of view in degrees.
-    pub fn y_fov(&self) -> f64 {
-        let aspect = self.width as f64 / self.height as f64;
-        (2.0 * ((0.5 * self.x_fov().to_radians()).tan() / aspect).atan()).to_degrees()
-    }
 }
 
 /// Mitsuba's default field of view (50 mm lens, 36 × 24 mm film), along the

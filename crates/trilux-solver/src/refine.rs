@@ -647,7 +647,7 @@ impl<const N: usize> RefineContext<'_, N> {
             partial: (vjk > 0.0 && vjk < 1.0) || straddle_k,
             driver,
         };
-        self.link_or_split(task, i, j, n, known, link, errors);
+        self.link_or_split(task, (i, j, n), known, link, errors);
     }
 
     /// A node whose elements were found not to see each other: as in stage
@@ -737,13 +737,10 @@ impl<const N: usize> RefineContext<'_, N> {
     /// element that matters most (the BRDF's driver when the BRDF error
     /// dominates, otherwise the larger of J and K), trying the others when
     /// it cannot split, and links when none can.
-    #[allow(clippy::too_many_arguments)]
     fn link_or_split(
         &self,
         task: &mut TripleTask<'_, N>,
-        i: ElementId,
-        j: ElementId,
-        n: u32,
+        (i, j, n): (ElementId, ElementId, u32),
         known: Incidence<N>,
         link: NodeLink<N>,
         e: TripleErrors,

@@ -259,7 +259,6 @@ fn pair_rule(pa: &[(DVec3, DVec3, f64)], pb: &[(DVec3, DVec3, f64)]) -> f64 {
 /// cannot see the other side's rule error), and the side whose refinement
 /// changed the estimate most is refined further (as hierarchical radiosity
 /// refines the link's worse end).
-#[allow(clippy::too_many_arguments)]
 fn pair_adaptive(
     a: &QDom<'_>,
     pa: &[(DVec3, DVec3, f64)],
