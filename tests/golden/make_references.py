@@ -26,7 +26,7 @@ Relative RMSE, the definition used here and by `cargo xtask golden`:
 (the RMS error normalised by the RMS of the reference).
 
 Variant: `llvm_ad_spectral` when the scene has a <spectrum> with
-wavelength:value pairs (the scene is spectral in trilux too: design.md §2),
+wavelength:value pairs (the scene is spectral in trilux too: README, "Scene format"),
 else `llvm_ad_rgb`. Both output linear sRGB.
 
 The film size and the integrator are replaced in a temporary copy of the

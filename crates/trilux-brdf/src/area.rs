@@ -1,9 +1,10 @@
 //! Area reflectance R(I→J→K) and the BRDF variation estimate over three
-//! elements (paper Eq. 5; notes/algorithm.md §1–2).
+//! elements (paper Eq. 5; docs/solver.md, "Area reflectance").
 //!
 //! Light leaves element I, reflects on element J and leaves towards element
-//! K. With the radiance coefficient of notes §1 (the paper's printed integral
-//! normalises by ∫∫G, a flux ratio; notes §1 explain the correction):
+//! K. With the radiance coefficient (the paper's printed integral
+//! normalises by ∫∫G, a flux ratio; docs/solver.md, "Area reflectance",
+//! explains the correction):
 //!
 //!   R(I→J→K) ≈ π · F_{J→I} · fr(I→J→K),
 //!
@@ -12,7 +13,8 @@
 //! V_{J→I} is the caller's (the solver caches F·V per interaction).
 //!
 //! The Lambertian part is an exact constant: π F_JI ρ_d/π = ρ_d F_JI,
-//! independent of K (it needs no per-receiver interactions, design.md §2).
+//! independent of K (it needs no per-receiver interactions: docs/architecture.md, "Two-point
+//! and stored transport").
 //! Only the glossy part varies over the elements, and only it is sampled by
 //! [`brdf_variation`].
 
@@ -111,7 +113,7 @@ pub enum Element {
     K,
 }
 
-/// The spread of the glossy fr over three elements (notes §2).
+/// The spread of the glossy fr over three elements (docs/solver.md, "Refinement").
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BrdfVariation<const N: usize> {
     /// Band-wise minimum of the sampled glossy fr.
@@ -133,7 +135,7 @@ pub struct BrdfVariation<const N: usize> {
 
 impl<const N: usize> BrdfVariation<N> {
     /// ΔR ≈ π F_JI (fr_max − fr_min), the largest band: the BRDF error
-    /// FrErr compares against (notes §2, step 3).
+    /// FrErr compares against (docs/solver.md, "Refinement").
     pub fn delta_r(&self, ff_ji: f64) -> f64 {
         std::f64::consts::PI * ff_ji * (self.fr_max - self.fr_min).max_value().max(0.0)
     }
@@ -150,7 +152,7 @@ impl<const N: usize> BrdfVariation<N> {
     }
 }
 
-/// Estimates the spread of the glossy fr over I, J and K (notes §2, step 3):
+/// Estimates the spread of the glossy fr over I, J and K (docs/solver.md, "Refinement"):
 /// fr at J for directions from I's points to K's points, varying one element
 /// at a time around the three centres, plus the mirror direction of I's
 /// centre about J when it falls inside K (a narrow lobe between K's points

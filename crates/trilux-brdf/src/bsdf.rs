@@ -180,7 +180,6 @@ impl<const N: usize> Bsdf<N> {
         self.side(side).is_none_or(Lobe::is_black)
     }
 
-
     /// Samples a light direction wi for the viewer direction `wo` from
     /// (approximately) fr·cos; `u` uniform in [0, 1)². `None` when the
     /// sample carries nothing (back side of a one-sided material, a

@@ -1,5 +1,5 @@
-//! Area reflectance R(I→J→K) = π F_JI fr (paper Eq. 5, notes §1) and the
-//! BRDF variation estimate (notes §2).
+//! Area reflectance R(I→J→K) = π F_JI fr (paper Eq. 5; docs/solver.md, "Area reflectance") and the
+//! BRDF variation estimate (docs/solver.md, "Refinement").
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 mod common;
@@ -63,7 +63,7 @@ fn lambertian_part_is_rho_times_form_factor() {
     assert_eq!(v.delta_r(0.3), 0.0);
 }
 
-/// R(I→J→K)·F_JK = R(K→J→I)·F_JI (notes §1), from the BRDF's reciprocity.
+/// R(I→J→K)·F_JK = R(K→J→I)·F_JI (docs/solver.md, "Area reflectance"), from the BRDF's reciprocity.
 #[test]
 fn area_reflectance_reciprocity() {
     let b = Bsdf::<10>::new(&BsdfParams::Blend {
@@ -87,7 +87,7 @@ fn area_reflectance_reciprocity() {
 
 /// The flux ratio r(I→J→K) = π fr F_JK summed over receivers K tiling the
 /// hemisphere above J equals J's directional albedo for light from I
-/// (notes §1: Σ_K r ≤ albedo ≤ 1, with equality for a complete tiling).
+/// (docs/solver.md, "Area reflectance": Σ_K r ≤ albedo ≤ 1, with equality for a complete tiling).
 #[test]
 fn flux_ratios_over_a_hemisphere_sum_to_the_albedo() {
     for p in [

@@ -1,4 +1,4 @@
-//! Energy: directional albedo against validation.md's table (separable
+//! Energy: directional albedo against docs/validation.md's table (separable
 //! Smith, F = 1) and against an independent Monte Carlo estimate.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
@@ -8,7 +8,7 @@ use common::{Rng, conductor, dir_deg, gold};
 use glam::DVec3;
 use trilux_brdf::{Bsdf, Distribution};
 
-/// validation.md, "Microfacet directional albedo", separable Smith column
+/// docs/validation.md, "Microfacet directional albedo", separable Smith column
 /// (computed there with the exact Smith G1; Mitsuba's rational Beckmann G1
 /// differs by < 0.35%, inside the 0.005 tolerance of issue 3).
 const TABLE: [(Distribution, f64, [f64; 4]); 8] = [

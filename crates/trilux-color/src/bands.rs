@@ -4,7 +4,7 @@
 //! the first band reaches down to 360 nm and the last up to 830 nm, the
 //! ends of the CIE table, so that no part of the visible spectrum is lost
 //! (cutting at 400–700 loses 0.4% of R and 0.6% of B for a flat spectrum:
-//! validation.md). A band value is the average of the spectrum over the band.
+//! docs/validation.md, "Colour"). A band value is the average of the spectrum over the band.
 //! Its colour is Σ_b s_b ∫_b (x̄, ȳ, z̄) dλ / ∫ ȳ dλ, which is exact for any
 //! spectrum that is constant over each band (in particular a flat one), and
 //! an approximation otherwise whose error `cargo xtask color` measures.

@@ -1,7 +1,7 @@
 //! CIE colorimetry on continuous spectra: the 1931 2° observer at 1 nm, the
 //! D65 illuminant, sampled (piecewise-linear) spectra and their exact XYZ.
 //!
-//! Conventions (validation.md, "Colour"):
+//! Conventions (docs/validation.md, "Colour"):
 //! - the colour-matching functions are the CIE's 1 nm table over 360–830 nm,
 //!   linear between the table's wavelengths and zero outside;
 //! - XYZ of a spectrum s is ∫ s(λ) (x̄, ȳ, z̄)(λ) dλ / ∫ ȳ(λ) dλ, so that the
@@ -349,7 +349,7 @@ mod tests {
 
     #[test]
     fn equal_energy_chromaticity() {
-        // validation.md: equal-energy xy = (0.333314, 0.333288) with the 1 nm table.
+        // docs/validation.md: equal-energy xy = (0.333314, 0.333288) with the 1 nm table.
         let s = SampledSpectrum::new(&[(360.0, 1.0), (830.0, 1.0)]).unwrap();
         let xyz = s.to_xyz();
         let sum: f64 = xyz.iter().sum();
@@ -360,7 +360,7 @@ mod tests {
 
     #[test]
     fn d65_white_point() {
-        // validation.md: D65 with a perfect reflector: xy = (0.312726, 0.329023).
+        // docs/validation.md: D65 with a perfect reflector: xy = (0.312726, 0.329023).
         let pts: Vec<(f64, f64)> = (0..95)
             .map(|i| (360.0 + 5.0 * i as f64, D65_5NM[i]))
             .collect();
@@ -387,7 +387,7 @@ mod tests {
 
     #[test]
     fn mitsuba_check_values() {
-        // design.md §3: the Cornell light in RGB mode is (20.7108, 10.8546, 2.77115).
+        // Mitsuba 3.9's value for the Cornell light in RGB mode is (20.7108, 10.8546, 2.77115).
         let s = SampledSpectrum::new(&[(400.0, 0.0), (500.0, 8.0), (600.0, 15.6), (700.0, 18.4)])
             .unwrap();
         let rgb = mitsuba::spectrum_to_srgb(&s, false, false);

@@ -2,7 +2,7 @@
 //!
 //! The same written value means different things for a reflectance, for an
 //! emitter's radiance and for an unbounded quantity such as a conductor's η
-//! and k, exactly as in Mitsuba 3 (design.md §3; every RGB-mode rule below
+//! and k, exactly as in Mitsuba 3 (docs/architecture.md, "Colour"; every RGB-mode rule below
 //! was checked against Mitsuba 3.9.1's `scalar_rgb` variant on this machine):
 //!
 //! | written | [`Role::Reflectance`] | [`Role::Emission`] | [`Role::Unbounded`] |

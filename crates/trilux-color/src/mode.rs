@@ -3,7 +3,6 @@
 
 use serde::{Deserialize, Serialize};
 
-
 /// Bands of spectral mode: 20 of 15 nm over 400–700 nm (the outer ones
 /// reaching 360 and 830 nm). The paper used 10;
 /// against Mitsuba 3's continuous spectral rendering of the Cornell box,
@@ -49,7 +48,6 @@ impl Mode {
             Mode::Spectral => f.run::<SPECTRAL_BANDS>(),
         }
     }
-
 
     /// The lower-case name used on the command line and in stats (`rgb`,
     /// `spectral`).

@@ -4,7 +4,7 @@
 //! single-value or a sampled `<spectrum>`); conversion into the spectra of a
 //! particular solve (3 RGB bands or N spectral bands) happens later, because
 //! Mitsuba 3 converts the same written value differently for a reflectance
-//! and for an emitter (design.md §3).
+//! and for an emitter (docs/architecture.md, "Colour").
 
 use serde::{Deserialize, Serialize};
 
@@ -25,7 +25,7 @@ pub enum ColorParam {
 }
 
 impl ColorParam {
-    /// True when this value makes a scene spectral (design.md §2: a
+    /// True when this value makes a scene spectral (docs/architecture.md, "Colour": a
     /// `<spectrum>` with wavelength:value pairs).
     pub fn is_sampled(&self) -> bool {
         matches!(self, ColorParam::Sampled(_))

@@ -76,7 +76,7 @@ mod tests {
 
     #[test]
     fn encoding_matches_the_standard() {
-        // validation.md: 0.5 → 0.735357.
+        // docs/validation.md: 0.5 → 0.735357.
         assert!((encode_srgb(0.5) - 0.735357).abs() < 1e-6);
         assert_eq!(encode_srgb(0.0), 0.0);
         assert!((encode_srgb(1.0) - 1.0).abs() < 1e-12);
@@ -99,7 +99,7 @@ mod tests {
 
     #[test]
     fn d65_white_is_rgb_white() {
-        // validation.md: D65 XYZ/100 = (0.950469, 1, 1.088830) → ≈ (1, 1, 1).
+        // docs/validation.md: D65 XYZ/100 = (0.950469, 1, 1.088830) → ≈ (1, 1, 1).
         let rgb = xyz_to_linear_srgb([0.950469, 1.0, 1.088830]);
         for c in rgb {
             assert!((c - 1.0).abs() < 5e-4, "{rgb:?}");

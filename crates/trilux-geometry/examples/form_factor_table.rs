@@ -1,5 +1,5 @@
 //! Prints trilux's form factors beside the closed forms of
-//! notes/validation.md, at the default accuracy and at rel_tol 1e-7.
+//! docs/validation.md, at the default accuracy and at rel_tol 1e-7.
 //!
 //! Run: `cargo run -p trilux-geometry --release --example form_factor_table`
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic

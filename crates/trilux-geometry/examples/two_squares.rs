@@ -1,5 +1,5 @@
 //! Form factor between two parallel unit squares one unit apart, against the
-//! closed form (notes/validation.md (a): 0.199825), then with a blocker plate
+//! closed form (docs/validation.md (a): 0.199825), then with a blocker plate
 //! halfway between them.
 //!
 //! Run: `cargo run -p trilux-geometry --release --example two_squares`

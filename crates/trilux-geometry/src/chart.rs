@@ -294,7 +294,11 @@ fn centroid(mesh: &MeshData, t: u32) -> DVec3 {
 /// Grows charts from seeds in file order, always adding the connected
 /// candidate nearest the seed's centroid within the normal cone, up to the
 /// cap. Returns the charts and the chart of every triangle.
-fn grow_charts(mesh: &MeshData, adjacency: &Adjacency<'_>, cos_cone: f64) -> (Vec<Vec<u32>>, Vec<u32>) {
+fn grow_charts(
+    mesh: &MeshData,
+    adjacency: &Adjacency<'_>,
+    cos_cone: f64,
+) -> (Vec<Vec<u32>>, Vec<u32>) {
     let n = mesh.triangles.len();
     let mut chart_of = vec![u32::MAX; n];
     let mut charts: Vec<Vec<u32>> = Vec::new();

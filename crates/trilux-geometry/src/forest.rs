@@ -69,7 +69,6 @@ impl ElementForest {
         &self.geometry
     }
 
-
     /// The root element of an input surface.
     #[inline]
     pub fn root(&self, surface: SurfaceId) -> ElementId {

@@ -1,4 +1,4 @@
-//! Form factors against the closed forms of notes/validation.md.
+//! Form factors against the closed forms of docs/validation.md.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 mod common;

@@ -1,4 +1,4 @@
-//! Final gathering (paper §4.5, Fig. 11; notes/algorithm.md §6).
+//! Final gathering (paper §4.5, Fig. 11).
 //!
 //! A ray from the eye meets the scene at x_s. The radiance leaving x_s
 //! towards the eye is
@@ -85,7 +85,7 @@ pub struct BsdfSample<const N: usize> {
 pub enum ExtraBounce {
     /// Always read the solution at the first gather hit (the paper's §4.5).
     Never,
-    /// Where the solution's steps would show (notes §6): the gather hit is
+    /// Where the solution's steps would show: the gather hit is
     /// closer than `close_factor` × the linear size of the element it hit,
     /// the BSDF lobe at x_s subtends less than the element's solid angle, or
     /// the hit surface is glossy (its stored radiance is constant over whole
@@ -329,7 +329,7 @@ impl<'a, S> FinalGather<'a, S> {
         bands::add(l, bands::mul(bs.weight, lr))
     }
 
-    /// The notes' §6 rule: would the piecewise-constant solution show here?
+    /// The extra-bounce rule: would the piecewise-constant solution show here?
     fn wants_extra_bounce<const N: usize>(
         &self,
         xs: &SurfacePoint<S::Locator>,

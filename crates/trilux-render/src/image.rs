@@ -111,7 +111,6 @@ impl Image {
         &self.pixels
     }
 
-
     /// Pixel (x, y).
     pub fn get(&self, x: u32, y: u32) -> [f32; 3] {
         self.pixels[y as usize * self.width as usize + x as usize]

@@ -107,7 +107,6 @@ impl Camera {
             FovAxis::Larger => from_y(),
         }
     }
-
 }
 
 /// Mitsuba's default field of view (50 mm lens, 36 × 24 mm film), along the

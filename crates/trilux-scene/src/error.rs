@@ -1,6 +1,6 @@
 //! Errors of scene loading, each carrying the place in the file that caused it.
 //!
-//! Every error displays as `FILE:LINE:COL: what is wrong` (design.md §3), like a
+//! Every error displays as `FILE:LINE:COL: what is wrong` (README, "Scene format"), like a
 //! compiler's, so that the command line can print it on one line. Lines and
 //! columns count from 1 and point at the element or attribute value at fault.
 

@@ -53,7 +53,7 @@ pub struct Scene {
     /// stats; trilux's solver has its own stopping rule).
     pub max_depth: Option<i64>,
     /// True when some `<spectrum>` in use gives wavelength:value pairs: the
-    /// scene then solves in spectral bands by default (design.md §2).
+    /// scene then solves in spectral bands by default.
     pub spectral: bool,
     /// Number of `<bsdf>` elements of each type written in the file (nested
     /// ones included; a referenced BSDF counts once).

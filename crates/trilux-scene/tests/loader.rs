@@ -1,4 +1,4 @@
-//! One test (at least) per element of the supported subset (design.md §3),
+//! One test (at least) per element of the supported subset (README, "Scene format"),
 //! with expected values from Mitsuba 3's documented defaults and semantics.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 

@@ -55,6 +55,6 @@ fn sheet_of_8192_triangles_loads_as_a_few_input_surfaces() {
     );
     let geometry = scene.build_geometry().unwrap_or_else(|e| panic!("{e}"));
     let surfaces = geometry.surfaces().len();
-    // Charts, not triangles: a handful of input surfaces (design.md §2).
+    // Charts, not triangles: a handful of input surfaces (docs/architecture.md, "Meshes").
     assert!((1..=64).contains(&surfaces), "{surfaces} input surfaces");
 }

@@ -1,4 +1,5 @@
-//! The energy ledger (notes §7): where every watt of emitted flux went.
+//! The energy ledger (docs/solver.md, "Energy ledger"): where every watt
+//! of emitted flux went.
 //!
 //! Kept in f64 per band. For each shot of a source with unshot flux δΦ_S:
 //! δΦ_S leaves the residual; the flux arriving on receivers through the links

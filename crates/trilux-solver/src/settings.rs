@@ -8,7 +8,8 @@ use serde::{Deserialize, Serialize};
 pub enum Transport {
     /// Lambertian parts keep one outgoing radiance per element (two-point,
     /// like hierarchical radiosity); interactions are stored only for glossy
-    /// senders (design.md §2, notes §7). The default.
+    /// senders (docs/architecture.md, "Two-point and stored transport"). The
+    /// default.
     TwoPoint,
     /// The paper's uniform treatment: every sender, Lambertian or not, keeps
     /// per-receiver interactions. For ablation and cross-checking.

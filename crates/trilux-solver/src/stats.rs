@@ -1,4 +1,4 @@
-//! Statistics of a solve, as `--stats` writes them (design.md §3).
+//! Statistics of a solve, as `--stats` writes them (README, "Using it").
 
 use serde::{Deserialize, Serialize};
 

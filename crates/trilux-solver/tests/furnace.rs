@@ -1,4 +1,4 @@
-//! The furnace (validation.md, "Whole-system checks"): inside a closed box
+//! The furnace (docs/validation.md, "Whole-system checks"): inside a closed box
 //! whose every face is Lambertian with ρ = 0.5 and emits Le = 1, the radiance
 //! is Le / (1 − ρ) everywhere (2 for Le = 1), for any discretisation, because every
 //! element's form factors sum to 1.

@@ -1,4 +1,4 @@
-//! The energy ledger on random scenes (notes §7): emitted = absorbed +
+//! The energy ledger on random scenes (docs/solver.md, "Energy ledger"): emitted = absorbed +
 //! escaped + residual, no shot and no receiving element creates energy, the
 //! residual never grows from one shot to the next, and no radiance is
 //! negative or not finite.

@@ -1,4 +1,4 @@
-//! Single-bounce checks between plates (validation.md, "Whole-system
+//! Single-bounce checks between plates (docs/validation.md, "Whole-system
 //! checks"): only the emitter shoots (a shot budget of 1), so what the
 //! receivers hold is exactly the first bounce.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
@@ -40,7 +40,7 @@ fn one_bounce_settings() -> SolverSettings {
     s
 }
 
-/// Closed form (a) of validation.md: parallel, directly opposed unit
+/// Closed form (a) of docs/validation.md: parallel, directly opposed unit
 /// squares at distance 1 have F = 0.199825. The receiver's mean radiance
 /// after one bounce is ρ Le F; at its centre the point form factor (c) is
 /// 0.239456 and the solution may differ by at most its refinement bound

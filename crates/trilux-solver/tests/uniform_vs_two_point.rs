@@ -1,6 +1,7 @@
 //! The paper's uniform treatment (every sender keeps per-receiver
 //! interactions) and trilux's two-point treatment of Lambertian parts must
-//! agree on a diffuse scene (design.md §2): compared on the classic Cornell
+//! agree on a diffuse scene (docs/architecture.md, "Two-point and stored
+//! transport"): compared on the classic Cornell
 //! box, surface by surface, on a fixed grid of points through the Solution
 //! API.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic

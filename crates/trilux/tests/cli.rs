@@ -1,6 +1,6 @@
 //! The `trilux` binary: scene errors give exactly one line
 //! `error: FILE:LINE:COL: ...` on stderr and exit status 1; usage errors exit
-//! with clap's status 2; `info --json` has exactly design.md §3's keys.
+//! with clap's status 2; `info --json` has exactly the documented keys (README, "Using it").
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 use std::path::{Path, PathBuf};
@@ -279,7 +279,7 @@ fn info_json_has_exactly_the_design_keys() {
 fn info_json_for_the_cornell_box() {
     let v = info_json(&scenes_dir().join("cornell-box.xml"), &["--mode", "rgb"]);
     assert_eq!(v["shapes"], 8);
-    // One input surface per rectangle, one per cube face (design.md §2).
+    // One input surface per rectangle, one per cube face (docs/architecture.md, "Meshes").
     assert_eq!(v["input_surfaces"], 6 + 2 * 6);
     assert_eq!(v["emitters"], 1);
     assert_eq!(v["bsdfs"], serde_json::json!({ "diffuse": 3 }));
@@ -298,7 +298,7 @@ fn info_json_for_the_cornell_box() {
     );
     // π · A · L: the light is 0.46 × 0.38 (Mitsuba's area 0.1748) and the
     // classic light spectrum is linear sRGB (20.7108, 10.8546, 2.77115)
-    // (design.md §3, Mitsuba 3.9). 1e-4 relative: the check value's digits.
+    // (Mitsuba 3.9's value). 1e-4 relative: the check value's digits.
     let power = v["emitted_power"].as_array().expect("array");
     for (p, l) in power.iter().zip([20.7108, 10.8546, 2.77115]) {
         let want = std::f64::consts::PI * 0.1748 * l;
