@@ -96,12 +96,11 @@ proptest! {
             prop_assert!((0.0..=1.0).contains(&v));
             // Reciprocity for elements whose boxes are well apart (smooth
             // kernel): within the stated errors plus 2% for the sampled
-            // estimates' statistical error, at every magnitude. (Until
-            // session 3 a planar element that saw a non-planar cluster only
-            // through a sliver in front of one of its pieces could miss it
-            // entirely, 0 against up to 3.4e-6; the integration domain is
-            // now clipped to each piece's front half-space. The cases are
-            // kept in the regressions file.)
+            // estimates' statistical error, at every magnitude. (A planar
+            // element that sees a non-planar cluster only through a sliver in
+            // front of one of its pieces is the hard case: the integration
+            // domain is clipped to each piece's front half-space so that it
+            // is not missed; such cases are kept in the regressions file.)
             let (ei, ej) = (g.element(i), g.element(j));
             let gap = (ei.bounds.centre() - ej.bounds.centre()).length() - 0.5 * (ei.bounds.diagonal().length() + ej.bounds.diagonal().length());
             if gap > 0.5 * ei.bounds.diagonal().length().max(ej.bounds.diagonal().length()) {
