@@ -92,7 +92,7 @@ impl<const N: usize> Conductor<N> {
     /// 12 midpoints each) so that the distributions' long tails are resolved;
     /// φ uses 96 midpoints over a half turn (the integrand is even in φ once wo
     /// is rotated into the xz plane). ≈ 28k evaluations. Accuracy: see the
-    /// tests (against docs/docs/validation.md's table and against sampling).
+    /// tests (against docs/validation.md's table and against sampling).
     pub fn albedo(&self, wo: DVec3) -> Spectrum<N> {
         if wo.z <= 0.0 {
             return Spectrum::zero();

@@ -5,7 +5,7 @@
 //!
 //! Contents, in reading order:
 //! - [`spectrum`]: [`Spectrum<N>`](Spectrum), light in `N` bands (3: RGB
-//!   mode, 10: the paper's spectral mode), per-band arithmetic, XYZ and
+//!   mode, 20 in spectral mode, any N in general), per-band arithmetic, XYZ and
 //!   luminance.
 //! - [`mode`]: [`Mode`] (RGB or spectral) and the rule that picks it.
 //! - [`param`]: colour values as a scene file states them ([`ColorParam`]).

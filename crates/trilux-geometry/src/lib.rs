@@ -119,7 +119,8 @@ pub use face::{FaceElement, FaceId, PerFace, Side, Sided};
 pub use forest::ElementForest;
 pub use form_factor::{
     FormFactor, FormFactorOptions, MAX_POLYGON_PIECES, form_factor, form_factor_batch,
-    form_factor_front, point_to_polygon, point_to_polygon_front,
+    PointFormFactors, form_factor_front, point_form_factor, point_to_polygon,
+    point_to_polygon_front,
 };
 pub use geometry::{Geometry, Hit, RAY_EPSILON, Ray};
 pub use ids::{ElementId, SurfaceId};

@@ -18,11 +18,12 @@ fn print_stats(s: &trilux_solver::SolveStats) {
     let sum = |v: &[f64]| v.iter().sum::<f64>();
     let e = sum(&s.emitted_flux);
     println!(
-        "CR {:.4}, shots {}, elements {}, interactions {}; of emitted: absorbed {:.4}, escaped {:.4}, residual {:.4}",
+        "CR {:.4}, shots {}, elements {}, interactions {}, gather links {}; of emitted: absorbed {:.4}, escaped {:.4}, residual {:.4}",
         s.convergence_ratio,
         s.shots,
         s.elements,
         s.interactions,
+        s.gather_links,
         sum(&s.absorbed_flux) / e,
         sum(&s.escaped_flux) / e,
         sum(&s.residual_flux) / e
@@ -81,9 +82,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         image.write_exr(out)?;
     }
     println!(
-        "solve {:.2} s, render {:.2} s, extra bounces {} of {} gather rays, mean {:?}",
+        "solve {:.2} s, render {:.2} s, {} link senders, {} shadow rays, extra bounces {} of {} gather rays, mean {:?}",
         outcome.solve_seconds,
         stats.seconds,
+        stats.gather.link_senders,
+        stats.gather.shadow_rays,
         stats.gather.extra_bounces,
         stats.gather.gather_rays,
         image.mean()

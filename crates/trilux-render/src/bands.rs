@@ -1,7 +1,7 @@
 //! Per-band radiance as plain `[f64; N]` arrays.
 //!
 //! The integrator is generic over the number of bands `N` (3 in RGB mode,
-//! 10 in the paper's spectral mode). It only needs addition and products, so
+//! 20 in spectral mode). It only needs addition and products, so
 //! it works on arrays; the adapter to the solver converts its spectra.
 
 /// All bands zero.

@@ -18,7 +18,25 @@ use crate::film::Film;
 use crate::filter::ReconstructionFilter;
 use crate::gather::{ExtraBounce, FinalGather, GatherScene, GatherStats};
 use crate::image::Image;
+use crate::link_gather::{Caches, LinkGather, Preview};
 use crate::sampler::{MAX_SAMPLES, PixelSampler, dims};
+
+/// How a camera sample reads the solution.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Estimator {
+    /// The solution's gather links at the primary hit (Lambertian parts
+    /// without Monte Carlo noise but in penumbrae), a gather ray for glossy
+    /// parts (`link_gather`). The default.
+    #[default]
+    Links,
+    /// The path gather of paper §4.5: a light sample and a BSDF-sampled
+    /// gather ray at the primary hit, the solution read at the gather hit
+    /// (or one bounce later, by the extra-bounce rule).
+    Paths,
+    /// No random rays: the links with their own visibility, one mirror
+    /// reading for glossy parts (`link_gather::Preview`).
+    Preview,
+}
 
 /// How to render.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -30,7 +48,9 @@ pub struct RenderSettings {
     pub seed: u32,
     /// Reconstruction filter (Mitsuba's Gaussian by default).
     pub filter: ReconstructionFilter,
-    /// When to continue a gather path one bounce ([`ExtraBounce`]).
+    /// How a camera sample reads the solution.
+    pub estimator: Estimator,
+    /// When the path gather continues one bounce ([`ExtraBounce`]).
     pub extra_bounce: ExtraBounce,
     /// Tile edge in pixels.
     pub tile_size: u32,
@@ -42,6 +62,7 @@ impl Default for RenderSettings {
             spp: 64,
             seed: 0,
             filter: ReconstructionFilter::default(),
+            estimator: Estimator::default(),
             extra_bounce: ExtraBounce::default(),
             tile_size: 16,
         }
@@ -102,12 +123,33 @@ where
     let total = (tiles_x * tiles_y) as usize;
     let border = settings.filter.radius().ceil() as i64;
     let done = AtomicUsize::new(0);
-    let gather = FinalGather {
+    let paths = FinalGather {
         scene,
         extra: settings.extra_bounce,
     };
+    let links = LinkGather {
+        scene,
+        fallback: FinalGather {
+            scene,
+            extra: settings.extra_bounce,
+        },
+        glossy_scene: scene.has_glossy_faces(),
+    };
+    let preview = Preview { scene };
+    let sample = |origin,
+                  dir,
+                  sampler: &PixelSampler,
+                  caches: &mut Caches<N>,
+                  stats: &mut GatherStats|
+     -> [f64; N] {
+        match settings.estimator {
+            Estimator::Links => links.camera_sample::<N>(origin, dir, sampler, caches, stats),
+            Estimator::Paths => paths.camera_sample::<N>(origin, dir, sampler, stats),
+            Estimator::Preview => preview.camera_sample::<N>(origin, dir, caches, stats),
+        }
+    };
     // Each dimension layout must fit the sequence: two levels of gather.
-    const { assert!(dims::GATHER + 2 * dims::PER_LEVEL <= 256) };
+    const { assert!(dims::LINKS + 8 <= 256) };
 
     let tiles: Vec<(Film, GatherStats)> = (0..total)
         .into_par_iter()
@@ -124,15 +166,16 @@ where
                 settings.filter,
             );
             let mut stats = GatherStats::default();
+            let mut caches = Caches::<N>::default();
             for y in ty..ty + th {
                 for x in tx..tx + tw {
+                    caches.pixel.clear();
                     let mut sampler = PixelSampler::new(settings.seed, x, y);
                     for s in 0..settings.spp {
                         sampler.start_sample(s);
                         let film_pos = DVec2::new(x as f64, y as f64) + sampler.get2(dims::FILM);
                         let ray = camera.ray(film_pos);
-                        let l =
-                            gather.camera_sample::<N>(ray.origin, ray.dir, &sampler, &mut stats);
+                        let l = sample(ray.origin, ray.dir, &sampler, &mut caches, &mut stats);
                         let rgb = to_rgb(&l);
                         if rgb.iter().all(|v| v.is_finite()) {
                             film.splat(film_pos.x, film_pos.y, rgb);

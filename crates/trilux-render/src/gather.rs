@@ -174,6 +174,66 @@ pub trait GatherScene<const N: usize>: Sync {
     fn shading_differs(&self, _at: &SurfacePoint<Self::Locator>) -> bool {
         false
     }
+
+    /// The Lambertian part's reflectance ρ_d at `at` on the side of `wo`
+    /// (zero where there is none).
+    fn diffuse_albedo(&self, _at: &SurfacePoint<Self::Locator>, _wo: DVec3) -> [f64; N] {
+        [0.0; N]
+    }
+
+    /// The radiance arriving at `at` (on the side of `wo`) from the
+    /// solution's senders, Σ_i L_i F(x → i) V(x, i), so that ρ_d times it
+    /// is the Lambertian reflected radiance (`link_gather`), reusing what
+    /// `cache` holds for the same leaf; `None` when the scene has no
+    /// solution links to gather.
+    fn solution_irradiance(
+        &self,
+        _at: &SurfacePoint<Self::Locator>,
+        _wo: DVec3,
+        _visibility: crate::link_gather::LinkVisibility<'_>,
+        _cache: &mut crate::link_sum::LinkCache<N>,
+        _stats: &mut GatherStats,
+    ) -> Option<[f64; N]> {
+        None
+    }
+
+    /// True when the BSDF at `at` has a glossy part on the side of `wo`.
+    fn is_glossy(&self, _at: &SurfacePoint<Self::Locator>, _wo: DVec3) -> bool {
+        false
+    }
+
+    /// The glossy part fr_glossy(ω_i, ω_o)·|cos θ_i| of [`Self::bsdf_cos`].
+    fn glossy_cos(&self, _at: &SurfacePoint<Self::Locator>, _wi: DVec3, _wo: DVec3) -> [f64; N] {
+        [0.0; N]
+    }
+
+    /// The solution's reflected radiance at `from` towards `towards`
+    /// without its Lambertian part (the stored glossy radiance).
+    fn reflected_glossy(
+        &self,
+        _from: &SurfacePoint<Self::Locator>,
+        _towards: &SurfacePoint<Self::Locator>,
+    ) -> [f64; N] {
+        [0.0; N]
+    }
+
+    /// A direction sampled with density cos θ/π about the normal on the
+    /// side of `wo` (the Lambertian part's importance), `None` below the
+    /// surface.
+    fn sample_cosine(&self, _at: &SurfacePoint<Self::Locator>, _wo: DVec3, _u: DVec2) -> Option<DVec3> {
+        None
+    }
+
+    /// True when some face of the scene has a glossy part.
+    fn has_glossy_faces(&self) -> bool {
+        false
+    }
+
+    /// The mirror direction of `wo` about the shading normal at `at` and
+    /// the glossy part's directional albedo there (for previews).
+    fn mirror(&self, _at: &SurfacePoint<Self::Locator>, _wo: DVec3) -> Option<(DVec3, [f64; N])> {
+        None
+    }
 }
 
 /// The power heuristic (β = 2) weight of a strategy with density `a`
@@ -203,6 +263,8 @@ pub struct GatherStats {
     pub extra_bounces: u64,
     /// Samples dropped because a value was not finite (should stay 0).
     pub dropped: u64,
+    /// Senders of gather links evaluated (point form factors).
+    pub link_senders: u64,
 }
 
 impl GatherStats {
@@ -213,6 +275,7 @@ impl GatherStats {
         self.shadow_rays += o.shadow_rays;
         self.extra_bounces += o.extra_bounces;
         self.dropped += o.dropped;
+        self.link_senders += o.link_senders;
     }
 }
 
@@ -255,7 +318,7 @@ impl<'a, S> FinalGather<'a, S> {
     /// Reflected radiance leaving `x` towards `wo`: light sample + gather
     /// ray, MIS-combined; gather hits read the solution (level 0 may
     /// continue one bounce by the [`ExtraBounce`] rule).
-    fn gather<const N: usize>(
+    pub(crate) fn gather<const N: usize>(
         &self,
         x: &SurfacePoint<S::Locator>,
         wo: DVec3,

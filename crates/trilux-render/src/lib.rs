@@ -22,6 +22,9 @@
 //!   per pixel, decorrelated by the seed.
 //! - [`gather`]: the abstraction the integrator is written against
 //!   ([`GatherScene`]) and the final-gather estimator itself.
+//! - [`link_gather`]: rendering from the solution's gather links (the
+//!   default) and the noise-free preview; [`link_sum`]: the sum over the
+//!   links at one point.
 //! - [`solved`]: [`GatherScene`] for trilux's geometry, BRDFs and a
 //!   solution ([`RadianceSolution`]).
 //! - [`pipeline`]: the one orchestration — prepare a loaded scene in its
@@ -46,6 +49,8 @@ pub mod film;
 pub mod filter;
 pub mod gather;
 pub mod image;
+pub mod link_gather;
+pub mod link_sum;
 pub mod pipeline;
 pub mod sampler;
 pub mod solved;
@@ -53,7 +58,7 @@ pub mod view;
 
 pub use camera::{Camera, FovAxis, Ray};
 pub use compare::{Comparison, compare};
-pub use driver::{RenderSettings, RenderStats, render, render_image};
+pub use driver::{Estimator, RenderSettings, RenderStats, render, render_image};
 pub use error::RenderError;
 pub use film::Film;
 pub use filter::ReconstructionFilter;

@@ -20,6 +20,11 @@ pub mod dims {
     /// Dimensions one gather level uses: light pick (1), point on the light
     /// (2), BSDF direction (2).
     pub const PER_LEVEL: u32 = 5;
+    /// The cosine-sampled direction of the link gather's glossy-sender term
+    /// (2 dimensions per level, three levels, after three gather levels).
+    pub const GLOSSY_SENDERS: u32 = GATHER + 3 * PER_LEVEL;
+    /// First dimension of the shadow rays of partly visible gather links.
+    pub const LINKS: u32 = GLOSSY_SENDERS + 6;
 }
 
 /// Largest number of samples per pixel the sequence supports.

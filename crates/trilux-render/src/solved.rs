@@ -27,10 +27,13 @@ use std::sync::Arc;
 use glam::{DVec2, DVec3};
 use trilux_brdf::{Bsdf, Frame};
 use trilux_color::Spectrum;
-use trilux_geometry::{ElementForest, FaceId, Geometry, Ray, Side, SurfaceCoord, SurfaceId};
-use trilux_solver::{PreparedScene, SurfaceSite};
+use trilux_geometry::{
+    ElementForest, ElementId, FaceElement, FaceId, Geometry, Ray, Side, SurfaceCoord, SurfaceId,
+};
+use trilux_solver::{GatherLink, PreparedScene, SurfaceSite};
 
-use crate::gather::{BsdfSample, GatherScene, LightSample, SurfacePoint};
+use crate::gather::{BsdfSample, GatherScene, GatherStats, LightSample, SurfacePoint};
+use crate::link_gather::LinkVisibility;
 
 /// What the renderer needs of a view-independent solution.
 pub trait RadianceSolution<const N: usize>: Sync {
@@ -41,6 +44,26 @@ pub trait RadianceSolution<const N: usize>: Sync {
     fn forest(&self) -> &ElementForest;
     /// Reflected radiance (emission excluded) leaving `from` towards `to`.
     fn reflected(&self, from: &SurfaceSite, to: &SurfaceSite) -> Spectrum<N>;
+
+    /// True when the solution has gather links (`trilux_solver::gather_links`).
+    fn has_links(&self) -> bool {
+        false
+    }
+
+    /// Calls `f` with every gather link into element `e` and the radiance
+    /// its sender sends.
+    fn for_each_link(&self, _e: FaceElement, _f: &mut dyn FnMut(&GatherLink, Spectrum<N>)) {}
+
+    /// The final radiance L + Le element `e` of `face` sends (for refining
+    /// a sender near the point being shaded).
+    fn face_radiance(&self, _face: FaceId, _e: ElementId) -> Spectrum<N> {
+        Spectrum::zero()
+    }
+
+    /// The stored (glossy) part alone of [`Self::reflected`].
+    fn reflected_glossy(&self, _from: &SurfaceSite, _to: &SurfaceSite) -> Spectrum<N> {
+        Spectrum::zero()
+    }
 }
 
 /// A stand-in solution that knows no indirect light (every reflected
@@ -113,6 +136,10 @@ pub struct SolvedScene<'a, const N: usize, S> {
     emitters: Vec<(SurfaceId, f64)>,
     /// Pick probability / area, by surface index (0 when not emitting).
     light_density: Vec<f64>,
+    /// Every element's shape for point form factors (the link sums).
+    ff: trilux_geometry::PointFormFactors,
+    /// Some material has a glossy part on some side.
+    glossy_faces: bool,
 }
 
 impl<'a, const N: usize, S: RadianceSolution<N>> SolvedScene<'a, N, S> {
@@ -149,12 +176,23 @@ impl<'a, const N: usize, S: RadianceSolution<N>> SolvedScene<'a, N, S> {
         if let Some(last) = emitters.last_mut() {
             last.1 = 1.0;
         }
+        let ff = if solution.has_links() {
+            trilux_geometry::PointFormFactors::new(solution.forest())
+        } else {
+            trilux_geometry::PointFormFactors::new(&ElementForest::new(Arc::clone(scene.geometry())))
+        };
+        let glossy_faces = scene
+            .materials()
+            .iter()
+            .any(|b| Side::BOTH.iter().any(|&s| b.has_glossy(s)));
         Self {
             scene,
             solution,
             lobe_sr,
             emitters,
             light_density,
+            ff,
+            glossy_faces,
         }
     }
 
@@ -296,6 +334,88 @@ impl<const N: usize, S: RadianceSolution<N>> GatherScene<N> for SolvedScene<'_, 
         // More than about 1° apart.
         at.locator.shading_normal.dot(at.normal).abs() < 0.9998
     }
+
+    fn diffuse_albedo(&self, at: &SurfacePoint<HitLocator>, wo: DVec3) -> [f64; N] {
+        self.bsdf(at).diffuse_albedo(viewer_side(at, wo)).0
+    }
+
+    fn solution_irradiance(
+        &self,
+        at: &SurfacePoint<HitLocator>,
+        wo: DVec3,
+        visibility: LinkVisibility<'_>,
+        cache: &mut crate::link_sum::LinkCache<N>,
+        stats: &mut GatherStats,
+    ) -> Option<[f64; N]> {
+        if !self.solution.has_links() {
+            return None;
+        }
+        let side = viewer_side(at, wo);
+        let receiver = crate::link_sum::Receiver {
+            x: at.point,
+            n: at.locator.shading_normal * side.sign(),
+            leaf: FaceElement::new(
+                self.solution
+                    .forest()
+                    .locate(at.locator.surface, at.locator.coord),
+                side,
+            ),
+        };
+        let sum =
+            crate::link_sum::link_sum(self.solution, &self.ff, &receiver, visibility, cache, stats);
+        Some(sum.0)
+    }
+
+    fn is_glossy(&self, at: &SurfacePoint<HitLocator>, wo: DVec3) -> bool {
+        self.bsdf(at).has_glossy(viewer_side(at, wo))
+    }
+
+    fn glossy_cos(&self, at: &SurfacePoint<HitLocator>, wi: DVec3, wo: DVec3) -> [f64; N] {
+        let frame = Frame::from_normal(at.locator.shading_normal);
+        let (wi, wo) = (frame.to_local(wi), frame.to_local(wo));
+        (self.bsdf(at).eval_glossy(wi, wo) * wi.z.abs()).0
+    }
+
+    fn reflected_glossy(
+        &self,
+        from: &SurfacePoint<HitLocator>,
+        towards: &SurfacePoint<HitLocator>,
+    ) -> [f64; N] {
+        let d = towards.point - from.point;
+        let from_side = Side::from_back(from.normal.dot(d) < 0.0);
+        let to_side = Side::from_back(towards.normal.dot(-d) < 0.0);
+        self.solution
+            .reflected_glossy(&Self::site(from, from_side), &Self::site(towards, to_side))
+            .0
+    }
+
+    fn sample_cosine(&self, at: &SurfacePoint<HitLocator>, wo: DVec3, u: DVec2) -> Option<DVec3> {
+        let n = at.locator.shading_normal * viewer_side(at, wo).sign();
+        let local = trilux_brdf::lobe::square_to_cosine_hemisphere(u);
+        let wi = Frame::from_normal(n).to_world(local);
+        (wi.dot(at.normal) * wo.dot(at.normal) > 0.0).then_some(wi)
+    }
+
+    fn has_glossy_faces(&self) -> bool {
+        self.glossy_faces
+    }
+
+    fn mirror(&self, at: &SurfacePoint<HitLocator>, wo: DVec3) -> Option<(DVec3, [f64; N])> {
+        let n = at.locator.shading_normal;
+        let wi = 2.0 * n.dot(wo) * n - wo;
+        if wi.dot(at.normal) * wo.dot(at.normal) <= 0.0 {
+            return None;
+        }
+        let frame = Frame::from_normal(n);
+        let bsdf = self.bsdf(at);
+        let glossy = bsdf.albedo(frame.to_local(wo)) - bsdf.diffuse_albedo(viewer_side(at, wo));
+        Some((wi, glossy.max(Spectrum::zero()).0))
+    }
+}
+
+/// The side of `at`'s surface the viewer direction `wo` is on (geometric).
+fn viewer_side(at: &SurfacePoint<HitLocator>, wo: DVec3) -> Side {
+    Side::from_back(at.normal.dot(wo) < 0.0)
 }
 
 /// The solver's solution answers the renderer's queries directly.
@@ -308,5 +428,19 @@ impl<const N: usize> RadianceSolution<N> for trilux_solver::Solution<N> {
     }
     fn reflected(&self, from: &SurfaceSite, to: &SurfaceSite) -> Spectrum<N> {
         self.radiance(from, to)
+    }
+    fn has_links(&self) -> bool {
+        !self.all_gather_links().is_empty()
+    }
+    fn for_each_link(&self, e: FaceElement, f: &mut dyn FnMut(&GatherLink, Spectrum<N>)) {
+        for (link, l) in self.gather_links(e) {
+            f(link, l);
+        }
+    }
+    fn face_radiance(&self, face: FaceId, e: ElementId) -> Spectrum<N> {
+        trilux_solver::Solution::face_radiance(self, face, e)
+    }
+    fn reflected_glossy(&self, from: &SurfaceSite, to: &SurfaceSite) -> Spectrum<N> {
+        self.stored_radiance(from, to)
     }
 }

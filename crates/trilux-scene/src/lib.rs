@@ -4,8 +4,7 @@
 //! (their plain-data parameter types), `glam`, `roxmltree` and `tobj`.
 //! File formats live only here; the solver and the renderer never parse.
 //!
-//! The loader reads the subset of Mitsuba 3's XML listed in the README
-//! (and in the README) with Mitsuba's semantics and defaults, and refuses
+//! The loader reads the subset of Mitsuba 3's XML listed in the README with Mitsuba's semantics and defaults, and refuses
 //! anything else with an error that displays as `FILE:LINE:COL: what is
 //! wrong`. Like Mitsuba's parser it works in stages:
 //!

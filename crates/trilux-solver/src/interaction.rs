@@ -197,15 +197,13 @@ impl<const N: usize> Hierarchy<N> {
         }
     }
 
-    /// Unshot radiance for the element pair (i, j): that of the deepest node
-    /// whose elements contain i and j (after push-pull every node's δL is
-    /// the flux-weighted average of its subtree).
-    pub fn unshot_for(&self, forest: &ElementForest, i: ElementId, j: ElementId) -> Spectrum<N> {
+    /// The deepest node whose elements contain the element pair (i, j).
+    pub fn node_for(&self, forest: &ElementForest, i: ElementId, j: ElementId) -> u32 {
         let mut n = 0u32;
         loop {
             let node = &self.nodes[n as usize];
             let Some(children) = self.children(n) else {
-                return node.unshot;
+                return n;
             };
             let next = children.into_iter().find(|&c| {
                 let child = &self.nodes[c as usize];
@@ -217,7 +215,7 @@ impl<const N: usize> Hierarchy<N> {
             });
             match next {
                 Some(c) => n = c,
-                None => return node.unshot,
+                None => return n,
             }
         }
     }

@@ -20,6 +20,7 @@
 //! - [`solver`]: preparing a solve and the progressive loop (§4, Fig. 7
 //!   and 9); `shot`: one shot's phases; `glossy`: the glossy
 //!   renormalisation.
+//! - [`gather_links`]: the final gather's links, kept for rendering.
 //! - [`ledger`]: where the energy went.
 //! - [`solution`]: the radiance query for final gathering and the file
 //!   format.
@@ -30,6 +31,7 @@
 
 pub mod error;
 mod faces;
+pub mod gather_links;
 mod glossy;
 mod interaction;
 pub mod ledger;
@@ -44,6 +46,7 @@ pub mod stats;
 mod throughput;
 
 pub use error::SolverError;
+pub use gather_links::{GatherLink, GatherLinks, LinkSource};
 pub use interaction::Split;
 pub use ledger::Ledger;
 pub use prepared::{PrepareError, PreparedScene, SceneDescription};

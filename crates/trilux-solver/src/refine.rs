@@ -39,24 +39,59 @@ use crate::radiosity::ElementRadiance;
 use crate::settings::{SolverSettings, Transport};
 use crate::throughput::{Throughput, ThroughputCache, compute_throughput};
 
-/// What a shot sends from: unshot radiance by element pair.
+/// What a sender sends: its unshot radiance δL (a shot), or its final
+/// radiance L plus emission (the gather links made after the solve).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Sent {
+    /// δL, during the solve.
+    Unshot,
+    /// L + Le, after the solve.
+    Final,
+}
+
+/// Where refinement takes the radiance a sender sends, by element pair.
 pub(crate) enum Sender<'a, const N: usize> {
-    /// A Lambertian side: δL of its element tree, the same towards every j.
+    /// A Lambertian face: the radiance of its element tree, the same
+    /// towards every j.
     Radiosity {
         /// The face's per-element radiance.
         field: &'a ElementRadiance<N>,
         /// The side it sends from.
         side: Side,
+        /// Unshot or final radiance.
+        sent: Sent,
+        /// The face's emitted radiance (added to the final radiance).
+        emission: Spectrum<N>,
     },
     /// A stored interaction hierarchy.
-    Stored(&'a Hierarchy<N>),
+    Stored {
+        /// The hierarchy.
+        hierarchy: &'a Hierarchy<N>,
+        /// Unshot or final radiance.
+        sent: Sent,
+    },
 }
 
 impl<const N: usize> Sender<'_, N> {
+    /// The radiance element i sends towards element j.
     fn unshot(&self, forest: &ElementForest, i: ElementId, j: ElementId) -> Spectrum<N> {
-        match self {
-            Sender::Radiosity { field, side } => field.unshot[*side][i.index()],
-            Sender::Stored(h) => h.unshot_for(forest, i, j),
+        match *self {
+            Sender::Radiosity {
+                field,
+                side,
+                sent,
+                emission,
+            } => match sent {
+                Sent::Unshot => field.unshot[side][i.index()],
+                Sent::Final => field.radiance[side][i.index()] + emission,
+            },
+            Sender::Stored { hierarchy, sent } => {
+                let node = &hierarchy.nodes[hierarchy.node_for(forest, i, j) as usize];
+                match sent {
+                    Sent::Unshot => node.unshot,
+                    Sent::Final => node.radiance,
+                }
+            }
         }
     }
 }
@@ -338,13 +373,12 @@ impl<const N: usize> RefineContext<'_, N> {
     /// δL̄_i = Σ a_c δL_c / Σ a_c) and F̂ point-to-disc estimates.
     fn sender_varies(&self, shot: PairShot<'_, N>, i: ElementId, j: ElementId) -> bool {
         let PairShot { sender, si, sj } = shot;
-        let Sender::Radiosity { field, side } = sender else {
+        let Sender::Radiosity { side: s, .. } = *sender else {
             return false;
         };
         let Some(children) = self.forest.element(i).children() else {
             return false;
         };
-        let s = *side;
         let ej = self.forest.element(j);
         let nj = ej.normal * sj.side().sign();
         let ni = si.side().sign();
@@ -353,7 +387,7 @@ impl<const N: usize> RefineContext<'_, N> {
             let ec = self.forest.element(c);
             let a = self.exposed_area[s][c.index()];
             let f = a * disc_estimate(ec.centre, ec.normal * ni, ej.centre, nj, ej.area);
-            let dl = field.unshot[s][c.index()].sum();
+            let dl = sender.unshot(self.forest, c, j).sum();
             resolved += f * dl;
             weight += f;
             mean += a * dl;

@@ -57,7 +57,7 @@ pub struct SolverSettings {
     /// FFErr: a pair link is accurate enough when the point form factor to
     /// the sender varies by less than this over the receiver (so that the
     /// gathered radiance can be pushed down unchanged); three-point links
-    /// compare the point-to-disc estimates of (j, k) against it (HSA91).
+    /// compare the spread of the point form factor over (j, k) against it.
     pub ff_eps: f64,
     /// FrErr: bound on π F (fr_max − fr_min) over the three elements.
     pub fr_eps: f64,

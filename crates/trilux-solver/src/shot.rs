@@ -11,7 +11,7 @@
 //! 5. [`Solver::receive`]: per pair link (a "group"), the Lambertian share
 //!    goes straight into j's radiance, the glossy share is renormalised
 //!    (`glossy`) and the ledger books what was absorbed.
-//! 6. [`Solver::gather_links`] and [`Solver::unlink`]: the node links add
+//! 6. [`Solver::apply_node_links`] and [`Solver::unlink`]: the node links add
 //!    their (renormalised) radiance, then links die and δL of the source is
 //!    zeroed (links live for one shot: memory O(n + k²), §4.2).
 
@@ -23,8 +23,30 @@ use trilux_color::Spectrum;
 use trilux_geometry::{ElementId, FaceId, Visibility};
 
 use crate::interaction::Hierarchy;
-use crate::refine::{Incidence, NodeLink, PairLink, PairShot, RefineContext, Sender, TripleTask};
+use crate::refine::{
+    Incidence, NodeLink, PairLink, PairShot, RefineContext, Sender, Sent, TripleTask,
+};
 use crate::solver::{Solver, Source};
+
+/// The refinement context over the parts of `s` that refinement reads (a
+/// macro of field borrows, so that the hierarchies stay free to borrow
+/// mutably beside it).
+macro_rules! refine_context {
+    ($s:expr) => {
+        RefineContext {
+            forest: &$s.forest,
+            visibility: Visibility::new(&$s.forest, $s.burial.as_ref()),
+            settings: &$s.settings,
+            faces: &$s.faces,
+            materials: $s.scene.materials(),
+            cache: &$s.cache,
+            flux_threshold: $s.settings.flux_eps * $s.emitted.sum(),
+            points: &$s.points,
+            interior: &$s.interior,
+            exposed_area: &$s.exposed_area,
+        }
+    };
+}
 
 /// The most a stored interaction's shot is scaled up to carry its whole
 /// unshot flux (see [`shot_scale`]).
@@ -137,8 +159,13 @@ impl<const N: usize> Solver<N> {
                 Sending::Radiosity(f) => Sender::Radiosity {
                     field: ctx.field,
                     side: f.side(),
+                    sent: Sent::Unshot,
+                    emission: Spectrum::zero(),
                 },
-                Sending::Stored { hierarchy, .. } => Sender::Stored(hierarchy),
+                Sending::Stored { hierarchy, .. } => Sender::Stored {
+                    hierarchy,
+                    sent: Sent::Unshot,
+                },
             };
             let pair_links = stage_one(&ctx.refine, &sender, send_face, &pairs);
             let incidences = incidences(&ctx.refine, &sender, send_face, &pair_links);
@@ -155,7 +182,7 @@ impl<const N: usize> Solver<N> {
         let scale = shot_scale(&pair_links, phi, matches!(source, Source::Stored(_)));
         let node_links = self.book_lost(stage_two);
         let group_scale = self.receive(&pair_links, &incidences, &node_links, scale, phi);
-        self.gather_links(&node_links, scale, &group_scale);
+        self.apply_node_links(&node_links, scale, &group_scale);
         let live = pair_links.len() + node_links.len();
         self.stats.links_peak = self.stats.links_peak.max(live);
         self.stats.links_total += live as u64;
@@ -204,24 +231,17 @@ impl<const N: usize> Solver<N> {
     /// The refinement context (borrowing what refinement reads) beside the
     /// stored hierarchies that stage 2 refines.
     fn split_for_shot(&mut self) -> (ShotContext<'_, N>, &mut Vec<Option<Hierarchy<N>>>) {
-        let flux_threshold = self.settings.flux_eps * self.emitted.sum();
-        let refine = RefineContext {
-            forest: &self.forest,
-            visibility: Visibility::new(&self.forest, self.burial.as_ref()),
-            settings: &self.settings,
-            faces: &self.faces,
-            materials: self.scene.materials(),
-            cache: &self.cache,
-            flux_threshold,
-            points: &self.points,
-            interior: &self.interior,
-            exposed_area: &self.exposed_area,
-        };
+        let refine = refine_context!(self);
         let ctx = ShotContext {
             refine,
             field: &self.field,
         };
         (ctx, &mut self.hierarchies)
+    }
+
+    /// The refinement context of this solver (everything refinement reads).
+    pub(crate) fn refine_context(&self) -> RefineContext<'_, N> {
+        refine_context!(self)
     }
 
     /// Flux that a split could not keep leaves the residual (it is booked
@@ -243,7 +263,7 @@ impl<const N: usize> Solver<N> {
     /// Phase 6a: every node link adds its radiance, scaled by the shot and
     /// its group, to its node's L^G and the node's flux to its hierarchy's
     /// key (the renormalisation applies to both alike).
-    fn gather_links(
+    fn apply_node_links(
         &mut self,
         node_links: &[NodeLink<N>],
         shot_scale: Spectrum<N>,
@@ -289,6 +309,7 @@ impl<const N: usize> Solver<N> {
         }
     }
 }
+
 
 /// What a shot's refinement reads.
 pub(crate) struct ShotContext<'a, const N: usize> {

@@ -404,8 +404,10 @@ impl<const N: usize> Solver<N> {
                 self.used[n.to.index()] = true;
             }
         }
+        let links = self.gather_links();
         let residual = self.residual();
         let stats = &mut self.stats;
+        stats.gather_links = links.len();
         stats.elements = self.used.iter().filter(|&&u| u).count();
         stats.interactions = self
             .hierarchies
@@ -426,7 +428,7 @@ impl<const N: usize> Solver<N> {
         stats.solve_seconds = seconds;
         stats.min_shot_escaped = self.ledger.min_shot_escaped;
         stats.min_element_absorbed = self.ledger.min_element_absorbed;
-        Solution::from_solver(self)
+        Solution::from_solver(self, links)
     }
 
     /// The element trees (pre-subdivided to the depth limits).

@@ -23,6 +23,10 @@ pub struct SolveStats {
     pub links_peak: usize,
     /// Links created over the whole solve.
     pub links_total: u64,
+    /// Gather links kept with the solution for rendering (the final
+    /// gather's transfers, `gather_links`).
+    #[serde(default)]
+    pub gather_links: usize,
     /// Shooting iterations.
     pub shots: u64,
     /// CR = (IF − RF)/IF (paper §6).

@@ -9,8 +9,8 @@
 //! total. The reference's own noise is ≤ 0.12 % (its `relative_stderr`);
 //! the rest is the solver's discretisation at the default quality (flux
 //! threshold 1e-5 of the emitted flux, piecewise-constant radiance near
-//! the boxes' contact with the floor), measured at 0.5–1.6 % per face and
-//! 1.1 % in total (docs/results.md, "The solution surface by surface").
+//! the boxes' contact with the floor), measured at 0.3–1.4 % per face and
+//! 0.86 % in total (docs/results.md, "The solution surface by surface").
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 use std::path::PathBuf;

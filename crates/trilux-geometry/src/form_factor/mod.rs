@@ -53,6 +53,7 @@
 
 pub(crate) mod cubature;
 pub mod lambert;
+pub mod point;
 pub(crate) mod sampled;
 
 use std::f64::consts::PI;
@@ -71,6 +72,7 @@ use cubature::{QDom, integrate_pairs};
 use lambert::{Poly, integrate_lambert};
 
 pub use lambert::{point_to_polygon, point_to_polygon_front};
+pub use point::PointFormFactors;
 
 /// Clusters with at most this many pieces are treated as polygon sets
 /// (Lambert's formula, deterministic cubature); larger ones are sampled.
@@ -199,6 +201,28 @@ pub fn form_factor(
     sampled::estimate(forest, from, to, polys, opts.samples)
 }
 
+/// The form factor from a differential area at `x` with unit normal `n` to
+/// a face of an element, F(dA_x → to) = ∫_to cos θ_x cos θ_y / (π r²) dA_y
+/// (unoccluded, one-sided on both ends): Lambert's closed form for quads
+/// and clusters of triangle pieces (exact), the degree-5 rule of each
+/// integration domain for curved pieces and disks (accurate when `x` is
+/// farther than the element's size; a caller near the element refines it).
+pub fn point_form_factor(forest: &ElementForest, x: DVec3, n: DVec3, to: FaceElement) -> f64 {
+    if let Some(polys) = element_polygons_up_to(forest, to, usize::MAX) {
+        return lambert::lambert_sum(x, n, &polys);
+    }
+    let Some(doms) = element_domains(forest, to) else {
+        return 0.0;
+    };
+    let mut f = 0.0;
+    for d in &doms {
+        for (y, ny, w) in d.points() {
+            f += w * kernel(x, n, y, ny);
+        }
+    }
+    f.min(1.0)
+}
+
 /// True if both elements are planar and lie in the same plane (then no
 /// light passes between them, whatever the sides).
 pub(crate) fn coplanar(forest: &ElementForest, a: ElementId, b: ElementId) -> bool {
@@ -230,6 +254,15 @@ pub(crate) fn coplanar(forest: &ElementForest, a: ElementId, b: ElementId) -> bo
 /// rectangle of a planar quad, or a cluster of at most
 /// [`MAX_POLYGON_PIECES`] pieces.
 fn element_polygons(forest: &ElementForest, fe: FaceElement) -> Option<Vec<Poly>> {
+    element_polygons_up_to(forest, fe, MAX_POLYGON_PIECES)
+}
+
+/// [`element_polygons`] for clusters of at most `max_pieces` pieces.
+fn element_polygons_up_to(
+    forest: &ElementForest,
+    fe: FaceElement,
+    max_pieces: usize,
+) -> Option<Vec<Poly>> {
     let (id, s) = (fe.element, fe.side.sign());
     let e = forest.element(id);
     match (e.domain, &forest.geometry().surface(e.surface).geom) {
@@ -246,7 +279,7 @@ fn element_polygons(forest: &ElementForest, fe: FaceElement) -> Option<Vec<Poly>
             }])
         }
         (ElementDomain::Cluster { count, .. }, SurfaceGeom::Chart { mesh, .. })
-            if count as usize <= MAX_POLYGON_PIECES =>
+            if count as usize <= max_pieces =>
         {
             let m = &forest.geometry().meshes[*mesh as usize];
             Some(

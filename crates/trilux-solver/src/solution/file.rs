@@ -11,6 +11,10 @@
 //!          receiver face u32, node count u32, and per node: sender
 //!          element u32, receiver element u32, first child u32, split u8,
 //!          throughput f64, radiance N × f32
+//!          gather links: row count u32 and row starts u32 (one per face
+//!          element, plus the end), link count u32, and per link: sender
+//!          element u32, sender face u32, source tag u8 (0 face, 1 node),
+//!          source face or hierarchy u32, node u32, visibility f32
 //! ```
 //!
 //! The solve hash covers the scene description, the band count and the
@@ -28,8 +32,9 @@ use std::sync::Arc;
 use trilux_color::Spectrum;
 use trilux_geometry::{ElementId, FaceId, Sided};
 
-use super::{Solution, index_by_faces};
+use super::{Parts, Solution};
 use crate::error::SolverError;
+use crate::gather_links::{GatherLink, GatherLinks, LinkSource};
 use crate::interaction::{Hierarchy, NO_CHILD, Node, Split};
 use crate::prepared::{Fnv1a, PreparedScene};
 use crate::settings::SolverSettings;
@@ -38,7 +43,7 @@ use crate::stats::SolveStats;
 
 const MAGIC: &[u8; 8] = b"TRILUXS\0";
 /// Version of the solution file format.
-pub const FORMAT_VERSION: u32 = 3;
+pub const FORMAT_VERSION: u32 = 4;
 /// Bytes of the header before the payload.
 const HEADER_LEN: usize = 8 + 4 + 8 + 4 + 8 + 8;
 /// The largest statistics block a reader accepts (64 MiB).
@@ -85,6 +90,9 @@ impl Out {
     fn f64(&mut self, v: f64) {
         self.0.extend_from_slice(&v.to_le_bytes());
     }
+    fn f32(&mut self, v: f32) {
+        self.0.extend_from_slice(&v.to_le_bytes());
+    }
     fn spectrum<const N: usize>(&mut self, s: &Spectrum<N>) {
         for b in 0..N {
             self.0.extend_from_slice(&(s[b] as f32).to_le_bytes());
@@ -125,6 +133,9 @@ impl In<'_> {
     }
     fn f64(&mut self) -> Result<f64, Bad> {
         Ok(f64::from_le_bytes(self.array()?))
+    }
+    fn f32(&mut self) -> Result<f32, Bad> {
+        Ok(f32::from_le_bytes(self.array()?))
     }
     /// A count of items of `size` bytes each, refused when the rest of the
     /// payload cannot hold them.
@@ -216,6 +227,7 @@ impl<const N: usize> Solution<N> {
                 w.spectrum(&n.radiance);
             }
         }
+        write_links(&mut w, &self.links);
         Ok(w.0)
     }
 
@@ -278,12 +290,13 @@ impl<const N: usize> Solution<N> {
         }
         let radiance = read_sided(&mut r, |r| r.radiance::<N>(), forest.element_count())?;
         let exposed_area = read_sided(&mut r, read_area, forest.element_count())?;
-        let hierarchies = read_hierarchies::<N>(&mut r, 2 * surfaces as u32, elements as u32)?;
+        let faces = 2 * surfaces as u32;
+        let hierarchies = read_hierarchies::<N>(&mut r, faces, elements as u32)?;
+        let links = read_links(&mut r, faces, elements as u32, &hierarchies)?;
         if r.pos != payload.len() {
             return Err("trailing bytes after the solution".into());
         }
-        Ok(Solution {
-            by_faces: index_by_faces(&hierarchies),
+        Ok(Solution::assemble(Parts {
             scene,
             forest,
             settings: settings.clone(),
@@ -291,8 +304,9 @@ impl<const N: usize> Solution<N> {
             exposed_area,
             radiance,
             hierarchies,
+            links,
             stats,
-        })
+        }))
     }
 }
 
@@ -418,6 +432,89 @@ fn read_node<const N: usize>(r: &mut In<'_>, elements: u32) -> Result<Node<N>, B
         radiance,
         unshot: Spectrum::zero(),
         gathered: Spectrum::zero(),
+    })
+}
+
+fn write_links(w: &mut Out, links: &GatherLinks) {
+    let (offsets, all) = links.raw();
+    w.u32(offsets.len() as u32);
+    offsets.iter().for_each(|&o| w.u32(o));
+    w.u32(all.len() as u32);
+    for l in all {
+        w.u32(l.sender.0);
+        w.u32(l.sender_face.0);
+        match l.source {
+            LinkSource::Face(f) => {
+                w.u8(0);
+                w.u32(f.0);
+                w.u32(0);
+            }
+            LinkSource::Node { hierarchy, node } => {
+                w.u8(1);
+                w.u32(hierarchy);
+                w.u32(node);
+            }
+        }
+        w.f32(l.visibility);
+    }
+}
+
+/// Bytes of one gather link in the file.
+const LINK_BYTES: usize = 4 + 4 + 1 + 4 + 4 + 4;
+
+fn read_links<const N: usize>(
+    r: &mut In<'_>,
+    faces: u32,
+    elements: u32,
+    hierarchies: &[Hierarchy<N>],
+) -> Result<GatherLinks, Bad> {
+    let rows = r.u32()?;
+    if u64::from(rows) != 2 * u64::from(elements) + 1 {
+        return Err("corrupt gather links (row count)".into());
+    }
+    let rows = r.count(u64::from(rows), 4, "gather link row")?;
+    let offsets = (0..rows).map(|_| r.u32()).collect::<Result<Vec<_>, Bad>>()?;
+    let count = r.u32()?;
+    let count = r.count(u64::from(count), LINK_BYTES, "gather link")?;
+    let links = (0..count)
+        .map(|_| read_link(r, faces, elements, hierarchies))
+        .collect::<Result<Vec<_>, Bad>>()?;
+    GatherLinks::from_raw(offsets, links)
+}
+
+fn read_link<const N: usize>(
+    r: &mut In<'_>,
+    faces: u32,
+    elements: u32,
+    hierarchies: &[Hierarchy<N>],
+) -> Result<GatherLink, Bad> {
+    let (sender, sender_face, tag, a, b) = (r.u32()?, r.u32()?, r.u8()?, r.u32()?, r.u32()?);
+    let visibility = r.f32()?;
+    let bad = |what: &str| Err(format!("corrupt gather link ({what})"));
+    if sender >= elements || sender_face >= faces {
+        return bad("sender out of range");
+    }
+    let source = match tag {
+        0 if a < faces => LinkSource::Face(FaceId(a)),
+        1 if hierarchies
+            .get(a as usize)
+            .is_some_and(|h| (b as usize) < h.nodes.len()) =>
+        {
+            LinkSource::Node {
+                hierarchy: a,
+                node: b,
+            }
+        }
+        _ => return bad("source"),
+    };
+    if !(visibility.is_finite() && (0.0..=1.0).contains(&visibility)) {
+        return bad("visibility");
+    }
+    Ok(GatherLink {
+        sender: ElementId(sender),
+        sender_face: FaceId(sender_face),
+        source,
+        visibility,
     })
 }
 

@@ -9,6 +9,7 @@ use std::sync::Arc;
 use trilux_color::Spectrum;
 use trilux_geometry::{ElementForest, FaceId, Side, Sided, SurfaceCoord, SurfaceId};
 
+use crate::gather_links::{GatherLink, GatherLinks, link_radiance};
 use crate::interaction::Hierarchy;
 use crate::prepared::PreparedScene;
 use crate::settings::SolverSettings;
@@ -30,6 +31,10 @@ pub struct Solution<const N: usize> {
     radiance: Sided<Vec<Spectrum<N>>>,
     hierarchies: Vec<Hierarchy<N>>,
     by_faces: HashMap<(FaceId, FaceId), u32>,
+    /// The final gather's links into every receiving element.
+    links: GatherLinks,
+    /// The radiance every gather link's sender sends, in link order.
+    link_radiance: Vec<Spectrum<N>>,
     stats: SolveStats,
 }
 
@@ -53,6 +58,19 @@ impl SurfaceSite {
     }
 }
 
+/// What a solution is made of, before its derived indexes.
+pub(crate) struct Parts<const N: usize> {
+    pub scene: Arc<PreparedScene<N>>,
+    pub forest: ElementForest,
+    pub settings: SolverSettings,
+    pub depth_of: Vec<u32>,
+    pub exposed_area: Sided<Vec<f64>>,
+    pub radiance: Sided<Vec<Spectrum<N>>>,
+    pub hierarchies: Vec<Hierarchy<N>>,
+    pub links: GatherLinks,
+    pub stats: SolveStats,
+}
+
 /// The stored hierarchies' index by (sender face, receiver face).
 fn index_by_faces<const N: usize>(hierarchies: &[Hierarchy<N>]) -> HashMap<(FaceId, FaceId), u32> {
     hierarchies
@@ -63,7 +81,7 @@ fn index_by_faces<const N: usize>(hierarchies: &[Hierarchy<N>]) -> HashMap<(Face
 }
 
 impl<const N: usize> Solution<N> {
-    pub(crate) fn from_solver(solver: Solver<N>) -> Self {
+    pub(crate) fn from_solver(solver: Solver<N>, links: GatherLinks) -> Self {
         let hierarchies: Vec<Hierarchy<N>> = solver.hierarchies.into_iter().flatten().collect();
         let mut stats = solver.stats;
         // The ledger's per-element and per-shot minima are diagnostics worth
@@ -74,8 +92,7 @@ impl<const N: usize> Solution<N> {
                 solver.ledger.min_shot_escaped
             ));
         }
-        Solution {
-            by_faces: index_by_faces(&hierarchies),
+        Solution::assemble(Parts {
             scene: solver.scene,
             forest: solver.forest,
             settings: solver.settings,
@@ -83,8 +100,60 @@ impl<const N: usize> Solution<N> {
             exposed_area: solver.exposed_area,
             radiance: solver.field.radiance,
             hierarchies,
+            links,
             stats,
+        })
+    }
+
+    /// A solution from its parts (a solve's or a file's), with the indexes
+    /// derived from them.
+    fn assemble(p: Parts<N>) -> Self {
+        let link_radiance = p
+            .links
+            .iter()
+            .map(|(_, l)| {
+                link_radiance(
+                    l,
+                    &p.radiance,
+                    p.scene.emission(),
+                    |f| p.forest.geometry().surface(f.surface()).shape as usize,
+                    |h, n| {
+                        p.hierarchies
+                            .get(h as usize)
+                            .and_then(|h| h.nodes.get(n as usize))
+                            .map_or(Spectrum::zero(), |n| n.radiance)
+                    },
+                )
+            })
+            .collect();
+        Solution {
+            by_faces: index_by_faces(&p.hierarchies),
+            scene: p.scene,
+            forest: p.forest,
+            settings: p.settings,
+            depth_of: p.depth_of,
+            exposed_area: p.exposed_area,
+            radiance: p.radiance,
+            hierarchies: p.hierarchies,
+            links: p.links,
+            link_radiance,
+            stats: p.stats,
         }
+    }
+
+    /// The gather links into one face element, each with the radiance its
+    /// sender sends (`gather_links`).
+    pub fn gather_links(
+        &self,
+        e: trilux_geometry::FaceElement,
+    ) -> impl Iterator<Item = (&GatherLink, Spectrum<N>)> {
+        let row = self.links.row(e);
+        self.links.at(e).iter().zip(self.link_radiance[row].iter().copied())
+    }
+
+    /// All gather links (for statistics and the file).
+    pub fn all_gather_links(&self) -> &GatherLinks {
+        &self.links
     }
 
     /// Statistics of the solve that made this solution.
@@ -124,6 +193,28 @@ impl<const N: usize> Solution<N> {
             l += self.hierarchies[h as usize].radiance_at(&self.forest, from.coord, to.coord);
         }
         l
+    }
+
+    /// The stored (glossy, direction-dependent) part alone of
+    /// [`Solution::radiance`]: zero where no hierarchy joins the two faces.
+    pub fn stored_radiance(&self, from: &SurfaceSite, to: &SurfaceSite) -> Spectrum<N> {
+        match self.by_faces.get(&(from.face, to.face)) {
+            Some(&h) => self.hierarchies[h as usize].radiance_at(&self.forest, from.coord, to.coord),
+            None => Spectrum::zero(),
+        }
+    }
+
+    /// The final radiance L + Le that element `e` of a face sends (its
+    /// two-point radiance and, on an emitter's front, its emission).
+    pub fn face_radiance(&self, face: FaceId, e: trilux_geometry::ElementId) -> Spectrum<N> {
+        let le = match face.side() {
+            Side::Front => {
+                let shape = self.forest.geometry().surface(face.surface()).shape as usize;
+                self.scene.emission()[shape]
+            }
+            Side::Back => Spectrum::zero(),
+        };
+        self.radiance[face.side()][e.index()] + le
     }
 
     /// The Lambertian (two-point) reflected radiance alone at a point.

@@ -1,0 +1,377 @@
+//! Rendering from the solution's links: the final gather of hierarchical
+//! radiosity, at pixel resolution (Lischinski, Tampieri & Greenberg 1993;
+//! Smits, Arvo & Greenberg 1994).
+//!
+//! A camera ray meets the scene at x_s. Its radiance towards the eye is
+//!
+//! L(x_s → eye) = Le + ρ_d(x_s) [Σ_i L_i F(x_s → i) V(x_s, i) + E_g(x_s)]
+//!              + L_glossy(x_s → eye),
+//!
+//! - the **link sum** runs over the solution's gather links into the
+//!   elements containing x_s (`trilux_solver::gather_links`, [`link_sum`]):
+//!   every Lambertian sender element i with its final radiance L_i
+//!   (emitters included, so the sum holds the direct light too), F the
+//!   point-to-element form factor computed exactly at x_s, V the link's
+//!   visible fraction — 1 where its shadow rays all passed, traced per
+//!   camera sample where it is partial. It has no Monte Carlo noise but in
+//!   penumbrae.
+//! - **E_g**, the light that glossy senders reflect onto x_s, is not in the
+//!   links (a glossy sender's stored radiance is constant over whole
+//!   receiving elements, which would show as blocks): one cosine-sampled
+//!   ray from x_s, and where it meets a glossy part, that part's glossy
+//!   radiance towards x_s estimated as below. Scenes without glossy faces
+//!   skip it.
+//! - **L_glossy**, the glossy part of the BSDF at x_s, is estimated as the
+//!   paper's §4.5 does, by a BSDF-sampled gather ray with light sampling
+//!   (combined by MIS) weighting fr_glossy only. The gather hit x_d brings
+//!   its emission (MIS-weighted) and its reflected radiance towards x_s:
+//!   the link sum at x_d (with the links' own visibility) times ρ_d(x_d),
+//!   plus its own glossy part, one level deeper; beyond that level the
+//!   solution is read directly.
+//!
+//! [`Preview`] drops every random ray: the link sum with the links' own
+//! visibility at x_s, and for a glossy x_s one mirror-direction reading of
+//! the solution. A noise-free (not shadow-exact) view for walkthroughs.
+//!
+//! [`link_sum`]: crate::link_sum
+
+use glam::DVec3;
+
+use crate::bands;
+use crate::gather::{FinalGather, GatherScene, GatherStats, SurfacePoint, power_heuristic};
+use crate::link_sum::LinkCache;
+use crate::sampler::{PixelSampler, dims};
+
+/// How the link sum at a point resolves partial visibility.
+#[derive(Clone, Copy, Debug)]
+pub enum LinkVisibility<'a> {
+    /// The visible fraction the solve measured for each link.
+    Cached,
+    /// Shadow rays from the point to samples of each partly visible
+    /// sender, drawn from `sampler` from dimension `dim` on.
+    Traced {
+        /// The pixel's sample sequence.
+        sampler: &'a PixelSampler,
+        /// First dimension the rays may use.
+        dim: u32,
+    },
+}
+
+/// What one camera sample of the link gather may reuse: the pixel's link
+/// cache (primary hits) and a scratch cache (gather hits).
+#[derive(Clone, Debug, Default)]
+pub struct Caches<const N: usize> {
+    /// The current pixel's primary-hit cache.
+    pub pixel: LinkCache<N>,
+    /// Scratch space for gather hits.
+    pub scratch: LinkCache<N>,
+}
+
+/// Gather levels below the camera hit at which the link sum is still
+/// evaluated; deeper hits read the solution directly.
+const LINK_LEVELS: u32 = 1;
+
+/// The link-gather estimator (module docs), with the path gather for
+/// scenes without links.
+pub struct LinkGather<'a, S> {
+    /// The scene and its solution.
+    pub scene: &'a S,
+    /// The path gather, for a point the links cannot serve.
+    pub fallback: FinalGather<'a, S>,
+    /// True when some face of the scene is glossy (the E_g term is needed).
+    pub glossy_scene: bool,
+}
+
+/// One camera sample's state while the link gather evaluates it.
+struct Walk<'s, const N: usize> {
+    sampler: &'s PixelSampler,
+    caches: &'s mut Caches<N>,
+    stats: &'s mut GatherStats,
+}
+
+impl<S> LinkGather<'_, S> {
+    /// Radiance arriving at the eye along a camera ray (one sample).
+    pub fn camera_sample<const N: usize>(
+        &self,
+        origin: DVec3,
+        dir: DVec3,
+        sampler: &PixelSampler,
+        caches: &mut Caches<N>,
+        stats: &mut GatherStats,
+    ) -> [f64; N]
+    where
+        S: GatherScene<N>,
+    {
+        stats.camera_rays += 1;
+        let Some(xs) = self.scene.intersect(origin, dir) else {
+            return bands::zero();
+        };
+        let wo = -dir;
+        let scene = self.scene;
+        let mut w = Walk {
+            sampler,
+            caches,
+            stats,
+        };
+        let mut l = scene.emitted(&xs, wo);
+        let rho = scene.diffuse_albedo(&xs, wo);
+        if !bands::is_black(&rho) {
+            let visibility = LinkVisibility::Traced {
+                sampler,
+                dim: dims::LINKS,
+            };
+            match scene.solution_irradiance(&xs, wo, visibility, &mut w.caches.pixel, w.stats) {
+                Some(e) => {
+                    let e = bands::add(e, self.glossy_senders(&xs, wo, 0, &mut w));
+                    l = bands::add(l, bands::mul(rho, e));
+                }
+                // No links here: the path gather serves the whole BSDF.
+                None => {
+                    let lr = self.fallback.gather(&xs, wo, 0, sampler, w.stats);
+                    return finite_or_dropped(bands::add(l, lr), w.stats);
+                }
+            }
+        }
+        if scene.is_glossy(&xs, wo) {
+            l = bands::add(l, self.glossy(&xs, wo, 0, &mut w));
+        }
+        finite_or_dropped(l, w.stats)
+    }
+
+    /// E_g at a Lambertian `x` at gather `level`: the glossy radiance that
+    /// one cosine-sampled ray brings (module docs), so that ρ_d E_g
+    /// estimates its reflection. Estimated one level deeper from the camera
+    /// hit, read from the solution's stored radiance from a gather hit.
+    fn glossy_senders<const N: usize>(
+        &self,
+        x: &SurfacePoint<S::Locator>,
+        wo: DVec3,
+        level: u32,
+        w: &mut Walk<'_, N>,
+    ) -> [f64; N]
+    where
+        S: GatherScene<N>,
+    {
+        if !self.glossy_scene {
+            return bands::zero();
+        }
+        let scene = self.scene;
+        let u = w.sampler.get2(dims::GLOSSY_SENDERS + 2 * level);
+        let Some(wi) = scene.sample_cosine(x, wo, u) else {
+            return bands::zero();
+        };
+        w.stats.gather_rays += 1;
+        let Some(xd) = scene.intersect(x.point, wi) else {
+            return bands::zero();
+        };
+        let back = -wi;
+        if !scene.is_glossy(&xd, back) {
+            return bands::zero();
+        }
+        // With density cos θ/π the estimate of (1/π) ∫ L cos dω is L.
+        if level == 0 {
+            self.glossy(&xd, back, 1, w)
+        } else {
+            scene.reflected_glossy(&xd, x)
+        }
+    }
+
+    /// The glossy part of the reflected radiance at `x` towards `wo`, at
+    /// gather `level`: one light sample and one BSDF-sampled gather ray,
+    /// MIS-combined, each weighting fr_glossy.
+    fn glossy<const N: usize>(
+        &self,
+        x: &SurfacePoint<S::Locator>,
+        wo: DVec3,
+        level: u32,
+        w: &mut Walk<'_, N>,
+    ) -> [f64; N]
+    where
+        S: GatherScene<N>,
+    {
+        let scene = self.scene;
+        let base = dims::GATHER + level * dims::PER_LEVEL;
+        let mut l = light_sample(scene, x, wo, w.sampler, base, w.stats);
+        let Some(bs) = scene.sample_bsdf(x, wo, w.sampler.get2(base + 3)) else {
+            return l;
+        };
+        if !(bs.pdf > 0.0) {
+            return l;
+        }
+        let f = scene.glossy_cos(x, bs.wi, wo);
+        if bands::is_black(&f) {
+            return l;
+        }
+        w.stats.gather_rays += 1;
+        let Some(xd) = scene.intersect(x.point, bs.wi) else {
+            return l;
+        };
+        let back = -bs.wi;
+        let weight = bands::scale(f, 1.0 / bs.pdf);
+        let le = scene.emitted(&xd, back);
+        if !bands::is_black(&le) {
+            let cos_d = xd.normal.dot(back).abs();
+            let pdf_area = scene.light_pdf_area(&xd);
+            let mis = if pdf_area > 0.0 && cos_d > 0.0 {
+                power_heuristic(bs.pdf, pdf_area * xd.t * xd.t / cos_d)
+            } else {
+                1.0
+            };
+            l = bands::add(l, bands::scale(bands::mul(weight, le), mis));
+        }
+        let lr = self.reflected_at(&xd, x, back, level + 1, w);
+        bands::add(l, bands::mul(weight, lr))
+    }
+
+    /// The reflected radiance leaving a gather hit `xd` towards `x` (in
+    /// direction `towards`), at gather `level`: the link sum at xd times
+    /// ρ_d(xd) and xd's own glossy part, or, deeper than
+    /// [`LINK_LEVELS`], the solution's own reading.
+    fn reflected_at<const N: usize>(
+        &self,
+        xd: &SurfacePoint<S::Locator>,
+        x: &SurfacePoint<S::Locator>,
+        towards: DVec3,
+        level: u32,
+        w: &mut Walk<'_, N>,
+    ) -> [f64; N]
+    where
+        S: GatherScene<N>,
+    {
+        let scene = self.scene;
+        if level > LINK_LEVELS {
+            return scene.reflected(xd, x);
+        }
+        let Some(mut lambertian) =
+            lambertian_at(scene, xd, towards, &mut w.caches.scratch, w.stats)
+        else {
+            return scene.reflected(xd, x);
+        };
+        let rho = scene.diffuse_albedo(xd, towards);
+        if !bands::is_black(&rho) {
+            let e_g = self.glossy_senders(xd, towards, level, w);
+            lambertian = bands::add(lambertian, bands::mul(rho, e_g));
+        }
+        let glossy = if scene.is_glossy(xd, towards) {
+            self.glossy(xd, towards, level, w)
+        } else {
+            bands::zero()
+        };
+        bands::add(lambertian, glossy)
+    }
+}
+
+/// The preview estimator: no random rays (module docs).
+pub struct Preview<'a, S> {
+    /// The scene and its solution.
+    pub scene: &'a S,
+}
+
+impl<S> Preview<'_, S> {
+    /// Radiance arriving at the eye along a camera ray, without random
+    /// rays.
+    pub fn camera_sample<const N: usize>(
+        &self,
+        origin: DVec3,
+        dir: DVec3,
+        caches: &mut Caches<N>,
+        stats: &mut GatherStats,
+    ) -> [f64; N]
+    where
+        S: GatherScene<N>,
+    {
+        stats.camera_rays += 1;
+        let scene = self.scene;
+        let Some(xs) = scene.intersect(origin, dir) else {
+            return bands::zero();
+        };
+        let wo = -dir;
+        let mut l = scene.emitted(&xs, wo);
+        let rho = scene.diffuse_albedo(&xs, wo);
+        if !bands::is_black(&rho)
+            && let Some(e) =
+                scene.solution_irradiance(&xs, wo, LinkVisibility::Cached, &mut caches.pixel, stats)
+        {
+            l = bands::add(l, bands::mul(rho, e));
+        }
+        if scene.is_glossy(&xs, wo)
+            && let Some((wi, albedo)) = scene.mirror(&xs, wo)
+            && let Some(xd) = scene.intersect(xs.point, wi)
+        {
+            stats.gather_rays += 1;
+            let back = -wi;
+            let reflected = lambertian_at(scene, &xd, back, &mut caches.scratch, stats)
+                .map_or_else(|| scene.reflected(&xd, &xs), |l| {
+                    bands::add(l, scene.reflected_glossy(&xd, &xs))
+                });
+            let incoming = bands::add(scene.emitted(&xd, back), reflected);
+            l = bands::add(l, bands::mul(albedo, incoming));
+        }
+        finite_or_dropped(l, stats)
+    }
+}
+
+/// ρ_d(xd) times the link sum at `xd` with the links' own visibility
+/// (`None` where the scene has no links).
+fn lambertian_at<S: GatherScene<N>, const N: usize>(
+    scene: &S,
+    xd: &SurfacePoint<S::Locator>,
+    towards: DVec3,
+    scratch: &mut LinkCache<N>,
+    stats: &mut GatherStats,
+) -> Option<[f64; N]> {
+    let rho = scene.diffuse_albedo(xd, towards);
+    if bands::is_black(&rho) {
+        return Some(bands::zero());
+    }
+    scratch.clear();
+    scene
+        .solution_irradiance(xd, towards, LinkVisibility::Cached, scratch, stats)
+        .map(|e| bands::mul(rho, e))
+}
+
+/// One light sample for the glossy part at `x` (fr_glossy only), weighted
+/// by the power heuristic against BSDF sampling.
+fn light_sample<S: GatherScene<N>, const N: usize>(
+    scene: &S,
+    x: &SurfacePoint<S::Locator>,
+    wo: DVec3,
+    sampler: &PixelSampler,
+    base: u32,
+    stats: &mut GatherStats,
+) -> [f64; N] {
+    let Some(ls) = scene.sample_light(x, sampler.get1(base), sampler.get2(base + 1)) else {
+        return bands::zero();
+    };
+    let d = ls.point - x.point;
+    let dist2 = d.length_squared();
+    let dist = dist2.sqrt();
+    if !(dist > 0.0) || !(ls.pdf_area > 0.0) || bands::is_black(&ls.radiance) {
+        return bands::zero();
+    }
+    let wi = d / dist;
+    let cos_light = ls.normal.dot(-wi);
+    if cos_light <= 0.0 {
+        return bands::zero();
+    }
+    let f = scene.glossy_cos(x, wi, wo);
+    if bands::is_black(&f) {
+        return bands::zero();
+    }
+    stats.shadow_rays += 1;
+    if !scene.unoccluded(x, ls.point) {
+        return bands::zero();
+    }
+    let pdf_light = ls.pdf_area * dist2 / cos_light;
+    let w = power_heuristic(pdf_light, scene.bsdf_pdf(x, wo, wi));
+    bands::scale(bands::mul(f, ls.radiance), w / pdf_light)
+}
+
+fn finite_or_dropped<const N: usize>(l: [f64; N], stats: &mut GatherStats) -> [f64; N] {
+    if bands::is_finite(&l) {
+        l
+    } else {
+        stats.dropped += 1;
+        bands::zero()
+    }
+}
