@@ -53,6 +53,9 @@ pub struct Plan<'p> {
     pub source: SolutionSource<'p>,
     /// Save the solution there.
     pub save: Option<&'p Path>,
+    /// Return the solution file's bytes in [`Outcome::solution_file`], for
+    /// a caller that writes all its outputs at once (the `trilux` command).
+    pub solution_file: bool,
     /// Render a view.
     pub render: Option<RenderPlan>,
 }
@@ -64,6 +67,8 @@ pub struct Outcome {
     pub image: Option<Image>,
     /// The solve's statistics (`solve_seconds` 0 for a loaded solution).
     pub solve: SolveStats,
+    /// The solution file's bytes, when the plan asks for them.
+    pub solution_file: Option<Vec<u8>>,
     /// The render's statistics, when the plan renders.
     pub render: Option<RenderStats>,
     /// Wall-clock seconds spent preparing the scene (geometry, BVH,
@@ -185,6 +190,10 @@ impl WithBands for Run<'_, '_> {
         if let Some(path) = self.plan.save {
             solution.save(path)?;
         }
+        let solution_file = match self.plan.solution_file {
+            true => Some(solution.to_bytes()?),
+            false => None,
+        };
         let start = Instant::now();
         let rendered = match &self.view {
             Some((camera, settings)) => {
@@ -197,6 +206,7 @@ impl WithBands for Run<'_, '_> {
         Ok(Outcome {
             image,
             solve: std::mem::take(solution.stats_mut()),
+            solution_file,
             render,
             prepare_seconds,
             solve_seconds,

@@ -23,15 +23,18 @@ pub enum SolverError {
         #[source]
         source: serde_json::Error,
     },
-    /// Reading or writing a solution file failed.
-    #[error("{path}: {source}")]
-    Io {
+    /// A solution file could not be read.
+    #[error("{path}: cannot read the solution file: {source}")]
+    Read {
         /// The file.
         path: String,
         /// The cause.
         #[source]
-        source: std::io::Error,
+        source: trilux_files::ReadError,
     },
+    /// A solution file could not be written; the file is as it was.
+    #[error(transparent)]
+    Write(#[from] trilux_files::WriteError),
     /// A solution file is not one trilux can read, or belongs to another
     /// scene or mode.
     #[error("{path}: {message}")]

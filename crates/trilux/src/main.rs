@@ -67,6 +67,22 @@ pub fn set_threads(threads: Option<u32>) {
     }
 }
 
+/// Prints the warnings of a finished command: the solve's (caps reached,
+/// clamped reflectances) and the render's samples left out.
+pub fn warn(outcome: &trilux_render::Outcome) {
+    for w in &outcome.solve.warnings {
+        eprintln!("warning: {w}");
+    }
+    if let Some(r) = &outcome.render
+        && r.gather.dropped > 0
+    {
+        eprintln!(
+            "warning: {} camera samples had a value that is not finite and were left out of the image",
+            r.gather.dropped
+        );
+    }
+}
+
 /// The main job: the bundled default scene rendered into out/.
 fn render_default() -> anyhow::Result<()> {
     let scene = default_scene();

@@ -2,9 +2,6 @@
 //! parsers that turn a malformed value into a usage error (status 2) before
 //! any file is read.
 
-use std::path::{Path, PathBuf};
-
-use anyhow::{Result, bail};
 use clap::{Args, ValueEnum};
 use glam::DVec3;
 use trilux_color::Mode;
@@ -122,42 +119,4 @@ pub fn parse_lookat(text: &str) -> Result<LookAt, String> {
         9 => Ok((v(0), v(3), Some(v(6)))),
         n => Err(format!("takes 6 or 9 numbers (eye, target[, up]), got {n}")),
     }
-}
-
-/// Refuses an output whose folder does not exist, before any work.
-pub fn check_output(path: &Path, what: &str) -> Result<()> {
-    let parent = path.parent().filter(|p| !p.as_os_str().is_empty());
-    if let Some(dir) = parent
-        && !dir.is_dir()
-    {
-        bail!(
-            "{}: cannot write the {what}: the folder {} does not exist",
-            path.display(),
-            dir.display()
-        );
-    }
-    Ok(())
-}
-
-/// Refuses a set of outputs where two are the same file or one is an
-/// input, before any work.
-pub fn check_distinct(inputs: &[&Path], outputs: &[(&Path, &str)]) -> Result<()> {
-    let key =
-        |p: &Path| -> PathBuf { std::fs::canonicalize(p).unwrap_or_else(|_| p.to_path_buf()) };
-    for (k, (out, what)) in outputs.iter().enumerate() {
-        if let Some(input) = inputs.iter().find(|i| key(i) == key(out)) {
-            bail!(
-                "{}: the {what} would overwrite the input {}",
-                out.display(),
-                input.display()
-            );
-        }
-        if let Some((_, other)) = outputs[..k].iter().find(|(o, _)| key(o) == key(out)) {
-            bail!(
-                "{}: the {what} and the {other} are the same file",
-                out.display()
-            );
-        }
-    }
-    Ok(())
 }

@@ -15,7 +15,7 @@ use crate::settings::SolverSettings;
 use crate::solver::Solver;
 use crate::stats::SolveStats;
 
-pub use file::{FORMAT_VERSION, solve_hash};
+pub use file::{FORMAT_VERSION, MAX_FILE_BYTES, solve_hash};
 
 /// A view-independent solution of the scene's light.
 pub struct Solution<const N: usize> {
