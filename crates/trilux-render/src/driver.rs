@@ -108,8 +108,10 @@ where
     };
     // Each dimension layout must fit the sequence: two levels of gather.
     const { assert!(dims::GATHER + 2 * dims::PER_LEVEL <= 256) };
+    // The whole film first: a film too large for memory fails before work.
+    let mut image = Film::new(0, 0, w as usize, h as usize, settings.filter)?;
 
-    let tiles: Vec<(Film, GatherStats)> = (0..total)
+    let tiles: Vec<Result<(Film, GatherStats), RenderError>> = (0..total)
         .into_par_iter()
         .map(|t| {
             let tx = (t as u32 % tiles_x) * ts;
@@ -122,7 +124,7 @@ where
                 (tw as i64 + 2 * border) as usize,
                 (th as i64 + 2 * border) as usize,
                 settings.filter,
-            );
+            )?;
             let mut stats = GatherStats::default();
             for y in ty..ty + th {
                 for x in tx..tx + tw {
@@ -143,15 +145,15 @@ where
                 }
             }
             progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);
-            (film, stats)
+            Ok((film, stats))
         })
         .collect();
 
-    let mut image = Film::new(0, 0, w as usize, h as usize, settings.filter);
     let mut stats = RenderStats::default();
-    for (film, s) in &tiles {
-        image.merge(film);
-        stats.gather.add(s);
+    for tile in tiles {
+        let (film, s) = tile?;
+        image.merge(&film);
+        stats.gather.add(&s);
     }
     stats.seconds = start.elapsed().as_secs_f64();
     Ok((image.develop(), stats))

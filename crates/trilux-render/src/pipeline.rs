@@ -101,12 +101,18 @@ impl Observer<'_> {
 }
 
 /// The scene's camera with `view`'s overrides (an error when the scene has
-/// no sensor or the view is invalid).
+/// no sensor or the view is invalid; at the `<sensor>` when the scene's own
+/// values are at fault).
 pub fn scene_camera(scene: &Scene, view: &ViewOverrides) -> Result<Camera, RenderError> {
     let cam = scene.camera.as_ref().ok_or_else(|| RenderError::NoCamera {
         path: scene.path.clone(),
     })?;
-    camera_of(cam, view)
+    camera_of(cam, view).map_err(|e| match e {
+        RenderError::Camera(m) if *view == ViewOverrides::default() => {
+            SceneError::at(&cam.location, m).into()
+        }
+        e => e,
+    })
 }
 
 /// The scene prepared for `N` bands; errors point at the shape (or its
@@ -140,8 +146,14 @@ fn located(scene: &Scene, e: &PrepareError) -> SceneError {
     SceneError::at(&location, e.problem())
 }
 
-/// Carries out `plan` on `scene` (module docs).
-pub fn run(scene: &Scene, plan: &Plan<'_>, observer: Observer<'_>) -> Result<Outcome, RenderError> {
+/// Everything [`run`] checks before the long work: the render settings,
+/// the camera with its overrides, the solver settings. Only the scene's
+/// camera is read, so a caller can check a scene whose meshes are not read
+/// yet (`trilux_scene::Pending`).
+pub fn check(
+    scene: &Scene,
+    plan: &Plan<'_>,
+) -> Result<Option<(Camera, RenderSettings)>, RenderError> {
     let view = match &plan.render {
         Some(r) => {
             r.settings.validate()?;
@@ -152,6 +164,12 @@ pub fn run(scene: &Scene, plan: &Plan<'_>, observer: Observer<'_>) -> Result<Out
     plan.solver
         .validate()
         .map_err(trilux_solver::SolverError::Settings)?;
+    Ok(view)
+}
+
+/// Carries out `plan` on `scene` (module docs).
+pub fn run(scene: &Scene, plan: &Plan<'_>, observer: Observer<'_>) -> Result<Outcome, RenderError> {
+    let view = check(scene, plan)?;
     plan.mode.with_bands(Run {
         scene,
         plan,

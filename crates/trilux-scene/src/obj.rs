@@ -9,9 +9,15 @@
 //! normals recomputed from the faces with angle weights (Thürmer & Wüthrich,
 //! the weighting Mitsuba's `recompute_vertex_normals` uses). With
 //! `face_normals` there are none.
+//!
+//! The file must be a regular file of at most
+//! [`MAX_OBJ_BYTES`](crate::limits::MAX_OBJ_BYTES) (`/dev/zero` is an
+//! error, not an endless read); [`parse_obj`] reads the same format from
+//! bytes already in memory.
 
-use std::io::BufReader;
 use std::path::Path;
+
+use crate::limits::MAX_OBJ_BYTES;
 
 use glam::DVec3;
 use trilux_geometry::TriangleMesh;
@@ -19,14 +25,15 @@ use trilux_geometry::TriangleMesh;
 /// Why an OBJ file could not be read (the caller adds the scene location).
 #[derive(Debug, thiserror::Error)]
 pub enum ObjError {
-    /// The file could not be opened or read.
+    /// The file could not be read (missing, not a regular file, too
+    /// large).
     #[error("cannot read OBJ file {}: {source}", path.display())]
     Io {
         /// The OBJ file.
         path: std::path::PathBuf,
-        /// The operating system's reason.
+        /// Why.
         #[source]
-        source: std::io::Error,
+        source: trilux_files::ReadError,
     },
     /// tobj refused the contents.
     #[error("malformed OBJ file {}: {reason}", path.display())]
@@ -52,17 +59,22 @@ pub enum ObjError {
 
 /// Reads an OBJ file into one triangle mesh (all its objects merged).
 pub fn load_obj(path: &Path, face_normals: bool) -> Result<TriangleMesh, ObjError> {
-    let file = std::fs::File::open(path).map_err(|source| ObjError::Io {
+    let bytes = trilux_files::read_limited(path, MAX_OBJ_BYTES).map_err(|source| ObjError::Io {
         path: path.to_path_buf(),
         source,
     })?;
+    parse_obj(&bytes, path, face_normals)
+}
+
+/// [`load_obj`] on the bytes of an OBJ file; `path` names it in errors.
+pub fn parse_obj(bytes: &[u8], path: &Path, face_normals: bool) -> Result<TriangleMesh, ObjError> {
     let options = tobj::LoadOptions {
         single_index: true,
         triangulate: true,
         ignore_points: true,
         ignore_lines: true,
     };
-    let (models, _materials) = tobj::load_obj_buf(&mut BufReader::new(file), &options, |_| {
+    let (models, _materials) = tobj::load_obj_buf(&mut &bytes[..], &options, |_| {
         Ok((Vec::new(), Default::default()))
     })
     .map_err(|e| ObjError::Parse {

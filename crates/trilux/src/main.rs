@@ -112,13 +112,33 @@ fn run(cli: Cli) -> anyhow::Result<()> {
     }
 }
 
+/// The longest line of an error message (a quoted value of megabytes
+/// loses its middle).
+const MAX_LINE_CHARS: usize = 1000;
+
+/// Prints a usage error with clap's message, each line capped, and exits
+/// with clap's status (2); help and version go to stdout as usual.
+fn usage_error(e: clap::Error) -> ExitCode {
+    if !e.use_stderr() {
+        e.exit();
+    }
+    for line in e.render().to_string().lines() {
+        eprintln!("{}", trilux_scene::error::elide(line, MAX_LINE_CHARS));
+    }
+    ExitCode::from(u8::try_from(e.exit_code()).unwrap_or(2))
+}
+
 fn main() -> ExitCode {
     // Usage errors exit here with clap's message and status 2.
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => return usage_error(e),
+    };
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             let message = e.to_string().replace(['\n', '\r'], " ");
+            let message = trilux_scene::error::elide(&message, MAX_LINE_CHARS);
             eprintln!("error: {message}");
             ExitCode::FAILURE
         }

@@ -9,7 +9,9 @@ use trilux_render::{
     ExtraBounce, Observer, Plan, RenderPlan, RenderSettings, SolutionSource, ViewOverrides,
 };
 
-use crate::options::{LookAt, SolveOptions, parse_fov, parse_lookat, parse_positive};
+use crate::options::{
+    LookAt, SolveOptions, parse_film_edge, parse_fov, parse_lookat, parse_spp, parse_threads,
+};
 use crate::output::{Outputs, stats_json};
 use crate::progress::Bars;
 
@@ -41,16 +43,16 @@ pub struct RenderArgs {
     #[arg(long)]
     pub stats: Option<PathBuf>,
     /// Camera samples per pixel (default: the scene sampler's sample_count).
-    #[arg(long, value_parser = parse_positive)]
+    #[arg(long, value_parser = parse_spp)]
     pub spp: Option<u32>,
-    /// Film width in pixels (default: the scene's).
-    #[arg(long, value_parser = parse_positive)]
+    /// Film width in pixels (default: the scene's; docs/limits.md).
+    #[arg(long, value_parser = parse_film_edge)]
     pub width: Option<u32>,
-    /// Film height in pixels (default: the scene's).
-    #[arg(long, value_parser = parse_positive)]
+    /// Film height in pixels (default: the scene's; docs/limits.md).
+    #[arg(long, value_parser = parse_film_edge)]
     pub height: Option<u32>,
     /// Worker threads (default: all cores).
-    #[arg(long, value_parser = parse_positive)]
+    #[arg(long, value_parser = parse_threads)]
     pub threads: Option<u32>,
     /// Seed of the sample sequences.
     #[arg(long, default_value_t = 0)]
@@ -123,15 +125,15 @@ impl RenderArgs {
 pub fn run(args: &RenderArgs) -> Result<()> {
     crate::set_threads(args.threads);
     let outputs = args.plan_outputs()?;
-    let scene = trilux_scene::load(&args.scene)?;
-    let camera = scene.camera.as_ref().with_context(|| {
+    let pending = trilux_scene::open(&args.scene)?;
+    let camera = pending.scene().camera.as_ref().with_context(|| {
         format!(
             "{}: the scene has no <sensor> to render from",
-            scene.path.display()
+            args.scene.display()
         )
     })?;
     let plan = Plan {
-        mode: args.options.mode(&scene),
+        mode: args.options.mode(pending.scene()),
         solver: args.options.settings(),
         source: match &args.solution {
             Some(path) => SolutionSource::Load(path),
@@ -141,6 +143,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         solution_file: false,
         render: Some(args.render_plan(camera)),
     };
+    trilux_render::pipeline::check(pending.scene(), &plan)?;
+    let scene = pending.finish()?;
     let bars = Bars::new(true);
     let mut on_shot = |p: &trilux_solver::Progress| bars.solve(p);
     let on_tile = |done: usize, total: usize| bars.render(done, total);

@@ -7,7 +7,7 @@ use anyhow::{Context, Result};
 use clap::Args;
 use trilux_render::{Observer, Plan, SolutionSource};
 
-use crate::options::{SolveOptions, parse_positive};
+use crate::options::{SolveOptions, parse_threads};
 use crate::output::{Outputs, stats_json};
 use crate::progress::Bars;
 
@@ -23,7 +23,7 @@ pub struct SolveArgs {
     #[arg(long)]
     pub stats: Option<PathBuf>,
     /// Worker threads (default: all cores).
-    #[arg(long, value_parser = parse_positive)]
+    #[arg(long, value_parser = parse_threads)]
     pub threads: Option<u32>,
     #[command(flatten)]
     pub options: SolveOptions,
@@ -35,15 +35,17 @@ pub fn run(args: &SolveArgs) -> Result<()> {
     let mut outputs = vec![(args.output.as_path(), "solution")];
     outputs.extend(args.stats.as_deref().map(|p| (p, "statistics")));
     let outputs = Outputs::plan(&outputs, &[args.scene.as_path()], None)?;
-    let scene = trilux_scene::load(&args.scene)?;
+    let pending = trilux_scene::open(&args.scene)?;
     let plan = Plan {
-        mode: args.options.mode(&scene),
+        mode: args.options.mode(pending.scene()),
         solver: args.options.settings(),
         source: SolutionSource::Solve,
         save: None,
         solution_file: true,
         render: None,
     };
+    trilux_render::pipeline::check(pending.scene(), &plan)?;
+    let scene = pending.finish()?;
     let bars = Bars::new(false);
     let mut on_shot = |p: &trilux_solver::Progress| bars.solve(p);
     let outcome = trilux_render::pipeline::run(

@@ -331,7 +331,7 @@ fn the_default_out_folder_is_made_only_when_something_is_written() {
     };
     // A failure leaves no out/ behind.
     let out = run("missing-mesh.xml");
-    assert_refused(&out, "no-such-mesh.obj");
+    assert_refused(&out, "the scene has no <sensor>");
     assert!(!dir.join("out").exists());
     assert_ok(&run("sub-scene.xml"));
     assert!(dir.join("out/sub-scene.exr").is_file());
