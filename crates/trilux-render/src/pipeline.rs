@@ -15,7 +15,7 @@ use trilux_color::{Mode, WithBands};
 use trilux_scene::{Scene, SceneError};
 use trilux_solver::{
     PrepareError, PreparedScene, Progress, SceneDescription, Solution, SolveStats, Solver,
-    SolverSettings,
+    SolverError, SolverSettings,
 };
 
 use crate::camera::Camera;
@@ -167,6 +167,29 @@ pub fn check(
     Ok(view)
 }
 
+/// A solver error at its place in the scene file, when it names a shape.
+fn located_solver(scene: &Scene, e: SolverError) -> RenderError {
+    match e {
+        SolverError::NoFiniteSolution { shape, band, bands } => {
+            let location = scene.shapes.get(shape).map_or_else(
+                || scene.shape_location(shape),
+                |s| {
+                    s.emitter
+                        .as_ref()
+                        .map_or(s.location.clone(), |em| em.location.clone())
+                },
+            );
+            SceneError::at(
+                &location,
+                trilux_solver::error::no_finite_solution(band, bands),
+            )
+            .into()
+        }
+        SolverError::Prepare(p) => located(scene, &p).into(),
+        e => e.into(),
+    }
+}
+
 /// Carries out `plan` on `scene` (module docs).
 pub fn run(scene: &Scene, plan: &Plan<'_>, observer: Observer<'_>) -> Result<Outcome, RenderError> {
     let view = check(scene, plan)?;
@@ -195,9 +218,9 @@ impl WithBands for Run<'_, '_> {
         let prepare_seconds = start.elapsed().as_secs_f64();
         let start = Instant::now();
         let mut solution = match self.plan.source {
-            SolutionSource::Solve => {
-                Solver::new(prepared, self.plan.solver.clone())?.solve(|p| (self.observer.solve)(p))
-            }
+            SolutionSource::Solve => Solver::new(prepared, self.plan.solver.clone())
+                .map_err(|e| located_solver(self.scene, e))?
+                .solve(|p| (self.observer.solve)(p)),
             SolutionSource::Load(path) => {
                 let mut s = Solution::load(path, prepared, &self.plan.solver)?;
                 s.stats_mut().solve_seconds = 0.0;

@@ -183,6 +183,19 @@ fn area_emitter(e: &Element) -> Result<AreaEmitter> {
     // Mitsuba's default radiance is 1.
     let radiance = props.color("radiance")?.unwrap_or(ColorParam::Float(1.0));
     check_color(&radiance, &props.loc("radiance"), "radiance", None)?;
+    if let Some(v) = radiance
+        .values()
+        .into_iter()
+        .find(|v| *v > crate::limits::MAX_RADIANCE)
+    {
+        return Err(SceneError::at(
+            &props.loc("radiance"),
+            format!(
+                "radiance {v:e} is beyond the limit {:e} (docs/limits.md)",
+                crate::limits::MAX_RADIANCE
+            ),
+        ));
+    }
     props.finish()?;
     Ok(AreaEmitter {
         radiance,

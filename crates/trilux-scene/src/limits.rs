@@ -64,8 +64,5 @@ pub fn check_film(width: u32, height: u32) -> Result<(), String> {
     Ok(())
 }
 
-/// Largest emitted radiance (1e20 in any band): light is summed over
-/// bounces and bands and stored as 32-bit floats (largest 3.4e38) in
-/// solution and image files; 1e20 leaves eighteen orders of magnitude for
-/// the sums and the areas (the sun's radiance is about 2e7 W/(sr m²)).
-pub const MAX_RADIANCE: f64 = 1e20;
+/// Largest emitted radiance (1e20 in any band).
+pub use trilux_color::MAX_RADIANCE;

@@ -28,6 +28,7 @@
 // Band loops index several per-band arrays in step.
 #![allow(clippy::needless_range_loop)]
 
+mod divergence;
 pub mod error;
 mod faces;
 mod glossy;

@@ -264,3 +264,71 @@ fn misleading_messages_say_what_is_wrong() {
         assert_refused_by_every_command(&scene, &format!("{}:2:", s(&scene)), what);
     }
 }
+
+/// `FILE:LINE:COL: ` at the start of `stderr` after "error: ".
+fn located_at(stderr: &str, file: &str) -> bool {
+    let Some(rest) = stderr.strip_prefix(&format!("error: {file}:")) else {
+        return false;
+    };
+    let mut parts = rest.splitn(3, ':');
+    let number =
+        |p: Option<&str>| p.is_some_and(|p| !p.is_empty() && p.bytes().all(|b| b.is_ascii_digit()));
+    number(parts.next()) && number(parts.next()) && parts.next().is_some_and(|r| r.starts_with(' '))
+}
+
+#[test]
+fn every_scene_error_from_every_command_is_located() {
+    let dir = folder("scene-located");
+    write(&dir, "flat.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n");
+    write(
+        &dir,
+        "far.obj",
+        "v 0 0 0\nv 1e30 0 0\nv 0 1e30 0\nf 1 2 3\n",
+    );
+    write(&dir, "index.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n");
+    write(
+        &dir,
+        "nan.obj",
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn nan 0 1\nf 1//1 2//1 3//1\n",
+    );
+    let obj =
+        |f: &str| format!("<shape type=\"obj\"><string name=\"filename\" value=\"{f}\"/></shape>");
+    let closed = "<shape type=\"cube\"><boolean name=\"flip_normals\" value=\"true\"/><bsdf type=\"diffuse\"><float name=\"reflectance\" value=\"1\"/></bsdf><emitter type=\"area\"/></shape>";
+    let cases: Vec<(String, bool)> = vec![
+        (obj("flat.obj"), true),
+        (obj("far.obj"), true),
+        (obj("index.obj"), true),
+        (obj("nan.obj"), true),
+        (obj("missing.obj"), true),
+        ("<shape type=\"rectangle\"><bsdf type=\"diffuse\"><spectrum name=\"reflectance\" value=\"400:0.5, 500:1e400\"/></bsdf></shape>".into(), true),
+        ("<shape type=\"rectangle\"><emitter type=\"area\"><rgb name=\"radiance\" value=\"1e300, 0, 0\"/></emitter></shape>".into(), true),
+        ("<shape type=\"sphere\"><float name=\"radius\" value=\"1e-300\"/></shape>".into(), true),
+        ("<shape type=\"rectangle\"><bsdf type=\"roughconductor\"><float name=\"alpha\" value=\"-1\"/></bsdf></shape>".into(), true),
+        ("<shape type=\"rectangle\"><transform name=\"to_world\"><scale value=\"1e-8\"/></transform></shape>".into(), true),
+        (closed.into(), false),
+    ];
+    for (k, (body, info_refuses)) in cases.iter().enumerate() {
+        let scene = write(
+            &dir,
+            &format!("case{k}.xml"),
+            format!("{HEAD}\n{SENSOR}\n{body}\n</scene>\n"),
+        );
+        let sol = dir.join("x.sol");
+        let exr = dir.join("x.exr");
+        let mut commands = vec![
+            vec!["solve", s(&scene), "-o", s(&sol), "--quality", "draft"],
+            vec!["render", s(&scene), "-o", s(&exr), "--quality", "draft"],
+        ];
+        if *info_refuses {
+            commands.push(vec!["info", s(&scene)]);
+        }
+        for args in commands {
+            let out = trilux(&args);
+            let stderr = String::from_utf8_lossy(&out.stderr);
+            assert_eq!(out.status.code(), Some(1), "{body}: {args:?}: {stderr}");
+            assert_eq!(stderr.lines().count(), 1, "{stderr}");
+            assert!(located_at(&stderr, s(&scene)), "{body}: {args:?}: {stderr}");
+        }
+        assert!(!sol.exists() && !exr.exists());
+    }
+}
