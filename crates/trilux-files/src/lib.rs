@@ -8,7 +8,7 @@
 //! - [`read`]: an input is read only if it is a regular file (after
 //!   following symbolic links) no larger than a stated limit, so that
 //!   `/dev/zero`, a FIFO or a 100 GB file is an error, not an unbounded read.
-//! - [`write`]: outputs are planned before any work ([`Output::plan`]: the
+//! - [`mod@write`]: outputs are planned before any work ([`Output::plan`]: the
 //!   folder exists, the path is not a folder, symbolic links are followed
 //!   to the file they name) and written all or none at the end
 //!   ([`write_all`]): each regular file is staged in an exclusively created

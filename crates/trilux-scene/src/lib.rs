@@ -1,7 +1,8 @@
 //! # trilux-scene — the scene model and its file formats
 //!
 //! Layer: depends on `trilux-color`, `trilux-geometry` and `trilux-brdf`
-//! (their plain-data parameter types), `glam`, `roxmltree` and `tobj`.
+//! (their plain-data parameter types), `trilux-files` (bounded reads),
+//! `glam`, `roxmltree` and `tobj`.
 //! File formats live only here; the solver and the renderer never parse.
 //!
 //! The loader reads the subset of Mitsuba 3's XML listed in design.md §3

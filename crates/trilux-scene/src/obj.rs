@@ -10,10 +10,9 @@
 //! the weighting Mitsuba's `recompute_vertex_normals` uses). With
 //! `face_normals` there are none.
 //!
-//! The file must be a regular file of at most
-//! [`MAX_OBJ_BYTES`](crate::limits::MAX_OBJ_BYTES) (`/dev/zero` is an
-//! error, not an endless read); [`parse_obj`] reads the same format from
-//! bytes already in memory.
+//! The file must be a regular file of at most [`MAX_OBJ_BYTES`]
+//! (`/dev/zero` is an error, not an endless read); [`parse_obj`] reads the
+//! same format from bytes already in memory.
 
 use std::path::Path;
 

@@ -10,7 +10,7 @@
 //! whose cross-section is not a circle after `to_world` (Mitsuba only warns;
 //! the exact analytic intersection needs a circle), a zero total area, and a
 //! missing or malformed OBJ file. An OBJ file is only named here
-//! ([`MeshRequest`]); it is read once the whole scene file is checked
+//! (`MeshRequest`); it is read once the whole scene file is checked
 //! (`crate::meshes`).
 
 use std::path::Path;

@@ -4,7 +4,9 @@
 //! 1; command-line usage errors (unknown options, malformed values) keep
 //! clap's message and exit with status 2, before any file is read.
 //! Subcommands live one per module; the work itself is
-//! `trilux_render::pipeline`'s. Number-list options whose values may begin
+//! `trilux_render::pipeline`'s. Every output is planned before any work and
+//! written all or none at the end (`output`); the scene's meshes are read
+//! only once the camera and options are checked (`trilux_scene::open`). Number-list options whose values may begin
 //! with '-' (`--lookat -0.5,1,2,...`) need `#[arg(allow_hyphen_values =
 //! true)]` on the argument (`allow_negative_numbers` only covers plain
 //! numbers, not comma lists).
