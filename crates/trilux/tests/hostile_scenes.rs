@@ -332,3 +332,108 @@ fn every_scene_error_from_every_command_is_located() {
         assert!(!sol.exists() && !exr.exists());
     }
 }
+
+#[test]
+fn deep_reference_chains_are_not_called_cycles() {
+    let dir = folder("scene-ref-depth");
+    let mut text = format!("{HEAD}\n<bsdf type=\"diffuse\" id=\"b0\"/>\n");
+    for i in 1..70 {
+        text += &format!(
+            "<bsdf type=\"twosided\" id=\"b{i}\"><ref id=\"b{}\"/></bsdf>\n",
+            i - 1
+        );
+    }
+    text += "</scene>\n";
+    let scene = write(&dir, "chain.xml", &text);
+    assert_refused_by_every_command(
+        &scene,
+        s(&scene),
+        "elements nest more than 64 deep once references are expanded",
+    );
+    let out = trilux(&["info", s(&scene)]);
+    assert!(!String::from_utf8_lossy(&out.stderr).contains("cycle"));
+}
+
+/// Runs the binary and checks a refusal (status `code`, one line for
+/// status 1) that does not come from reading the mesh.
+fn assert_refused_before_meshes(args: &[&str], code: i32, what: &str) {
+    let start = Instant::now();
+    let out = trilux(args);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(code), "{args:?}: {stderr}");
+    if code == 1 {
+        assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    }
+    assert!(
+        stderr.contains(what),
+        "{args:?}: {stderr:?} should say {what:?}"
+    );
+    assert!(
+        !stderr.contains("no-such-mesh"),
+        "{args:?}: the mesh was read first: {stderr}"
+    );
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert!(start.elapsed() < Duration::from_secs(2));
+}
+
+#[test]
+fn arguments_camera_film_and_outputs_are_checked_before_meshes_or_solving() {
+    let dir = folder("scene-checks-first");
+    let mesh = "<shape type=\"obj\"><string name=\"filename\" value=\"no-such-mesh.obj\"/></shape>";
+    let with_sensor = write(
+        &dir,
+        "with.xml",
+        format!("{HEAD}\n{SENSOR}\n{mesh}\n</scene>\n"),
+    );
+    let without = write(&dir, "without.xml", format!("{HEAD}\n{mesh}\n</scene>\n"));
+    let big_film = write(
+        &dir,
+        "film.xml",
+        format!(
+            "{HEAD}\n<sensor type=\"perspective\"><film type=\"hdrfilm\"><integer name=\"width\" value=\"100000\"/><integer name=\"height\" value=\"100000\"/></film></sensor>\n{mesh}\n</scene>\n"
+        ),
+    );
+    let exr = dir.join("x.exr");
+    let (w, wo, film, x) = (s(&with_sensor), s(&without), s(&big_film), s(&exr));
+    // Usage errors (status 2), before any file is read.
+    assert_refused_before_meshes(&["render", w, "-o", x, "--width", "0"], 2, "--width");
+    assert_refused_before_meshes(
+        &["render", w, "-o", x, "--lookat", "1,2,3"],
+        2,
+        "6 or 9 numbers",
+    );
+    assert_refused_before_meshes(&["render", w, "-o", x, "--spp", "0"], 2, "--spp");
+    assert_refused_before_meshes(
+        &[
+            "render",
+            w,
+            "-o",
+            x,
+            "--width",
+            "4294967295",
+            "--height",
+            "4294967295",
+        ],
+        2,
+        "must lie in 1..=32768",
+    );
+    assert_refused_before_meshes(&["solve", w, "-o", x, "--threads", "0"], 2, "--threads");
+    // The outputs, the sensor and the film (status 1), before the mesh.
+    let missing = dir.join("missing").join("x.exr");
+    assert_refused_before_meshes(&["render", w, "-o", s(&missing)], 1, "does not exist");
+    assert_refused_before_meshes(&["render", wo, "-o", x], 1, "the scene has no <sensor>");
+    assert_refused_before_meshes(
+        &[
+            "render", w, "-o", x, "--width", "30000", "--height", "30000",
+        ],
+        1,
+        "film size 30000 × 30000 (900000000 pixels, about 50.3 GiB of memory) is beyond the limits",
+    );
+    assert_refused_before_meshes(&["render", film, "-o", x], 1, &format!("{film}:2:"));
+    assert_refused_before_meshes(
+        &["render", w, "-o", x, "--lookat", "1,2,3,1,2,3"],
+        1,
+        "invalid camera",
+    );
+    assert!(!exr.exists());
+}
