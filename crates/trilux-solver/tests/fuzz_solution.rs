@@ -11,15 +11,14 @@
 
 #[path = "../../../tests/support/capped_alloc.rs"]
 mod capped_alloc;
+mod common;
 
 use std::sync::Arc;
 
 use capped_alloc::{Capped, Rng, peak, reset_peak};
 use glam::DVec2;
 use trilux_geometry::{FaceId, Side, SurfaceId};
-use trilux_solver::{
-    PreparedScene, Quality, SceneDescription, Solution, SolverSettings, SurfaceSite,
-};
+use trilux_solver::{PreparedScene, Quality, Solution, SolverSettings, SurfaceSite};
 
 #[global_allocator]
 static ALLOCATOR: Capped = Capped;
@@ -175,17 +174,7 @@ fn exercise(s: &Solution<3>, rng: &mut Rng) {
 #[test]
 fn mutated_solution_files_never_panic_nor_allocate_beyond_twice_the_intact_load() {
     let scene = trilux_scene::load_str(SCENE, "fuzz.xml").unwrap();
-    let (shapes, bsdfs, emission) = (
-        scene.geometry_shapes(),
-        scene.bsdf_params(),
-        scene.emitter_radiance(),
-    );
-    let desc = SceneDescription {
-        shapes: &shapes,
-        bsdfs: &bsdfs,
-        emission: &emission,
-    };
-    let prepared: Arc<PreparedScene<3>> = Arc::new(PreparedScene::new(&desc).unwrap());
+    let prepared: Arc<PreparedScene<3>> = common::prepare_scene(&scene);
     let settings = SolverSettings::preset(Quality::Draft);
     let solution = trilux_solver::Solver::new(Arc::clone(&prepared), settings.clone())
         .unwrap()

@@ -8,11 +8,8 @@ use std::path::Path;
 use std::process::Output;
 
 mod common;
+use common::hostile::{assert_refused, s};
 use common::{folder, trilux};
-
-fn s(p: &Path) -> &str {
-    p.to_str().expect("utf-8 path")
-}
 
 /// A closed box (reflectance 0.5, emitting 1) holding a smaller box, seen
 /// from inside; every length is multiplied by `scale` and the whole is
@@ -59,14 +56,6 @@ fn render(dir: &Path, name: &str, text: &str) -> (Output, std::path::PathBuf) {
     let exr = dir.join(format!("{name}.exr"));
     let out = trilux(&["render", s(&path), "-o", s(&exr), "--quality", "draft"]);
     (out, exr)
-}
-
-fn assert_refused(out: &Output, prefix: &str, what: &str) {
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1), "{stderr}");
-    assert_eq!(stderr.lines().count(), 1, "{stderr}");
-    assert!(stderr.starts_with(&format!("error: {prefix}")), "{stderr}");
-    assert!(stderr.contains(what), "{stderr:?} should say {what:?}");
 }
 
 #[test]

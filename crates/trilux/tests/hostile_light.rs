@@ -6,52 +6,13 @@
 //! brighter than its radiance.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test may panic
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Output;
 use std::time::{Duration, Instant};
 
 mod common;
+use common::hostile::{assert_refused, furnace, s, write};
 use common::{folder, trilux};
-
-fn s(p: &Path) -> &str {
-    p.to_str().expect("utf-8 path")
-}
-
-/// A closed box seen from inside: reflectance `rho`, radiance `le` (the
-/// `<float name="radiance">` is on line 9, its value at column 27).
-fn furnace(rho: &str, le: &str, scale: f64) -> String {
-    format!(
-        r#"<scene version="3.0.0">
-  <sensor type="perspective">
-    <float name="fov" value="60"/>
-    <transform name="to_world"><lookat origin="0,0,{z}" target="0,0,{t}" up="0,1,0"/></transform>
-    <sampler type="independent"><integer name="sample_count" value="4"/></sampler>
-    <film type="hdrfilm"><integer name="width" value="12"/><integer name="height" value="12"/></film>
-  </sensor>
-  <shape type="cube"><boolean name="flip_normals" value="true"/><transform name="to_world"><scale value="{scale:e}"/></transform>
-    <emitter type="area"><float name="radiance" value="{le}"/></emitter>
-    <bsdf type="diffuse"><float name="reflectance" value="{rho}"/></bsdf>
-  </shape>
-</scene>
-"#,
-        z = 0.5 * scale,
-        t = -scale
-    )
-}
-
-fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
-    let p = dir.join(name);
-    std::fs::write(&p, text).unwrap();
-    p
-}
-
-fn assert_refused(out: &Output, prefix: &str, what: &str) {
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1), "{stderr}");
-    assert_eq!(stderr.lines().count(), 1, "{stderr}");
-    assert!(stderr.starts_with(&format!("error: {prefix}")), "{stderr}");
-    assert!(stderr.contains(what), "{stderr:?} should say {what:?}");
-}
 
 fn render(scene: &Path, exr: &Path, extra: &[&str]) -> Output {
     let mut args = vec!["render", s(scene), "-o", s(exr), "--quality", "draft"];
@@ -68,7 +29,7 @@ fn radiance_beyond_the_limit_is_refused_where_it_is_written() {
         ("inf", 1.0),
         ("1.0001e20", 1.0),
     ] {
-        let scene = write(&dir, "over.xml", &furnace("0.5", le, scale));
+        let scene = write(&dir, "over.xml", furnace("0.5", le, scale));
         let exr = dir.join("over.exr");
         for out in [
             trilux(&["info", s(&scene)]),
@@ -90,7 +51,7 @@ fn radiance_beyond_the_limit_is_refused_where_it_is_written() {
 fn radiance_at_the_limit_renders_finite_pixels() {
     let dir = folder("light-limit");
     for mode in ["rgb", "spectral"] {
-        let scene = write(&dir, "limit.xml", &furnace("0.5", "1e20", 1e6));
+        let scene = write(&dir, "limit.xml", furnace("0.5", "1e20", 1e6));
         let exr = dir.join(format!("limit-{mode}.exr"));
         let out = render(&scene, &exr, &["--mode", mode]);
         assert!(
@@ -117,7 +78,7 @@ fn radiance_at_the_limit_renders_finite_pixels() {
 #[test]
 fn a_closed_scene_reflecting_everything_is_refused_before_the_solve() {
     let dir = folder("light-trapped");
-    let scene = write(&dir, "trapped.xml", &furnace("1", "1", 1.0));
+    let scene = write(&dir, "trapped.xml", furnace("1", "1", 1.0));
     let exr = dir.join("trapped.exr");
     let sol = dir.join("trapped.sol");
     let start = Instant::now();
@@ -156,7 +117,7 @@ fn a_closed_scene_reflecting_everything_is_refused_before_the_solve() {
 fn a_solve_that_stops_at_its_cap_says_so() {
     let dir = folder("light-cap");
     // Reflectance 0.9999 converges, but far beyond draft's 20 000 shots.
-    let scene = write(&dir, "slow.xml", &furnace("0.9999", "1", 1.0));
+    let scene = write(&dir, "slow.xml", furnace("0.9999", "1", 1.0));
     let sol = dir.join("slow.sol");
     let out = trilux(&["solve", s(&scene), "-o", s(&sol), "--quality", "draft"]);
     let stderr = String::from_utf8_lossy(&out.stderr);

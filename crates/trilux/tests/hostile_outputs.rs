@@ -8,25 +8,11 @@
 use std::collections::BTreeMap;
 use std::io::Read;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Command;
 
 mod common;
+use common::hostile::{assert_ok, assert_refused, furnace, mkfifo, s};
 use common::{folder, trilux};
-
-/// A small closed scene that solves and renders in a fraction of a second.
-const SCENE: &str = r#"<scene version="3.0.0">
-  <sensor type="perspective">
-    <float name="fov" value="60"/>
-    <transform name="to_world"><lookat origin="0,0,0.5" target="0,0,-1" up="0,1,0"/></transform>
-    <sampler type="independent"><integer name="sample_count" value="2"/></sampler>
-    <film type="hdrfilm"><integer name="width" value="12"/><integer name="height" value="12"/></film>
-  </sensor>
-  <shape type="cube"><boolean name="flip_normals" value="true"/>
-    <bsdf type="diffuse"><float name="reflectance" value="0.5"/></bsdf>
-    <emitter type="area"><float name="radiance" value="1.0"/></emitter>
-  </shape>
-</scene>
-"#;
 
 /// The same scene with a mesh that does not exist: any error it gives
 /// shows that the scene was loaded, so an output error instead shows that
@@ -35,10 +21,6 @@ const SCENE_MISSING_MESH: &str = r#"<scene version="3.0.0">
   <shape type="obj"><string name="filename" value="no-such-mesh.obj"/></shape>
 </scene>
 "#;
-
-fn s(p: &Path) -> &str {
-    p.to_str().expect("utf-8 path")
-}
 
 /// Every file under `dir` (recursively) with its bytes.
 fn snapshot(dir: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
@@ -57,32 +39,11 @@ fn snapshot(dir: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
     out
 }
 
-/// One line `error: ...` containing `what`, status 1, no panic.
-fn assert_refused(out: &Output, what: &str) {
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(
-        out.status.code(),
-        Some(1),
-        "{what}: status; stderr {stderr}"
-    );
-    assert_eq!(stderr.lines().count(), 1, "{what}: one line: {stderr}");
-    assert!(stderr.starts_with("error: "), "{stderr}");
-    assert!(stderr.contains(what), "{stderr:?} should say {what:?}");
-}
-
-fn assert_ok(out: &Output) {
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-}
-
 /// A folder holding the scene, a mesh-less copy and a draft solution.
 fn setup(name: &str) -> (PathBuf, PathBuf) {
     let dir = folder(name);
     let scene = dir.join("scene.xml");
-    std::fs::write(&scene, SCENE).unwrap();
+    std::fs::write(&scene, furnace("0.5", "1.0", 1.0)).unwrap();
     std::fs::write(dir.join("missing-mesh.xml"), SCENE_MISSING_MESH).unwrap();
     (dir, scene)
 }
@@ -96,10 +57,6 @@ fn solve(scene: &Path, sol: &Path) {
         "--quality",
         "draft",
     ]));
-}
-
-fn mkfifo(path: &Path) {
-    assert!(Command::new("mkfifo").arg(path).status().unwrap().success());
 }
 
 #[test]
@@ -134,7 +91,7 @@ fn a_symbolic_link_output_stays_a_link() {
     std::os::unix::fs::symlink("scene.xml", &to_scene).unwrap();
     let before = snapshot(&dir);
     let out = trilux(&["render", s(&scene), "-o", s(&to_scene)]);
-    assert_refused(&out, "would overwrite the input");
+    assert_refused(&out, "", "would overwrite the input");
     assert_eq!(snapshot(&dir), before);
 }
 
@@ -270,7 +227,7 @@ fn an_output_equal_to_an_input_or_another_output_is_refused_first() {
         let before = snapshot(&dir);
         let args: Vec<&str> = args.iter().map(String::as_str).collect();
         let out = trilux(&args);
-        assert_refused(&out, what);
+        assert_refused(&out, "", what);
         assert!(
             !String::from_utf8_lossy(&out.stderr).contains("no-such-mesh"),
             "outputs are checked before the scene is loaded: {args:?}"
@@ -314,7 +271,7 @@ fn one_failing_output_leaves_the_others_as_they_were() {
         "--stats",
         s(&stats),
     ]);
-    assert_refused(&out, "does not exist");
+    assert_refused(&out, "", "does not exist");
     assert_eq!(snapshot(&dir), before);
 }
 
@@ -331,7 +288,7 @@ fn the_default_out_folder_is_made_only_when_something_is_written() {
     };
     // A failure leaves no out/ behind.
     let out = run("missing-mesh.xml");
-    assert_refused(&out, "the scene has no <sensor>");
+    assert_refused(&out, "", "the scene has no <sensor>");
     assert!(!dir.join("out").exists());
     assert_ok(&run("sub-scene.xml"));
     assert!(dir.join("out/sub-scene.exr").is_file());

@@ -5,16 +5,12 @@
 //! `error: FILE:LINE:COL: ...` (status 1), from every command, quickly.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test may panic
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::path::Path;
 use std::time::{Duration, Instant};
 
 mod common;
+use common::hostile::{mkfifo, s, write};
 use common::{folder, trilux};
-
-fn s(p: &Path) -> &str {
-    p.to_str().expect("utf-8 path")
-}
 
 /// Runs `info`, `solve` and `render` on `scene` and checks each error: one
 /// line starting with `error: {prefix}` and containing `what`, status 1,
@@ -52,12 +48,6 @@ fn assert_refused_by_every_command(scene: &Path, prefix: &str, what: &str) {
         assert!(out.stdout.is_empty() || args[0] == "info");
     }
     assert!(!sol.exists() && !exr.exists(), "no output left behind");
-}
-
-fn write(dir: &Path, name: &str, bytes: impl AsRef<[u8]>) -> PathBuf {
-    let p = dir.join(name);
-    std::fs::write(&p, bytes).unwrap();
-    p
 }
 
 const HEAD: &str = r#"<scene version="3.0.0">"#;
@@ -135,11 +125,6 @@ fn exponential_references_are_bounded() {
         &format!("{}:2:", s(&cycle)),
         "reference cycle: a → b → a",
     );
-}
-
-/// Makes a FIFO (an endless input stands for /dev/zero; never a real device).
-fn mkfifo(path: &Path) {
-    assert!(Command::new("mkfifo").arg(path).status().unwrap().success());
 }
 
 #[test]

@@ -10,34 +10,10 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 mod common;
+use common::hostile::{fnv, furnace, s};
 use common::{folder, trilux};
 
-const SCENE: &str = r#"<scene version="3.0.0">
-  <sensor type="perspective">
-    <transform name="to_world"><lookat origin="0,0,0.5" target="0,0,-1" up="0,1,0"/></transform>
-    <film type="hdrfilm"><integer name="width" value="8"/><integer name="height" value="8"/></film>
-  </sensor>
-  <shape type="cube"><boolean name="flip_normals" value="true"/>
-    <bsdf type="diffuse"><float name="reflectance" value="0.5"/></bsdf>
-    <emitter type="area"><float name="radiance" value="1.0"/></emitter>
-  </shape>
-</scene>
-"#;
-
 const HEADER: usize = 40;
-
-fn s(p: &Path) -> &str {
-    p.to_str().expect("utf-8 path")
-}
-
-fn fnv(bytes: &[u8]) -> u64 {
-    let mut h = 0xcbf2_9ce4_8422_2325u64;
-    for &b in bytes {
-        h ^= u64::from(b);
-        h = h.wrapping_mul(0x0100_0000_01b3);
-    }
-    h
-}
 
 /// The bytes with a header whose length and checksum fit the payload.
 fn with_valid_header(mut bytes: Vec<u8>) -> Vec<u8> {
@@ -51,7 +27,7 @@ fn with_valid_header(mut bytes: Vec<u8>) -> Vec<u8> {
 fn setup() -> (PathBuf, PathBuf, Vec<u8>) {
     let dir = folder("solutions");
     let scene = dir.join("scene.xml");
-    std::fs::write(&scene, SCENE).unwrap();
+    std::fs::write(&scene, furnace("0.5", "1.0", 1.0)).unwrap();
     let sol = dir.join("good.sol");
     let out = trilux(&["solve", s(&scene), "-o", s(&sol), "--quality", "draft"]);
     assert!(
@@ -64,7 +40,7 @@ fn setup() -> (PathBuf, PathBuf, Vec<u8>) {
 }
 
 /// Renders `scene` from solution `bytes` and checks the refusal.
-fn assert_refused(dir: &Path, scene: &Path, bytes: &[u8], what: &str) {
+fn assert_solution_refused(dir: &Path, scene: &Path, bytes: &[u8], what: &str) {
     let sol = dir.join("bad.sol");
     std::fs::write(&sol, bytes).unwrap();
     let exr = dir.join("bad.exr");
@@ -96,7 +72,7 @@ fn corrupted_payloads_under_valid_headers_are_refused() {
     let depths = HEADER + 8 + stats_len + 4;
     let mut deep = good.clone();
     deep[depths..depths + 4].copy_from_slice(&30u32.to_le_bytes());
-    assert_refused(
+    assert_solution_refused(
         &dir,
         &scene,
         &with_valid_header(deep),
@@ -108,7 +84,7 @@ fn corrupted_payloads_under_valid_headers_are_refused() {
     for bad in [f32::NAN, f32::INFINITY, -1.0] {
         let mut b = good.clone();
         b[radiance..radiance + 4].copy_from_slice(&bad.to_le_bytes());
-        assert_refused(
+        assert_solution_refused(
             &dir,
             &scene,
             &with_valid_header(b),
@@ -117,8 +93,8 @@ fn corrupted_payloads_under_valid_headers_are_refused() {
     }
     let mut flipped = good.clone();
     flipped[radiance] ^= 0x40;
-    assert_refused(&dir, &scene, &flipped, "checksum mismatch");
-    assert_refused(
+    assert_solution_refused(&dir, &scene, &flipped, "checksum mismatch");
+    assert_solution_refused(
         &dir,
         &scene,
         &good[..good.len() - 3],
@@ -126,9 +102,9 @@ fn corrupted_payloads_under_valid_headers_are_refused() {
     );
     let mut extended = good.clone();
     extended.extend_from_slice(b"more");
-    assert_refused(&dir, &scene, &with_valid_header(extended), "trailing bytes");
-    assert_refused(&dir, &scene, b"TRILUXS\0", "truncated");
-    assert_refused(
+    assert_solution_refused(&dir, &scene, &with_valid_header(extended), "trailing bytes");
+    assert_solution_refused(&dir, &scene, b"TRILUXS\0", "truncated");
+    assert_solution_refused(
         &dir,
         &scene,
         b"not a solution",
