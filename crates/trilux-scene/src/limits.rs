@@ -12,6 +12,15 @@ pub const MAX_SCENE_BYTES: u64 = 64 << 20;
 /// elements more again.
 pub const MAX_OBJ_BYTES: u64 = 256 << 20;
 
+/// Most triangles of one OBJ mesh (4 million): a file of short lines
+/// (`f 1 2 3`) holds 30 million in [`MAX_OBJ_BYTES`], and every triangle
+/// costs a few hundred bytes once built into charts, elements and the BVH.
+pub const MAX_OBJ_TRIANGLES: usize = 4_000_000;
+
+/// Most vertices of one OBJ mesh (12 million: three per triangle, what
+/// splitting by position, texture and normal index can make).
+pub const MAX_OBJ_VERTICES: usize = 12_000_000;
+
 /// Most XML nodes in a scene file (elements, text and comments).
 pub const MAX_XML_NODES: u32 = 2_000_000;
 

@@ -48,6 +48,16 @@ pub enum ObjError {
         /// The OBJ file.
         path: std::path::PathBuf,
     },
+    /// The mesh has more triangles or vertices than the loader takes.
+    #[error("OBJ file {} has {triangles} triangles and {vertices} vertices; the limits are {} and {} (docs/limits.md)", path.display(), crate::limits::MAX_OBJ_TRIANGLES, crate::limits::MAX_OBJ_VERTICES)]
+    TooLarge {
+        /// The OBJ file.
+        path: std::path::PathBuf,
+        /// Its triangles.
+        triangles: usize,
+        /// Its vertices (after splitting by position, texture and normal).
+        vertices: usize,
+    },
     /// A coordinate is not finite.
     #[error("OBJ file {} has a coordinate that is not a finite number", path.display())]
     NotFinite {
@@ -67,6 +77,16 @@ pub fn load_obj(path: &Path, face_normals: bool) -> Result<TriangleMesh, ObjErro
 
 /// [`load_obj`] on the bytes of an OBJ file; `path` names it in errors.
 pub fn parse_obj(bytes: &[u8], path: &Path, face_normals: bool) -> Result<TriangleMesh, ObjError> {
+    // Before tobj spends memory on them: every face line makes at least
+    // one triangle, every vertex line one position.
+    let (faces, positions) = count_lines(bytes);
+    if faces > crate::limits::MAX_OBJ_TRIANGLES || positions > crate::limits::MAX_OBJ_VERTICES {
+        return Err(ObjError::TooLarge {
+            path: path.to_path_buf(),
+            triangles: faces,
+            vertices: positions,
+        });
+    }
     let options = tobj::LoadOptions {
         single_index: true,
         triangulate: true,
@@ -81,6 +101,15 @@ pub fn parse_obj(bytes: &[u8], path: &Path, face_normals: bool) -> Result<Triang
         reason: e.to_string(),
     })?;
 
+    let triangles: usize = models.iter().map(|m| m.mesh.indices.len() / 3).sum();
+    let vertices: usize = models.iter().map(|m| m.mesh.positions.len() / 3).sum();
+    if triangles > crate::limits::MAX_OBJ_TRIANGLES || vertices > crate::limits::MAX_OBJ_VERTICES {
+        return Err(ObjError::TooLarge {
+            path: path.to_path_buf(),
+            triangles,
+            vertices,
+        });
+    }
     let mut mesh = TriangleMesh {
         face_normals,
         ..Default::default()
@@ -128,6 +157,21 @@ pub fn parse_obj(bytes: &[u8], path: &Path, face_normals: bool) -> Result<Triang
         Some(vertex_normals(&mesh.positions, &mesh.triangles))
     };
     Ok(mesh)
+}
+
+/// Lines that start (after blanks) with `f` and with `v` then a blank.
+fn count_lines(bytes: &[u8]) -> (usize, usize) {
+    let (mut faces, mut positions) = (0, 0);
+    for line in bytes.split(|&b| b == b'\n') {
+        let start = line.iter().position(|b| !b.is_ascii_whitespace());
+        let rest = start.map_or(&[][..], |i| &line[i..]);
+        match rest {
+            [b'f', b' ' | b'\t', ..] => faces += 1,
+            [b'v', b' ' | b'\t', ..] => positions += 1,
+            _ => {}
+        }
+    }
+    (faces, positions)
 }
 
 /// Angle-weighted smooth vertex normals (Mitsuba's `recompute_vertex_normals`).

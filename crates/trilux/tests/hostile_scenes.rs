@@ -166,6 +166,22 @@ fn inputs_that_never_end_or_are_too_large_are_refused_unread() {
         &format!("{}:2:", s(&scene)),
         "it is 300 MiB or more, and the limit is 256 MiB",
     );
+    // 4.1 million one-line triangles in 33 MB: refused before parsing.
+    let mut many = b"v 0 0 0\nv 1 0 0\nv 0 1 0\n".to_vec();
+    many.extend(b"f 1 2 3\n".repeat(4_100_000));
+    write(&dir, "many.obj", many);
+    let scene = write(
+        &dir,
+        "many-mesh.xml",
+        format!(
+            "{HEAD}\n<shape type=\"obj\"><string name=\"filename\" value=\"many.obj\"/></shape>\n{SENSOR}</scene>"
+        ),
+    );
+    assert_refused_by_every_command(
+        &scene,
+        &format!("{}:2:", s(&scene)),
+        "has 4100000 triangles and 3 vertices; the limits are 4000000 and 12000000",
+    );
     let big_scene = dir.join("big.xml");
     std::fs::File::create(&big_scene)
         .unwrap()
