@@ -140,6 +140,7 @@ pub fn render_trilux(
         solver: SolverSettings::preset(quality),
         source: SolutionSource::Solve,
         save: None,
+        solution_file: false,
         render: Some(RenderPlan { view, settings }),
     };
     let outcome = Observer::quiet(|o| trilux_render::pipeline::run(&scene, &plan, o))?;

@@ -38,6 +38,13 @@ pub use bands::Bands;
 pub use cie::SampledSpectrum;
 pub use convert::Role;
 pub use error::ColorError;
+
+/// Largest emitted radiance a scene may state, in any band (1e20; see
+/// docs/limits.md): light is summed over bounces, bands and areas and kept
+/// in 32-bit floats (largest 3.4e38) in solution and image files, so 1e20
+/// leaves eighteen orders of magnitude for the sums (the sun's radiance is
+/// about 2e7 W/(sr m²)).
+pub const MAX_RADIANCE: f64 = 1e20;
 pub use mode::{Mode, SPECTRAL_BANDS, WithBands};
 pub use param::ColorParam;
 pub use spectrum::{Rgb, Spectrum};

@@ -25,6 +25,7 @@ use crate::element::rect_element;
 use crate::error::{GeometryError, ShapeProblem};
 use crate::geometry::Geometry;
 use crate::ids::SurfaceId;
+use crate::limits::{MAX_OFFSET_RATIO, MIN_SCENE_SIZE, within};
 use crate::patch::Patch;
 use crate::shape::{Shape, ShapeKind, TriangleMesh};
 use crate::surface::{InputSurface, SurfaceGeom, SurfaceKind};
@@ -35,17 +36,31 @@ impl Geometry {
     ///
     /// Errors name the offending shape: non-finite or singular transforms,
     /// non-finite parameters, non-positive radii, zero area, bad mesh
-    /// indices. Non-uniform scale and shear are supported for every shape
-    /// (a sphere becomes an exact ellipsoid, a disk an exact ellipse).
+    /// indices, coordinates outside [`crate::limits`] (checked before the
+    /// BVH is built). Non-uniform scale and shear are supported for every
+    /// shape (a sphere becomes an exact ellipsoid, a disk an exact
+    /// ellipse).
     pub fn build(shapes: &[Shape]) -> Result<Geometry, GeometryError> {
         let mut b = Builder::default();
+        let mut reach = Vec::with_capacity(shapes.len());
         for (index, shape) in shapes.iter().enumerate() {
             b.shape = index as u32;
-            b.add_shape(shape).map_err(|problem| GeometryError {
+            let first = b.surfaces.len();
+            let err = |problem| GeometryError {
                 shape: index,
                 problem,
-            })?;
+            };
+            b.add_shape(shape).map_err(err)?;
+            let bounds = b.surfaces[first..]
+                .iter()
+                .fold(Bounds::EMPTY, |acc, s| acc.union(s.bounds));
+            let coordinate = largest_coordinate(&bounds);
+            if !within(coordinate) {
+                return Err(err(ShapeProblem::BeyondCoordinateLimit { coordinate }));
+            }
+            reach.push((coordinate, bounds.diagonal().length()));
         }
+        check_scale(&b, &reach)?;
         Ok(b.finish())
     }
 
@@ -53,6 +68,48 @@ impl Geometry {
     pub fn build_shared(shapes: &[Shape]) -> Result<Arc<Geometry>, GeometryError> {
         Geometry::build(shapes).map(Arc::new)
     }
+}
+
+/// The largest absolute coordinate of a box (0 for an empty one).
+fn largest_coordinate(b: &Bounds) -> f64 {
+    if b.is_empty() {
+        return 0.0;
+    }
+    b.min.abs().max(b.max.abs()).max_element()
+}
+
+/// Refuses a scene too small, or too far from the origin for its size
+/// ([`crate::limits`]), naming the largest shape or the one reaching
+/// furthest. `reach` is each shape's (largest coordinate, diagonal).
+fn check_scale(b: &Builder, reach: &[(f64, f64)]) -> Result<(), GeometryError> {
+    let bounds = b
+        .surfaces
+        .iter()
+        .fold(Bounds::EMPTY, |a, s| a.union(s.bounds));
+    if bounds.is_empty() {
+        return Ok(());
+    }
+    let size = bounds.diagonal().length();
+    let pick = |key: fn(&(f64, f64)) -> f64| {
+        (0..reach.len())
+            .max_by(|&i, &j| key(&reach[i]).total_cmp(&key(&reach[j])))
+            .unwrap_or(0)
+    };
+    if size < MIN_SCENE_SIZE {
+        return Err(GeometryError {
+            shape: pick(|r| r.1),
+            problem: ShapeProblem::SceneTooSmall { size },
+        });
+    }
+    let far = pick(|r| r.0);
+    let coordinate = reach.get(far).map_or(0.0, |r| r.0);
+    if coordinate > MAX_OFFSET_RATIO * size {
+        return Err(GeometryError {
+            shape: far,
+            problem: ShapeProblem::FarFromOrigin { coordinate, size },
+        });
+    }
+    Ok(())
 }
 
 /// What the shapes become, collected shape by shape.
@@ -418,6 +475,15 @@ fn world_shading_normals(
 fn world_mesh(mesh: &TriangleMesh, xf: &Affine, sign: f64) -> Result<MeshData, ShapeProblem> {
     let shading_normals = world_shading_normals(mesh, xf)?;
     let positions: Vec<DVec3> = mesh.positions.iter().map(|p| xf.point(*p)).collect();
+    // Before any work on them: charts of points beyond the limit mean
+    // nothing (and their areas may overflow).
+    if let Some(coordinate) = positions
+        .iter()
+        .map(|p| p.abs().max_element())
+        .find(|c| !within(*c))
+    {
+        return Err(ShapeProblem::BeyondCoordinateLimit { coordinate });
+    }
     let scale = Bounds::from_points(positions.iter().copied())
         .diagonal()
         .length();

@@ -62,6 +62,37 @@ pub enum ShapeProblem {
         /// Vertex index.
         vertex: usize,
     },
+    /// A point of the shape lies beyond [`crate::limits::MAX_COORDINATE`].
+    #[error(
+        "the shape reaches coordinate {coordinate:.3e}, beyond the coordinate limit ±{:e} (docs/limits.md)",
+        crate::limits::MAX_COORDINATE
+    )]
+    BeyondCoordinateLimit {
+        /// The largest absolute coordinate of the shape.
+        coordinate: f64,
+    },
+    /// The whole scene (this being its largest shape) is smaller than
+    /// [`crate::limits::MIN_SCENE_SIZE`].
+    #[error(
+        "the whole scene is {size:.3e} across, below the smallest size {:e} (docs/limits.md): scale it up",
+        crate::limits::MIN_SCENE_SIZE
+    )]
+    SceneTooSmall {
+        /// The diagonal of the scene's bounding box.
+        size: f64,
+    },
+    /// The scene lies too far from the origin for its size (this shape
+    /// reaching furthest).
+    #[error(
+        "the shape reaches coordinate {coordinate:.3e}, more than {:e} times the scene's size {size:.3e} (docs/limits.md): move the scene nearer the origin",
+        crate::limits::MAX_OFFSET_RATIO
+    )]
+    FarFromOrigin {
+        /// The shape's largest absolute coordinate.
+        coordinate: f64,
+        /// The diagonal of the scene's bounding box.
+        size: f64,
+    },
     /// The mesh has per-vertex normals, but not one per vertex.
     #[error("the mesh has {normals} normals for {positions} vertices")]
     NormalCountMismatch {

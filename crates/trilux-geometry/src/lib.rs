@@ -50,7 +50,8 @@
 //!   conventions ([`Shape`], [`ShapeKind`], [`TriangleMesh`]); checked
 //!   against Mitsuba 3.9 ray hits in `tests/mitsuba.rs`.
 //! - [`build`]: [`Geometry::build`] turns shapes into input surfaces and
-//!   BVH primitives; errors in [`error`] name the shape.
+//!   BVH primitives; errors in [`error`] name the shape; the coordinates it
+//!   accepts are in [`limits`].
 //! - [`geometry`]: the immutable [`Geometry`] (input surfaces, meshes, BVH)
 //!   and its ray queries ([`Ray`], [`Hit`], `intersect`, `occluded` and
 //!   their rayon batch forms).
@@ -101,6 +102,7 @@ pub mod forest;
 pub mod form_factor;
 pub mod geometry;
 pub mod ids;
+pub mod limits;
 mod patch;
 mod quadrature;
 pub mod sampling;
@@ -118,8 +120,8 @@ pub use error::{GeometryError, ShapeProblem};
 pub use face::{FaceElement, FaceId, PerFace, Side, Sided};
 pub use forest::ElementForest;
 pub use form_factor::{
-    FormFactor, FormFactorOptions, MAX_POLYGON_PIECES, form_factor, form_factor_batch,
-    PointFormFactors, form_factor_front, point_form_factor, point_to_polygon,
+    FormFactor, FormFactorOptions, MAX_POLYGON_PIECES, PointFormFactors, form_factor,
+    form_factor_batch, form_factor_front, point_form_factor, point_to_polygon,
     point_to_polygon_front,
 };
 pub use geometry::{Geometry, Hit, RAY_EPSILON, Ray};

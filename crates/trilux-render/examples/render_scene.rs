@@ -61,6 +61,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         solver,
         source: SolutionSource::Solve,
         save: None,
+        solution_file: false,
         render: Some(RenderPlan {
             view: ViewOverrides {
                 width: size,

@@ -40,6 +40,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         solver: SolverSettings::preset(Quality::Default),
         source: SolutionSource::Solve,
         save: Some(&file),
+        solution_file: false,
         render: Some(render),
     };
     let solved = Observer::quiet(|o| trilux_render::pipeline::run(&scene, &plan, o))?;

@@ -34,6 +34,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         solver: SolverSettings::preset(Quality::Default),
         source: SolutionSource::Solve,
         save: Some(&file),
+        solution_file: false,
         render: None,
     };
     let t = Instant::now();

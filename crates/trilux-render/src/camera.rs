@@ -121,11 +121,7 @@ impl Camera {
         width: u32,
         height: u32,
     ) -> Result<Self, RenderError> {
-        if width == 0 || height == 0 {
-            return Err(RenderError::Camera(format!(
-                "film size {width}x{height} must be at least 1x1"
-            )));
-        }
+        trilux_scene::limits::check_film(width, height).map_err(RenderError::Camera)?;
         if !(fov_deg.is_finite() && fov_deg > 0.0 && fov_deg < 180.0) {
             return Err(RenderError::Camera(format!(
                 "fov {fov_deg} must lie strictly between 0 and 180 degrees"

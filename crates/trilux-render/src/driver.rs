@@ -26,12 +26,12 @@ use crate::sampler::{MAX_SAMPLES, PixelSampler, dims};
 pub enum Estimator {
     /// The solution's gather links at the primary hit (Lambertian parts
     /// without Monte Carlo noise but in penumbrae), a gather ray for glossy
-    /// parts (`link_gather`). The default.
-    #[default]
+    /// parts (`link_gather`).
     Links,
     /// The path gather of paper §4.5: a light sample and a BSDF-sampled
     /// gather ray at the primary hit, the solution read at the gather hit
-    /// (or one bounce later, by the extra-bounce rule).
+    /// (or one bounce later, by the extra-bounce rule). The default.
+    #[default]
     Paths,
     /// No random rays: the links with their own visibility, one mirror
     /// reading for glossy parts (`link_gather::Preview`).
@@ -148,10 +148,13 @@ where
             Estimator::Preview => preview.camera_sample::<N>(origin, dir, caches, stats),
         }
     };
-    // Each dimension layout must fit the sequence: two levels of gather.
+    // Each dimension layout must fit the sequence (three gather levels and
+    // the link gather's rays).
     const { assert!(dims::LINKS + 8 <= 256) };
+    // The whole film first: a film too large for memory fails before work.
+    let mut image = Film::new(0, 0, w as usize, h as usize, settings.filter)?;
 
-    let tiles: Vec<(Film, GatherStats)> = (0..total)
+    let tiles: Vec<Result<(Film, GatherStats), RenderError>> = (0..total)
         .into_par_iter()
         .map(|t| {
             let tx = (t as u32 % tiles_x) * ts;
@@ -164,7 +167,7 @@ where
                 (tw as i64 + 2 * border) as usize,
                 (th as i64 + 2 * border) as usize,
                 settings.filter,
-            );
+            )?;
             let mut stats = GatherStats::default();
             let mut caches = Caches::<N>::default();
             for y in ty..ty + th {
@@ -186,15 +189,15 @@ where
                 }
             }
             progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);
-            (film, stats)
+            Ok((film, stats))
         })
         .collect();
 
-    let mut image = Film::new(0, 0, w as usize, h as usize, settings.filter);
     let mut stats = RenderStats::default();
-    for (film, s) in &tiles {
-        image.merge(film);
-        stats.gather.add(s);
+    for tile in tiles {
+        let (film, s) = tile?;
+        image.merge(&film);
+        stats.gather.add(&s);
     }
     stats.seconds = start.elapsed().as_secs_f64();
     Ok((image.develop(), stats))

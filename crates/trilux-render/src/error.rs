@@ -25,13 +25,26 @@ pub enum RenderError {
     /// Solving, or saving or loading a solution, failed.
     #[error(transparent)]
     Solver(#[from] trilux_solver::SolverError),
-    /// An image could not be written; nothing is left at `path`.
-    #[error("cannot write {path}: {reason}")]
-    Write {
-        /// The output path asked for.
-        path: PathBuf,
-        /// What failed.
+    /// An output could not be written; the file is as it was.
+    #[error(transparent)]
+    Output(#[from] trilux_files::WriteError),
+    /// An image could not be encoded.
+    #[error("cannot encode the {format} image: {reason}")]
+    Encode {
+        /// "EXR" or "PNG".
+        format: &'static str,
+        /// The encoder's reason.
         reason: String,
+    },
+    /// A pixel is not finite: such an image is never written.
+    #[error("pixel ({x}, {y}) is not finite ({value:?}): the image is not written")]
+    NonFinitePixel {
+        /// Column.
+        x: u32,
+        /// Row.
+        y: u32,
+        /// Its value.
+        value: [f32; 3],
     },
     /// An image could not be read.
     #[error("cannot read {path}: {reason}")]

@@ -12,6 +12,7 @@
 //! order, which keeps renders bit-for-bit deterministic however rayon
 //! schedules the tiles.
 
+use crate::error::RenderError;
 use crate::filter::ReconstructionFilter;
 use crate::image::Image;
 
@@ -33,23 +34,36 @@ pub struct Film {
 }
 
 impl Film {
-    /// A buffer covering pixels [x0, x0 + width) × [y0, y0 + height).
+    /// A buffer covering pixels [x0, x0 + width) × [y0, y0 + height); an
+    /// error, not an abort, when the memory cannot be had.
     pub fn new(
         x0: i64,
         y0: i64,
         width: usize,
         height: usize,
         filter: ReconstructionFilter,
-    ) -> Self {
-        Self {
+    ) -> Result<Self, RenderError> {
+        let no_memory = || {
+            RenderError::Settings(format!(
+                "not enough memory for a {width} × {height} film (docs/limits.md)"
+            ))
+        };
+        let n = width.checked_mul(height).ok_or_else(no_memory)?;
+        let mut sums = Vec::new();
+        sums.try_reserve_exact(n).map_err(|_| no_memory())?;
+        sums.resize(n, [0.0; 3]);
+        let mut weights = Vec::new();
+        weights.try_reserve_exact(n).map_err(|_| no_memory())?;
+        weights.resize(n, 0.0);
+        Ok(Self {
             x0,
             y0,
             width,
             height,
             filter,
-            sums: vec![[0.0; 3]; width * height],
-            weights: vec![0.0; width * height],
-        }
+            sums,
+            weights,
+        })
     }
 
     /// Splats one sample of linear RGB `value` taken at film position
@@ -150,7 +164,7 @@ mod tests {
     #[test]
     fn a_constant_develops_to_itself_with_any_filter() {
         for f in [ReconstructionFilter::default(), ReconstructionFilter::Box] {
-            let mut film = Film::new(0, 0, 7, 5, f);
+            let mut film = Film::new(0, 0, 7, 5, f).unwrap();
             let mut k = 0u32;
             for j in 0..5 {
                 for i in 0..7 {
@@ -176,7 +190,7 @@ mod tests {
         // A single sample at the centre of pixel (3,3): pixels within 2 px
         // get the same value; its weight pattern is w(dx)·w(dy).
         let f = ReconstructionFilter::default();
-        let mut film = Film::new(0, 0, 8, 8, f);
+        let mut film = Film::new(0, 0, 8, 8, f).unwrap();
         film.splat(3.5, 3.5, [1.0, 1.0, 1.0]);
         assert!((film.weights[3 * 8 + 3] - f.eval(0.0).powi(2)).abs() < 1e-15);
         assert!((film.weights[3 * 8 + 4] - f.eval(0.0) * f.eval(1.0)).abs() < 1e-15);
@@ -186,9 +200,9 @@ mod tests {
     #[test]
     fn tiles_merge_to_the_whole() {
         let f = ReconstructionFilter::default();
-        let mut whole = Film::new(0, 0, 6, 6, f);
-        let mut a = Film::new(-2, -2, 7, 10, f); // columns 0..3 plus border
-        let mut b = Film::new(1, -2, 7, 10, f); // columns 3..6 plus border
+        let mut whole = Film::new(0, 0, 6, 6, f).unwrap();
+        let mut a = Film::new(-2, -2, 7, 10, f).unwrap(); // columns 0..3 plus border
+        let mut b = Film::new(1, -2, 7, 10, f).unwrap(); // columns 3..6 plus border
         let samples = [
             (0.3, 0.7, 1.0),
             (2.9, 4.1, 2.0),
@@ -203,7 +217,7 @@ mod tests {
                 b.splat(x, y, [v; 3])
             }
         }
-        let mut merged = Film::new(0, 0, 6, 6, f);
+        let mut merged = Film::new(0, 0, 6, 6, f).unwrap();
         merged.merge(&a);
         merged.merge(&b);
         for (m, w) in merged.weights.iter().zip(&whole.weights) {

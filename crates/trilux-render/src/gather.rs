@@ -220,12 +220,23 @@ pub trait GatherScene<const N: usize>: Sync {
     /// A direction sampled with density cos θ/π about the normal on the
     /// side of `wo` (the Lambertian part's importance), `None` below the
     /// surface.
-    fn sample_cosine(&self, _at: &SurfacePoint<Self::Locator>, _wo: DVec3, _u: DVec2) -> Option<DVec3> {
+    fn sample_cosine(
+        &self,
+        _at: &SurfacePoint<Self::Locator>,
+        _wo: DVec3,
+        _u: DVec2,
+    ) -> Option<DVec3> {
         None
     }
 
     /// True when some face of the scene has a glossy part.
     fn has_glossy_faces(&self) -> bool {
+        false
+    }
+
+    /// True when the scene's solution has gather links (else the link
+    /// gather hands every sample to the path gather).
+    fn has_links(&self) -> bool {
         false
     }
 

@@ -1,16 +1,21 @@
 //! Finished images and their files.
 //!
-//! - EXR: linear float RGB (32-bit float per channel, ZIP compression), the
-//!   values exactly as rendered (spectral renders converted to linear sRGB).
+//! - EXR: linear float RGB (32-bit float per channel, ZIP compression in
+//!   blocks of 16 scan lines), the values exactly as rendered (spectral
+//!   renders converted to linear sRGB).
 //! - PNG: 8-bit sRGB. Tone map: each linear value is multiplied by
 //!   2^exposure, **clamped** to [0, 1], then encoded with the sRGB transfer
 //!   curve (IEC 61966-2-1) and rounded. No other curve is applied.
 //!
-//! Writes are atomic: the data go to a temporary file in the same folder,
-//! which is renamed over the destination only when complete. A failed write
-//! removes the temporary file, so no half-written image is ever left.
+//! An image with a pixel that is not finite is never written: encoding it
+//! is an error. Files are written with `trilux_files` (a symbolic link's
+//! target is replaced, a FIFO or device written through, a regular file
+//! replaced only once the new one is complete); a caller with several
+//! outputs encodes each ([`Image::exr_bytes`], [`Image::png_bytes`]) and
+//! writes them all or none with `trilux_files::write_all`.
 
-use std::path::{Path, PathBuf};
+use std::io::Cursor;
+use std::path::Path;
 
 use crate::error::RenderError;
 
@@ -29,42 +34,6 @@ pub fn srgb_encode(linear: f64) -> f64 {
     } else {
         1.055 * linear.powf(1.0 / 2.4) - 0.055
     }
-}
-
-fn write_err(path: &Path, reason: impl ToString) -> RenderError {
-    RenderError::Write {
-        path: path.to_path_buf(),
-        reason: reason.to_string(),
-    }
-}
-
-/// Runs `write` on a temporary path beside `path`, then renames it to
-/// `path`. On failure the temporary file is removed.
-pub fn write_atomically(
-    path: &Path,
-    write: impl FnOnce(&Path) -> Result<(), String>,
-) -> Result<(), RenderError> {
-    let name = path
-        .file_name()
-        .ok_or_else(|| write_err(path, "not a file name"))?
-        .to_string_lossy()
-        .into_owned();
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
-    if !dir.is_dir() {
-        return Err(write_err(path, "the folder does not exist"));
-    }
-    // Keep the extension last: the exr crate picks nothing from it, but
-    // other tools looking at a stray temporary file would.
-    let tmp = dir.join(format!(".{name}.tmp-{}", std::process::id()));
-    let result = write(&tmp).and_then(|()| std::fs::rename(&tmp, path).map_err(|e| e.to_string()));
-    if let Err(reason) = result {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(write_err(path, reason));
-    }
-    Ok(())
 }
 
 impl Image {
@@ -111,6 +80,11 @@ impl Image {
         &self.pixels
     }
 
+    /// Mutable pixels, row-major from the top-left.
+    pub fn pixels_mut(&mut self) -> &mut [[f32; 3]] {
+        &mut self.pixels
+    }
+
     /// Pixel (x, y).
     pub fn get(&self, x: u32, y: u32) -> [f32; 3] {
         self.pixels[y as usize * self.width as usize + x as usize]
@@ -127,16 +101,57 @@ impl Image {
         m.map(|v| v / self.pixels.len() as f64)
     }
 
-    /// Writes linear float RGB OpenEXR, atomically.
+    /// The first pixel that is not finite, as (x, y), if any.
+    pub fn first_non_finite(&self) -> Option<(u32, u32)> {
+        let i = self
+            .pixels
+            .iter()
+            .position(|p| !p.iter().all(|c| c.is_finite()))?;
+        let w = self.width as usize;
+        Some(((i % w) as u32, (i / w) as u32))
+    }
+
+    /// Refuses an image with a pixel that is not finite.
+    fn check_finite(&self) -> Result<(), RenderError> {
+        match self.first_non_finite() {
+            None => Ok(()),
+            Some((x, y)) => Err(RenderError::NonFinitePixel {
+                x,
+                y,
+                value: self.get(x, y),
+            }),
+        }
+    }
+
+    /// The OpenEXR file of this image (linear float RGB, ZIP).
+    pub fn exr_bytes(&self) -> Result<Vec<u8>, RenderError> {
+        use exr::prelude::{Encoding, Image as ExrImage, SpecificChannels, Vec2, WritableImage};
+        self.check_finite()?;
+        let w = self.width as usize;
+        let channels = SpecificChannels::rgb(|Vec2(x, y): Vec2<usize>| {
+            let p = self.pixels[y * w + x];
+            (p[0], p[1], p[2])
+        });
+        let image = ExrImage::from_encoded_channels(
+            (w, self.height as usize),
+            Encoding::SMALL_LOSSLESS,
+            channels,
+        );
+        let mut bytes = Cursor::new(Vec::new());
+        image
+            .write()
+            .to_buffered(&mut bytes)
+            .map_err(|e| RenderError::Encode {
+                format: "EXR",
+                reason: e.to_string(),
+            })?;
+        Ok(bytes.into_inner())
+    }
+
+    /// Writes linear float RGB OpenEXR (module docs).
     pub fn write_exr(&self, path: &Path) -> Result<(), RenderError> {
-        write_atomically(path, |tmp| {
-            let w = self.width as usize;
-            exr::prelude::write_rgb_file(tmp, w, self.height as usize, |x, y| {
-                let p = self.pixels[y * w + x];
-                (p[0], p[1], p[2])
-            })
-            .map_err(|e| e.to_string())
-        })
+        let bytes = self.exr_bytes()?;
+        trilux_files::write_one(path, "EXR image", &bytes).map_err(RenderError::from)
     }
 
     /// Encodes 8-bit sRGB: clamp(value · 2^exposure, 0, 1), sRGB curve.
@@ -154,21 +169,31 @@ impl Image {
         out
     }
 
-    /// Writes an 8-bit sRGB PNG (tone map: see the module docs), atomically.
-    pub fn write_png(&self, path: &Path, exposure: f64) -> Result<(), RenderError> {
+    /// The 8-bit sRGB PNG file of this image (tone map: see the module
+    /// docs).
+    pub fn png_bytes(&self, exposure: f64) -> Result<Vec<u8>, RenderError> {
+        self.check_finite()?;
         let data = self.to_srgb8(exposure);
         let mut bytes = Vec::new();
+        let encode = |e: png::EncodingError| RenderError::Encode {
+            format: "PNG",
+            reason: e.to_string(),
+        };
         {
             let mut enc = png::Encoder::new(&mut bytes, self.width, self.height);
             enc.set_color(png::ColorType::Rgb);
             enc.set_depth(png::BitDepth::Eight);
             enc.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
-            let mut w = enc.write_header().map_err(|e| write_err(path, e))?;
-            w.write_image_data(&data).map_err(|e| write_err(path, e))?;
+            let mut w = enc.write_header().map_err(encode)?;
+            w.write_image_data(&data).map_err(encode)?;
         }
-        write_atomically(path, |tmp| {
-            std::fs::write(tmp, &bytes).map_err(|e| e.to_string())
-        })
+        Ok(bytes)
+    }
+
+    /// Writes an 8-bit sRGB PNG (module docs).
+    pub fn write_png(&self, path: &Path, exposure: f64) -> Result<(), RenderError> {
+        let bytes = self.png_bytes(exposure)?;
+        trilux_files::write_one(path, "PNG image", &bytes).map_err(RenderError::from)
     }
 
     /// Reads the first RGB(A) layer of an OpenEXR file (alpha ignored).
@@ -195,6 +220,7 @@ impl Image {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::path::PathBuf;
 
     fn tmpdir(tag: &str) -> PathBuf {
         let d = std::env::temp_dir().join(format!("trilux-render-{tag}-{}", std::process::id()));
@@ -222,11 +248,40 @@ mod tests {
         let missing = d.join("no/such/folder/x.exr");
         assert!(img.write_exr(&missing).is_err());
         assert!(img.write_png(&d.join("no/x.png"), 0.0).is_err());
-        // A folder in place of the output file: the rename fails.
+        // A folder in place of the output file is refused.
         std::fs::create_dir_all(d.join("taken.exr")).unwrap();
         assert!(img.write_exr(&d.join("taken.exr")).is_err());
         let left: Vec<_> = std::fs::read_dir(&d).unwrap().collect();
         assert_eq!(left.len(), 1, "only the folder we made: {left:?}");
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+
+    #[test]
+    fn exr_is_zip_compressed_as_documented() {
+        let img = Image::from_pixels(3, 2, vec![[0.5, 1.0, 2.0]; 6]).unwrap();
+        let bytes = img.exr_bytes().unwrap();
+        let meta = exr::meta::MetaData::read_from_buffered(Cursor::new(&bytes), false).unwrap();
+        assert_eq!(
+            meta.headers[0].compression,
+            exr::compression::Compression::ZIP16
+        );
+    }
+
+    #[test]
+    fn a_non_finite_pixel_is_never_written() {
+        let d = tmpdir("non-finite");
+        for bad in [f32::INFINITY, f32::NAN, f32::NEG_INFINITY] {
+            let mut img = Image::black(3, 2);
+            img.pixels_mut()[4] = [0.0, bad, 0.0];
+            let e = img.exr_bytes().unwrap_err();
+            assert!(
+                e.to_string().starts_with("pixel (1, 1) is not finite"),
+                "{e}"
+            );
+            assert!(img.png_bytes(0.0).is_err());
+            assert!(img.write_exr(&d.join("x.exr")).is_err());
+        }
+        assert_eq!(std::fs::read_dir(&d).unwrap().count(), 0);
         std::fs::remove_dir_all(&d).unwrap();
     }
 

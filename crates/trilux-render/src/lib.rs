@@ -1,8 +1,8 @@
 //! # trilux-render — final gathering from a solution
 //!
 //! Layer: the top library layer. It may depend on every trilux library crate
-//! (`trilux-color`, `trilux-geometry`, `trilux-brdf`, `trilux-scene`,
-//! `trilux-solver`); nothing depends on it but the `trilux` command and
+//! (`trilux-color`, `trilux-files`, `trilux-geometry`, `trilux-brdf`,
+//! `trilux-scene`, `trilux-solver`); nothing depends on it but the `trilux` command and
 //! `xtask`.
 //!
 //! A view-independent solution (paper §3–§5) says how much light leaves every
@@ -32,7 +32,8 @@
 //! - [`filter`]: reconstruction filters (Mitsuba's Gaussian, box).
 //! - [`film`]: splatting samples through the filter, per-pixel normalisation.
 //! - [`driver`]: tiles rendered in parallel (rayon), merged deterministically.
-//! - [`image`]: the finished [`Image`], EXR and PNG output (atomic writes).
+//! - [`image`]: the finished [`Image`], its EXR (ZIP) and PNG files (never
+//!   with a non-finite pixel; written through `trilux-files`).
 //! - [`analytic`]: analytic scenes with known answers (tests, benches).
 //! - [`mod@compare`]: relative RMSE and mean ratio against a reference image.
 //! - [`bands`]: small helpers on per-band radiance arrays.

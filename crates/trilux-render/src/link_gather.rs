@@ -102,6 +102,9 @@ impl<S> LinkGather<'_, S> {
     where
         S: GatherScene<N>,
     {
+        if !self.scene.has_links() {
+            return self.fallback.camera_sample(origin, dir, sampler, stats);
+        }
         stats.camera_rays += 1;
         let Some(xs) = self.scene.intersect(origin, dir) else {
             return bands::zero();
@@ -195,7 +198,7 @@ impl<S> LinkGather<'_, S> {
         let Some(bs) = scene.sample_bsdf(x, wo, w.sampler.get2(base + 3)) else {
             return l;
         };
-        if !(bs.pdf > 0.0) {
+        if bs.pdf.is_nan() || bs.pdf <= 0.0 {
             return l;
         }
         let f = scene.glossy_cos(x, bs.wi, wo);
@@ -301,9 +304,10 @@ impl<S> Preview<'_, S> {
             stats.gather_rays += 1;
             let back = -wi;
             let reflected = lambertian_at(scene, &xd, back, &mut caches.scratch, stats)
-                .map_or_else(|| scene.reflected(&xd, &xs), |l| {
-                    bands::add(l, scene.reflected_glossy(&xd, &xs))
-                });
+                .map_or_else(
+                    || scene.reflected(&xd, &xs),
+                    |l| bands::add(l, scene.reflected_glossy(&xd, &xs)),
+                );
             let incoming = bands::add(scene.emitted(&xd, back), reflected);
             l = bands::add(l, bands::mul(albedo, incoming));
         }
@@ -346,7 +350,12 @@ fn light_sample<S: GatherScene<N>, const N: usize>(
     let d = ls.point - x.point;
     let dist2 = d.length_squared();
     let dist = dist2.sqrt();
-    if !(dist > 0.0) || !(ls.pdf_area > 0.0) || bands::is_black(&ls.radiance) {
+    if dist.is_nan()
+        || dist <= 0.0
+        || ls.pdf_area.is_nan()
+        || ls.pdf_area <= 0.0
+        || bands::is_black(&ls.radiance)
+    {
         return bands::zero();
     }
     let wi = d / dist;

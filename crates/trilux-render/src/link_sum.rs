@@ -195,7 +195,7 @@ fn refine_near<const N: usize, S: RadianceSolution<N>>(
     ff: &PointFormFactors,
     r: &Receiver,
     entry: &mut LeafSum<N>,
-    near: &mut Vec<Term<N>>,
+    near: &mut [Term<N>],
     stats: &mut GatherStats,
 ) {
     for t in near.iter_mut() {
@@ -207,13 +207,21 @@ fn refine_near<const N: usize, S: RadianceSolution<N>>(
         + near.iter().map(|t| t.c.sum() * t.v).sum::<f64>();
     let (full, partial) = (&mut entry.full, &mut entry.partial);
     for &t in near.iter() {
-        near_field(solution, ff, r, t, NEAR_FIELD_TOLERANCE * total, stats, &mut |t| {
-            if t.v >= 1.0 {
-                *full += t.c;
-            } else {
-                partial.push(t);
-            }
-        });
+        near_field(
+            solution,
+            ff,
+            r,
+            t,
+            NEAR_FIELD_TOLERANCE * total,
+            stats,
+            &mut |t| {
+                if t.v >= 1.0 {
+                    *full += t.c;
+                } else {
+                    partial.push(t);
+                }
+            },
+        );
     }
 }
 
@@ -239,7 +247,10 @@ fn near_field<const N: usize, S: RadianceSolution<N>>(
     };
     let lc = children.map(|c| solution.face_radiance(face, c));
     let mean = t.l.sum();
-    let delta = lc.iter().map(|l| (l.sum() - mean).abs()).fold(0.0, f64::max);
+    let delta = lc
+        .iter()
+        .map(|l| (l.sum() - mean).abs())
+        .fold(0.0, f64::max);
     let f = if mean > 0.0 { t.c.sum() / mean } else { 0.0 };
     if e.is_planar() && delta * f <= tolerance {
         return out(t);
@@ -277,7 +288,7 @@ fn partly_visible<const N: usize, S: RadianceSolution<N>>(
     };
     let weights: Vec<f64> = terms.iter().map(|t| t.c.sum()).collect();
     let total_w: f64 = weights.iter().sum();
-    if !(total_w > 0.0) {
+    if total_w.is_nan() || total_w <= 0.0 {
         return Spectrum::zero();
     }
     let forest = solution.forest();

@@ -15,7 +15,7 @@ use trilux_color::{Mode, WithBands};
 use trilux_scene::{Scene, SceneError};
 use trilux_solver::{
     PrepareError, PreparedScene, Progress, SceneDescription, Solution, SolveStats, Solver,
-    SolverSettings,
+    SolverError, SolverSettings,
 };
 
 use crate::camera::Camera;
@@ -53,6 +53,9 @@ pub struct Plan<'p> {
     pub source: SolutionSource<'p>,
     /// Save the solution there.
     pub save: Option<&'p Path>,
+    /// Return the solution file's bytes in [`Outcome::solution_file`], for
+    /// a caller that writes all its outputs at once (the `trilux` command).
+    pub solution_file: bool,
     /// Render a view.
     pub render: Option<RenderPlan>,
 }
@@ -64,6 +67,8 @@ pub struct Outcome {
     pub image: Option<Image>,
     /// The solve's statistics (`solve_seconds` 0 for a loaded solution).
     pub solve: SolveStats,
+    /// The solution file's bytes, when the plan asks for them.
+    pub solution_file: Option<Vec<u8>>,
     /// The render's statistics, when the plan renders.
     pub render: Option<RenderStats>,
     /// Wall-clock seconds spent preparing the scene (geometry, BVH,
@@ -96,12 +101,18 @@ impl Observer<'_> {
 }
 
 /// The scene's camera with `view`'s overrides (an error when the scene has
-/// no sensor or the view is invalid).
+/// no sensor or the view is invalid; at the `<sensor>` when the scene's own
+/// values are at fault).
 pub fn scene_camera(scene: &Scene, view: &ViewOverrides) -> Result<Camera, RenderError> {
     let cam = scene.camera.as_ref().ok_or_else(|| RenderError::NoCamera {
         path: scene.path.clone(),
     })?;
-    camera_of(cam, view)
+    camera_of(cam, view).map_err(|e| match e {
+        RenderError::Camera(m) if *view == ViewOverrides::default() => {
+            SceneError::at(&cam.location, m).into()
+        }
+        e => e,
+    })
 }
 
 /// The scene prepared for `N` bands; errors point at the shape (or its
@@ -135,8 +146,14 @@ fn located(scene: &Scene, e: &PrepareError) -> SceneError {
     SceneError::at(&location, e.problem())
 }
 
-/// Carries out `plan` on `scene` (module docs).
-pub fn run(scene: &Scene, plan: &Plan<'_>, observer: Observer<'_>) -> Result<Outcome, RenderError> {
+/// Everything [`run`] checks before the long work: the render settings,
+/// the camera with its overrides, the solver settings. Only the scene's
+/// camera is read, so a caller can check a scene whose meshes are not read
+/// yet (`trilux_scene::Pending`).
+pub fn check(
+    scene: &Scene,
+    plan: &Plan<'_>,
+) -> Result<Option<(Camera, RenderSettings)>, RenderError> {
     let view = match &plan.render {
         Some(r) => {
             r.settings.validate()?;
@@ -147,6 +164,35 @@ pub fn run(scene: &Scene, plan: &Plan<'_>, observer: Observer<'_>) -> Result<Out
     plan.solver
         .validate()
         .map_err(trilux_solver::SolverError::Settings)?;
+    Ok(view)
+}
+
+/// A solver error at its place in the scene file, when it names a shape.
+fn located_solver(scene: &Scene, e: SolverError) -> RenderError {
+    match e {
+        SolverError::NoFiniteSolution { shape, band, bands } => {
+            let location = scene.shapes.get(shape).map_or_else(
+                || scene.shape_location(shape),
+                |s| {
+                    s.emitter
+                        .as_ref()
+                        .map_or(s.location.clone(), |em| em.location.clone())
+                },
+            );
+            SceneError::at(
+                &location,
+                trilux_solver::error::no_finite_solution(band, bands),
+            )
+            .into()
+        }
+        SolverError::Prepare(p) => located(scene, &p).into(),
+        e => e.into(),
+    }
+}
+
+/// Carries out `plan` on `scene` (module docs).
+pub fn run(scene: &Scene, plan: &Plan<'_>, observer: Observer<'_>) -> Result<Outcome, RenderError> {
+    let view = check(scene, plan)?;
     plan.mode.with_bands(Run {
         scene,
         plan,
@@ -172,9 +218,9 @@ impl WithBands for Run<'_, '_> {
         let prepare_seconds = start.elapsed().as_secs_f64();
         let start = Instant::now();
         let mut solution = match self.plan.source {
-            SolutionSource::Solve => {
-                Solver::new(prepared, self.plan.solver.clone())?.solve(|p| (self.observer.solve)(p))
-            }
+            SolutionSource::Solve => Solver::new(prepared, self.plan.solver.clone())
+                .map_err(|e| located_solver(self.scene, e))?
+                .solve(|p| (self.observer.solve)(p)),
             SolutionSource::Load(path) => {
                 let mut s = Solution::load(path, prepared, &self.plan.solver)?;
                 s.stats_mut().solve_seconds = 0.0;
@@ -185,6 +231,10 @@ impl WithBands for Run<'_, '_> {
         if let Some(path) = self.plan.save {
             solution.save(path)?;
         }
+        let solution_file = match self.plan.solution_file {
+            true => Some(solution.to_bytes()?),
+            false => None,
+        };
         let start = Instant::now();
         let rendered = match &self.view {
             Some((camera, settings)) => {
@@ -197,6 +247,7 @@ impl WithBands for Run<'_, '_> {
         Ok(Outcome {
             image,
             solve: std::mem::take(solution.stats_mut()),
+            solution_file,
             render,
             prepare_seconds,
             solve_seconds,

@@ -179,7 +179,9 @@ impl<'a, const N: usize, S: RadianceSolution<N>> SolvedScene<'a, N, S> {
         let ff = if solution.has_links() {
             trilux_geometry::PointFormFactors::new(solution.forest())
         } else {
-            trilux_geometry::PointFormFactors::new(&ElementForest::new(Arc::clone(scene.geometry())))
+            trilux_geometry::PointFormFactors::new(&ElementForest::new(Arc::clone(
+                scene.geometry(),
+            )))
         };
         let glossy_faces = scene
             .materials()
@@ -398,6 +400,10 @@ impl<const N: usize, S: RadianceSolution<N>> GatherScene<N> for SolvedScene<'_, 
 
     fn has_glossy_faces(&self) -> bool {
         self.glossy_faces
+    }
+
+    fn has_links(&self) -> bool {
+        self.solution.has_links()
     }
 
     fn mirror(&self, at: &SurfacePoint<HitLocator>, wo: DVec3) -> Option<(DVec3, [f64; N])> {

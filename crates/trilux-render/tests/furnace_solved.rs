@@ -30,6 +30,7 @@ fn solved_furnace_renders_two() {
         solver: SolverSettings::preset(Quality::Default),
         source: SolutionSource::Solve,
         save: None,
+        solution_file: false,
         render: Some(RenderPlan { view, settings }),
     };
     let outcome = Observer::quiet(|o| trilux_render::pipeline::run(&scene, &plan, o)).unwrap();

@@ -227,3 +227,45 @@ fn bad_settings_are_errors() {
         assert!(render_image::<_, 3>(&scene, &cam, &s, rgb3, |_, _| {}).is_err());
     }
 }
+
+#[test]
+fn non_finite_samples_are_counted_and_left_out() {
+    // Every 7th sample's colour is NaN: the render counts each one in
+    // `dropped` (which the command reports as a warning) and no pixel is
+    // anything but the finite value of the others.
+    use std::sync::atomic::{AtomicU64, Ordering};
+    let scene = Furnace {
+        le: 0.0,
+        rho: 0.5,
+        reflected: 2.0,
+        element: 0.5,
+    };
+    let settings = RenderSettings {
+        spp: 8,
+        extra_bounce: ExtraBounce::Never,
+        ..Default::default()
+    };
+    let k = AtomicU64::new(0);
+    let poison = |l: &[f64; 3]| {
+        if k.fetch_add(1, Ordering::Relaxed).is_multiple_of(7) {
+            [f64::NAN; 3]
+        } else {
+            *l
+        }
+    };
+    let (img, stats) = render_image::<_, 3>(
+        &scene,
+        &furnace_camera(16, 16),
+        &settings,
+        poison,
+        |_, _| {},
+    )
+    .unwrap();
+    let total = 16 * 16 * 8;
+    assert_eq!(stats.gather.dropped, k.load(Ordering::Relaxed).div_ceil(7));
+    assert!(stats.gather.dropped > 0 && stats.gather.dropped < total);
+    assert!(img.first_non_finite().is_none());
+    for c in img.pixels().iter().flatten() {
+        assert!((c - 1.0).abs() < 1e-6, "{c}");
+    }
+}

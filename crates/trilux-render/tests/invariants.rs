@@ -50,7 +50,7 @@ proptest! {
         gaussian in any::<bool>(),
     ) {
         let f = if gaussian { ReconstructionFilter::default() } else { ReconstructionFilter::Box };
-        let mut film = Film::new(0, 0, 8, 6, f);
+        let mut film = Film::new(0, 0, 8, 6, f).unwrap();
         for &(x, y) in &samples {
             film.splat(x, y, [v, 2.0 * v, 0.5]);
         }

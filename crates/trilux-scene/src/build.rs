@@ -16,21 +16,28 @@ use crate::material::{build_bsdf, check_color};
 use crate::props::Props;
 use crate::resolve::Resolved;
 use crate::scene::{AreaEmitter, Scene, SceneShape};
-use crate::shape::build_shape;
+use crate::shape::{MeshRequest, build_shape};
 use crate::xml::Element;
 
-/// Builds the scene from the resolved tree. `path` is the scene file.
-pub(crate) fn build(resolved: Resolved, path: &Path) -> Result<Scene> {
+/// Builds the scene from the resolved tree. `path` is the scene file. OBJ
+/// shapes come with empty meshes and, beside the scene, the requests to
+/// read them (shape index, request).
+pub(crate) fn build(resolved: Resolved, path: &Path) -> Result<(Scene, Vec<(usize, MeshRequest)>)> {
     let scene_el = &resolved.scene;
     scene_el.check_attrs(&["version"])?;
     let folder = path.parent().unwrap_or(Path::new("."));
     let mut shapes = Vec::new();
+    let mut meshes = Vec::new();
     let mut camera: Option<(Camera, &Element)> = None;
     let mut integrator: Option<&Element> = None;
     let mut max_depth = None;
     for e in &scene_el.children {
         match e.tag.as_str() {
-            "shape" => shapes.push(scene_shape(e, folder)?),
+            "shape" => {
+                let (shape, request) = scene_shape(e, folder)?;
+                meshes.extend(request.map(|r| (shapes.len(), r)));
+                shapes.push(shape);
+            }
             "bsdf" => {
                 // A definition: built once here so that errors in unused
                 // definitions are reported too.
@@ -89,14 +96,15 @@ pub(crate) fn build(resolved: Resolved, path: &Path) -> Result<Scene> {
                 .as_ref()
                 .is_some_and(|em| em.radiance.is_sampled())
     });
-    Ok(Scene {
+    let scene = Scene {
         path: path.to_path_buf(),
         shapes,
         camera,
         max_depth,
         spectral,
         bsdf_counts: resolved.bsdf_counts,
-    })
+    };
+    Ok((scene, meshes))
 }
 
 /// True when some colour of the BSDF is a sampled spectrum.
@@ -119,7 +127,7 @@ fn bsdf_is_sampled(b: &BsdfParams) -> bool {
     }
 }
 
-fn scene_shape(e: &Element, folder: &Path) -> Result<SceneShape> {
+fn scene_shape(e: &Element, folder: &Path) -> Result<(SceneShape, Option<MeshRequest>)> {
     e.check_attrs(&["type", "id", "name"])?;
     let props = Props::new(e)?;
     let mut bsdf = None;
@@ -149,15 +157,16 @@ fn scene_shape(e: &Element, folder: &Path) -> Result<SceneShape> {
             }
         }
     }
-    let shape = build_shape(&props, folder)?;
+    let (shape, request) = build_shape(&props, folder)?;
     props.finish()?;
-    Ok(SceneShape {
+    let shape = SceneShape {
         id: e.attr("id").map(|a| a.value.clone()),
         shape,
         bsdf: bsdf.unwrap_or_default(),
         emitter,
         location: e.loc.clone(),
-    })
+    };
+    Ok((shape, request))
 }
 
 fn area_emitter(e: &Element) -> Result<AreaEmitter> {
@@ -174,6 +183,19 @@ fn area_emitter(e: &Element) -> Result<AreaEmitter> {
     // Mitsuba's default radiance is 1.
     let radiance = props.color("radiance")?.unwrap_or(ColorParam::Float(1.0));
     check_color(&radiance, &props.loc("radiance"), "radiance", None)?;
+    if let Some(v) = radiance
+        .values()
+        .into_iter()
+        .find(|v| *v > crate::limits::MAX_RADIANCE)
+    {
+        return Err(SceneError::at(
+            &props.loc("radiance"),
+            format!(
+                "radiance {v:e} is beyond the limit {:e} (docs/limits.md)",
+                crate::limits::MAX_RADIANCE
+            ),
+        ));
+    }
     props.finish()?;
     Ok(AreaEmitter {
         radiance,
@@ -261,6 +283,16 @@ fn sensor(e: &Element) -> Result<Camera> {
         }
     }
     let origin = world_from_camera.transform_point3(DVec3::ZERO);
+    let largest = origin.abs().max_element();
+    if !trilux_geometry::limits::within(largest) {
+        return Err(SceneError::at(
+            &props.loc("to_world"),
+            format!(
+                "the camera's position: {}",
+                trilux_geometry::limits::beyond(largest)
+            ),
+        ));
+    }
     let (target, up) = match transform.as_ref().and_then(|t| t.lookat) {
         Some(la) => (la.target, la.up),
         None => (
@@ -307,6 +339,7 @@ fn sensor(e: &Element) -> Result<Camera> {
         height,
         rfilter,
         sample_count,
+        location: e.loc.clone(),
     })
 }
 
@@ -334,6 +367,14 @@ fn film(e: &Element) -> Result<(u32, u32, ReconstructionFilter)> {
     let props = Props::new(e)?;
     let width = positive_u32(&props, "width", 768)?;
     let height = positive_u32(&props, "height", 576)?;
+    crate::limits::check_film(width, height).map_err(|m| {
+        let at = if props.has("width") {
+            "width"
+        } else {
+            "height"
+        };
+        SceneError::at(&props.loc(at), m)
+    })?;
     props.ignore(&["pixel_format", "component_format"]);
     let mut rfilter = ReconstructionFilter::Gaussian;
     for (i, o) in props.objects.iter().enumerate() {

@@ -10,6 +10,8 @@
 use glam::{DMat4, DVec3};
 use serde::Serialize;
 
+use crate::error::SourceLocation;
+
 /// The image axis along which `fov` is measured.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "lowercase")]
@@ -86,6 +88,9 @@ pub struct Camera {
     pub rfilter: ReconstructionFilter,
     /// Samples per pixel (the sampler's `sample_count`).
     pub sample_count: u32,
+    /// Where the `<sensor>` is written.
+    #[serde(skip)]
+    pub location: SourceLocation,
 }
 
 impl Camera {

@@ -41,20 +41,22 @@ pub enum SceneError {
     Read {
         /// The scene file.
         path: PathBuf,
-        /// The operating system's reason.
+        /// Why (the operating system's reason, not a regular file, too
+        /// large).
         #[source]
-        source: std::io::Error,
+        source: trilux_files::ReadError,
     },
 }
 
 impl SceneError {
     /// An error at `location`.
     pub fn at(location: &SourceLocation, message: impl Into<String>) -> Self {
-        // One line, whatever the message (the command prints one line).
+        // One line, whatever the message (the command prints one line), and
+        // a short one, whatever value it quotes.
         let message: String = message.into();
         SceneError::At {
             location: location.clone(),
-            message: message.replace(['\n', '\r'], " "),
+            message: elide(&message.replace(['\n', '\r'], " "), MAX_MESSAGE_CHARS),
         }
     }
 
@@ -65,6 +67,23 @@ impl SceneError {
             SceneError::Read { .. } => None,
         }
     }
+}
+
+/// The longest message an error carries; longer ones (a quoted value of
+/// megabytes) lose their middle.
+pub const MAX_MESSAGE_CHARS: usize = 400;
+
+/// `text` cut to at most `max` characters by replacing its middle with
+/// "…(N characters)…", so that both its start and its end stay readable.
+pub fn elide(text: &str, max: usize) -> String {
+    let count = text.chars().count();
+    if count <= max {
+        return text.to_string();
+    }
+    let keep = max.saturating_sub(30) / 2;
+    let head: String = text.chars().take(keep).collect();
+    let tail: String = text.chars().skip(count - keep).collect();
+    format!("{head}…({} characters)…{tail}", count - 2 * keep)
 }
 
 /// Shorthand for results of the loader.

@@ -1,7 +1,8 @@
 //! # trilux-scene — the scene model and its file formats
 //!
 //! Layer: depends on `trilux-color`, `trilux-geometry` and `trilux-brdf`
-//! (their plain-data parameter types), `glam`, `roxmltree` and `tobj`.
+//! (their plain-data parameter types), `trilux-files` (bounded reads),
+//! `glam`, `roxmltree` and `tobj`.
 //! File formats live only here; the solver and the renderer never parse.
 //!
 //! The loader reads the subset of Mitsuba 3's XML listed in the README with Mitsuba's semantics and defaults, and refuses
@@ -12,8 +13,14 @@
 //!    each with its source location; `<default>` and `$name` substitution.
 //! 2. `resolve`: `<ref id>` replaced by the `<bsdf id>` it names.
 //! 3. `build`: typed parameters (`props`, `value`, [`transform`]) → the
-//!    model: shapes ([`shape`], [`obj`]), materials (`material`), area
-//!    lights and the camera ([`camera`]).
+//!    model: shapes ([`shape`]), materials (`material`), area lights and the
+//!    camera ([`camera`]).
+//! 4. [`meshes`]: the OBJ files the shapes name ([`obj`]), read last, so
+//!    that a command can check the camera and its options against the
+//!    [`Pending`] scene first ([`open`]).
+//!
+//! Before all of it, the file must be a regular file of UTF-8 text
+//! (`text`); every stage is bounded ([`limits`], docs/limits.md).
 //!
 //! The model ([`scene`]) knows nothing about XML:
 //! [`Scene`] → [`SceneShape`] (a `trilux_geometry::Shape`, a
@@ -29,12 +36,15 @@
 mod build;
 pub mod camera;
 pub mod error;
+pub mod limits;
 mod material;
+pub mod meshes;
 pub mod obj;
 mod props;
 mod resolve;
 pub mod scene;
 pub mod shape;
+mod text;
 pub mod transform;
 mod value;
 mod xml;
@@ -44,6 +54,7 @@ use std::sync::Arc;
 
 pub use camera::{Camera, FovAxis, ReconstructionFilter};
 pub use error::{SceneError, SourceLocation};
+pub use meshes::Pending;
 pub use scene::{AreaEmitter, Scene, SceneShape};
 pub use shape::surface_area;
 pub use transform::LookAt;
@@ -59,12 +70,28 @@ pub fn load_with_params(
     path: impl AsRef<Path>,
     params: &[(String, String)],
 ) -> Result<Scene, SceneError> {
+    open_with_params(path, params)?.finish()
+}
+
+/// Reads and checks a scene file, all but its OBJ meshes ([`Pending`]).
+pub fn open(path: impl AsRef<Path>) -> Result<Pending, SceneError> {
+    open_with_params(path, &[])
+}
+
+/// [`open`] with `$name` parameter values.
+pub fn open_with_params(
+    path: impl AsRef<Path>,
+    params: &[(String, String)],
+) -> Result<Pending, SceneError> {
     let path = path.as_ref();
-    let text = std::fs::read_to_string(path).map_err(|source| SceneError::Read {
-        path: path.to_path_buf(),
-        source,
+    let bytes = trilux_files::read_limited(path, limits::MAX_SCENE_BYTES).map_err(|source| {
+        SceneError::Read {
+            path: path.to_path_buf(),
+            source,
+        }
     })?;
-    load_str_with_params(&text, path, params)
+    let text = text::decode(&bytes, path)?;
+    open_str(text, path, params)
 }
 
 /// Loads a scene from text; `path` names it in errors and anchors relative
@@ -79,9 +106,13 @@ pub fn load_str_with_params(
     path: impl AsRef<Path>,
     params: &[(String, String)],
 ) -> Result<Scene, SceneError> {
-    let path = path.as_ref();
+    open_str(text, path.as_ref(), params)?.finish()
+}
+
+fn open_str(text: &str, path: &Path, params: &[(String, String)]) -> Result<Pending, SceneError> {
     let file: Arc<Path> = Arc::from(path);
     let tree = xml::parse(text, &file, params)?;
     let resolved = resolve::resolve(&tree)?;
-    build::build(resolved, path)
+    let (scene, meshes) = build::build(resolved, path)?;
+    Ok(Pending::new(scene, meshes))
 }

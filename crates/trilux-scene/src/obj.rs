@@ -9,9 +9,14 @@
 //! normals recomputed from the faces with angle weights (Thürmer & Wüthrich,
 //! the weighting Mitsuba's `recompute_vertex_normals` uses). With
 //! `face_normals` there are none.
+//!
+//! The file must be a regular file of at most [`MAX_OBJ_BYTES`]
+//! (`/dev/zero` is an error, not an endless read); [`parse_obj`] reads the
+//! same format from bytes already in memory.
 
-use std::io::BufReader;
 use std::path::Path;
+
+use crate::limits::MAX_OBJ_BYTES;
 
 use glam::DVec3;
 use trilux_geometry::TriangleMesh;
@@ -19,14 +24,15 @@ use trilux_geometry::TriangleMesh;
 /// Why an OBJ file could not be read (the caller adds the scene location).
 #[derive(Debug, thiserror::Error)]
 pub enum ObjError {
-    /// The file could not be opened or read.
+    /// The file could not be read (missing, not a regular file, too
+    /// large).
     #[error("cannot read OBJ file {}: {source}", path.display())]
     Io {
         /// The OBJ file.
         path: std::path::PathBuf,
-        /// The operating system's reason.
+        /// Why.
         #[source]
-        source: std::io::Error,
+        source: trilux_files::ReadError,
     },
     /// tobj refused the contents.
     #[error("malformed OBJ file {}: {reason}", path.display())]
@@ -42,6 +48,16 @@ pub enum ObjError {
         /// The OBJ file.
         path: std::path::PathBuf,
     },
+    /// The mesh has more triangles or vertices than the loader takes.
+    #[error("OBJ file {} has {triangles} triangles and {vertices} vertices; the limits are {} and {} (docs/limits.md)", path.display(), crate::limits::MAX_OBJ_TRIANGLES, crate::limits::MAX_OBJ_VERTICES)]
+    TooLarge {
+        /// The OBJ file.
+        path: std::path::PathBuf,
+        /// Its triangles.
+        triangles: usize,
+        /// Its vertices (after splitting by position, texture and normal).
+        vertices: usize,
+    },
     /// A coordinate is not finite.
     #[error("OBJ file {} has a coordinate that is not a finite number", path.display())]
     NotFinite {
@@ -52,17 +68,32 @@ pub enum ObjError {
 
 /// Reads an OBJ file into one triangle mesh (all its objects merged).
 pub fn load_obj(path: &Path, face_normals: bool) -> Result<TriangleMesh, ObjError> {
-    let file = std::fs::File::open(path).map_err(|source| ObjError::Io {
+    let bytes = trilux_files::read_limited(path, MAX_OBJ_BYTES).map_err(|source| ObjError::Io {
         path: path.to_path_buf(),
         source,
     })?;
+    parse_obj(&bytes, path, face_normals)
+}
+
+/// [`load_obj`] on the bytes of an OBJ file; `path` names it in errors.
+pub fn parse_obj(bytes: &[u8], path: &Path, face_normals: bool) -> Result<TriangleMesh, ObjError> {
+    // Before tobj spends memory on them: every face line makes at least
+    // one triangle, every vertex line one position.
+    let (faces, positions) = count_lines(bytes);
+    if faces > crate::limits::MAX_OBJ_TRIANGLES || positions > crate::limits::MAX_OBJ_VERTICES {
+        return Err(ObjError::TooLarge {
+            path: path.to_path_buf(),
+            triangles: faces,
+            vertices: positions,
+        });
+    }
     let options = tobj::LoadOptions {
         single_index: true,
         triangulate: true,
         ignore_points: true,
         ignore_lines: true,
     };
-    let (models, _materials) = tobj::load_obj_buf(&mut BufReader::new(file), &options, |_| {
+    let (models, _materials) = tobj::load_obj_buf(&mut &bytes[..], &options, |_| {
         Ok((Vec::new(), Default::default()))
     })
     .map_err(|e| ObjError::Parse {
@@ -70,6 +101,15 @@ pub fn load_obj(path: &Path, face_normals: bool) -> Result<TriangleMesh, ObjErro
         reason: e.to_string(),
     })?;
 
+    let triangles: usize = models.iter().map(|m| m.mesh.indices.len() / 3).sum();
+    let vertices: usize = models.iter().map(|m| m.mesh.positions.len() / 3).sum();
+    if triangles > crate::limits::MAX_OBJ_TRIANGLES || vertices > crate::limits::MAX_OBJ_VERTICES {
+        return Err(ObjError::TooLarge {
+            path: path.to_path_buf(),
+            triangles,
+            vertices,
+        });
+    }
     let mut mesh = TriangleMesh {
         face_normals,
         ..Default::default()
@@ -117,6 +157,21 @@ pub fn load_obj(path: &Path, face_normals: bool) -> Result<TriangleMesh, ObjErro
         Some(vertex_normals(&mesh.positions, &mesh.triangles))
     };
     Ok(mesh)
+}
+
+/// Lines that start (after blanks) with `f` and with `v` then a blank.
+fn count_lines(bytes: &[u8]) -> (usize, usize) {
+    let (mut faces, mut positions) = (0, 0);
+    for line in bytes.split(|&b| b == b'\n') {
+        let start = line.iter().position(|b| !b.is_ascii_whitespace());
+        let rest = start.map_or(&[][..], |i| &line[i..]);
+        match rest {
+            [b'f', b' ' | b'\t', ..] => faces += 1,
+            [b'v', b' ' | b'\t', ..] => positions += 1,
+            _ => {}
+        }
+    }
+    (faces, positions)
 }
 
 /// Angle-weighted smooth vertex normals (Mitsuba's `recompute_vertex_normals`).

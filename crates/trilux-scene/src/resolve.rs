@@ -4,10 +4,15 @@
 //! After this pass the tree has no `<ref>` left: each reference is replaced
 //! by a copy of the element it names (BSDF parameters are plain data, so a
 //! copy is as good as sharing). Only BSDFs can be referenced.
+//!
+//! A reference to a BSDF that is being expanded is a cycle, refused as
+//! one; the expanded tree is bounded in depth and in size
+//! (`crate::limits`), since references can nest and multiply.
 
 use std::collections::{BTreeMap, HashMap};
 
 use crate::error::{Result, SceneError};
+use crate::limits::{MAX_DEPTH, MAX_ELEMENTS};
 use crate::xml::Element;
 
 /// The tree with references replaced, and how many `<bsdf>` elements of each
@@ -25,7 +30,12 @@ pub(crate) fn resolve(scene: &Element) -> Result<Resolved> {
     collect_ids(scene, &mut ids)?;
     let mut bsdf_counts = BTreeMap::new();
     count_bsdfs(scene, &mut bsdf_counts);
-    let scene = substitute(scene, &ids, 0)?;
+    let mut expander = Expander {
+        ids: &ids,
+        elements: 0,
+        expanding: Vec::new(),
+    };
+    let scene = expander.substitute(scene, 1)?;
     Ok(Resolved { scene, bsdf_counts })
 }
 
@@ -62,44 +72,87 @@ fn count_bsdfs(e: &Element, counts: &mut BTreeMap<String, usize>) {
     }
 }
 
-/// Copies `e`, replacing each `<ref>` by a resolved copy of its target.
-fn substitute(e: &Element, ids: &HashMap<String, &Element>, depth: usize) -> Result<Element> {
-    if depth > 64 {
-        return Err(SceneError::at(
-            &e.loc,
-            "references nest too deeply (a reference cycle?)",
-        ));
-    }
-    let mut out = Element {
-        tag: e.tag.clone(),
-        attrs: e.attrs.clone(),
-        children: Vec::with_capacity(e.children.len()),
-        loc: e.loc.clone(),
-    };
-    for child in &e.children {
-        if child.tag == "ref" {
-            child.check_attrs(&["id", "name"])?;
-            let id = child.required("id")?;
-            let target = ids.get(&id.value).ok_or_else(|| {
-                SceneError::at(&id.loc, format!("reference to unknown id \"{}\"", id.value))
-            })?;
-            if target.tag != "bsdf" {
-                return Err(SceneError::at(
-                    &id.loc,
-                    format!(
-                        "\"{}\" names a {}; only <bsdf> elements can be referenced",
-                        id.value,
-                        target.describe()
-                    ),
-                ));
-            }
-            if !child.children.is_empty() {
-                return Err(SceneError::at(&child.loc, "<ref> has no child elements"));
-            }
-            out.children.push(substitute(target, ids, depth + 1)?);
-        } else {
-            out.children.push(substitute(child, ids, depth + 1)?);
+/// The state of the expansion of references.
+struct Expander<'a> {
+    ids: &'a HashMap<String, &'a Element>,
+    /// Elements made so far.
+    elements: usize,
+    /// The ids of the elements being copied, outermost first.
+    expanding: Vec<&'a str>,
+}
+
+impl<'a> Expander<'a> {
+    /// Copies `e` (at nesting `depth`, `<scene>` being 1), replacing each
+    /// `<ref>` by a resolved copy of its target.
+    fn substitute(&mut self, e: &'a Element, depth: usize) -> Result<Element> {
+        if depth > MAX_DEPTH {
+            return Err(SceneError::at(
+                &e.loc,
+                format!(
+                    "elements nest more than {MAX_DEPTH} deep once references are expanded, the limit (docs/limits.md)"
+                ),
+            ));
         }
+        self.elements += 1;
+        if self.elements > MAX_ELEMENTS {
+            return Err(SceneError::at(
+                &e.loc,
+                format!(
+                    "references expand the scene to more than {MAX_ELEMENTS} elements, the limit (docs/limits.md)"
+                ),
+            ));
+        }
+        let mut out = Element {
+            tag: e.tag.clone(),
+            attrs: e.attrs.clone(),
+            children: Vec::with_capacity(e.children.len()),
+            loc: e.loc.clone(),
+        };
+        let id = e.attr("id").map(|a| a.value.as_str());
+        self.expanding.extend(id);
+        for child in &e.children {
+            let copy = if child.tag == "ref" {
+                self.reference(child, depth)?
+            } else {
+                self.substitute(child, depth + 1)?
+            };
+            out.children.push(copy);
+        }
+        if id.is_some() {
+            self.expanding.pop();
+        }
+        Ok(out)
     }
-    Ok(out)
+
+    /// The resolved copy of what `<ref>` element `r` names.
+    fn reference(&mut self, r: &'a Element, depth: usize) -> Result<Element> {
+        r.check_attrs(&["id", "name"])?;
+        let id = r.required("id")?;
+        let (name, target) = self.ids.get_key_value(&id.value).ok_or_else(|| {
+            SceneError::at(&id.loc, format!("reference to unknown id \"{}\"", id.value))
+        })?;
+        if target.tag != "bsdf" {
+            return Err(SceneError::at(
+                &id.loc,
+                format!(
+                    "\"{}\" names a {}; only <bsdf> elements can be referenced",
+                    id.value,
+                    target.describe()
+                ),
+            ));
+        }
+        if !r.children.is_empty() {
+            return Err(SceneError::at(&r.loc, "<ref> has no child elements"));
+        }
+        if self.expanding.contains(&name.as_str()) {
+            let mut chain = self.expanding.clone();
+            chain.push(name);
+            let start = chain.iter().position(|n| *n == name.as_str()).unwrap_or(0);
+            return Err(SceneError::at(
+                &id.loc,
+                format!("reference cycle: {}", chain[start..].join(" → ")),
+            ));
+        }
+        self.substitute(target, depth + 1)
+    }
 }

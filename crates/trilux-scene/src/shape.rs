@@ -9,15 +9,17 @@
 //! scale), zero radius or length, a sphere scaled non-uniformly, a cylinder
 //! whose cross-section is not a circle after `to_world` (Mitsuba only warns;
 //! the exact analytic intersection needs a circle), a zero total area, and a
-//! missing or malformed OBJ file.
+//! missing or malformed OBJ file. An OBJ file is only named here
+//! (`MeshRequest`); it is read once the whole scene file is checked
+//! (`crate::meshes`).
 
 use std::path::Path;
 
 use glam::{DMat3, DVec3};
+use trilux_geometry::limits::{MAX_COORDINATE, within};
 use trilux_geometry::{Shape, ShapeKind};
 
-use crate::error::{Result, SceneError};
-use crate::obj::load_obj;
+use crate::error::{Result, SceneError, SourceLocation};
 use crate::props::Props;
 use crate::transform::{coordinate_system, linear_part};
 
@@ -78,9 +80,27 @@ fn same_length_orthogonal(a: DVec3, b: DVec3) -> bool {
     (la - lb).abs() <= 1e-6 * la.max(lb) && a.dot(b).abs() <= 1e-6 * la * lb
 }
 
+/// An OBJ file a `<shape type="obj">` names, to be read after the whole
+/// scene file is checked.
+#[derive(Clone, Debug)]
+pub(crate) struct MeshRequest {
+    /// The file (relative names resolved against the scene's folder).
+    pub path: std::path::PathBuf,
+    /// `face_normals` of the shape.
+    pub face_normals: bool,
+    /// Where the file name is written.
+    pub filename: SourceLocation,
+    /// Where the `<shape>` is written.
+    pub shape: SourceLocation,
+}
+
 /// Builds the shape of a `<shape>` element. `props` are its parameters;
 /// `folder` is the scene file's folder (OBJ file names are relative to it).
-pub(crate) fn build_shape(props: &Props<'_>, folder: &Path) -> Result<Shape> {
+/// An OBJ shape comes with an empty mesh and the request to read it.
+pub(crate) fn build_shape(
+    props: &Props<'_>,
+    folder: &Path,
+) -> Result<(Shape, Option<MeshRequest>)> {
     let e = props.owner();
     let to_world = props
         .transform("to_world")?
@@ -88,8 +108,21 @@ pub(crate) fn build_shape(props: &Props<'_>, folder: &Path) -> Result<Shape> {
         .unwrap_or_default();
     let flip_normals = props.boolean("flip_normals")?.unwrap_or(false);
     let l: DMat3 = linear_part(&to_world);
+    let largest = to_world
+        .to_cols_array()
+        .into_iter()
+        .map(f64::abs)
+        .fold(0.0, f64::max);
+    if !within(largest) {
+        return Err(SceneError::at(
+            &props.loc("to_world"),
+            format!(
+                "to_world scales or moves by {largest:e}, beyond the coordinate limit ±{MAX_COORDINATE:e} (docs/limits.md)"
+            ),
+        ));
+    }
     let scale = l.x_axis.length() * l.y_axis.length() * l.z_axis.length();
-    if l.determinant().abs() <= 1e-12 * scale || !scale.is_finite() {
+    if l.determinant().abs() <= 1e-12 * scale {
         return Err(SceneError::at(
             &props.loc("to_world"),
             "to_world is singular (a zero scale?): the shape would have no area or no normal",
@@ -105,6 +138,7 @@ pub(crate) fn build_shape(props: &Props<'_>, folder: &Path) -> Result<Shape> {
         }
         Ok(v)
     };
+    let mut request = None;
     let kind = match e.plugin_type()? {
         "rectangle" => ShapeKind::Rectangle,
         "cube" => ShapeKind::Cube,
@@ -152,10 +186,16 @@ pub(crate) fn build_shape(props: &Props<'_>, folder: &Path) -> Result<Shape> {
                 )
             })?;
             let face_normals = props.boolean("face_normals")?.unwrap_or(false);
-            let path = folder.join(&name);
-            let mesh = load_obj(&path, face_normals)
-                .map_err(|err| SceneError::at(&props.loc("filename"), err.to_string()))?;
-            ShapeKind::Mesh(mesh)
+            request = Some(MeshRequest {
+                path: folder.join(&name),
+                face_normals,
+                filename: props.loc("filename"),
+                shape: e.loc.clone(),
+            });
+            ShapeKind::Mesh(trilux_geometry::TriangleMesh {
+                face_normals,
+                ..Default::default()
+            })
         }
         other => {
             return Err(SceneError::at(
@@ -171,12 +211,17 @@ pub(crate) fn build_shape(props: &Props<'_>, folder: &Path) -> Result<Shape> {
         world_from_object: to_world,
         flip_normals,
     };
-    let area = surface_area(&shape);
-    if !(area > 0.0 && area.is_finite()) {
-        return Err(SceneError::at(
-            &e.loc,
-            format!("{} has zero area", e.describe()),
-        ));
+    if request.is_none() {
+        check_area(&shape, &e.loc, &e.describe())?;
     }
-    Ok(shape)
+    Ok((shape, request))
+}
+
+/// Refuses a shape of zero (or non-finite) area, at `loc`.
+pub(crate) fn check_area(shape: &Shape, loc: &SourceLocation, describe: &str) -> Result<()> {
+    let area = surface_area(shape);
+    if !(area > 0.0 && area.is_finite()) {
+        return Err(SceneError::at(loc, format!("{describe} has zero area")));
+    }
+    Ok(())
 }

@@ -6,6 +6,8 @@
 use glam::{DMat3, DMat4, DVec3, DVec4};
 use serde::Serialize;
 
+use trilux_geometry::limits::{beyond, within};
+
 use crate::error::{Result, SceneError, SourceLocation};
 use crate::value::{parse_f64, parse_list, parse_n, parse_xyz};
 use crate::xml::Element;
@@ -151,6 +153,15 @@ fn parse_lookat(op: &Element) -> Result<LookAt> {
     let missing = |n: &str| SceneError::at(&op.loc, format!("<lookat> needs \"{n}\""));
     let origin = vec3_attr(op, "origin")?.ok_or_else(|| missing("origin"))?;
     let target = vec3_attr(op, "target")?.ok_or_else(|| missing("target"))?;
+    for (name, v) in [("origin", origin), ("target", target)] {
+        let largest = v.abs().max_element();
+        if !within(largest) {
+            return Err(SceneError::at(
+                &op.required(name)?.loc,
+                format!("<lookat> {name}: {}", beyond(largest)),
+            ));
+        }
+    }
     let dir = target - origin;
     if dir.length_squared() == 0.0 {
         return Err(SceneError::at(
@@ -170,7 +181,11 @@ fn parse_lookat(op: &Element) -> Result<LookAt> {
 /// looks down its +z axis with +x to the left and +y up.
 pub(crate) fn world_from_camera(l: &LookAt, loc: &SourceLocation) -> Result<DMat4> {
     let dir = (l.target - l.origin).normalize();
-    let left = l.up.cross(dir);
+    // Only up's direction matters: scaled to at most 1, a huge up does not
+    // overflow the cross product.
+    let scale = l.up.abs().max_element();
+    let up = if scale > 1.0 { l.up / scale } else { l.up };
+    let left = up.cross(dir);
     if left.length_squared() <= 1e-20 || !left.is_finite() {
         return Err(SceneError::at(
             loc,

@@ -7,11 +7,17 @@
 //! (in document order), unless the caller already set `n`; every attribute
 //! value has its `$name` references replaced. An undefined `$name` is an error,
 //! as in Mitsuba.
+//!
+//! Bounded (`crate::limits`): the number of XML nodes, the nesting depth
+//! (checked before each level is entered, so deep nesting is an error, not
+//! a stack overflow), the length of each substituted value and the bytes
+//! substitution produces over the whole file.
 
 use std::path::Path;
 use std::sync::Arc;
 
 use crate::error::{Result, SceneError, SourceLocation};
+use crate::limits::{MAX_DEPTH, MAX_EXPANDED_BYTES, MAX_VALUE_BYTES, MAX_XML_NODES};
 
 /// One attribute of an element, after substitution.
 #[derive(Clone, Debug)]
@@ -87,6 +93,7 @@ impl Element {
 pub(crate) fn parse(text: &str, file: &Arc<Path>, params: &[(String, String)]) -> Result<Element> {
     let options = roxmltree::ParsingOptions {
         allow_dtd: false,
+        nodes_limit: MAX_XML_NODES,
         ..Default::default()
     };
     let doc = roxmltree::Document::parse_with_options(text, options).map_err(|e| {
@@ -96,6 +103,14 @@ pub(crate) fn parse(text: &str, file: &Arc<Path>, params: &[(String, String)]) -
             line: pos.row,
             col: pos.col,
         };
+        if matches!(e, roxmltree::Error::NodesLimitReached) {
+            return SceneError::at(
+                &loc,
+                format!(
+                    "the file has more than {MAX_XML_NODES} XML nodes, the limit (docs/limits.md)"
+                ),
+            );
+        }
         // roxmltree repeats the position inside its message: drop it there.
         let message = e
             .to_string()
@@ -106,6 +121,7 @@ pub(crate) fn parse(text: &str, file: &Arc<Path>, params: &[(String, String)]) -
         doc: &doc,
         file: file.clone(),
         params: params.to_vec(),
+        expanded: 0,
     };
     let root = doc.root_element();
     let root_loc = ctx.loc(root.range().start);
@@ -119,14 +135,15 @@ pub(crate) fn parse(text: &str, file: &Arc<Path>, params: &[(String, String)]) -
         ));
     }
     let tree = ctx
-        .element(root)?
+        .element(root, 1)?
         .ok_or_else(|| SceneError::at(&root_loc, "the root element must be <scene>"))?;
     check_version(&tree)?;
     Ok(tree)
 }
 
-/// Mitsuba requires `version` on `<scene>`; files older than 2.0 use other
-/// parameter names, which this loader does not translate.
+/// Mitsuba requires `version="MAJOR.MINOR.PATCH"` on `<scene>`; files
+/// older than 2.0 use other parameter names, which this loader does not
+/// translate.
 fn check_version(scene: &Element) -> Result<()> {
     let v = scene.attr("version").ok_or_else(|| {
         SceneError::at(
@@ -134,17 +151,27 @@ fn check_version(scene: &Element) -> Result<()> {
             "<scene> needs a version attribute (version=\"3.0.0\")",
         )
     })?;
-    let major = v
+    let parts: Vec<Option<u32>> = v
         .value
         .split('.')
-        .next()
-        .and_then(|m| m.trim().parse::<u32>().ok());
-    match major {
-        Some(2 | 3) => Ok(()),
-        _ => Err(SceneError::at(
+        .map(|p| {
+            let digits = !p.is_empty() && p.bytes().all(|b| b.is_ascii_digit());
+            digits.then(|| p.parse().ok()).flatten()
+        })
+        .collect();
+    match parts[..] {
+        [Some(2 | 3), Some(_), Some(_)] => Ok(()),
+        [Some(_), Some(_), Some(_)] => Err(SceneError::at(
             &v.loc,
             format!(
                 "unsupported scene version \"{}\" (this loader reads Mitsuba 2 and 3 scenes)",
+                v.value
+            ),
+        )),
+        _ => Err(SceneError::at(
+            &v.loc,
+            format!(
+                "malformed scene version \"{}\" (three numbers, as in version=\"3.0.0\")",
                 v.value
             ),
         )),
@@ -155,6 +182,8 @@ struct Context<'a, 'input> {
     doc: &'a roxmltree::Document<'input>,
     file: Arc<Path>,
     params: Vec<(String, String)>,
+    /// Bytes produced by `$name` substitution so far.
+    expanded: usize,
 }
 
 impl Context<'_, '_> {
@@ -167,10 +196,16 @@ impl Context<'_, '_> {
         }
     }
 
-    /// Converts one element; `None` for a `<default>`, which only defines a
-    /// parameter.
-    fn element(&mut self, node: roxmltree::Node<'_, '_>) -> Result<Option<Element>> {
+    /// Converts one element at nesting `depth` (`<scene>` is 1); `None`
+    /// for a `<default>`, which only defines a parameter.
+    fn element(&mut self, node: roxmltree::Node<'_, '_>, depth: usize) -> Result<Option<Element>> {
         let loc = self.loc(node.range().start);
+        if depth > MAX_DEPTH {
+            return Err(SceneError::at(
+                &loc,
+                format!("elements nest more than {MAX_DEPTH} deep, the limit (docs/limits.md)"),
+            ));
+        }
         let tag = node.tag_name().name().to_string();
         let mut attrs = Vec::new();
         for a in node.attributes() {
@@ -203,7 +238,7 @@ impl Context<'_, '_> {
         let mut element = element;
         for child in node.children() {
             if child.is_element() {
-                if let Some(e) = self.element(child)? {
+                if let Some(e) = self.element(child, depth + 1)? {
                     element.children.push(e);
                 }
             } else if child.is_text() {
@@ -219,8 +254,9 @@ impl Context<'_, '_> {
         Ok(Some(element))
     }
 
-    /// Replaces every `$name` in `value` by its parameter value.
-    fn substitute(&self, value: &str, loc: &SourceLocation) -> Result<String> {
+    /// Replaces every `$name` in `value` by its parameter value, within
+    /// the limits on one value and on the whole file.
+    fn substitute(&mut self, value: &str, loc: &SourceLocation) -> Result<String> {
         if !value.contains('$') {
             return Ok(value.to_string());
         }
@@ -237,7 +273,28 @@ impl Context<'_, '_> {
                 return Err(SceneError::at(loc, "a lone '$' in an attribute value"));
             }
             match self.params.iter().find(|(n, _)| n == name) {
-                Some((_, v)) => out.push_str(v),
+                Some((_, v)) => {
+                    if out.len() + v.len() > MAX_VALUE_BYTES {
+                        return Err(SceneError::at(
+                            loc,
+                            format!(
+                                "the value grows beyond {} when ${name} is substituted, the limit (docs/limits.md)",
+                                trilux_files::human_bytes(MAX_VALUE_BYTES as u64)
+                            ),
+                        ));
+                    }
+                    self.expanded += v.len();
+                    if self.expanded > MAX_EXPANDED_BYTES {
+                        return Err(SceneError::at(
+                            loc,
+                            format!(
+                                "$name substitution produces more than {} over the file, the limit (docs/limits.md)",
+                                trilux_files::human_bytes(MAX_EXPANDED_BYTES as u64)
+                            ),
+                        ));
+                    }
+                    out.push_str(v);
+                }
                 None => {
                     return Err(SceneError::at(
                         loc,

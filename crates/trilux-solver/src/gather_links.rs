@@ -151,7 +151,7 @@ impl<const N: usize> Solver<N> {
         let faces: Vec<(FaceId, &TransportFace<N>)> = self
             .faces
             .iter()
-            .filter(|(_, f)| !f.is_absorber() && !(f.rho_d.is_black() && f.emission.is_black()))
+            .filter(|(_, f)| !(f.rho_d.is_black() && f.emission.is_black()))
             .collect();
         let from_faces = faces.par_iter().flat_map_iter(|&(face, f)| {
             let sender = Sender::Radiosity {

@@ -1,7 +1,8 @@
 //! # trilux-solver — progressive hierarchical three-point transport
 //!
-//! Layer: depends on `trilux-color`, `trilux-geometry` and `trilux-brdf`;
-//! it never parses files: it takes a [`SceneDescription`], the plain data
+//! Layer: depends on `trilux-color`, `trilux-geometry`, `trilux-brdf` and
+//! `trilux-files` (the solution file's bounded read and safe write); it
+//! never parses scene files: it takes a [`SceneDescription`], the plain data
 //! the scene layer hands over, and prepares it once ([`PreparedScene`]).
 //! Implements Dumont, Bouatouch & Gosselin (1997), "A Progressive Algorithm
 //! for Three Point Transport"; docs/solver.md says where it departs.
@@ -12,6 +13,8 @@
 //! - [`settings`]: FFErr, FrErr, MinArea, the photometric threshold, CR
 //!   target, quality presets, two-point or uniform transport.
 //! - `faces`: the faces of input surfaces that send and receive light.
+//! - `divergence`: scenes with no finite solution (light never absorbed
+//!   and never escaping), refused before the solve.
 //! - `throughput`: T = A F V per element pair, cached (paper §4.6).
 //! - `radiosity`: two-point radiance of Lambertian parts, push-pull.
 //! - `interaction`: interaction hierarchies (paper §3.2), flux-weighted
@@ -23,12 +26,13 @@
 //! - [`gather_links`]: the final gather's links, kept for rendering.
 //! - [`ledger`]: where the energy went.
 //! - [`solution`]: the radiance query for final gathering and the file
-//!   format.
+//!   format (checksummed, every field validated).
 //! - [`stats`]: what `--stats` writes.
 #![forbid(unsafe_code)]
 // Band loops index several per-band arrays in step.
 #![allow(clippy::needless_range_loop)]
 
+mod divergence;
 pub mod error;
 mod faces;
 pub mod gather_links;

@@ -57,6 +57,15 @@ pub enum PrepareError {
         /// Index of the shape.
         shape: usize,
     },
+    /// An emitter's radiance is beyond [`MAX_BAND_RADIANCE`] in these
+    /// bands, or its flux π·A·Le overflows.
+    #[error(
+        "shape {shape}: emitted radiance beyond 1e30 in some band, or a flux that overflows (docs/limits.md)"
+    )]
+    FluxOverflow {
+        /// Index of the shape.
+        shape: usize,
+    },
     /// The three per-shape lists differ in length.
     #[error("{shapes} shapes but {bsdfs} materials and {emission} emitter entries")]
     Lengths {
@@ -83,6 +92,10 @@ impl PrepareError {
             PrepareError::BadEmission { .. } => {
                 "emitted radiance must be finite and non-negative".into()
             }
+            PrepareError::FluxOverflow { .. } => {
+                "emitted radiance beyond 1e30 in some band, or a flux that overflows (docs/limits.md)"
+                    .into()
+            }
             PrepareError::Lengths { .. } | PrepareError::Hash(_) => self.to_string(),
         }
     }
@@ -91,7 +104,9 @@ impl PrepareError {
     pub fn is_emitter(&self) -> bool {
         matches!(
             self,
-            PrepareError::Emission { .. } | PrepareError::BadEmission { .. }
+            PrepareError::Emission { .. }
+                | PrepareError::BadEmission { .. }
+                | PrepareError::FluxOverflow { .. }
         )
     }
 
@@ -101,7 +116,8 @@ impl PrepareError {
             PrepareError::Geometry(e) => Some(e.shape),
             PrepareError::Material { shape, .. }
             | PrepareError::Emission { shape, .. }
-            | PrepareError::BadEmission { shape } => Some(*shape),
+            | PrepareError::BadEmission { shape }
+            | PrepareError::FluxOverflow { shape } => Some(*shape),
             PrepareError::Lengths { .. } | PrepareError::Hash(_) => None,
         }
     }
@@ -136,12 +152,13 @@ impl<const N: usize> PreparedScene<N> {
                 Bsdf::new(p).map_err(|source| PrepareError::Material { shape, source })
             })
             .collect::<Result<_, _>>()?;
-        let emission = desc
+        let emission: Vec<Spectrum<N>> = desc
             .emission
             .iter()
             .enumerate()
             .map(|(shape, e)| emitted(shape, e.as_ref()))
             .collect::<Result<_, _>>()?;
+        check_flux(&geometry, &emission)?;
         Ok(PreparedScene {
             geometry,
             materials,
@@ -193,6 +210,35 @@ fn emitted<const N: usize>(
     } else {
         Err(PrepareError::BadEmission { shape })
     }
+}
+
+/// The largest radiance of any band of an emitter (1e30): the scene file
+/// may state at most [`trilux_color::MAX_RADIANCE`] (1e20), which
+/// conversion to bands can scale a few times; this is the solver's own
+/// guard, far enough below the 32-bit floats of the solution file (3.4e38)
+/// for the sums of many reflections.
+pub const MAX_BAND_RADIANCE: f64 = 1e30;
+
+/// Refuses an emitter whose flux π·A·Le overflows in some band (it would
+/// make an infinite solution, which no renderer can use), and one whose
+/// radiance is beyond [`MAX_BAND_RADIANCE`].
+fn check_flux<const N: usize>(
+    geometry: &Geometry,
+    emission: &[Spectrum<N>],
+) -> Result<(), PrepareError> {
+    let mut area = vec![0.0; emission.len()];
+    for surface in geometry.surfaces() {
+        if let Some(a) = area.get_mut(surface.shape as usize) {
+            *a += surface.area();
+        }
+    }
+    for (shape, le) in emission.iter().enumerate() {
+        let flux = std::f64::consts::PI * area[shape] * le.max_value();
+        if !flux.is_finite() || le.max_value() > MAX_BAND_RADIANCE {
+            return Err(PrepareError::FluxOverflow { shape });
+        }
+    }
+    Ok(())
 }
 
 /// FNV-1a (64 bits) as an `io::Write`: stable across platforms and Rust

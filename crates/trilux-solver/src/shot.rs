@@ -310,7 +310,6 @@ impl<const N: usize> Solver<N> {
     }
 }
 
-
 /// What a shot's refinement reads.
 pub(crate) struct ShotContext<'a, const N: usize> {
     pub refine: RefineContext<'a, N>,

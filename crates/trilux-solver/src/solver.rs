@@ -248,6 +248,15 @@ impl<const N: usize> Solver<N> {
         settings.validate().map_err(SolverError::Settings)?;
         let depth_of = depth_limits(scene.geometry(), &settings);
         let forest = presubdivided(Arc::clone(scene.geometry()), &depth_of);
+        if let Some(t) =
+            crate::divergence::trapped_light(&forest, scene.materials(), scene.emission())
+        {
+            return Err(SolverError::NoFiniteSolution {
+                shape: t.shape,
+                band: t.band,
+                bands: N,
+            });
+        }
         let albedo = scene
             .materials()
             .par_iter()
@@ -383,6 +392,13 @@ impl<const N: usize> Solver<N> {
                 interactions: self.interaction_count(),
                 live_links: live,
             });
+        }
+        let cr = self.convergence_ratio();
+        if cr < self.settings.convergence {
+            self.stats.warnings.push(format!(
+                "the solve stopped at its cap of {} shots with convergence ratio {cr:.4}, short of its target {} (surfaces that reflect nearly all light converge slowly: lower a reflectance, or ask for less with --convergence)",
+                self.stats.shots, self.settings.convergence
+            ));
         }
         self.finish(start.elapsed().as_secs_f64())
     }

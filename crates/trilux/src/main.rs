@@ -4,7 +4,9 @@
 //! 1; command-line usage errors (unknown options, malformed values) keep
 //! clap's message and exit with status 2, before any file is read.
 //! Subcommands live one per module; the work itself is
-//! `trilux_render::pipeline`'s. Number-list options whose values may begin
+//! `trilux_render::pipeline`'s. Every output is planned before any work and
+//! written all or none at the end (`output`); the scene's meshes are read
+//! only once the camera and options are checked (`trilux_scene::open`). Number-list options whose values may begin
 //! with '-' (`--lookat -0.5,1,2,...`) need `#[arg(allow_hyphen_values =
 //! true)]` on the argument (`allow_negative_numbers` only covers plain
 //! numbers, not comma lists).
@@ -67,6 +69,22 @@ pub fn set_threads(threads: Option<u32>) {
     }
 }
 
+/// Prints the warnings of a finished command: the solve's (caps reached,
+/// clamped reflectances) and the render's samples left out.
+pub fn warn(outcome: &trilux_render::Outcome) {
+    for w in &outcome.solve.warnings {
+        eprintln!("warning: {w}");
+    }
+    if let Some(r) = &outcome.render
+        && r.gather.dropped > 0
+    {
+        eprintln!(
+            "warning: {} camera samples had a value that is not finite and were left out of the image",
+            r.gather.dropped
+        );
+    }
+}
+
 /// The main job: the bundled default scene rendered into out/.
 fn render_default() -> anyhow::Result<()> {
     let scene = default_scene();
@@ -96,13 +114,33 @@ fn run(cli: Cli) -> anyhow::Result<()> {
     }
 }
 
+/// The longest line of an error message (a quoted value of megabytes
+/// loses its middle).
+const MAX_LINE_CHARS: usize = 1000;
+
+/// Prints a usage error with clap's message, each line capped, and exits
+/// with clap's status (2); help and version go to stdout as usual.
+fn usage_error(e: clap::Error) -> ExitCode {
+    if !e.use_stderr() {
+        e.exit();
+    }
+    for line in e.render().to_string().lines() {
+        eprintln!("{}", trilux_scene::error::elide(line, MAX_LINE_CHARS));
+    }
+    ExitCode::from(u8::try_from(e.exit_code()).unwrap_or(2))
+}
+
 fn main() -> ExitCode {
     // Usage errors exit here with clap's message and status 2.
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => return usage_error(e),
+    };
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             let message = e.to_string().replace(['\n', '\r'], " ");
+            let message = trilux_scene::error::elide(&message, MAX_LINE_CHARS);
             eprintln!("error: {message}");
             ExitCode::FAILURE
         }

@@ -2,9 +2,6 @@
 //! parsers that turn a malformed value into a usage error (status 2) before
 //! any file is read.
 
-use std::path::{Path, PathBuf};
-
-use anyhow::{Result, bail};
 use clap::{Args, ValueEnum};
 use glam::DVec3;
 use trilux_color::Mode;
@@ -74,7 +71,7 @@ impl SolveOptions {
 fn parse_unit(text: &str) -> Result<f64, String> {
     let v: f64 = text
         .parse()
-        .map_err(|_| format!("'{text}' is not a number"))?;
+        .map_err(|_| format!("{} is not a number", quoted(text)))?;
     if v.is_finite() && (0.0..=1.0).contains(&v) {
         Ok(v)
     } else {
@@ -82,20 +79,46 @@ fn parse_unit(text: &str) -> Result<f64, String> {
     }
 }
 
-/// An integer of at least 1.
-pub fn parse_positive(text: &str) -> Result<u32, String> {
+/// `text` quoted for a message, its middle elided when long (a value of
+/// megabytes must not become an error line of megabytes).
+pub fn quoted(text: &str) -> String {
+    format!("'{}'", trilux_scene::error::elide(text, 60))
+}
+
+/// An integer in `1..=max`.
+fn parse_in(text: &str, max: u32, what: &str) -> Result<u32, String> {
     match text.parse::<u32>() {
-        Ok(v) if v >= 1 => Ok(v),
-        Ok(_) => Err("must be at least 1".into()),
-        Err(_) => Err(format!("'{text}' is not a positive integer")),
+        Ok(v) if (1..=max).contains(&v) => Ok(v),
+        Ok(_) => Err(format!("must lie in 1..={max} ({what})")),
+        Err(_) => Err(format!("{} is not a positive integer", quoted(text))),
     }
+}
+
+/// Worker threads: 1 to 1024.
+pub fn parse_threads(text: &str) -> Result<u32, String> {
+    parse_in(text, 1024, "threads")
+}
+
+/// A film edge: 1 to `MAX_FILM_EDGE` pixels (docs/limits.md).
+pub fn parse_film_edge(text: &str) -> Result<u32, String> {
+    use trilux_scene::limits::MAX_FILM_EDGE;
+    parse_in(text, MAX_FILM_EDGE, "pixels, docs/limits.md")
+}
+
+/// Samples per pixel: 1 to the sampler's maximum.
+pub fn parse_spp(text: &str) -> Result<u32, String> {
+    parse_in(
+        text,
+        trilux_render::sampler::MAX_SAMPLES,
+        "samples per pixel",
+    )
 }
 
 /// A field of view in (0, 180) degrees.
 pub fn parse_fov(text: &str) -> Result<f64, String> {
     let v: f64 = text
         .parse()
-        .map_err(|_| format!("'{text}' is not a number"))?;
+        .map_err(|_| format!("{} is not a number", quoted(text)))?;
     if v.is_finite() && v > 0.0 && v < 180.0 {
         Ok(v)
     } else {
@@ -112,9 +135,12 @@ pub fn parse_lookat(text: &str) -> Result<LookAt, String> {
         .split(',')
         .map(|v| v.trim().parse::<f64>())
         .collect::<Result<_, _>>()
-        .map_err(|_| format!("'{text}' is not a comma-separated list of numbers"))?;
-    if values.iter().any(|v| !v.is_finite()) {
-        return Err("values must be finite".into());
+        .map_err(|_| format!("{} is not a comma-separated list of numbers", quoted(text)))?;
+    use trilux_geometry::limits::{MAX_COORDINATE, within};
+    if values.iter().any(|v| !within(*v)) {
+        return Err(format!(
+            "values must be finite and within the coordinate limit ±{MAX_COORDINATE:e} (docs/limits.md)"
+        ));
     }
     let v = |i: usize| DVec3::new(values[i], values[i + 1], values[i + 2]);
     match values.len() {
@@ -122,42 +148,4 @@ pub fn parse_lookat(text: &str) -> Result<LookAt, String> {
         9 => Ok((v(0), v(3), Some(v(6)))),
         n => Err(format!("takes 6 or 9 numbers (eye, target[, up]), got {n}")),
     }
-}
-
-/// Refuses an output whose folder does not exist, before any work.
-pub fn check_output(path: &Path, what: &str) -> Result<()> {
-    let parent = path.parent().filter(|p| !p.as_os_str().is_empty());
-    if let Some(dir) = parent
-        && !dir.is_dir()
-    {
-        bail!(
-            "{}: cannot write the {what}: the folder {} does not exist",
-            path.display(),
-            dir.display()
-        );
-    }
-    Ok(())
-}
-
-/// Refuses a set of outputs where two are the same file or one is an
-/// input, before any work.
-pub fn check_distinct(inputs: &[&Path], outputs: &[(&Path, &str)]) -> Result<()> {
-    let key =
-        |p: &Path| -> PathBuf { std::fs::canonicalize(p).unwrap_or_else(|_| p.to_path_buf()) };
-    for (k, (out, what)) in outputs.iter().enumerate() {
-        if let Some(input) = inputs.iter().find(|i| key(i) == key(out)) {
-            bail!(
-                "{}: the {what} would overwrite the input {}",
-                out.display(),
-                input.display()
-            );
-        }
-        if let Some((_, other)) = outputs[..k].iter().find(|(o, _)| key(o) == key(out)) {
-            bail!(
-                "{}: the {what} and the {other} are the same file",
-                out.display()
-            );
-        }
-    }
-    Ok(())
 }

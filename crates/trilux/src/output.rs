@@ -1,35 +1,128 @@
-//! Writing what the commands produce: images, statistics JSON.
+//! The command's outputs: every one planned and checked before any work
+//! (`trilux_files::Output::plan`: folder, kind of file, symbolic links),
+//! none equal to an input or to another, and all written or none at the
+//! end (`trilux_files::write_all`).
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result};
-use trilux_render::Image;
+use anyhow::{Result, bail};
+use trilux_files::{FileIdentity, Output};
 
-/// The statistics JSON: the solver's figures plus the render time.
-pub fn stats_json(stats: &trilux_solver::SolveStats, render_seconds: f64) -> serde_json::Value {
-    let mut value = serde_json::to_value(stats).unwrap_or(serde_json::Value::Null);
+/// The outputs of one command, in the order given to [`Outputs::plan`].
+pub struct Outputs {
+    planned: Vec<Output>,
+    /// The default folder (`out/`) when this command made it: removed
+    /// again if it is still empty when the command ends (a failure).
+    made: Option<PathBuf>,
+}
+
+impl Drop for Outputs {
+    fn drop(&mut self) {
+        if let Some(dir) = &self.made {
+            // Fails, as it should, once the folder holds the outputs.
+            let _ = std::fs::remove_dir(dir);
+        }
+    }
+}
+
+impl Outputs {
+    /// Plans `outputs` (path and what it is) of a command reading
+    /// `inputs`. `default_folder` is the folder of outputs the user did not
+    /// name, made when missing (and removed again if nothing is written).
+    pub fn plan(
+        outputs: &[(&Path, &str)],
+        inputs: &[&Path],
+        default_folder: Option<&Path>,
+    ) -> Result<Outputs> {
+        let mut made = None;
+        if let Some(dir) = default_folder
+            && !dir.exists()
+        {
+            std::fs::create_dir_all(dir)
+                .map_err(|e| anyhow::anyhow!("{}: cannot create the folder: {e}", dir.display()))?;
+            made = Some(dir.to_path_buf());
+        }
+        let mut planned = Outputs {
+            planned: Vec::new(),
+            made,
+        };
+        for (path, what) in outputs {
+            planned.planned.push(Output::plan(path, what)?);
+        }
+        planned.check_distinct(inputs)?;
+        Ok(planned)
+    }
+
+    /// Refuses an output that is an input, or the same file as another
+    /// output (two outputs written through to one device are allowed:
+    /// nothing is overwritten).
+    fn check_distinct(&self, inputs: &[&Path]) -> Result<()> {
+        // An input that cannot be identified (missing) is reported by the
+        // loader, with its own message.
+        let inputs: Vec<(&Path, FileIdentity)> = inputs
+            .iter()
+            .filter_map(|p| FileIdentity::of(p).ok().map(|id| (*p, id)))
+            .collect();
+        for (k, out) in self.planned.iter().enumerate() {
+            if let Some((input, _)) = inputs.iter().find(|(_, id)| id == out.identity()) {
+                bail!(
+                    "{}: the {} would overwrite the input {}",
+                    out.path().display(),
+                    out.what(),
+                    input.display()
+                );
+            }
+            let same = |o: &&Output| o.identity() == out.identity();
+            if let Some(other) = self.planned[..k].iter().find(same)
+                && !(other.is_write_through() && out.is_write_through())
+            {
+                bail!(
+                    "{}: the {} and the {} are the same file",
+                    out.path().display(),
+                    out.what(),
+                    other.what()
+                );
+            }
+        }
+        Ok(())
+    }
+
+    /// Writes every output, `bytes` in the planned order, or none.
+    pub fn write(&self, bytes: &[Vec<u8>]) -> Result<()> {
+        if bytes.len() != self.planned.len() {
+            bail!(
+                "{} outputs planned, {} produced",
+                self.planned.len(),
+                bytes.len()
+            );
+        }
+        let items: Vec<(&Output, &[u8])> = self
+            .planned
+            .iter()
+            .zip(bytes)
+            .map(|(o, b)| (o, b.as_slice()))
+            .collect();
+        trilux_files::write_all(&items)?;
+        Ok(())
+    }
+}
+
+/// The statistics JSON: the solver's figures plus the render time and
+/// what the render left out.
+pub fn stats_json(
+    stats: &trilux_solver::SolveStats,
+    render: Option<&trilux_render::RenderStats>,
+    render_seconds: f64,
+) -> Result<Vec<u8>> {
+    let mut value = serde_json::to_value(stats)?;
     if let Some(map) = value.as_object_mut() {
         map.insert("render_seconds".into(), serde_json::json!(render_seconds));
+        if let Some(r) = render {
+            map.insert(
+                "dropped_samples".into(),
+                serde_json::json!(r.gather.dropped),
+            );
+        }
     }
-    value
-}
-
-/// Writes JSON atomically (temporary file, then rename).
-pub fn write_json(path: &Path, value: &impl serde::Serialize) -> Result<()> {
-    let text = serde_json::to_string_pretty(value)?;
-    let tmp = path.with_extension("tmp-trilux");
-    std::fs::write(&tmp, text).with_context(|| format!("{}: cannot write", path.display()))?;
-    std::fs::rename(&tmp, path).map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        anyhow::anyhow!("{}: cannot write: {e}", path.display())
-    })
-}
-
-/// Writes the EXR and, if asked, the PNG (exposure 0, clamped).
-pub fn write_images(image: &Image, exr: &Path, png: Option<&Path>) -> Result<()> {
-    image.write_exr(exr)?;
-    if let Some(png) = png {
-        image.write_png(png, 0.0)?;
-    }
-    Ok(())
+    Ok(serde_json::to_vec_pretty(&value)?)
 }

@@ -10,9 +10,9 @@ use trilux_render::{
 };
 
 use crate::options::{
-    LookAt, SolveOptions, check_distinct, check_output, parse_fov, parse_lookat, parse_positive,
+    LookAt, SolveOptions, parse_film_edge, parse_fov, parse_lookat, parse_spp, parse_threads,
 };
-use crate::output::{stats_json, write_images, write_json};
+use crate::output::{Outputs, stats_json};
 use crate::progress::Bars;
 
 /// Where the gather continues one bounce before reading the solution.
@@ -43,16 +43,16 @@ pub struct RenderArgs {
     #[arg(long)]
     pub stats: Option<PathBuf>,
     /// Camera samples per pixel (default: the scene sampler's sample_count).
-    #[arg(long, value_parser = parse_positive)]
+    #[arg(long, value_parser = parse_spp)]
     pub spp: Option<u32>,
-    /// Film width in pixels (default: the scene's).
-    #[arg(long, value_parser = parse_positive)]
+    /// Film width in pixels (default: the scene's; docs/limits.md).
+    #[arg(long, value_parser = parse_film_edge)]
     pub width: Option<u32>,
-    /// Film height in pixels (default: the scene's).
-    #[arg(long, value_parser = parse_positive)]
+    /// Film height in pixels (default: the scene's; docs/limits.md).
+    #[arg(long, value_parser = parse_film_edge)]
     pub height: Option<u32>,
     /// Worker threads (default: all cores).
-    #[arg(long, value_parser = parse_positive)]
+    #[arg(long, value_parser = parse_threads)]
     pub threads: Option<u32>,
     /// Seed of the sample sequences.
     #[arg(long, default_value_t = 0)]
@@ -84,28 +84,19 @@ pub fn default_output(scene: &Path) -> PathBuf {
 }
 
 impl RenderArgs {
-    /// The EXR path: `-o`, or the default in `out/` (made when missing).
-    fn output(&self) -> Result<PathBuf> {
-        match &self.output {
-            Some(p) => Ok(p.clone()),
-            None => {
-                std::fs::create_dir_all("out").context("out: cannot create the folder")?;
-                Ok(default_output(&self.scene))
-            }
-        }
-    }
-
-    /// Every output checked, and checked against the inputs, before work.
-    fn check_outputs(&self, exr: &Path) -> Result<()> {
+    /// Every output planned (the default `out/` made when missing) and
+    /// checked against the inputs, before any work: the EXR, then the PNG
+    /// and the statistics when asked for.
+    fn plan_outputs(&self) -> Result<Outputs> {
+        let default = default_output(&self.scene);
+        let exr = self.output.as_deref().unwrap_or(&default);
         let mut outputs = vec![(exr, "image")];
         outputs.extend(self.png.as_deref().map(|p| (p, "PNG")));
         outputs.extend(self.stats.as_deref().map(|p| (p, "statistics")));
-        for (path, what) in &outputs {
-            check_output(path, what)?;
-        }
         let mut inputs = vec![self.scene.as_path()];
         inputs.extend(self.solution.as_deref());
-        check_distinct(&inputs, &outputs)
+        let folder = self.output.is_none().then(|| Path::new("out"));
+        Outputs::plan(&outputs, &inputs, folder)
     }
 
     /// Samples, seed, filter and extra-bounce rule of this render.
@@ -133,25 +124,27 @@ impl RenderArgs {
 /// Runs `trilux render`.
 pub fn run(args: &RenderArgs) -> Result<()> {
     crate::set_threads(args.threads);
-    let exr = args.output()?;
-    args.check_outputs(&exr)?;
-    let scene = trilux_scene::load(&args.scene)?;
-    let camera = scene.camera.as_ref().with_context(|| {
+    let outputs = args.plan_outputs()?;
+    let pending = trilux_scene::open(&args.scene)?;
+    let camera = pending.scene().camera.as_ref().with_context(|| {
         format!(
             "{}: the scene has no <sensor> to render from",
-            scene.path.display()
+            args.scene.display()
         )
     })?;
     let plan = Plan {
-        mode: args.options.mode(&scene),
+        mode: args.options.mode(pending.scene()),
         solver: args.options.settings(),
         source: match &args.solution {
             Some(path) => SolutionSource::Load(path),
             None => SolutionSource::Solve,
         },
         save: None,
+        solution_file: false,
         render: Some(args.render_plan(camera)),
     };
+    trilux_render::pipeline::check(pending.scene(), &plan)?;
+    let scene = pending.finish()?;
     let bars = Bars::new(true);
     let mut on_shot = |p: &trilux_solver::Progress| bars.solve(p);
     let on_tile = |done: usize, total: usize| bars.render(done, total);
@@ -165,13 +158,19 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     );
     bars.finish();
     let outcome = outcome?;
-    let image = outcome.image.context("the render produced no image")?;
-    write_images(&image, &exr, args.png.as_deref())?;
-    if let Some(path) = &args.stats {
-        write_json(path, &stats_json(&outcome.solve, outcome.render_seconds))?;
+    let image = outcome
+        .image
+        .as_ref()
+        .context("the render produced no image")?;
+    let mut files = vec![image.exr_bytes()?];
+    if args.png.is_some() {
+        files.push(image.png_bytes(0.0)?);
     }
-    for w in &outcome.solve.warnings {
-        eprintln!("warning: {w}");
+    if args.stats.is_some() {
+        let render = outcome.render.as_ref();
+        files.push(stats_json(&outcome.solve, render, outcome.render_seconds)?);
     }
+    outputs.write(&files)?;
+    crate::warn(&outcome);
     Ok(())
 }

@@ -3,12 +3,12 @@
 
 use std::path::PathBuf;
 
-use anyhow::Result;
+use anyhow::{Context, Result};
 use clap::Args;
 use trilux_render::{Observer, Plan, SolutionSource};
 
-use crate::options::{SolveOptions, check_distinct, check_output, parse_positive};
-use crate::output::{stats_json, write_json};
+use crate::options::{SolveOptions, parse_threads};
+use crate::output::{Outputs, stats_json};
 use crate::progress::Bars;
 
 /// Arguments of `trilux solve`.
@@ -23,7 +23,7 @@ pub struct SolveArgs {
     #[arg(long)]
     pub stats: Option<PathBuf>,
     /// Worker threads (default: all cores).
-    #[arg(long, value_parser = parse_positive)]
+    #[arg(long, value_parser = parse_threads)]
     pub threads: Option<u32>,
     #[command(flatten)]
     pub options: SolveOptions,
@@ -32,21 +32,20 @@ pub struct SolveArgs {
 /// Runs `trilux solve`.
 pub fn run(args: &SolveArgs) -> Result<()> {
     crate::set_threads(args.threads);
-    check_output(&args.output, "solution")?;
     let mut outputs = vec![(args.output.as_path(), "solution")];
-    if let Some(stats) = &args.stats {
-        check_output(stats, "statistics")?;
-        outputs.push((stats.as_path(), "statistics"));
-    }
-    check_distinct(&[args.scene.as_path()], &outputs)?;
-    let scene = trilux_scene::load(&args.scene)?;
+    outputs.extend(args.stats.as_deref().map(|p| (p, "statistics")));
+    let outputs = Outputs::plan(&outputs, &[args.scene.as_path()], None)?;
+    let pending = trilux_scene::open(&args.scene)?;
     let plan = Plan {
-        mode: args.options.mode(&scene),
+        mode: args.options.mode(pending.scene()),
         solver: args.options.settings(),
         source: SolutionSource::Solve,
-        save: Some(&args.output),
+        save: None,
+        solution_file: true,
         render: None,
     };
+    trilux_render::pipeline::check(pending.scene(), &plan)?;
+    let scene = pending.finish()?;
     let bars = Bars::new(false);
     let mut on_shot = |p: &trilux_solver::Progress| bars.solve(p);
     let outcome = trilux_render::pipeline::run(
@@ -58,12 +57,16 @@ pub fn run(args: &SolveArgs) -> Result<()> {
         },
     );
     bars.finish();
-    let outcome = outcome?;
-    if let Some(path) = &args.stats {
-        write_json(path, &stats_json(&outcome.solve, 0.0))?;
+    let mut outcome = outcome?;
+    let solution = outcome
+        .solution_file
+        .take()
+        .context("the solve produced no solution file")?;
+    let mut files = vec![solution];
+    if args.stats.is_some() {
+        files.push(stats_json(&outcome.solve, None, 0.0)?);
     }
-    for w in &outcome.solve.warnings {
-        eprintln!("warning: {w}");
-    }
+    outputs.write(&files)?;
+    crate::warn(&outcome);
     Ok(())
 }

@@ -48,6 +48,10 @@ pub const FORMAT_VERSION: u32 = 4;
 const HEADER_LEN: usize = 8 + 4 + 8 + 4 + 8 + 8;
 /// The largest statistics block a reader accepts (64 MiB).
 const MAX_STATS_LEN: usize = 1 << 26;
+/// The largest solution file a reader accepts (4 GiB, docs/limits.md): far
+/// beyond what the depth limits let a solve store for any scene that fits
+/// in memory, and a bound on what a file can make the reader allocate.
+pub const MAX_FILE_BYTES: u64 = 4 << 30;
 
 /// The hash of everything a solve depends on: the scene description, the
 /// band count (both in [`PreparedScene::content_hash`]) and the solver
@@ -161,9 +165,9 @@ impl In<'_> {
 }
 
 impl<const N: usize> Solution<N> {
-    /// Writes the solution to `path` (atomically: a temporary file renamed
-    /// into place).
-    pub fn save(&self, path: &Path) -> Result<(), SolverError> {
+    /// The solution file's bytes (module docs), for a caller that writes
+    /// several outputs at once (`trilux_files::write_all`).
+    pub fn to_bytes(&self) -> Result<Vec<u8>, SolverError> {
         let hash = solve_hash(&self.scene, &self.settings)?;
         let payload = self.payload()?;
         let mut out = Out(Vec::with_capacity(HEADER_LEN + payload.len()));
@@ -174,19 +178,15 @@ impl<const N: usize> Solution<N> {
         out.u64(payload.len() as u64);
         out.u64(fnv(&payload));
         out.0.extend_from_slice(&payload);
-        let io = |source| SolverError::Io {
-            path: path.display().to_string(),
-            source,
-        };
-        let tmp = path.with_extension("tmp-trilux");
-        std::fs::write(&tmp, &out.0).map_err(|e| {
-            let _ = std::fs::remove_file(&tmp);
-            io(e)
-        })?;
-        std::fs::rename(&tmp, path).map_err(|e| {
-            let _ = std::fs::remove_file(&tmp);
-            io(e)
-        })
+        Ok(out.0)
+    }
+
+    /// Writes the solution to `path` (a regular file is replaced only once
+    /// the new one is complete; see `trilux_files`).
+    pub fn save(&self, path: &Path) -> Result<(), SolverError> {
+        let bytes = self.to_bytes()?;
+        trilux_files::write_one(path, "solution", &bytes)?;
+        Ok(())
     }
 
     /// The payload bytes (module docs).
@@ -240,20 +240,30 @@ impl<const N: usize> Solution<N> {
         settings: &SolverSettings,
     ) -> Result<Self, SolverError> {
         let shown = path.display().to_string();
-        let bytes = std::fs::read(path).map_err(|source| SolverError::Io {
-            path: shown.clone(),
-            source,
-        })?;
-        let hash = solve_hash(&scene, settings)?;
-        let payload =
-            check_header::<N>(&bytes, hash).map_err(|message| SolverError::SolutionFile {
+        let bytes = trilux_files::read_limited(path, MAX_FILE_BYTES).map_err(|source| {
+            SolverError::Read {
                 path: shown.clone(),
-                message,
-            })?;
-        Self::parse(payload, scene, settings).map_err(|message| SolverError::SolutionFile {
+                source,
+            }
+        })?;
+        Self::from_bytes(&bytes, scene, settings).map_err(|message| SolverError::SolutionFile {
             path: shown,
             message,
         })
+    }
+
+    /// Reads a solution from the bytes of its file; the error says what is
+    /// wrong (the caller names the file). Never panics, and allocates no
+    /// more than the scene's element trees and a small multiple of
+    /// `bytes.len()`, whatever the bytes (module docs).
+    pub fn from_bytes(
+        bytes: &[u8],
+        scene: Arc<PreparedScene<N>>,
+        settings: &SolverSettings,
+    ) -> Result<Self, String> {
+        let hash = solve_hash(&scene, settings).map_err(|e| e.to_string())?;
+        let payload = check_header::<N>(bytes, hash)?;
+        Self::parse(payload, scene, settings)
     }
 
     /// The payload of a verified file (module docs).
@@ -473,7 +483,9 @@ fn read_links<const N: usize>(
         return Err("corrupt gather links (row count)".into());
     }
     let rows = r.count(u64::from(rows), 4, "gather link row")?;
-    let offsets = (0..rows).map(|_| r.u32()).collect::<Result<Vec<_>, Bad>>()?;
+    let offsets = (0..rows)
+        .map(|_| r.u32())
+        .collect::<Result<Vec<_>, Bad>>()?;
     let count = r.u32()?;
     let count = r.count(u64::from(count), LINK_BYTES, "gather link")?;
     let links = (0..count)

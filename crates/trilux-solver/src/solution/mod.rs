@@ -16,7 +16,7 @@ use crate::settings::SolverSettings;
 use crate::solver::Solver;
 use crate::stats::SolveStats;
 
-pub use file::{FORMAT_VERSION, solve_hash};
+pub use file::{FORMAT_VERSION, MAX_FILE_BYTES, solve_hash};
 
 /// A view-independent solution of the scene's light.
 pub struct Solution<const N: usize> {
@@ -148,7 +148,10 @@ impl<const N: usize> Solution<N> {
         e: trilux_geometry::FaceElement,
     ) -> impl Iterator<Item = (&GatherLink, Spectrum<N>)> {
         let row = self.links.row(e);
-        self.links.at(e).iter().zip(self.link_radiance[row].iter().copied())
+        self.links
+            .at(e)
+            .iter()
+            .zip(self.link_radiance[row].iter().copied())
     }
 
     /// All gather links (for statistics and the file).
@@ -199,7 +202,9 @@ impl<const N: usize> Solution<N> {
     /// [`Solution::radiance`]: zero where no hierarchy joins the two faces.
     pub fn stored_radiance(&self, from: &SurfaceSite, to: &SurfaceSite) -> Spectrum<N> {
         match self.by_faces.get(&(from.face, to.face)) {
-            Some(&h) => self.hierarchies[h as usize].radiance_at(&self.forest, from.coord, to.coord),
+            Some(&h) => {
+                self.hierarchies[h as usize].radiance_at(&self.forest, from.coord, to.coord)
+            }
             None => Spectrum::zero(),
         }
     }

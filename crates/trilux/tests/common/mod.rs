@@ -1,4 +1,7 @@
 //! Helpers shared by the binary's integration tests.
+#![allow(dead_code)] // each test binary uses some of them
+
+pub mod hostile;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};

@@ -1,0 +1,77 @@
+//! What a scene file may ask of memory and time (docs/limits.md gives the
+//! reasons). Each limit is far above any scene trilux can solve in
+//! reasonable time, and low enough that a hostile file is refused, with
+//! its location, before it costs more than a few hundred megabytes.
+
+/// Largest scene file (64 MiB): scenes hold no inline geometry, so real
+/// ones are kilobytes; the parsed tree takes several times the text.
+pub const MAX_SCENE_BYTES: u64 = 64 << 20;
+
+/// Largest OBJ file (256 MiB, about 4 million triangles): the mesh in
+/// memory takes several times the text, and the solver's charts and
+/// elements more again.
+pub const MAX_OBJ_BYTES: u64 = 256 << 20;
+
+/// Most triangles of one OBJ mesh (4 million): a file of short lines
+/// (`f 1 2 3`) holds 30 million in [`MAX_OBJ_BYTES`], and every triangle
+/// costs a few hundred bytes once built into charts, elements and the BVH.
+pub const MAX_OBJ_TRIANGLES: usize = 4_000_000;
+
+/// Most vertices of one OBJ mesh (12 million: three per triangle, what
+/// splitting by position, texture and normal index can make).
+pub const MAX_OBJ_VERTICES: usize = 12_000_000;
+
+/// Most XML nodes in a scene file (elements, text and comments).
+pub const MAX_XML_NODES: u32 = 2_000_000;
+
+/// Deepest nesting of elements, `<scene>` counting as 1, also after
+/// `<ref>`s are replaced by what they name. Mitsuba scenes nest about 6
+/// deep (scene, shape, bsdf, bsdf, spectrum); the loader's stages recurse
+/// once per level.
+pub const MAX_DEPTH: usize = 64;
+
+/// Most elements once every `<ref>` is replaced by a copy of what it names
+/// (a chain of BSDFs each referencing the previous one twice doubles at
+/// every step). About 400 MB of expanded tree at the limit.
+pub const MAX_ELEMENTS: usize = 1_000_000;
+
+/// Longest attribute value after its `$name`s are substituted (1 MiB: a
+/// spectrum of ten thousand samples is 150 KB).
+pub const MAX_VALUE_BYTES: usize = 1 << 20;
+
+/// Most bytes that `$name` substitution may produce over the whole file
+/// (16 MiB): `<default>`s that expand into one another grow exponentially.
+pub const MAX_EXPANDED_BYTES: usize = 16 << 20;
+
+/// Longest film edge in pixels (32 768) and most pixels (2^26 = 67 M, e.g.
+/// 8192 × 8192): the render keeps about 60 bytes per pixel (filter sums and
+/// weights, the image, its encoded files), 4 GB at the limit.
+pub const MAX_FILM_EDGE: u32 = 32_768;
+
+/// Most film pixels (see [`MAX_FILM_EDGE`]).
+pub const MAX_FILM_PIXELS: u64 = 1 << 26;
+
+/// Bytes a render keeps per film pixel, about (see [`MAX_FILM_EDGE`]).
+pub const FILM_BYTES_PER_PIXEL: u64 = 60;
+
+/// Refuses a film size outside the limits, saying what the limits are and
+/// what the size would need.
+pub fn check_film(width: u32, height: u32) -> Result<(), String> {
+    if width == 0 || height == 0 {
+        return Err(format!(
+            "film size {width} × {height} must be at least 1 × 1"
+        ));
+    }
+    let pixels = u64::from(width) * u64::from(height);
+    if width > MAX_FILM_EDGE || height > MAX_FILM_EDGE || pixels > MAX_FILM_PIXELS {
+        return Err(format!(
+            "film size {width} × {height} ({pixels} pixels, about {} of memory) is beyond the limits: {MAX_FILM_EDGE} pixels a side and {MAX_FILM_PIXELS} pixels in all (8192 × 8192, about {}) (docs/limits.md)",
+            trilux_files::human_bytes(pixels.saturating_mul(FILM_BYTES_PER_PIXEL)),
+            trilux_files::human_bytes(MAX_FILM_PIXELS * FILM_BYTES_PER_PIXEL),
+        ));
+    }
+    Ok(())
+}
+
+/// Largest emitted radiance (1e20 in any band).
+pub use trilux_color::MAX_RADIANCE;

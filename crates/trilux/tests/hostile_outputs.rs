@@ -1,0 +1,295 @@
+//! Hostile outputs through the binary (issue 14, "data loss and damage"):
+//! a symbolic link stays a link, a FIFO stays a FIFO, an output equal to
+//! an input or to another output is refused before any work, an unrelated
+//! file is never touched by the temporary file, and a failing output
+//! leaves every other one as it was.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test may panic
+
+use std::collections::BTreeMap;
+use std::io::Read;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+mod common;
+use common::hostile::{assert_ok, assert_refused, furnace, mkfifo, s};
+use common::{folder, trilux};
+
+/// The same scene with a mesh that does not exist: any error it gives
+/// shows that the scene was loaded, so an output error instead shows that
+/// outputs are checked first.
+const SCENE_MISSING_MESH: &str = r#"<scene version="3.0.0">
+  <shape type="obj"><string name="filename" value="no-such-mesh.obj"/></shape>
+</scene>
+"#;
+
+/// Every file under `dir` (recursively) with its bytes.
+fn snapshot(dir: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
+    let mut out = BTreeMap::new();
+    for e in std::fs::read_dir(dir).unwrap() {
+        let p = e.unwrap().path();
+        let meta = std::fs::symlink_metadata(&p).unwrap();
+        if meta.is_dir() {
+            out.extend(snapshot(&p));
+        } else if meta.is_file() {
+            out.insert(p.clone(), std::fs::read(&p).unwrap());
+        } else {
+            out.insert(p.clone(), b"(not a regular file)".to_vec());
+        }
+    }
+    out
+}
+
+/// A folder holding the scene, a mesh-less copy and a draft solution.
+fn setup(name: &str) -> (PathBuf, PathBuf) {
+    let dir = folder(name);
+    let scene = dir.join("scene.xml");
+    std::fs::write(&scene, furnace("0.5", "1.0", 1.0)).unwrap();
+    std::fs::write(dir.join("missing-mesh.xml"), SCENE_MISSING_MESH).unwrap();
+    (dir, scene)
+}
+
+fn solve(scene: &Path, sol: &Path) {
+    assert_ok(&trilux(&[
+        "solve",
+        s(scene),
+        "-o",
+        s(sol),
+        "--quality",
+        "draft",
+    ]));
+}
+
+#[test]
+fn a_symbolic_link_output_stays_a_link() {
+    let (dir, scene) = setup("out-symlink");
+    let real = dir.join("real.exr");
+    std::fs::write(&real, "old").unwrap();
+    let link = dir.join("link.exr");
+    std::os::unix::fs::symlink("real.exr", &link).unwrap();
+    assert_ok(&trilux(&[
+        "render",
+        s(&scene),
+        "-o",
+        s(&link),
+        "--quality",
+        "draft",
+    ]));
+    assert!(
+        std::fs::symlink_metadata(&link)
+            .unwrap()
+            .file_type()
+            .is_symlink()
+    );
+    let bytes = std::fs::read(&real).unwrap();
+    assert_eq!(
+        &bytes[..4],
+        &[0x76, 0x2f, 0x31, 0x01],
+        "an EXR behind the link"
+    );
+    // A link to the scene is the scene.
+    let to_scene = dir.join("to-scene.exr");
+    std::os::unix::fs::symlink("scene.xml", &to_scene).unwrap();
+    let before = snapshot(&dir);
+    let out = trilux(&["render", s(&scene), "-o", s(&to_scene)]);
+    assert_refused(&out, "", "would overwrite the input");
+    assert_eq!(snapshot(&dir), before);
+}
+
+#[test]
+fn a_fifo_output_is_written_through() {
+    let (dir, scene) = setup("out-fifo");
+    let fifo = dir.join("pipe.exr");
+    mkfifo(&fifo);
+    let reader = {
+        let fifo = fifo.clone();
+        std::thread::spawn(move || {
+            let mut bytes = Vec::new();
+            std::fs::File::open(&fifo)
+                .unwrap()
+                .read_to_end(&mut bytes)
+                .unwrap();
+            bytes
+        })
+    };
+    let png = dir.join("a.png");
+    let args = ["render", s(&scene), "-o", s(&fifo), "--png", s(&png)];
+    assert_ok(&trilux(&[&args[..], &["--quality", "draft"]].concat()));
+    let bytes = reader.join().unwrap();
+    assert_eq!(
+        &bytes[..4],
+        &[0x76, 0x2f, 0x31, 0x01],
+        "an EXR through the FIFO"
+    );
+    let meta = std::fs::symlink_metadata(&fifo).unwrap();
+    assert!(std::os::unix::fs::FileTypeExt::is_fifo(&meta.file_type()));
+    assert!(png.is_file());
+}
+
+#[test]
+fn an_output_equal_to_an_input_or_another_output_is_refused_first() {
+    let (dir, scene) = setup("out-same");
+    let sol = dir.join("x.sol");
+    solve(&scene, &sol);
+    std::fs::create_dir(dir.join("sub")).unwrap();
+    std::fs::hard_link(&scene, dir.join("hard.xml")).unwrap();
+    let m = dir.join("missing-mesh.xml");
+    let p = |name: &str| dir.join(name).to_string_lossy().into_owned();
+    let cases: Vec<(Vec<String>, &str)> = vec![
+        (
+            vec!["solve".into(), p("scene.xml"), "-o".into(), p("scene.xml")],
+            "would overwrite the input",
+        ),
+        (
+            vec![
+                "solve".into(),
+                p("missing-mesh.xml"),
+                "-o".into(),
+                p("sub/../missing-mesh.xml"),
+            ],
+            "would overwrite the input",
+        ),
+        (
+            vec!["solve".into(), p("scene.xml"), "-o".into(), p("hard.xml")],
+            "would overwrite the input",
+        ),
+        (
+            vec![
+                "solve".into(),
+                s(&m).into(),
+                "-o".into(),
+                p("a.sol"),
+                "--stats".into(),
+                p("a.sol"),
+            ],
+            "the statistics and the solution are the same file",
+        ),
+        (
+            vec![
+                "solve".into(),
+                s(&m).into(),
+                "-o".into(),
+                p("new.sol"),
+                "--stats".into(),
+                p("sub/../new.sol"),
+            ],
+            "are the same file",
+        ),
+        (
+            vec![
+                "render".into(),
+                s(&m).into(),
+                "-o".into(),
+                p("a.exr"),
+                "--png".into(),
+                p("a.exr"),
+            ],
+            "the PNG and the image are the same file",
+        ),
+        (
+            vec![
+                "render".into(),
+                s(&m).into(),
+                "-o".into(),
+                p("a.exr"),
+                "--stats".into(),
+                p("sub/../a.exr"),
+            ],
+            "are the same file",
+        ),
+        (
+            vec![
+                "render".into(),
+                p("scene.xml"),
+                "--solution".into(),
+                p("x.sol"),
+                "-o".into(),
+                p("x.sol"),
+            ],
+            "would overwrite the input",
+        ),
+        (
+            vec!["render".into(), s(&m).into(), "-o".into(), p("sub")],
+            "it is a folder",
+        ),
+        (
+            vec![
+                "render".into(),
+                s(&m).into(),
+                "-o".into(),
+                p("a.exr"),
+                "--stats".into(),
+                p("no/such/folder/s.json"),
+            ],
+            "does not exist",
+        ),
+    ];
+    for (args, what) in cases {
+        let before = snapshot(&dir);
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let out = trilux(&args);
+        assert_refused(&out, "", what);
+        assert!(
+            !String::from_utf8_lossy(&out.stderr).contains("no-such-mesh"),
+            "outputs are checked before the scene is loaded: {args:?}"
+        );
+        assert_eq!(snapshot(&dir), before, "nothing touched: {args:?}");
+    }
+}
+
+#[test]
+fn the_temporary_file_never_replaces_an_unrelated_file() {
+    let (dir, scene) = setup("out-tmp-name");
+    for name in ["keep.tmp-trilux", ".keep.sol.tmp", "keep.sol.tmp"] {
+        std::fs::write(dir.join(name), "unrelated").unwrap();
+    }
+    solve(&scene, &dir.join("keep.sol"));
+    for name in ["keep.tmp-trilux", ".keep.sol.tmp", "keep.sol.tmp"] {
+        assert_eq!(
+            std::fs::read_to_string(dir.join(name)).unwrap(),
+            "unrelated"
+        );
+    }
+    // Nothing else left beside the solution and the scenes.
+    assert_eq!(snapshot(&dir).len(), 6);
+}
+
+#[test]
+fn one_failing_output_leaves_the_others_as_they_were() {
+    let (dir, scene) = setup("out-all-or-none");
+    let exr = dir.join("a.exr");
+    std::fs::write(&exr, "previous image").unwrap();
+    let before = snapshot(&dir);
+    let png = dir.join("a.png");
+    let stats = dir.join("missing").join("a.json");
+    let out = trilux(&[
+        "render",
+        s(&scene),
+        "-o",
+        s(&exr),
+        "--png",
+        s(&png),
+        "--stats",
+        s(&stats),
+    ]);
+    assert_refused(&out, "", "does not exist");
+    assert_eq!(snapshot(&dir), before);
+}
+
+#[test]
+fn the_default_out_folder_is_made_only_when_something_is_written() {
+    let (dir, scene) = setup("out-default");
+    std::fs::copy(&scene, dir.join("sub-scene.xml")).unwrap();
+    let run = |scene: &str| {
+        Command::new(env!("CARGO_BIN_EXE_trilux"))
+            .current_dir(&dir)
+            .args(["render", scene, "--quality", "draft"])
+            .output()
+            .unwrap()
+    };
+    // A failure leaves no out/ behind.
+    let out = run("missing-mesh.xml");
+    assert_refused(&out, "", "the scene has no <sensor>");
+    assert!(!dir.join("out").exists());
+    assert_ok(&run("sub-scene.xml"));
+    assert!(dir.join("out/sub-scene.exr").is_file());
+}
