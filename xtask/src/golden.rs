@@ -12,16 +12,18 @@
 //! Commands:
 //! - `cargo xtask golden compare IMAGE.exr REFERENCE.exr [--mask MASK.exr]`
 //!   prints the metrics of any two EXRs of the same size;
-//! - `cargo xtask golden [--spp N] [--quality Q] [--only NAME]...` solves and
+//! - `cargo xtask golden [--spp N] [--quality Q] [--gather G] [--only NAME]...` solves and
 //!   renders every scene that has a reference, at the reference's size
-//!   (in-process, with the library the `trilux` command uses), and compares,
-//!   failing above [`MAX_REL_RMSE`] or outside [`MAX_MEAN_BIAS`].
+//!   (in-process, with the library the `trilux` command uses) and at the
+//!   scene's own render settings (its sampler's sample count unless
+//!   `--spp`), and compares, failing above [`MAX_REL_RMSE`] or outside
+//!   [`MAX_MEAN_BIAS`].
 
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 use trilux_render::{
-    Comparison, ExtraBounce, Image, Observer, Plan, RenderPlan, RenderSettings, SolutionSource,
+    Comparison, Estimator, Image, Observer, Plan, RenderPlan, RenderSettings, SolutionSource,
     ViewOverrides, compare,
 };
 use trilux_solver::{Quality, SolverSettings};
@@ -92,13 +94,29 @@ pub fn references(only: &[String]) -> Result<Vec<Reference>> {
     Ok(out)
 }
 
-/// One trilux run: solve plus render of `scenes/NAME.xml` at the given
-/// size, quality preset and samples per pixel, in-process through
+/// What one trilux run of `scenes/NAME.xml` does, in-process through
 /// `trilux_render::pipeline::run` (the same code the command runs).
+pub struct TriluxSpec<'a> {
+    /// Scene name (file stem in scenes/).
+    pub name: &'a str,
+    /// Film size (the reference's).
+    pub size: (u32, u32),
+    /// Quality preset of the solve.
+    pub quality: Quality,
+    /// Solve, or load a saved solution.
+    pub source: SolutionSource<'a>,
+    /// Save the solution there.
+    pub save: Option<&'a Path>,
+    /// Render with these changes to the scene's render settings (`None`:
+    /// no render).
+    pub render: Option<&'a dyn Fn(&mut RenderSettings)>,
+}
+
+/// What a trilux run gave.
 pub struct TriluxRun {
-    /// The rendered image.
-    pub image: Image,
-    /// Seconds of the solve, preparing the scene included.
+    /// The rendered image (when the spec renders).
+    pub image: Option<Image>,
+    /// Seconds of preparing the scene plus solving or loading.
     pub solve_seconds: f64,
     /// Seconds of the render.
     pub render_seconds: f64,
@@ -106,49 +124,55 @@ pub struct TriluxRun {
     pub convergence_ratio: f64,
 }
 
-/// Solves and renders `scenes/NAME.xml` (see [`TriluxRun`]).
-pub fn render_trilux(
-    name: &str,
-    width: u32,
-    height: u32,
-    quality: &str,
-    spp: u32,
-    extra: ExtraBounce,
-) -> Result<TriluxRun> {
-    let path = root().join(format!("scenes/{name}.xml"));
+/// Runs `spec` (see [`TriluxSpec`]).
+pub fn run_trilux(spec: &TriluxSpec<'_>) -> Result<TriluxRun> {
+    let path = root().join(format!("scenes/{}.xml", spec.name));
     let scene = trilux_scene::load(&path).map_err(|e| anyhow::anyhow!("{e}"))?;
-    let quality = match quality {
+    let camera = scene.camera.as_ref().context("the scene has no camera")?;
+    let render = spec.render.map(|tweak| {
+        let mut settings = RenderSettings::for_scene(camera);
+        tweak(&mut settings);
+        let view = ViewOverrides {
+            width: Some(spec.size.0),
+            height: Some(spec.size.1),
+            ..Default::default()
+        };
+        RenderPlan { view, settings }
+    });
+    let plan = Plan {
+        mode: scene.mode(),
+        solver: SolverSettings::preset(spec.quality),
+        source: spec.source,
+        save: spec.save,
+        solution_file: false,
+        render,
+    };
+    let outcome = Observer::quiet(|o| trilux_render::pipeline::run(&scene, &plan, o))?;
+    Ok(TriluxRun {
+        image: outcome.image,
+        solve_seconds: outcome.prepare_seconds + outcome.solve_seconds,
+        render_seconds: outcome.render_seconds,
+        convergence_ratio: outcome.solve.convergence_ratio,
+    })
+}
+
+/// An estimator by name.
+pub fn estimator(name: &str) -> Result<Estimator> {
+    Ok(match name {
+        "links" => Estimator::Links,
+        "paths" => Estimator::Paths,
+        "preview" => Estimator::Preview,
+        other => bail!("unknown estimator {other} (links, paths, preview)"),
+    })
+}
+
+/// A quality preset by name.
+pub fn quality(name: &str) -> Result<Quality> {
+    Ok(match name {
         "draft" => Quality::Draft,
         "default" => Quality::Default,
         "high" => Quality::High,
         other => bail!("unknown quality {other}"),
-    };
-    let camera = scene.camera.as_ref().context("the scene has no camera")?;
-    let settings = RenderSettings {
-        spp,
-        seed: 0,
-        extra_bounce: extra,
-        ..RenderSettings::for_scene(camera)
-    };
-    let view = ViewOverrides {
-        width: Some(width),
-        height: Some(height),
-        ..Default::default()
-    };
-    let plan = Plan {
-        mode: scene.mode(),
-        solver: SolverSettings::preset(quality),
-        source: SolutionSource::Solve,
-        save: None,
-        solution_file: false,
-        render: Some(RenderPlan { view, settings }),
-    };
-    let outcome = Observer::quiet(|o| trilux_render::pipeline::run(&scene, &plan, o))?;
-    Ok(TriluxRun {
-        image: outcome.image.context("the plan renders")?,
-        solve_seconds: outcome.prepare_seconds + outcome.solve_seconds,
-        render_seconds: outcome.render_seconds,
-        convergence_ratio: outcome.solve.convergence_ratio,
     })
 }
 
@@ -180,29 +204,40 @@ pub fn main(args: &[String]) -> Result<()> {
         print(image, &c);
         return Ok(());
     }
-    let mut spp = 64u32;
-    let mut quality = "default".to_string();
+    let mut spp = None;
+    let mut gather = None;
+    let mut quality_name = "default".to_string();
     let mut only = Vec::new();
     let mut it = args.iter();
     while let Some(a) = it.next() {
         match a.as_str() {
-            "--spp" => spp = it.next().context("--spp needs a value")?.parse()?,
-            "--quality" => quality = it.next().context("--quality needs a value")?.clone(),
+            "--spp" => spp = Some(it.next().context("--spp needs a value")?.parse()?),
+            "--quality" => quality_name = it.next().context("--quality needs a value")?.clone(),
             "--only" => only.push(it.next().context("--only needs a scene name")?.clone()),
+            "--gather" => gather = Some(estimator(it.next().context("--gather needs a name")?)?),
             other => bail!("unknown argument {other}"),
         }
     }
     let mut failed = Vec::new();
     for r in references(&only)? {
-        let run = render_trilux(
-            &r.name,
-            r.image.width(),
-            r.image.height(),
-            &quality,
-            spp,
-            ExtraBounce::default(),
-        )?;
-        let c = compare(&run.image, &r.image, r.mask.as_ref())?;
+        let spec = TriluxSpec {
+            name: &r.name,
+            size: (r.image.width(), r.image.height()),
+            quality: quality(&quality_name)?,
+            source: SolutionSource::Solve,
+            save: None,
+            render: Some(&|s: &mut RenderSettings| {
+                if let Some(spp) = spp {
+                    s.spp = spp;
+                }
+                if let Some(g) = gather {
+                    s.estimator = g;
+                }
+            }),
+        };
+        let run = run_trilux(&spec)?;
+        let image = run.image.context("the run renders")?;
+        let c = compare(&image, &r.image, r.mask.as_ref())?;
         print(&r.name, &c);
         println!(
             "{:<20} solve {:.2} s (CR {:.4}), render {:.2} s, reference noise {:?}",

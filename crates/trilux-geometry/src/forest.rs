@@ -323,6 +323,47 @@ impl ElementForest {
         }
     }
 
+    /// The corners of a parametric element in the order (min.u, min.v),
+    /// (max.u, min.v), (min.u, max.v), (max.u, max.v), each with its front
+    /// unit normal, so that a smooth quantity sampled there can be
+    /// interpolated bilinearly ([`Self::bilinear_weights`]); `None` for
+    /// mesh clusters, which have no (u, v) domain.
+    pub fn element_corners(&self, id: ElementId) -> Option<[(DVec3, DVec3); 4]> {
+        let e = &self.elements[id.index()];
+        match (e.domain, &self.geometry.surface(e.surface).geom) {
+            (ElementDomain::Rect { min, max }, SurfaceGeom::Patch(patch)) => {
+                let corner = |u: f64, v: f64| {
+                    let p = patch.eval(DVec2::new(u, v));
+                    (p.p, p.n)
+                };
+                Some([
+                    corner(min.x, min.y),
+                    corner(max.x, min.y),
+                    corner(min.x, max.y),
+                    corner(max.x, max.y),
+                ])
+            }
+            _ => None,
+        }
+    }
+
+    /// The bilinear weights of the point `coord` over the corners of
+    /// [`Self::element_corners`] (they sum to 1); `None` for clusters and
+    /// for a coordinate of another kind.
+    pub fn bilinear_weights(&self, id: ElementId, coord: SurfaceCoord) -> Option<[f64; 4]> {
+        let e = &self.elements[id.index()];
+        let (ElementDomain::Rect { min, max }, SurfaceCoord::Uv(uv)) = (e.domain, coord) else {
+            return None;
+        };
+        let size = max - min;
+        if size.x <= 0.0 || size.y <= 0.0 {
+            return None;
+        }
+        let st = ((uv - min) / size).clamp(DVec2::ZERO, DVec2::ONE);
+        let (s, t) = (st.x, st.y);
+        Some([(1.0 - s) * (1.0 - t), s * (1.0 - t), (1.0 - s) * t, s * t])
+    }
+
     /// Samples a point of element `id` from `u` ∈ [0,1)², with its exact
     /// area density ([`crate::sampling`]).
     pub fn sample_element(&self, id: ElementId, u: DVec2) -> SurfaceSample {

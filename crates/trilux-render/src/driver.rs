@@ -52,9 +52,21 @@ pub struct RenderSettings {
     pub estimator: Estimator,
     /// When the path gather continues one bounce ([`ExtraBounce`]).
     pub extra_bounce: ExtraBounce,
+    /// Adaptive sampling: a pixel stops once the standard error of its mean
+    /// luminance is below this fraction of the mean (of a floor, for dark
+    /// pixels), after [`MIN_ADAPTIVE_SPP`] samples; `spp` stays the most.
+    /// `None`: every pixel takes `spp`.
+    pub target_error: Option<f64>,
     /// Tile edge in pixels.
     pub tile_size: u32,
 }
+
+/// Samples every pixel takes before adaptive sampling may stop it.
+pub const MIN_ADAPTIVE_SPP: u32 = 4;
+
+/// Dark pixels are held to the target against this fraction of the
+/// image's mean luminance (a pilot estimate) rather than their own mean.
+const DARK_FLOOR: f64 = 0.05;
 
 impl Default for RenderSettings {
     fn default() -> Self {
@@ -64,6 +76,7 @@ impl Default for RenderSettings {
             filter: ReconstructionFilter::default(),
             estimator: Estimator::default(),
             extra_bounce: ExtraBounce::default(),
+            target_error: None,
             tile_size: 16,
         }
     }
@@ -90,6 +103,13 @@ impl RenderSettings {
         if self.tile_size == 0 {
             return Err(RenderError::Settings("tile size must be at least 1".into()));
         }
+        if let Some(t) = self.target_error
+            && !(t.is_finite() && t > 0.0)
+        {
+            return Err(RenderError::Settings(format!(
+                "target error {t} must be finite and positive"
+            )));
+        }
         if let ExtraBounce::Auto { close_factor } = self.extra_bounce
             && !(close_factor.is_finite() && close_factor >= 0.0)
         {
@@ -98,6 +118,79 @@ impl RenderSettings {
             )));
         }
         Ok(())
+    }
+}
+
+/// The three estimators over one scene, chosen by the settings.
+struct Estimators<'a, S> {
+    estimator: Estimator,
+    paths: FinalGather<'a, S>,
+    links: LinkGather<'a, S>,
+    preview: Preview<'a, S>,
+}
+
+impl<'a, S> Estimators<'a, S> {
+    fn new<const N: usize>(scene: &'a S, settings: &RenderSettings) -> Self
+    where
+        S: GatherScene<N>,
+    {
+        let paths = || FinalGather {
+            scene,
+            extra: settings.extra_bounce,
+        };
+        Estimators {
+            estimator: settings.estimator,
+            paths: paths(),
+            links: LinkGather {
+                scene,
+                fallback: paths(),
+                glossy_scene: scene.has_glossy_faces(),
+            },
+            preview: Preview { scene },
+        }
+    }
+
+    /// One camera sample through film position `film_pos`.
+    fn sample<const N: usize>(
+        &self,
+        camera: &Camera,
+        film_pos: DVec2,
+        sampler: &PixelSampler,
+        caches: &mut Caches<N>,
+        stats: &mut GatherStats,
+    ) -> [f64; N]
+    where
+        S: GatherScene<N>,
+    {
+        let ray = camera.ray(film_pos);
+        let (o, d) = (ray.origin, ray.dir);
+        match self.estimator {
+            Estimator::Links => self.links.camera_sample::<N>(o, d, sampler, caches, stats),
+            Estimator::Paths => self.paths.camera_sample::<N>(o, d, sampler, stats),
+            Estimator::Preview => self.preview.camera_sample::<N>(o, d, caches, stats),
+        }
+    }
+}
+
+/// When a pixel has enough samples.
+#[derive(Clone, Copy, Debug)]
+struct StopRule {
+    spp: u32,
+    /// (target relative error, absolute floor of the mean) when adaptive.
+    adaptive: Option<(f64, f64)>,
+}
+
+impl StopRule {
+    /// True after `n` samples of mean `m` and sample variance `v` (of the
+    /// luminance).
+    fn done(&self, n: u32, m: f64, v: f64) -> bool {
+        match self.adaptive {
+            _ if n >= self.spp => true,
+            Some((target, floor)) if n >= MIN_ADAPTIVE_SPP => {
+                (v / f64::from(n)).sqrt() <= target * m.max(floor)
+            }
+            _ => false,
+        }
     }
 }
 
@@ -118,82 +211,42 @@ where
     let start = Instant::now();
     let (w, h) = (camera.width(), camera.height());
     let ts = settings.tile_size;
-    let tiles_x = w.div_ceil(ts);
-    let tiles_y = h.div_ceil(ts);
+    let (tiles_x, tiles_y) = (w.div_ceil(ts), h.div_ceil(ts));
     let total = (tiles_x * tiles_y) as usize;
-    let border = settings.filter.radius().ceil() as i64;
     let done = AtomicUsize::new(0);
-    let paths = FinalGather {
-        scene,
-        extra: settings.extra_bounce,
-    };
-    let links = LinkGather {
-        scene,
-        fallback: FinalGather {
-            scene,
-            extra: settings.extra_bounce,
-        },
-        glossy_scene: scene.has_glossy_faces(),
-    };
-    let preview = Preview { scene };
-    let sample = |origin,
-                  dir,
-                  sampler: &PixelSampler,
-                  caches: &mut Caches<N>,
-                  stats: &mut GatherStats|
-     -> [f64; N] {
-        match settings.estimator {
-            Estimator::Links => links.camera_sample::<N>(origin, dir, sampler, caches, stats),
-            Estimator::Paths => paths.camera_sample::<N>(origin, dir, sampler, stats),
-            Estimator::Preview => preview.camera_sample::<N>(origin, dir, caches, stats),
-        }
-    };
+    let estimators = Estimators::new::<N>(scene, settings);
     // Each dimension layout must fit the sequence (three gather levels and
     // the link gather's rays).
     const { assert!(dims::LINKS + 8 <= 256) };
     // The whole film first: a film too large for memory fails before work.
     let mut image = Film::new(0, 0, w as usize, h as usize, settings.filter)?;
-
+    let mut stats = RenderStats::default();
+    let rule = StopRule {
+        spp: settings.spp,
+        adaptive: settings.target_error.map(|t| {
+            let (mean, pilot) = pilot_mean(&estimators, camera, settings.seed, &to_rgb);
+            stats.gather.add(&pilot);
+            (t, DARK_FLOOR * mean)
+        }),
+    };
     let tiles: Vec<Result<(Film, GatherStats), RenderError>> = (0..total)
         .into_par_iter()
         .map(|t| {
             let tx = (t as u32 % tiles_x) * ts;
             let ty = (t as u32 / tiles_x) * ts;
-            let tw = ts.min(w - tx);
-            let th = ts.min(h - ty);
-            let mut film = Film::new(
-                tx as i64 - border,
-                ty as i64 - border,
-                (tw as i64 + 2 * border) as usize,
-                (th as i64 + 2 * border) as usize,
-                settings.filter,
-            )?;
-            let mut stats = GatherStats::default();
-            let mut caches = Caches::<N>::default();
-            for y in ty..ty + th {
-                for x in tx..tx + tw {
-                    caches.pixel.clear();
-                    let mut sampler = PixelSampler::new(settings.seed, x, y);
-                    for s in 0..settings.spp {
-                        sampler.start_sample(s);
-                        let film_pos = DVec2::new(x as f64, y as f64) + sampler.get2(dims::FILM);
-                        let ray = camera.ray(film_pos);
-                        let l = sample(ray.origin, ray.dir, &sampler, &mut caches, &mut stats);
-                        let rgb = to_rgb(&l);
-                        if rgb.iter().all(|v| v.is_finite()) {
-                            film.splat(film_pos.x, film_pos.y, rgb);
-                        } else {
-                            stats.dropped += 1;
-                        }
-                    }
-                }
-            }
+            let tile = (tx, ty, ts.min(w - tx), ts.min(h - ty));
+            let job = TileJob {
+                estimators: &estimators,
+                camera,
+                settings,
+                rule,
+                to_rgb: &to_rgb,
+            };
+            let out = job.render(tile);
             progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);
-            Ok((film, stats))
+            out
         })
         .collect();
-
-    let mut stats = RenderStats::default();
     for tile in tiles {
         let (film, s) = tile?;
         image.merge(&film);
@@ -201,6 +254,128 @@ where
     }
     stats.seconds = start.elapsed().as_secs_f64();
     Ok((image.develop(), stats))
+}
+
+/// The image's mean luminance from a 32 × 32 pilot at one sample a pixel
+/// (the floor adaptive sampling holds dark pixels to), with what the
+/// pilot traced.
+fn pilot_mean<S: GatherScene<N>, const N: usize>(
+    estimators: &Estimators<'_, S>,
+    camera: &Camera,
+    seed: u32,
+    to_rgb: &(impl Fn(&[f64; N]) -> [f64; 3] + Sync),
+) -> (f64, GatherStats) {
+    const P: u32 = 32;
+    let (w, h) = (f64::from(camera.width()), f64::from(camera.height()));
+    // Collected, then summed in order: the floor is the same bit for bit
+    // whatever the number of threads.
+    let samples: Vec<(f64, GatherStats)> = (0..P * P)
+        .into_par_iter()
+        .map(|k| {
+            let (i, j) = (k % P, k / P);
+            let sampler = PixelSampler::new(seed ^ 0x5eed, i, j);
+            let pos = DVec2::new(
+                (f64::from(i) + 0.5) * w / f64::from(P),
+                (f64::from(j) + 0.5) * h / f64::from(P),
+            );
+            let mut caches = Caches::<N>::default();
+            let mut stats = GatherStats::default();
+            let l = estimators.sample(camera, pos, &sampler, &mut caches, &mut stats);
+            (luminance(to_rgb(&l)), stats)
+        })
+        .collect();
+    let mut stats = GatherStats::default();
+    let mut sum = 0.0;
+    for (y, s) in &samples {
+        sum += y;
+        stats.add(s);
+    }
+    ((sum / f64::from(P * P)).max(0.0), stats)
+}
+
+/// Rec. 709 luminance of linear sRGB (0 for a non-finite value).
+fn luminance(rgb: [f64; 3]) -> f64 {
+    let y = 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2];
+    if y.is_finite() { y } else { 0.0 }
+}
+
+/// What rendering one tile needs.
+struct TileJob<'a, S, F> {
+    estimators: &'a Estimators<'a, S>,
+    camera: &'a Camera,
+    settings: &'a RenderSettings,
+    rule: StopRule,
+    to_rgb: &'a F,
+}
+
+impl<S, F> TileJob<'_, S, F> {
+    /// The tile (x, y, width, height) into its own film, with a border of
+    /// the filter's radius.
+    fn render<const N: usize>(
+        &self,
+        (tx, ty, tw, th): (u32, u32, u32, u32),
+    ) -> Result<(Film, GatherStats), RenderError>
+    where
+        S: GatherScene<N>,
+        F: Fn(&[f64; N]) -> [f64; 3] + Sync,
+    {
+        let border = self.settings.filter.radius().ceil() as i64;
+        let mut film = Film::new(
+            tx as i64 - border,
+            ty as i64 - border,
+            (tw as i64 + 2 * border) as usize,
+            (th as i64 + 2 * border) as usize,
+            self.settings.filter,
+        )?;
+        let mut stats = GatherStats::default();
+        let mut caches = Caches::<N>::default();
+        for y in ty..ty + th {
+            for x in tx..tx + tw {
+                caches.pixel.clear();
+                caches.scratch.clear();
+                self.pixel(x, y, &mut film, &mut caches, &mut stats);
+            }
+        }
+        Ok((film, stats))
+    }
+
+    /// One pixel's samples, until the stop rule is met.
+    fn pixel<const N: usize>(
+        &self,
+        x: u32,
+        y: u32,
+        film: &mut Film,
+        caches: &mut Caches<N>,
+        stats: &mut GatherStats,
+    ) where
+        S: GatherScene<N>,
+        F: Fn(&[f64; N]) -> [f64; 3] + Sync,
+    {
+        let mut sampler = PixelSampler::new(self.settings.seed, x, y);
+        let (mut n, mut mean, mut m2) = (0u32, 0.0f64, 0.0f64);
+        while !self
+            .rule
+            .done(n, mean, if n > 1 { m2 / f64::from(n - 1) } else { 0.0 })
+        {
+            sampler.start_sample(n);
+            let film_pos = DVec2::new(x as f64, y as f64) + sampler.get2(dims::FILM);
+            let l = self
+                .estimators
+                .sample(self.camera, film_pos, &sampler, caches, stats);
+            let rgb = (self.to_rgb)(&l);
+            if rgb.iter().all(|v| v.is_finite()) {
+                film.splat(film_pos.x, film_pos.y, rgb);
+            } else {
+                stats.dropped += 1;
+            }
+            // Welford's running mean and variance of the luminance.
+            n += 1;
+            let y_l = luminance(rgb);
+            let delta = y_l - mean;
+            mean += delta / f64::from(n);
+            m2 += delta * (y_l - mean);
+        }
+    }
 }
 
 /// Renders the scene of `solution` through `camera` with `settings`.

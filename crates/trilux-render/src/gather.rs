@@ -197,6 +197,23 @@ pub trait GatherScene<const N: usize>: Sync {
         None
     }
 
+    /// Where the gather hit `at` (seen from `wo`) lies in one of
+    /// `coarse_near`, the senders a link sum took at their average close to
+    /// its point: the Lambertian radiance there from the link sum at `at`
+    /// less the average the links give that sender, so that a cosine ray's
+    /// mean corrects the average (`link_gather`, near-field correction).
+    /// `None` elsewhere.
+    fn near_correction(
+        &self,
+        _at: &SurfacePoint<Self::Locator>,
+        _wo: DVec3,
+        _coarse_near: &[trilux_geometry::FaceElement],
+        _cache: &mut crate::link_sum::LinkCache<N>,
+        _stats: &mut GatherStats,
+    ) -> Option<[f64; N]> {
+        None
+    }
+
     /// True when the BSDF at `at` has a glossy part on the side of `wo`.
     fn is_glossy(&self, _at: &SurfacePoint<Self::Locator>, _wo: DVec3) -> bool {
         false
@@ -276,6 +293,8 @@ pub struct GatherStats {
     pub dropped: u64,
     /// Senders of gather links evaluated (point form factors).
     pub link_senders: u64,
+    /// Cosine rays that corrected a near sender's average.
+    pub near_corrections: u64,
 }
 
 impl GatherStats {
@@ -287,6 +306,7 @@ impl GatherStats {
         self.extra_bounces += o.extra_bounces;
         self.dropped += o.dropped;
         self.link_senders += o.link_senders;
+        self.near_corrections += o.near_corrections;
     }
 }
 

@@ -47,6 +47,10 @@ use crate::sampler::{PixelSampler, dims};
 pub enum LinkVisibility<'a> {
     /// The visible fraction the solve measured for each link.
     Cached,
+    /// As `Cached`, and near senders taken at their link's level without
+    /// the near field's cut: for gather hits, whose error reaches the eye
+    /// weighted by a reflection.
+    Secondary,
     /// Shadow rays from the point to samples of each partly visible
     /// sender, drawn from `sampler` from dimension `dim` on.
     Traced {
@@ -125,7 +129,7 @@ impl<S> LinkGather<'_, S> {
             };
             match scene.solution_irradiance(&xs, wo, visibility, &mut w.caches.pixel, w.stats) {
                 Some(e) => {
-                    let e = bands::add(e, self.glossy_senders(&xs, wo, 0, &mut w));
+                    let e = bands::add(e, self.cosine_ray(&xs, wo, 0, &mut w));
                     l = bands::add(l, bands::mul(rho, e));
                 }
                 // No links here: the path gather serves the whole BSDF.
@@ -141,11 +145,13 @@ impl<S> LinkGather<'_, S> {
         finite_or_dropped(l, w.stats)
     }
 
-    /// E_g at a Lambertian `x` at gather `level`: the glossy radiance that
-    /// one cosine-sampled ray brings (module docs), so that ρ_d E_g
-    /// estimates its reflection. Estimated one level deeper from the camera
-    /// hit, read from the solution's stored radiance from a gather hit.
-    fn glossy_senders<const N: usize>(
+    /// The cosine ray's share of the irradiance at a Lambertian `x` at
+    /// gather `level` (module docs): E_g, the glossy radiance it brings,
+    /// and at the camera hit the near-field correction where it meets a
+    /// sender the link sum took at its average. Estimated one level deeper
+    /// from the camera hit, read from the solution's stored radiance from a
+    /// gather hit. Not traced when neither is needed.
+    fn cosine_ray<const N: usize>(
         &self,
         x: &SurfacePoint<S::Locator>,
         wo: DVec3,
@@ -155,7 +161,8 @@ impl<S> LinkGather<'_, S> {
     where
         S: GatherScene<N>,
     {
-        if !self.glossy_scene {
+        let correct = level == 0 && !w.caches.pixel.coarse_near().is_empty();
+        if !self.glossy_scene && !correct {
             return bands::zero();
         }
         let scene = self.scene;
@@ -168,15 +175,25 @@ impl<S> LinkGather<'_, S> {
             return bands::zero();
         };
         let back = -wi;
-        if !scene.is_glossy(&xd, back) {
-            return bands::zero();
-        }
         // With density cos θ/π the estimate of (1/π) ∫ L cos dω is L.
-        if level == 0 {
-            self.glossy(&xd, back, 1, w)
-        } else {
-            scene.reflected_glossy(&xd, x)
+        let mut e = bands::zero();
+        if correct {
+            let Caches { pixel, scratch } = &mut *w.caches;
+            let near = pixel.coarse_near();
+            if let Some(c) = scene.near_correction(&xd, back, near, scratch, w.stats) {
+                w.stats.near_corrections += 1;
+                e = c;
+            }
         }
+        if self.glossy_scene && scene.is_glossy(&xd, back) {
+            let g = if level == 0 {
+                self.glossy(&xd, back, 1, w)
+            } else {
+                scene.reflected_glossy(&xd, x)
+            };
+            e = bands::add(e, g);
+        }
+        e
     }
 
     /// The glossy part of the reflected radiance at `x` towards `wo`, at
@@ -252,7 +269,7 @@ impl<S> LinkGather<'_, S> {
         };
         let rho = scene.diffuse_albedo(xd, towards);
         if !bands::is_black(&rho) {
-            let e_g = self.glossy_senders(xd, towards, level, w);
+            let e_g = self.cosine_ray(xd, towards, level, w);
             lambertian = bands::add(lambertian, bands::mul(rho, e_g));
         }
         let glossy = if scene.is_glossy(xd, towards) {
@@ -328,9 +345,8 @@ fn lambertian_at<S: GatherScene<N>, const N: usize>(
     if bands::is_black(&rho) {
         return Some(bands::zero());
     }
-    scratch.clear();
     scene
-        .solution_irradiance(xd, towards, LinkVisibility::Cached, scratch, stats)
+        .solution_irradiance(xd, towards, LinkVisibility::Secondary, scratch, stats)
         .map(|e| bands::mul(rho, e))
 }
 

@@ -136,8 +136,8 @@ pub struct SolvedScene<'a, const N: usize, S> {
     emitters: Vec<(SurfaceId, f64)>,
     /// Pick probability / area, by surface index (0 when not emitting).
     light_density: Vec<f64>,
-    /// Every element's shape for point form factors (the link sums).
-    ff: trilux_geometry::PointFormFactors,
+    /// The link sums' point form factors and leaf links.
+    links: crate::link_sum::LinkField<N>,
     /// Some material has a glossy part on some side.
     glossy_faces: bool,
 }
@@ -176,12 +176,13 @@ impl<'a, const N: usize, S: RadianceSolution<N>> SolvedScene<'a, N, S> {
         if let Some(last) = emitters.last_mut() {
             last.1 = 1.0;
         }
-        let ff = if solution.has_links() {
-            trilux_geometry::PointFormFactors::new(solution.forest())
+        let links = if solution.has_links() {
+            let forest = solution.forest();
+            let ff = trilux_geometry::PointFormFactors::new(forest);
+            crate::link_sum::LinkField::new(ff, forest.element_count())
         } else {
-            trilux_geometry::PointFormFactors::new(&ElementForest::new(Arc::clone(
-                scene.geometry(),
-            )))
+            let forest = ElementForest::new(Arc::clone(scene.geometry()));
+            crate::link_sum::LinkField::new(trilux_geometry::PointFormFactors::new(&forest), 0)
         };
         let glossy_faces = scene
             .materials()
@@ -193,7 +194,7 @@ impl<'a, const N: usize, S: RadianceSolution<N>> SolvedScene<'a, N, S> {
             lobe_sr,
             emitters,
             light_density,
-            ff,
+            links,
             glossy_faces,
         }
     }
@@ -356,6 +357,7 @@ impl<const N: usize, S: RadianceSolution<N>> GatherScene<N> for SolvedScene<'_, 
         let receiver = crate::link_sum::Receiver {
             x: at.point,
             n: at.locator.shading_normal * side.sign(),
+            coord: at.locator.coord,
             leaf: FaceElement::new(
                 self.solution
                     .forest()
@@ -363,9 +365,59 @@ impl<const N: usize, S: RadianceSolution<N>> GatherScene<N> for SolvedScene<'_, 
                 side,
             ),
         };
-        let sum =
-            crate::link_sum::link_sum(self.solution, &self.ff, &receiver, visibility, cache, stats);
+        let sum = crate::link_sum::link_sum(
+            self.solution,
+            &self.links,
+            &receiver,
+            visibility,
+            cache,
+            stats,
+        );
         Some(sum.0)
+    }
+
+    fn near_correction(
+        &self,
+        at: &SurfacePoint<HitLocator>,
+        wo: DVec3,
+        coarse_near: &[FaceElement],
+        cache: &mut crate::link_sum::LinkCache<N>,
+        stats: &mut GatherStats,
+    ) -> Option<[f64; N]> {
+        let side = viewer_side(at, wo);
+        let forest = self.solution.forest();
+        let leaf = forest.locate(at.locator.surface, at.locator.coord);
+        let mut e = Some(leaf);
+        let sender = loop {
+            let c = e?;
+            if coarse_near.contains(&FaceElement::new(c, side)) {
+                break c;
+            }
+            e = forest.element(c).parent;
+        };
+        let rho = self.bsdf(at).diffuse_albedo(side);
+        let receiver = crate::link_sum::Receiver {
+            x: at.point,
+            n: at.locator.shading_normal * side.sign(),
+            coord: at.locator.coord,
+            leaf: FaceElement::new(leaf, side),
+        };
+        let visibility = LinkVisibility::Secondary;
+        let sum = crate::link_sum::link_sum(
+            self.solution,
+            &self.links,
+            &receiver,
+            visibility,
+            cache,
+            stats,
+        );
+        let face = FaceId::new(at.locator.surface, side);
+        let le = match side {
+            Side::Front => self.scene.emission()[at.locator.shape as usize],
+            Side::Back => Spectrum::zero(),
+        };
+        let average = self.solution.face_radiance(face, sender) - le;
+        Some((rho * sum - average).0)
     }
 
     fn is_glossy(&self, at: &SurfacePoint<HitLocator>, wo: DVec3) -> bool {

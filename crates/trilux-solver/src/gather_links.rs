@@ -142,12 +142,7 @@ impl GatherLinks {
 impl<const N: usize> Solver<N> {
     /// The gather links of the converged solution (module docs).
     pub(crate) fn gather_links(&self) -> GatherLinks {
-        let mut ctx = self.refine_context();
-        let eps: f64 = std::env::var("TRILUX_LINK_FLUX_EPS")
-            .ok()
-            .and_then(|v| v.parse().ok())
-            .unwrap_or(self.settings.flux_eps);
-        ctx.flux_threshold = eps * self.emitted.sum();
+        let ctx = self.refine_context();
         let faces: Vec<(FaceId, &TransportFace<N>)> = self
             .faces
             .iter()
@@ -188,6 +183,10 @@ fn links<const N: usize>(
             si: send_face,
             sj: r,
         };
+        // The renderer evaluates the point form factor at every pixel, so
+        // the receiver-side form-factor spread does not matter here:
+        // refinement only separates partial visibility and uneven sender
+        // radiance (an unbounded spread budget).
         ctx.refine_pair(shot, i, j, f64::INFINITY, &mut out);
     }
     out.into_iter()

@@ -114,6 +114,18 @@ pub fn parse_spp(text: &str) -> Result<u32, String> {
     )
 }
 
+/// A relative error target in (0, 1).
+pub fn parse_target_error(text: &str) -> Result<f64, String> {
+    let v: f64 = text
+        .parse()
+        .map_err(|_| format!("{} is not a number", quoted(text)))?;
+    if v.is_finite() && v > 0.0 && v < 1.0 {
+        Ok(v)
+    } else {
+        Err(format!("{v} is not in (0, 1)"))
+    }
+}
+
 /// A field of view in (0, 180) degrees.
 pub fn parse_fov(text: &str) -> Result<f64, String> {
     let v: f64 = text

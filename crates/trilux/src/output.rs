@@ -122,6 +122,10 @@ pub fn stats_json(
                 "dropped_samples".into(),
                 serde_json::json!(r.gather.dropped),
             );
+            map.insert(
+                "camera_samples".into(),
+                serde_json::json!(r.gather.camera_rays),
+            );
         }
     }
     Ok(serde_json::to_vec_pretty(&value)?)

@@ -6,11 +6,13 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
 use trilux_render::{
-    ExtraBounce, Observer, Plan, RenderPlan, RenderSettings, SolutionSource, ViewOverrides,
+    Estimator, ExtraBounce, Observer, Plan, RenderPlan, RenderSettings, SolutionSource,
+    ViewOverrides,
 };
 
 use crate::options::{
-    LookAt, SolveOptions, parse_film_edge, parse_fov, parse_lookat, parse_spp, parse_threads,
+    LookAt, SolveOptions, parse_film_edge, parse_fov, parse_lookat, parse_spp, parse_target_error,
+    parse_threads,
 };
 use crate::output::{Outputs, stats_json};
 use crate::progress::Bars;
@@ -25,6 +27,17 @@ pub enum ExtraBounceArg {
     Auto,
     /// Nowhere: the paper's §4.5.
     Never,
+}
+
+/// How a camera sample reads the solution.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum GatherArg {
+    /// A light sample and a BSDF-sampled gather ray at the first hit, the
+    /// solution read where the gather ray lands (paper §4.5).
+    Paths,
+    /// The solution's gather links re-evaluated at every pixel for
+    /// Lambertian parts, sampled rays for glossy parts (docs/rendering.md).
+    Links,
 }
 
 /// Arguments of `trilux render`.
@@ -68,7 +81,19 @@ pub struct RenderArgs {
     /// Field of view in degrees along the scene's fov_axis.
     #[arg(long, allow_hyphen_values = true, value_parser = parse_fov)]
     pub fov: Option<f64>,
-    /// Where the gather continues one bounce before reading the solution.
+    /// How a camera sample reads the solution.
+    #[arg(long, value_enum, default_value = "paths")]
+    pub gather: GatherArg,
+    /// A noise-free preview for walkthroughs: the solution with its links'
+    /// own visibility, no random rays (one sample a pixel unless --spp).
+    #[arg(long, conflicts_with_all = ["gather", "target_error"])]
+    pub preview: bool,
+    /// Adaptive sampling: a pixel stops once its estimated relative error
+    /// is below this (e.g. 0.02); --spp is then the most a pixel takes.
+    #[arg(long, value_parser = parse_target_error)]
+    pub target_error: Option<f64>,
+    /// Where the path gather continues one bounce before reading the
+    /// solution (--gather paths).
     #[arg(long, value_enum, default_value = "always")]
     pub extra_bounce: ExtraBounceArg,
     #[command(flatten)]
@@ -102,8 +127,16 @@ impl RenderArgs {
     /// Samples, seed, filter and extra-bounce rule of this render.
     fn render_plan(&self, camera: &trilux_scene::Camera) -> RenderPlan {
         let mut settings = RenderSettings::for_scene(camera);
-        settings.spp = self.spp.unwrap_or(settings.spp);
+        settings.spp = self
+            .spp
+            .unwrap_or(if self.preview { 1 } else { settings.spp });
         settings.seed = self.seed;
+        settings.estimator = match (self.preview, self.gather) {
+            (true, _) => Estimator::Preview,
+            (false, GatherArg::Links) => Estimator::Links,
+            (false, GatherArg::Paths) => Estimator::Paths,
+        };
+        settings.target_error = self.target_error;
         settings.extra_bounce = match self.extra_bounce {
             ExtraBounceArg::Always => ExtraBounce::Always,
             ExtraBounceArg::Auto => ExtraBounce::Auto { close_factor: 1.0 },
