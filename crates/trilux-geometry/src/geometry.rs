@@ -108,6 +108,13 @@ impl Geometry {
         self.bvh.len()
     }
 
+    /// Every triangle the ray queries test (mesh triangles and the two
+    /// halves of each planar quad; analytic shapes are not triangles), for
+    /// handing the same geometry to another ray tracer.
+    pub fn primitive_triangles(&self) -> Vec<[DVec3; 3]> {
+        self.bvh.triangles().collect()
+    }
+
     /// The parametric patch of a surface (`None` for mesh charts).
     pub(crate) fn patch(&self, surface: SurfaceId) -> Option<&Patch> {
         match &self.surfaces[surface.index()].geom {

@@ -1,0 +1,446 @@
+//! Ray queries: closest hit and occlusion over the whole scene.
+//!
+//! # Structure
+//!
+//! One wide BVH ([`wide`]) over all primitives: mesh triangles, the two
+//! triangles of every planar quad, and one primitive per disk, sphere and
+//! cylinder. obvhs builds the binary tree (PLOC and reinsertion over the
+//! primitives' boxes, padded by 4·10⁻⁶ × the scene's extent); this module
+//! collapses it into nodes of four children with f32 boxes, and leaves of
+//! up to four primitives stored as one [`Tri4`].
+//!
+//! A query ray is f64 (origin, non-unit direction, t in units of that
+//! direction). It is clipped in f64 to the scene's padded box and
+//! traversed as an f32 ray ([`traverse`]); each leaf is tested four
+//! triangles at once in f32 ([`tri4`]), and only the lanes that test cannot
+//! rule out are tested in f64 ([`triangle`], [`analytic`]), which gives
+//! every hit, t and barycentric coordinate. The f32 stages only ever skip
+//! what the f64 tests would miss, with stated error bounds (in [`traverse`]
+//! and [`tri4`]), so the answers are the f64 tests' own: those of brute
+//! force over every primitive.
+//!
+//! # Robustness
+//!
+//! - **Shared edges.** Triangles (mesh triangles and the halves of quads, so
+//!   also the six faces of a cube, whose corners are shared bit-for-bit)
+//!   use the watertight test of Woop, Benthin and Wald (JCGT 2013) in f64:
+//!   a ray through an edge or vertex hits at least one of the triangles
+//!   that share it.
+//! - **Analytic shapes** are intersected exactly, in object space
+//!   ([`analytic`]).
+//! - **Self-intersection** is the caller's: every query takes the ray
+//!   interval (tmin, tmax), and [`crate::Geometry`] sets tmin from its
+//!   relative epsilon ([`crate::RAY_EPSILON`]); f64 hits keep that epsilon
+//!   valid.
+//!
+//! This module knows primitives only; [`crate::Geometry`] turns a
+//! [`PrimHit`] into a hit on an input surface.
+
+mod analytic;
+mod traverse;
+mod tri4;
+mod triangle;
+mod wide;
+
+pub(crate) use analytic::{Analytic, AnalyticKind};
+
+use glam::{DVec2, DVec3};
+use obvhs::aabb::Aabb;
+use obvhs::bvh2::reinsertion::ReinsertionOptimizer;
+use obvhs::ploc::{PlocBuilder, PlocSearchDistance, SortPrecision};
+
+use crate::bounds::Bounds;
+use traverse::BoxRay;
+use tri4::{Ray4, Tri4};
+use triangle::{RayPre, intersect_triangle};
+use wide::{LEAF_SIZE, WideBvh, leaf_parts};
+
+/// What a triangle primitive belongs to.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum TriOwner {
+    Mesh { mesh: u32, tri: u32 },
+    Quad { surface: u32 },
+}
+
+/// A primitive of the BVH, with the scene shape it belongs to (so that a
+/// query can ignore one shape).
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum Prim {
+    /// A triangle of a mesh or half of a planar quad.
+    Tri {
+        v: [DVec3; 3],
+        owner: TriOwner,
+        shape: u32,
+    },
+    /// A disk, sphere or cylinder: an index into the analytic shapes.
+    Analytic { index: u32, shape: u32 },
+}
+
+impl Prim {
+    pub(crate) fn shape(&self) -> u32 {
+        match *self {
+            Prim::Tri { shape, .. } | Prim::Analytic { shape, .. } => shape,
+        }
+    }
+}
+
+/// Which primitive a closest-hit search found, and where.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct PrimHit {
+    /// Index of the primitive (BVH order).
+    pub prim: usize,
+    /// Ray parameter, in units of the query's direction.
+    pub t: f64,
+    /// Barycentrics (b1, b2) for triangles, zero for analytic shapes.
+    pub bary: DVec2,
+}
+
+/// The BVH and the primitives it holds.
+#[derive(Clone, Debug)]
+pub(crate) struct Bvh {
+    wide: WideBvh,
+    /// Primitives in leaf order.
+    prims: Vec<Prim>,
+    analytic: Vec<Analytic>,
+    /// Box padding: 4e-6 × the scene's extent.
+    pad: f64,
+    /// The scene's box, to which rays are clipped before traversal.
+    bounds: Bounds,
+    /// The scene's largest absolute coordinate.
+    extent: f64,
+    /// Coordinates beyond f32's range: every query tests every primitive.
+    brute: bool,
+}
+
+/// A ray clipped to the scene's box, ready for traversal.
+struct Traversal {
+    ray: BoxRay,
+    /// f64 ray parameter where the f32 ray starts.
+    start: f64,
+    /// |d|: f32 distances are (t − start) · len.
+    len: f64,
+    /// f32 distance where the clipped ray ends.
+    tmax: f32,
+}
+
+impl Traversal {
+    /// The f32 distance of f64 parameter t, rounded up.
+    #[inline(always)]
+    fn distance(&self, t: f64) -> f32 {
+        (((t - self.start) * self.len) as f32).next_up()
+    }
+}
+
+impl Bvh {
+    /// Builds the BVH over `prims` (module docs), with boxes padded by
+    /// 4e-6 × `extent`.
+    pub(crate) fn build(
+        prims: Vec<Prim>,
+        analytic: Vec<Analytic>,
+        bounds: Bounds,
+        extent: f64,
+    ) -> Bvh {
+        let pad = 4e-6 * extent;
+        let boxes: Vec<Aabb> = prims
+            .iter()
+            .map(|p| {
+                let b = match p {
+                    Prim::Tri { v, .. } => Bounds::from_points(*v),
+                    Prim::Analytic { index, .. } => analytic[*index as usize].bounds(),
+                }
+                .padded(pad);
+                Aabb::new(
+                    b.min.to_array().map(round_down).into(),
+                    b.max.to_array().map(round_up).into(),
+                )
+            })
+            .collect();
+        let mut bvh2 = PlocBuilder::with_capacity(boxes.len()).build(
+            PlocSearchDistance::Medium,
+            &boxes,
+            (0..boxes.len() as u32).collect(),
+            SortPrecision::U64,
+            3,
+        );
+        ReinsertionOptimizer::default().run(&mut bvh2, 0.05, None);
+        // PLOC leaves hold one primitive each; anything else (and
+        // coordinates f32 cannot hold) falls back to testing everything.
+        let brute = extent.is_nan()
+            || extent >= 1e30
+            || bvh2
+                .nodes
+                .iter()
+                .any(|n| n.is_leaf() && n.prim_count as usize > LEAF_SIZE);
+        let mut wide = if brute || prims.is_empty() {
+            WideBvh {
+                root: wide::EMPTY,
+                ..Default::default()
+            }
+        } else {
+            WideBvh::collapse(&bvh2, |ids| {
+                let mut lanes = [None; 4];
+                for (lane, &id) in ids.iter().enumerate() {
+                    if let Prim::Tri { v, .. } = prims[id as usize] {
+                        lanes[lane] = Some(v);
+                    }
+                }
+                Tri4::new(lanes)
+            })
+        };
+        let prims = leaf_order(&mut wide, prims);
+        Bvh {
+            wide,
+            prims,
+            analytic,
+            pad,
+            bounds,
+            extent,
+            brute,
+        }
+    }
+
+    /// Number of primitives (triangles and analytic shapes).
+    pub(crate) fn len(&self) -> usize {
+        self.prims.len()
+    }
+
+    /// A primitive, by its index in BVH order.
+    pub(crate) fn prim(&self, id: usize) -> &Prim {
+        &self.prims[id]
+    }
+
+    /// The triangle primitives' vertices.
+    pub(crate) fn triangles(&self) -> impl Iterator<Item = [DVec3; 3]> + '_ {
+        self.prims.iter().filter_map(|p| match p {
+            Prim::Tri { v, .. } => Some(*v),
+            Prim::Analytic { .. } => None,
+        })
+    }
+
+    /// An analytic shape.
+    pub(crate) fn analytic(&self, index: u32) -> &Analytic {
+        &self.analytic[index as usize]
+    }
+
+    #[inline]
+    fn test_prim(&self, prim: &Prim, pre: &RayPre, tmin: f64, tmax: f64) -> Option<(f64, DVec2)> {
+        match prim {
+            Prim::Tri { v, .. } => intersect_triangle(pre, v, tmin, tmax),
+            Prim::Analytic { index, .. } => self.analytic[*index as usize]
+                .intersect(pre.o, pre.d, tmin, tmax)
+                .map(|t| (t, DVec2::ZERO)),
+        }
+    }
+
+    /// Clips a ray to the padded scene box; `None` if it misses the box or
+    /// is not finite.
+    fn traversal(&self, o: DVec3, d: DVec3, tmin: f64, tmax: f64) -> Option<Traversal> {
+        let len = d.length();
+        if len <= 0.0 || !len.is_finite() || !o.is_finite() {
+            return None;
+        }
+        let b = self.bounds.padded(2.0 * self.pad + 1e-300);
+        let inv = 1.0 / d;
+        let t1 = (b.min - o) * inv;
+        let t2 = (b.max - o) * inv;
+        let near = t1.min(t2);
+        let far = t1.max(t2);
+        // NaN (0 × ∞ for a zero direction component on a slab edge) counts
+        // as unbounded.
+        let tn = [near.x, near.y, near.z]
+            .into_iter()
+            .filter(|x| !x.is_nan())
+            .fold(tmin.max(0.0), f64::max);
+        let tf = [far.x, far.y, far.z]
+            .into_iter()
+            .filter(|x| !x.is_nan())
+            .fold(tmax, f64::min);
+        if tn > tf || tn.is_nan() || tf.is_nan() {
+            return None;
+        }
+        let t = Traversal {
+            ray: BoxRay::new(o + tn * d, d / len),
+            start: tn,
+            len,
+            tmax: 0.0,
+        };
+        Some(Traversal {
+            tmax: t.distance(tf),
+            ..t
+        })
+    }
+
+    /// The closest primitive hit in (tmin, tmax), ignoring the primitives of
+    /// shape `skip`.
+    pub(crate) fn closest(
+        &self,
+        o: DVec3,
+        d: DVec3,
+        tmin: f64,
+        tmax: f64,
+        skip: Option<u32>,
+    ) -> Option<PrimHit> {
+        if self.brute {
+            return self.brute_force(o, d, tmin, tmax, skip, false);
+        }
+        let tr = self.traversal(o, d, tmin, tmax)?;
+        let pre = RayPre::new(o, d);
+        let r4 = Ray4::new(&pre, self.extent);
+        let mut best: Option<PrimHit> = None;
+        let mut best_t = tmax;
+        self.wide
+            .traverse::<true>(&tr.ray, tr.tmax, |leaf, tmax32| {
+                let (g, count) = leaf_parts(leaf);
+                let mut m = self.wide.groups[g].candidates(&r4) & ((1 << count) - 1);
+                while m != 0 {
+                    let id = self.wide.ids[g][m.trailing_zeros() as usize];
+                    m &= m - 1;
+                    let prim = &self.prims[id as usize];
+                    if skip == Some(prim.shape()) {
+                        continue;
+                    }
+                    if let Some((t, bary)) = self.test_prim(prim, &pre, tmin, best_t) {
+                        best_t = t;
+                        best = Some(PrimHit {
+                            prim: id as usize,
+                            t,
+                            bary,
+                        });
+                        *tmax32 = tr.distance(t);
+                    }
+                }
+                false
+            });
+        best
+    }
+
+    /// True if any primitive is hit in (tmin, tmax). Tries the primitive in
+    /// `hint` (the last occluder found, for coherent segments) first, and
+    /// stores the occluder it finds there.
+    pub(crate) fn any(
+        &self,
+        o: DVec3,
+        d: DVec3,
+        tmin: f64,
+        tmax: f64,
+        hint: &mut Option<u32>,
+    ) -> bool {
+        let pre = RayPre::new(o, d);
+        if let Some(h) = *hint
+            && let Some(prim) = self.prims.get(h as usize)
+            && self.test_prim(prim, &pre, tmin, tmax).is_some()
+        {
+            return true;
+        }
+        if self.brute {
+            let hit = self.brute_force(o, d, tmin, tmax, None, true);
+            if let Some(h) = hit {
+                *hint = Some(h.prim as u32);
+            }
+            return hit.is_some();
+        }
+        let Some(tr) = self.traversal(o, d, tmin, tmax) else {
+            return false;
+        };
+        let r4 = Ray4::new(&pre, self.extent);
+        let mut found = None;
+        self.wide.traverse::<false>(&tr.ray, tr.tmax, |leaf, _| {
+            let (g, count) = leaf_parts(leaf);
+            let mut m = self.wide.groups[g].candidates(&r4) & ((1 << count) - 1);
+            while m != 0 {
+                let id = self.wide.ids[g][m.trailing_zeros() as usize];
+                m &= m - 1;
+                if self
+                    .test_prim(&self.prims[id as usize], &pre, tmin, tmax)
+                    .is_some()
+                {
+                    found = Some(id);
+                    return true;
+                }
+            }
+            false
+        });
+        if found.is_some() {
+            *hint = found;
+        }
+        found.is_some()
+    }
+
+    /// The closest hit over every primitive, without the tree (the
+    /// reference for tests).
+    pub(crate) fn closest_brute_force(
+        &self,
+        o: DVec3,
+        d: DVec3,
+        tmin: f64,
+        tmax: f64,
+    ) -> Option<PrimHit> {
+        self.brute_force(o, d, tmin, tmax, None, false)
+    }
+
+    /// The closest hit (or, if `any`, the first found) over every
+    /// primitive not of shape `skip`.
+    fn brute_force(
+        &self,
+        o: DVec3,
+        d: DVec3,
+        tmin: f64,
+        tmax: f64,
+        skip: Option<u32>,
+        any: bool,
+    ) -> Option<PrimHit> {
+        let pre = RayPre::new(o, d);
+        let mut best: Option<PrimHit> = None;
+        let mut best_t = tmax;
+        for (i, p) in self.prims.iter().enumerate() {
+            if skip == Some(p.shape()) {
+                continue;
+            }
+            if let Some((t, bary)) = self.test_prim(p, &pre, tmin, best_t) {
+                best_t = t;
+                best = Some(PrimHit { prim: i, t, bary });
+                if any {
+                    break;
+                }
+            }
+        }
+        best
+    }
+}
+
+/// The primitives reordered as the leaves hold them (so that a leaf's
+/// primitives lie together in memory), with the leaves' indices renamed.
+fn leaf_order(wide: &mut WideBvh, prims: Vec<Prim>) -> Vec<Prim> {
+    let mut new_index = vec![u32::MAX; prims.len()];
+    let mut out = Vec::with_capacity(prims.len());
+    for ids in &mut wide.ids {
+        for id in ids.iter_mut() {
+            let slot = &mut new_index[*id as usize];
+            if *slot == u32::MAX {
+                *slot = out.len() as u32;
+                out.push(prims[*id as usize]);
+            }
+            *id = *slot;
+        }
+    }
+    // Primitives no leaf holds (none, unless the tree is empty or the
+    // fallback tests everything) keep their place after the others.
+    for (i, p) in prims.iter().enumerate() {
+        if new_index[i] == u32::MAX {
+            out.push(*p);
+        }
+    }
+    out
+}
+
+/// The largest f32 not above `x`.
+fn round_down(x: f64) -> f32 {
+    let f = x as f32;
+    if f64::from(f) > x { f.next_down() } else { f }
+}
+
+/// The smallest f32 not below `x`.
+fn round_up(x: f64) -> f32 {
+    let f = x as f32;
+    if f64::from(f) < x { f.next_up() } else { f }
+}
