@@ -16,7 +16,7 @@ use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
 use crate::bounds::Bounds;
-use crate::bvh::{Bvh, Prim, PrimHit, TriOwner};
+use crate::bvh::{Bvh, Prim, PrimHit, QueryRay, TriOwner};
 use crate::chart::MeshData;
 use crate::ids::SurfaceId;
 use crate::patch::{Patch, inverse_bilinear};
@@ -177,10 +177,18 @@ impl Geometry {
         RAY_EPSILON * (o.abs().max_element() + self.extent)
     }
 
+    /// A query ray and its tmin (ε / |dir|); `None` for a ray that is not
+    /// finite or has a zero direction.
+    #[inline]
+    fn query(&self, ray: &Ray) -> Option<(QueryRay, f64)> {
+        let q = QueryRay::new(ray.origin, ray.dir)?;
+        Some((q, RAY_EPSILON * (q.omax + self.extent) / q.len))
+    }
+
     /// The closest hit along `ray` with ε < t < `t_max` (ε: module docs).
     pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<Hit> {
-        let tmin = self.ray_epsilon(ray.origin) / ray.dir.length();
-        let h = self.bvh.closest(ray.origin, ray.dir, tmin, t_max, None)?;
+        let (q, tmin) = self.query(ray)?;
+        let h = self.bvh.closest(&q, tmin, t_max, None)?;
         Some(self.make_hit(ray.origin, ray.dir, h))
     }
 
@@ -188,17 +196,15 @@ impl Geometry {
     /// that start on a surface and must see what lies on it, even
     /// coincident with it).
     pub fn intersect_ignoring(&self, ray: &Ray, t_max: f64, shape: u32) -> Option<Hit> {
-        let tmin = self.ray_epsilon(ray.origin) / ray.dir.length();
-        let h = self
-            .bvh
-            .closest(ray.origin, ray.dir, tmin, t_max, Some(shape))?;
+        let (q, tmin) = self.query(ray)?;
+        let h = self.bvh.closest(&q, tmin, t_max, Some(shape))?;
         Some(self.make_hit(ray.origin, ray.dir, h))
     }
 
     /// True if `ray` hits anything with ε < t < `t_max`.
     pub fn ray_occluded(&self, ray: &Ray, t_max: f64) -> bool {
-        let tmin = self.ray_epsilon(ray.origin) / ray.dir.length();
-        self.bvh.any(ray.origin, ray.dir, tmin, t_max, &mut None)
+        self.query(ray)
+            .is_some_and(|(q, tmin)| self.bvh.any(&q, tmin, t_max, &mut None))
     }
 
     /// True if something lies strictly between points `p` and `q`. Safe when
@@ -211,17 +217,15 @@ impl Geometry {
     /// two elements): `hint` carries the last occluder found from one call
     /// to the next and is tested first. Start with `None`.
     pub fn occluded_hint(&self, p: DVec3, q: DVec3, hint: &mut Option<u32>) -> bool {
-        let d = q - p;
-        let len = d.length();
-        if len <= 0.0 || !len.is_finite() {
+        let Some(r) = QueryRay::new(p, q - p) else {
             return false;
-        }
-        let tmin = self.ray_epsilon(p) / len;
-        let tmax = 1.0 - self.ray_epsilon(q) / len;
+        };
+        let tmin = RAY_EPSILON * (r.omax + self.extent) / r.len;
+        let tmax = 1.0 - self.ray_epsilon(q) / r.len;
         if tmin >= tmax {
             return false;
         }
-        self.bvh.any(p, d, tmin, tmax, hint)
+        self.bvh.any(&r, tmin, tmax, hint)
     }
 
     /// [`Geometry::intersect`] for many rays, in parallel (rayon).
@@ -263,37 +267,46 @@ impl Geometry {
             t: h.t,
         };
         match self.bvh.prim(h.prim) {
-            Prim::Tri {
+            &Prim::Tri {
+                normal,
+                surface,
                 owner: TriOwner::Mesh { mesh, tri },
                 ..
             } => {
-                let m = &self.meshes[*mesh as usize];
+                let coord = SurfaceCoord::Triangle {
+                    index: tri,
+                    bary: h.bary,
+                };
+                let m = &self.meshes[mesh as usize];
+                let shading_normal = if m.shading_normals.is_some() {
+                    m.shading_normal(tri, h.bary)
+                } else {
+                    normal
+                };
                 Hit {
-                    shading_normal: m.shading_normal(*tri, h.bary),
-                    ..flat(
-                        m.tri_surface[*tri as usize],
-                        SurfaceCoord::Triangle {
-                            index: *tri,
-                            bary: h.bary,
-                        },
-                        m.tri_normal[*tri as usize],
-                    )
+                    shading_normal,
+                    ..flat(surface, coord, normal)
                 }
             }
-            Prim::Tri {
-                owner: TriOwner::Quad { surface },
+            &Prim::Tri {
+                normal,
+                surface,
+                owner: TriOwner::Quad { second, affine },
                 ..
             } => {
-                let (uv, n) = match self.patch(SurfaceId(*surface)) {
-                    Some(Patch::Quad { p, normal }) => {
-                        (inverse_bilinear(p, *normal, point), *normal)
-                    }
-                    _ => (DVec2::ZERO, DVec3::Z),
+                let (b1, b2) = (h.bary.x, h.bary.y);
+                let uv = match (affine, second) {
+                    (true, false) => DVec2::new(b1 + b2, b2).clamp(DVec2::ZERO, DVec2::ONE),
+                    (true, true) => DVec2::new(b1, b1 + b2).clamp(DVec2::ZERO, DVec2::ONE),
+                    (false, _) => match self.patch(SurfaceId(surface)) {
+                        Some(Patch::Quad { p, normal }) => inverse_bilinear(p, *normal, point),
+                        _ => DVec2::ZERO,
+                    },
                 };
-                flat(*surface, SurfaceCoord::Uv(uv), n)
+                flat(surface, SurfaceCoord::Uv(uv), normal)
             }
-            Prim::Analytic { index, .. } => {
-                let (s, uv, n) = self.bvh.analytic(*index).surface_at(o, d, h.t);
+            &Prim::Analytic { index, .. } => {
+                let (s, uv, n) = self.bvh.analytic(index).surface_at(o, d, h.t);
                 flat(s, SurfaceCoord::Uv(uv), n)
             }
         }

@@ -42,6 +42,37 @@ mod tri4;
 mod triangle;
 mod wide;
 
+/// Counters of traversal work on this thread (nodes, leaves, f64 hits, f64
+/// misses), for tuning: `--features trace-stats`.
+#[cfg(feature = "trace-stats")]
+pub mod stats {
+    thread_local! {
+        static STATS: std::cell::Cell<[u64; 4]> = const { std::cell::Cell::new([0; 4]) };
+    }
+
+    /// The counts since the last call, on this thread.
+    pub fn take() -> [u64; 4] {
+        STATS.with(|c| c.replace([0; 4]))
+    }
+
+    pub(crate) fn bump(i: usize) {
+        STATS.with(|c| {
+            let mut v = c.get();
+            v[i] += 1;
+            c.set(v);
+        })
+    }
+}
+
+/// Counts traversal work with `--features trace-stats`, else nothing.
+macro_rules! bump {
+    ($i:expr) => {
+        #[cfg(feature = "trace-stats")]
+        $crate::bvh::stats::bump($i);
+    };
+}
+use bump;
+
 pub(crate) use analytic::{Analytic, AnalyticKind};
 
 use glam::{DVec2, DVec3};
@@ -51,24 +82,38 @@ use obvhs::ploc::{PlocBuilder, PlocSearchDistance, SortPrecision};
 
 use crate::bounds::Bounds;
 use traverse::BoxRay;
-use tri4::{Ray4, Tri4};
+use tri4::{Ray4, Span4, Tri4};
 use triangle::{RayPre, intersect_triangle};
 use wide::{LEAF_SIZE, WideBvh, leaf_parts};
 
 /// What a triangle primitive belongs to.
 #[derive(Clone, Copy, Debug)]
 pub(crate) enum TriOwner {
-    Mesh { mesh: u32, tri: u32 },
-    Quad { surface: u32 },
+    Mesh {
+        mesh: u32,
+        tri: u32,
+    },
+    /// Half of a planar quad (p00, p10, p11, p01): the triangle
+    /// (p00, p10, p11) or, if `second`, (p00, p11, p01); `affine` if the
+    /// quad is a parallelogram.
+    Quad {
+        second: bool,
+        affine: bool,
+    },
 }
 
 /// A primitive of the BVH, with the scene shape it belongs to (so that a
 /// query can ignore one shape).
 #[derive(Clone, Copy, Debug)]
 pub(crate) enum Prim {
-    /// A triangle of a mesh or half of a planar quad.
+    /// A triangle of a mesh or half of a planar quad, with what a hit on it
+    /// needs (kept here so that a hit reads nothing else for them).
     Tri {
         v: [DVec3; 3],
+        /// Front-side unit geometric normal of the input surface.
+        normal: DVec3,
+        /// The input surface it lies on.
+        surface: u32,
         owner: TriOwner,
         shape: u32,
     },
@@ -110,6 +155,26 @@ pub(crate) struct Bvh {
     extent: f64,
     /// Coordinates beyond f32's range: every query tests every primitive.
     brute: bool,
+}
+
+/// A query's ray with its length and largest absolute origin coordinate
+/// (which the caller needs too, for the ray epsilon).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct QueryRay {
+    pub o: DVec3,
+    pub d: DVec3,
+    pub len: f64,
+    pub omax: f64,
+}
+
+impl QueryRay {
+    /// `None` unless `o` is finite and `d` finite and non-zero.
+    #[inline(always)]
+    pub(crate) fn new(o: DVec3, d: DVec3) -> Option<QueryRay> {
+        let len = d.length();
+        let omax = o.abs().max_element();
+        (len > 0.0 && len.is_finite() && omax.is_finite()).then_some(QueryRay { o, d, len, omax })
+    }
 }
 
 /// A ray clipped to the scene's box, ready for traversal.
@@ -163,10 +228,10 @@ impl Bvh {
             3,
         );
         ReinsertionOptimizer::default().run(&mut bvh2, 0.05, None);
-        // PLOC leaves hold one primitive each; anything else (and
-        // coordinates f32 cannot hold) falls back to testing everything.
-        let brute = extent.is_nan()
-            || extent >= 1e30
+        // PLOC leaves hold one primitive each; anything else, and scenes
+        // whose scale f32's range does not suit ([`tri4`]), fall back to
+        // testing everything.
+        let brute = !(1e-6..=1e15).contains(&extent)
             || bvh2
                 .nodes
                 .iter()
@@ -224,21 +289,41 @@ impl Bvh {
 
     #[inline]
     fn test_prim(&self, prim: &Prim, pre: &RayPre, tmin: f64, tmax: f64) -> Option<(f64, DVec2)> {
-        match prim {
+        let r = match prim {
             Prim::Tri { v, .. } => intersect_triangle(pre, v, tmin, tmax),
             Prim::Analytic { index, .. } => self.analytic[*index as usize]
                 .intersect(pre.o, pre.d, tmin, tmax)
                 .map(|t| (t, DVec2::ZERO)),
-        }
+        };
+        bump!(if r.is_some() { 2 } else { 3 });
+        r
     }
 
-    /// Clips a ray to the padded scene box; `None` if it misses the box or
-    /// is not finite.
-    fn traversal(&self, o: DVec3, d: DVec3, tmin: f64, tmax: f64) -> Option<Traversal> {
-        let len = d.length();
-        if len <= 0.0 || !len.is_finite() || !o.is_finite() {
-            return None;
-        }
+    /// The f32 traversal of a ray; `None` if it misses the padded scene box
+    /// or is not finite. A ray from within twice the scene's extent starts
+    /// at its own origin (the error bound in [`traverse`] allows for that);
+    /// one from farther away starts where it enters the box, in f64.
+    fn traversal(&self, q: &QueryRay, tmin: f64, tmax: f64) -> Option<Traversal> {
+        let (o, d, len) = (q.o, q.d, q.len);
+        let (start, end) = if q.omax <= 2.0 * self.extent {
+            (0.0, tmax)
+        } else {
+            self.clip(o, d, tmin, tmax)?
+        };
+        let t = Traversal {
+            ray: BoxRay::new(o + start * d, d / len),
+            start,
+            len,
+            tmax: 0.0,
+        };
+        Some(Traversal {
+            tmax: t.distance(end),
+            ..t
+        })
+    }
+
+    /// The part of (tmin, tmax) within the padded scene box.
+    fn clip(&self, o: DVec3, d: DVec3, tmin: f64, tmax: f64) -> Option<(f64, f64)> {
         let b = self.bounds.padded(2.0 * self.pad + 1e-300);
         let inv = 1.0 / d;
         let t1 = (b.min - o) * inv;
@@ -255,45 +340,34 @@ impl Bvh {
             .into_iter()
             .filter(|x| !x.is_nan())
             .fold(tmax, f64::min);
-        if tn > tf || tn.is_nan() || tf.is_nan() {
-            return None;
-        }
-        let t = Traversal {
-            ray: BoxRay::new(o + tn * d, d / len),
-            start: tn,
-            len,
-            tmax: 0.0,
-        };
-        Some(Traversal {
-            tmax: t.distance(tf),
-            ..t
-        })
+        (tn <= tf).then_some((tn, tf))
     }
 
     /// The closest primitive hit in (tmin, tmax), ignoring the primitives of
     /// shape `skip`.
     pub(crate) fn closest(
         &self,
-        o: DVec3,
-        d: DVec3,
+        q: &QueryRay,
         tmin: f64,
         tmax: f64,
         skip: Option<u32>,
     ) -> Option<PrimHit> {
         if self.brute {
-            return self.brute_force(o, d, tmin, tmax, skip, false);
+            return self.brute_force(q.o, q.d, tmin, tmax, skip, false);
         }
-        let tr = self.traversal(o, d, tmin, tmax)?;
-        let pre = RayPre::new(o, d);
-        let r4 = Ray4::new(&pre, self.extent);
+        let tr = self.traversal(q, tmin, tmax)?;
+        let pre = RayPre::new(q.o, q.d);
+        let r4 = Ray4::new(&pre, q.omax + self.extent);
+        let mut span = Span4::new(tmin, tmax);
         let mut best: Option<PrimHit> = None;
         let mut best_t = tmax;
         self.wide
             .traverse::<true>(&tr.ray, tr.tmax, |leaf, tmax32| {
                 let (g, count) = leaf_parts(leaf);
-                let mut m = self.wide.groups[g].candidates(&r4) & ((1 << count) - 1);
+                let leaf = &self.wide.leaves[g];
+                let mut m = leaf.tri.classify::<false>(&r4, &span).test & ((1 << count) - 1);
                 while m != 0 {
-                    let id = self.wide.ids[g][m.trailing_zeros() as usize];
+                    let id = leaf.ids[m.trailing_zeros() as usize];
                     m &= m - 1;
                     let prim = &self.prims[id as usize];
                     if skip == Some(prim.shape()) {
@@ -307,6 +381,7 @@ impl Bvh {
                             bary,
                         });
                         *tmax32 = tr.distance(t);
+                        span = span.with_max(t);
                     }
                 }
                 false
@@ -317,15 +392,8 @@ impl Bvh {
     /// True if any primitive is hit in (tmin, tmax). Tries the primitive in
     /// `hint` (the last occluder found, for coherent segments) first, and
     /// stores the occluder it finds there.
-    pub(crate) fn any(
-        &self,
-        o: DVec3,
-        d: DVec3,
-        tmin: f64,
-        tmax: f64,
-        hint: &mut Option<u32>,
-    ) -> bool {
-        let pre = RayPre::new(o, d);
+    pub(crate) fn any(&self, q: &QueryRay, tmin: f64, tmax: f64, hint: &mut Option<u32>) -> bool {
+        let pre = RayPre::new(q.o, q.d);
         if let Some(h) = *hint
             && let Some(prim) = self.prims.get(h as usize)
             && self.test_prim(prim, &pre, tmin, tmax).is_some()
@@ -333,22 +401,30 @@ impl Bvh {
             return true;
         }
         if self.brute {
-            let hit = self.brute_force(o, d, tmin, tmax, None, true);
+            let hit = self.brute_force(q.o, q.d, tmin, tmax, None, true);
             if let Some(h) = hit {
                 *hint = Some(h.prim as u32);
             }
             return hit.is_some();
         }
-        let Some(tr) = self.traversal(o, d, tmin, tmax) else {
+        let Some(tr) = self.traversal(q, tmin, tmax) else {
             return false;
         };
-        let r4 = Ray4::new(&pre, self.extent);
+        let r4 = Ray4::new(&pre, q.omax + self.extent);
+        let span = Span4::new(tmin, tmax);
         let mut found = None;
         self.wide.traverse::<false>(&tr.ray, tr.tmax, |leaf, _| {
             let (g, count) = leaf_parts(leaf);
-            let mut m = self.wide.groups[g].candidates(&r4) & ((1 << count) - 1);
+            let leaf = &self.wide.leaves[g];
+            let lanes = leaf.tri.classify::<true>(&r4, &span);
+            let valid = (1 << count) - 1;
+            if lanes.hits & valid != 0 {
+                found = Some(leaf.ids[(lanes.hits & valid).trailing_zeros() as usize]);
+                return true;
+            }
+            let mut m = lanes.test & valid;
             while m != 0 {
-                let id = self.wide.ids[g][m.trailing_zeros() as usize];
+                let id = leaf.ids[m.trailing_zeros() as usize];
                 m &= m - 1;
                 if self
                     .test_prim(&self.prims[id as usize], &pre, tmin, tmax)
@@ -413,8 +489,8 @@ impl Bvh {
 fn leaf_order(wide: &mut WideBvh, prims: Vec<Prim>) -> Vec<Prim> {
     let mut new_index = vec![u32::MAX; prims.len()];
     let mut out = Vec::with_capacity(prims.len());
-    for ids in &mut wide.ids {
-        for id in ids.iter_mut() {
+    for leaf in &mut wide.leaves {
+        for id in leaf.ids.iter_mut() {
             let slot = &mut new_index[*id as usize];
             if *slot == u32::MAX {
                 *slot = out.len() as u32;

@@ -135,11 +135,13 @@ impl WideBvh {
         let mut cur = self.root;
         loop {
             if cur & LEAF != 0 {
+                super::bump!(1);
                 if leaf(cur, &mut tmax) {
                     return;
                 }
             } else {
                 let node = &self.nodes[cur as usize];
+                super::bump!(0);
                 let (mask, entry) = ray.hit(node, tmax);
                 if mask != 0 {
                     cur = if ORDERED {

@@ -21,28 +21,36 @@ pub(crate) struct RayPre {
     pub k: [usize; 3],
     /// Shear constants (d_x / d_z, d_y / d_z, 1 / d_z) after permutation.
     pub s: [f64; 3],
+    /// The origin, permuted.
+    pub ok: [f64; 3],
 }
 
 impl RayPre {
+    #[inline(always)]
     pub(crate) fn new(o: DVec3, d: DVec3) -> RayPre {
+        // k_z: the largest |d| component (the first of equals); k_x, k_y
+        // the next two, swapped when d_kz < 0 (winding preserved). Selected
+        // without branches: ray directions are random.
+        const AXES: [[usize; 3]; 6] = [
+            [1, 2, 0],
+            [2, 0, 1],
+            [0, 1, 2],
+            [2, 1, 0],
+            [0, 2, 1],
+            [1, 0, 2],
+        ];
         let a = d.abs();
-        let kz = if a.x >= a.y && a.x >= a.z {
-            0
-        } else if a.y >= a.z {
-            1
-        } else {
-            2
-        };
-        let mut kx = (kz + 1) % 3;
-        let mut ky = (kx + 1) % 3;
-        if d[kz] < 0.0 {
-            std::mem::swap(&mut kx, &mut ky);
-        }
+        let is_x = (a.x >= a.y) & (a.x >= a.z);
+        let is_y = a.y >= a.z;
+        let kz = usize::from(!is_x) * (1 + usize::from(!is_y));
+        let k = AXES[kz + 3 * usize::from(d[kz] < 0.0)];
+        let [kx, ky, kz] = k;
         RayPre {
             o,
             d,
-            k: [kx, ky, kz],
+            k,
             s: [d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]],
+            ok: [o[kx], o[ky], o[kz]],
         }
     }
 }
@@ -58,26 +66,40 @@ pub(crate) fn intersect_triangle(
 ) -> Option<(f64, DVec2)> {
     let [kx, ky, kz] = r.k;
     let [sx, sy, sz] = r.s;
-    let a = v[0] - r.o;
-    let b = v[1] - r.o;
-    let c = v[2] - r.o;
-    let ax = a[kx] - sx * a[kz];
-    let ay = a[ky] - sy * a[kz];
-    let bx = b[kx] - sx * b[kz];
-    let by = b[ky] - sy * b[kz];
-    let cx = c[kx] - sx * c[kz];
-    let cy = c[ky] - sy * c[kz];
+    let [ox, oy, oz] = r.ok;
+    // Translated, permuted and sheared vertices (straight from the vertex
+    // components: no permuted copy, so nothing goes through the stack).
+    let project = |p: &DVec3| {
+        let z = p[kz] - oz;
+        ((p[kx] - ox) - sx * z, (p[ky] - oy) - sy * z, z)
+    };
+    let (ax, ay, az) = project(&v[0]);
+    let (bx, by, bz) = project(&v[1]);
+    let (cx, cy, cz) = project(&v[2]);
     let u = cx * by - cy * bx;
     let vv = ax * cy - ay * cx;
     let w = bx * ay - by * ax;
-    if (u < 0.0 || vv < 0.0 || w < 0.0) && (u > 0.0 || vv > 0.0 || w > 0.0) {
+    // Non-short-circuit: one branch, not six unpredictable ones.
+    let neg = (u < 0.0) | (vv < 0.0) | (w < 0.0);
+    let pos = (u > 0.0) | (vv > 0.0) | (w > 0.0);
+    if neg & pos {
         return None;
     }
     let det = u + vv + w;
     if det == 0.0 {
         return None;
     }
-    let t = (u * sz * a[kz] + vv * sz * b[kz] + w * sz * c[kz]) / det;
+    let num = u * sz * az + vv * sz * bz + w * sz * cz;
+    // Most misses here are far outside (tmin, tmax) (the triangle a ray
+    // starts on, triangles behind it or beyond the closest hit so far):
+    // decide those without the division, with a margin of 10⁻¹² (far
+    // above the products' rounding), so that the decision is the one the
+    // quotient below would give.
+    let (n, d) = if det > 0.0 { (num, det) } else { (-num, -det) };
+    if n < tmin * d * (1.0 - 1e-12) || n > tmax * d * (1.0 + 1e-12) {
+        return None;
+    }
+    let t = num / det;
     if !(t > tmin && t < tmax) {
         return None;
     }

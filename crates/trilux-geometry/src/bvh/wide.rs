@@ -67,17 +67,23 @@ impl WideNode {
     }
 }
 
-/// The collapsed tree: nodes, leaf groups and their primitive indices.
+/// A leaf: up to four primitives' f32 triangles and their indices (into
+/// the caller's list; lanes past the leaf's count repeat lane 0), side by
+/// side in memory.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Leaf {
+    pub tri: Tri4,
+    pub ids: [u32; 4],
+}
+
+/// The collapsed tree: nodes and leaves.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct WideBvh {
     pub nodes: Vec<WideNode>,
     /// The root: a node index, a leaf reference, or [`EMPTY`].
     pub root: u32,
-    /// Leaf groups, in tree order.
-    pub groups: Vec<Tri4>,
-    /// The primitives (indices into the caller's list) of each group's
-    /// lanes; lanes past the leaf's count repeat lane 0.
-    pub ids: Vec<[u32; 4]>,
+    /// Leaves, in tree order.
+    pub leaves: Vec<Leaf>,
     /// Longest root-to-leaf path, in nodes.
     pub depth: usize,
 }
@@ -98,9 +104,11 @@ impl WideBvh {
             let prims = subtree_prims(bvh2, b);
             let mut ids = [prims[0]; 4];
             ids[..prims.len()].copy_from_slice(&prims);
-            out.groups.push(group(&prims));
-            out.ids.push(ids);
-            LEAF | ((prims.len() as u32 - 1) << 29) | (out.groups.len() as u32 - 1)
+            out.leaves.push(Leaf {
+                tri: group(&prims),
+                ids,
+            });
+            LEAF | ((prims.len() as u32 - 1) << 29) | (out.leaves.len() as u32 - 1)
         };
         if counts[0] as usize <= LEAF_SIZE {
             out.root = leaf(&mut out, 0);
