@@ -61,6 +61,37 @@ fn main() -> Result<(), trilux_geometry::GeometryError> {
             "closest hit {closest:.0} ns/ray ({hits} hits), occlusion {shadow:.0} ns/segment ({occ} occluded)"
         );
     }
+    // The batch calls (several rays in flight), on one thread.
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap();
+    for _ in 0..3 {
+        let t0 = Instant::now();
+        let hits: usize = pool.install(|| {
+            rays.chunks(1 << 16)
+                .take(if only == "shadow" { 0 } else { usize::MAX })
+                .map(|c| {
+                    geom.intersect_batch(c, f64::INFINITY)
+                        .iter()
+                        .flatten()
+                        .count()
+                })
+                .sum()
+        });
+        let closest = t0.elapsed().as_nanos() as f64 / count as f64;
+        let t0 = Instant::now();
+        let occ: usize = pool.install(|| {
+            segs.chunks(1 << 16)
+                .take(if only == "closest" { 0 } else { usize::MAX })
+                .map(|c| geom.occluded_batch(c).iter().filter(|&&o| o).count())
+                .sum()
+        });
+        let shadow = t0.elapsed().as_nanos() as f64 / count as f64;
+        println!(
+            "batch: closest hit {closest:.0} ns/ray ({hits} hits), occlusion {shadow:.0} ns/segment ({occ} occluded)"
+        );
+    }
     Ok(())
 }
 

@@ -22,6 +22,9 @@ use crate::ids::SurfaceId;
 use crate::patch::{Patch, inverse_bilinear};
 use crate::surface::{InputSurface, SurfaceCoord, SurfaceGeom, SurfacePoint};
 
+/// Queries per rayon task in the batch calls.
+const BATCH_CHUNK: usize = 64;
+
 /// Relative self-intersection epsilon (see the module docs).
 pub const RAY_EPSILON: f64 = 1e-9;
 
@@ -217,21 +220,14 @@ impl Geometry {
     /// two elements): `hint` carries the last occluder found from one call
     /// to the next and is tested first. Start with `None`.
     pub fn occluded_hint(&self, p: DVec3, q: DVec3, hint: &mut Option<u32>) -> bool {
-        let Some(r) = QueryRay::new(p, q - p) else {
-            return false;
-        };
-        let tmin = RAY_EPSILON * (r.omax + self.extent) / r.len;
-        let tmax = 1.0 - self.ray_epsilon(q) / r.len;
-        if tmin >= tmax {
-            return false;
-        }
-        self.bvh.any(&r, tmin, tmax, hint)
+        self.segment(p, q)
+            .is_some_and(|(r, tmin, tmax)| self.bvh.any(&r, tmin, tmax, hint))
     }
 
     /// [`Geometry::intersect`] for many rays, in parallel (rayon).
     pub fn intersect_batch(&self, rays: &[Ray], t_max: f64) -> Vec<Option<Hit>> {
         rays.par_iter()
-            .with_min_len(64)
+            .with_min_len(BATCH_CHUNK)
             .map(|r| self.intersect(r, t_max))
             .collect()
     }
@@ -240,9 +236,19 @@ impl Geometry {
     pub fn occluded_batch(&self, segments: &[(DVec3, DVec3)]) -> Vec<bool> {
         segments
             .par_iter()
-            .with_min_len(64)
+            .with_min_len(BATCH_CHUNK)
             .map(|&(p, q)| self.occluded(p, q))
             .collect()
+    }
+
+    /// The query ray and interval of segment (p, q) for
+    /// [`Geometry::occluded`]: `None` if there is nothing between them.
+    #[inline]
+    fn segment(&self, p: DVec3, q: DVec3) -> Option<(QueryRay, f64, f64)> {
+        let r = QueryRay::new(p, q - p)?;
+        let tmin = RAY_EPSILON * (r.omax + self.extent) / r.len;
+        let tmax = 1.0 - self.ray_epsilon(q) / r.len;
+        (tmin < tmax).then_some((r, tmin, tmax))
     }
 
     /// Brute force closest hit over every primitive, without the BVH: the
