@@ -36,9 +36,10 @@ fn main() -> Result<(), trilux_geometry::GeometryError> {
         (geom, w)
     };
     println!(
-        "{which}: {} primitives, built with the workload in {:.2} s",
+        "{which}: {} primitives, built with the workload in {:.2} s; BVH {:?}",
         geom.primitive_count(),
-        t0.elapsed().as_secs_f64()
+        t0.elapsed().as_secs_f64(),
+        geom.bvh_stats()
     );
     #[cfg(feature = "trace-stats")]
     stats(&geom, &rays, &segs);

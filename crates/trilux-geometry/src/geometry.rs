@@ -64,6 +64,19 @@ impl Hit {
     }
 }
 
+/// Size and build time of a scene's BVH.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BvhStats {
+    /// Inner nodes (eight children each).
+    pub nodes: usize,
+    /// Leaves (up to four primitives each).
+    pub leaves: usize,
+    /// Longest root-to-leaf path, in inner nodes.
+    pub depth: usize,
+    /// Wall-clock seconds of the build (binary tree, collapse, leaves).
+    pub build_seconds: f64,
+}
+
 /// The immutable geometry of a scene: input surfaces, meshes, BVH.
 #[derive(Clone, Debug)]
 pub struct Geometry {
@@ -109,6 +122,11 @@ impl Geometry {
     /// quad, and one per disk, sphere and cylinder).
     pub fn primitive_count(&self) -> usize {
         self.bvh.len()
+    }
+
+    /// Size and build time of the BVH.
+    pub fn bvh_stats(&self) -> BvhStats {
+        self.bvh.stats()
     }
 
     /// Every triangle the ray queries test (mesh triangles and the two

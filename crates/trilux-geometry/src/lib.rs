@@ -123,7 +123,7 @@ pub use form_factor::{
     FormFactor, FormFactorOptions, MAX_POLYGON_PIECES, form_factor, form_factor_batch,
     form_factor_front, point_to_polygon, point_to_polygon_front,
 };
-pub use geometry::{Geometry, Hit, RAY_EPSILON, Ray};
+pub use geometry::{BvhStats, Geometry, Hit, RAY_EPSILON, Ray};
 pub use ids::{ElementId, SurfaceId};
 pub use sampling::SurfaceSample;
 pub use shape::{Shape, ShapeKind, TriangleMesh};

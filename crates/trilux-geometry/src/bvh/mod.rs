@@ -155,6 +155,8 @@ pub(crate) struct Bvh {
     extent: f64,
     /// Coordinates beyond f32's range: every query tests every primitive.
     brute: bool,
+    /// Wall-clock seconds the build took.
+    seconds: f64,
 }
 
 /// A query's ray with its length and largest absolute origin coordinate
@@ -205,6 +207,7 @@ impl Bvh {
         bounds: Bounds,
         extent: f64,
     ) -> Bvh {
+        let started = std::time::Instant::now();
         let pad = 4e-6 * extent;
         let boxes: Vec<Aabb> = prims
             .iter()
@@ -261,6 +264,17 @@ impl Bvh {
             bounds,
             extent,
             brute,
+            seconds: started.elapsed().as_secs_f64(),
+        }
+    }
+
+    /// Size and build time of the tree.
+    pub(crate) fn stats(&self) -> crate::geometry::BvhStats {
+        crate::geometry::BvhStats {
+            nodes: self.wide.nodes.len(),
+            leaves: self.wide.leaves.len(),
+            depth: self.wide.depth,
+            build_seconds: self.seconds,
         }
     }
 

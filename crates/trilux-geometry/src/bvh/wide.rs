@@ -101,14 +101,14 @@ impl WideBvh {
         }
         let counts = subtree_counts(bvh2);
         let mut leaf = |out: &mut WideBvh, b: usize| {
-            let prims = subtree_prims(bvh2, b);
+            let (prims, n) = subtree_prims(bvh2, b);
             let mut ids = [prims[0]; 4];
-            ids[..prims.len()].copy_from_slice(&prims);
+            ids[..n].copy_from_slice(&prims[..n]);
             out.leaves.push(Leaf {
-                tri: group(&prims),
+                tri: group(&prims[..n]),
                 ids,
             });
-            LEAF | ((prims.len() as u32 - 1) << 29) | (out.leaves.len() as u32 - 1)
+            LEAF | ((n as u32 - 1) << 29) | (out.leaves.len() as u32 - 1)
         };
         if counts[0] as usize <= LEAF_SIZE {
             out.root = leaf(&mut out, 0);
@@ -121,9 +121,9 @@ impl WideBvh {
         let mut work = vec![(0usize, 0usize, 1usize)];
         while let Some((w, b, depth)) = work.pop() {
             out.depth = out.depth.max(depth);
-            let kids = open(bvh2, b, &counts);
+            let (kids, n) = open(bvh2, b, &counts);
             let mut node = WideNode::empty();
-            for (slot, &k) in kids.iter().enumerate() {
+            for (slot, &k) in kids[..n].iter().enumerate() {
                 let r = if counts[k] as usize <= LEAF_SIZE {
                     leaf(&mut out, k)
                 } else {
@@ -144,25 +144,30 @@ impl WideBvh {
 /// Up to [`WIDTH`] binary subtrees under inner node `b`: its children, with
 /// the largest one that is not to become a leaf opened until the node is
 /// full.
-fn open(bvh2: &Bvh2, b: usize, counts: &[u32]) -> Vec<usize> {
+fn open(bvh2: &Bvh2, b: usize, counts: &[u32]) -> ([usize; WIDTH], usize) {
     let first = bvh2.nodes[b].first_index as usize;
-    let mut kids = vec![first, first + 1];
-    while kids.len() < WIDTH {
-        let best = kids
-            .iter()
-            .enumerate()
-            .filter(|&(_, &k)| counts[k] as usize > LEAF_SIZE)
-            .max_by(|x, y| {
-                let area = |k: usize| bvh2.nodes[k].aabb().half_area();
-                area(*x.1).total_cmp(&area(*y.1))
-            })
-            .map(|(i, _)| i);
+    let mut kids = [0; WIDTH];
+    kids[0] = first;
+    kids[1] = first + 1;
+    let mut n = 2;
+    while n < WIDTH {
+        let mut best = None;
+        let mut best_area = f32::NEG_INFINITY;
+        for (i, &k) in kids[..n].iter().enumerate() {
+            let node = &bvh2.nodes[k];
+            let area = node.aabb().half_area();
+            if !node.is_leaf() && counts[k] as usize > LEAF_SIZE && area > best_area {
+                best = Some(i);
+                best_area = area;
+            }
+        }
         let Some(i) = best else { break };
         let f = bvh2.nodes[kids[i]].first_index as usize;
         kids[i] = f;
-        kids.push(f + 1);
+        kids[n] = f + 1;
+        n += 1;
     }
-    kids
+    (kids, n)
 }
 
 /// The number of primitives under every binary node (post-order, with an
@@ -188,20 +193,31 @@ fn subtree_counts(bvh2: &Bvh2) -> Vec<u32> {
     counts
 }
 
-/// The primitive indices under binary node `b`.
-fn subtree_prims(bvh2: &Bvh2, b: usize) -> Vec<u32> {
-    let mut out = Vec::new();
-    let mut stack = vec![b];
-    while let Some(b) = stack.pop() {
-        let node = &bvh2.nodes[b];
+/// The primitive indices under binary node `b`, which holds at most
+/// [`LEAF_SIZE`] (so at most 2 × LEAF_SIZE − 1 nodes: a fixed stack).
+fn subtree_prims(bvh2: &Bvh2, b: usize) -> ([u32; LEAF_SIZE], usize) {
+    let mut out = [0; LEAF_SIZE];
+    let mut n = 0;
+    let mut stack = [0usize; 2 * LEAF_SIZE];
+    stack[0] = b;
+    let mut sp = 1;
+    while sp > 0 {
+        sp -= 1;
+        let node = &bvh2.nodes[stack[sp]];
         if node.is_leaf() {
             let f = node.first_index as usize;
-            out.extend_from_slice(&bvh2.primitive_indices[f..f + node.prim_count as usize]);
-        } else {
+            for &p in &bvh2.primitive_indices[f..f + node.prim_count as usize] {
+                if n < LEAF_SIZE {
+                    out[n] = p;
+                    n += 1;
+                }
+            }
+        } else if sp + 2 <= stack.len() {
             let f = node.first_index as usize;
-            stack.push(f + 1);
-            stack.push(f);
+            stack[sp] = f + 1;
+            stack[sp + 1] = f;
+            sp += 2;
         }
     }
-    out
+    (out, n)
 }
