@@ -79,6 +79,7 @@ use glam::{DVec2, DVec3};
 use obvhs::aabb::Aabb;
 use obvhs::bvh2::reinsertion::ReinsertionOptimizer;
 use obvhs::ploc::{PlocBuilder, PlocSearchDistance, SortPrecision};
+use rayon::prelude::*;
 
 use crate::bounds::Bounds;
 use traverse::BoxRay;
@@ -210,7 +211,7 @@ impl Bvh {
         let started = std::time::Instant::now();
         let pad = 4e-6 * extent;
         let boxes: Vec<Aabb> = prims
-            .iter()
+            .par_iter()
             .map(|p| {
                 let b = match p {
                     Prim::Tri { v, .. } => Bounds::from_points(*v),
@@ -224,13 +225,13 @@ impl Bvh {
             })
             .collect();
         let mut bvh2 = PlocBuilder::with_capacity(boxes.len()).build(
-            PlocSearchDistance::Medium,
+            PlocSearchDistance::Low,
             &boxes,
             (0..boxes.len() as u32).collect(),
             SortPrecision::U64,
-            3,
+            2,
         );
-        ReinsertionOptimizer::default().run(&mut bvh2, 0.05, None);
+        ReinsertionOptimizer::default().run(&mut bvh2, 0.02, None);
         // PLOC leaves hold one primitive each; anything else, and scenes
         // whose scale f32's range does not suit ([`tri4`]), fall back to
         // testing everything.
