@@ -6,15 +6,17 @@
 //!
 //! # Robustness
 //!
-//! The f32 ray starts where the f64 ray enters the scene's box and has a
-//! unit direction, so every traversal distance is at most the box's
-//! diagonal D ≤ 2√3 · extent. Each slab distance (p − o) / d carries a
-//! relative error of at most 3u (u = 2⁻²⁴), the rounded origin and
-//! direction move the ray by at most u · extent + u · D: together below
-//! 3·10⁻⁷ · extent, while every box is padded by 4·10⁻⁶ · extent
-//! ([`super::Bvh`]). A box the f64 ray passes through is therefore always
-//! entered. Zero direction components are replaced by 10⁻³⁰ (finite
-//! reciprocals: no 0 · ∞ = NaN in the slab test; the ray moves by 10⁻³⁰ · D).
+//! The f32 ray has a unit direction and starts either at the query's own
+//! origin, when that lies within 2 × extent of the world origin in every
+//! coordinate, or, in f64, where the ray enters the scene's box: in both
+//! cases every point of the scene lies within D ≤ 3√3 · extent of the f32
+//! origin. Each slab distance (p − o) / d carries a relative error of at
+//! most 3u (u = 2⁻²⁴), and rounding the origin and direction moves the ray
+//! by at most 2u · extent + u · D: together below 1.5·10⁻⁶ · extent, while
+//! every box is padded by 4·10⁻⁶ · extent ([`super::Bvh`]). A box the f64
+//! ray passes through is therefore always entered. Zero direction
+//! components are replaced by 10⁻³⁰ (finite reciprocals: no 0 · ∞ = NaN in
+//! the slab test; the ray moves by 10⁻³⁰ · D).
 
 use glam::{DVec3, Vec4};
 

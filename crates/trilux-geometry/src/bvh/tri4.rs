@@ -1,36 +1,48 @@
 //! Four triangles at once in f32: the watertight test of Woop, Benthin and
-//! Wald (JCGT 2013) on four SIMD lanes, used as a *conservative filter*.
-//! It rules out a triangle only when the f64 test of [`super::triangle`]
-//! would certainly miss it too; every lane it keeps is decided by that f64
-//! test, which alone gives t and the barycentrics. Results are therefore
-//! exactly those of the f64 test (same hits, same watertightness, same
-//! self-intersection rule), at the cost of an f32 test for almost every
-//! triangle the traversal reaches and an f64 test for the few near the ray.
+//! Wald (JCGT 2013) on four SIMD lanes, used as a *conservative filter* for
+//! the f64 test of [`super::triangle`]. It rules a lane out only when the
+//! f64 test would certainly miss it too, and calls a lane hit only when the
+//! f64 test would certainly hit it; every other lane is left to the f64
+//! test, which alone gives t and the barycentric coordinates. Answers are
+//! therefore exactly the f64 test's (same hits, same watertightness, same
+//! self-intersection rule), while the f64 test runs only for the few
+//! triangles near the ray's path, and an occlusion query usually needs none.
 //!
-//! # Error bound
+//! # Error bounds
 //!
 //! Let u = 2⁻²⁴ (f32 unit roundoff) and R = |o|∞ + extent (the scene's
 //! largest absolute coordinate bounds every vertex). Vertices V and origin O
-//! are rounded to f32 (|ΔV| ≤ u|v|, |ΔO| ≤ u|o|) and the shear constants
-//! s_x, s_y (|s| ≤ 1, computed in f64 as the f64 test does) are rounded too
-//! (|Δs| ≤ u). Then, to first order in u:
+//! are rounded to f32 (|ΔV| ≤ u|v|, |ΔO| ≤ u|o|), and so are the shear
+//! constants s_x, s_y (|s| ≤ 1) and s_z = 1/d_z, computed in f64 as the f64
+//! test does (|Δs| ≤ u|s|). To first order in u (the margins below cover
+//! the higher-order terms and the rounding of the bounds themselves):
 //!
 //! - a translated coordinate A = V − O is off by at most u|v| + u|o| +
-//!   u|A| ≤ 2uR;
-//! - a sheared coordinate a_x = A_kx − s_x A_kz (|a_x| ≤ 2R) is off by at most
-//!   2uR + uR + 2uR + uR + 2uR = 8uR, and so is a_y; the filter uses
+//!   u|A| ≤ 2uR; the filter uses e_z = 3uR;
+//! - a sheared coordinate a_x = A_kx − s_x A_kz (|a_x| ≤ 2R) is off by at
+//!   most 2uR + uR + 2uR + uR + 2uR = 8uR, and so is a_y; the filter uses
 //!   e₁ = 10uR;
 //! - an edge function U = c_x b_y − c_y b_x is off by at most
-//!   e₁ (S_b + S_c) + 2e₁² + 2u S_b S_c, with S_p = |p_x| + |p_y|, and all
-//!   three by at most E = 2 (e₁ (S + e₁) + u S²)(1 + 16u), S = max S_p (the
-//!   factor covers the rounding of E itself and the higher-order terms).
+//!   e₁ (S_b + S_c) + 2e₁² + 2u S_b S_c, with S_p = |p_x| + |p_y|; all
+//!   three by at most E = 2 (e₁ (S + e₁) + u S²)(1 + 16u), S = max S_p;
+//! - det = U + V + W is off by at most Δdet = (3E + 2uΣ)(1 + 8u), with
+//!   Σ = |U| + |V| + |W|; T = U a_z + V b_z + W c_z by at most
+//!   ΔT = (Σ (e_z + 3uZ) + 3E (Z + e_z))(1 + 8u), Z = max |z|; and
+//!   N = s_z T by at most ΔN = |s_z| (ΔT + 3u|T|)(1 + 8u).
 //!
-//! The f64 test's own error is below 10⁻¹³ R² < 2e₁² ≤ E. A lane is ruled
-//! out only if one edge function is below −E and another above +E: the
-//! exact edge functions, and the f64 ones, then have strictly mixed signs,
-//! and the f64 test misses. NaN or infinite lanes (analytic primitives are
-//! stored as NaN, overflowing coordinates become infinite) are never ruled
-//! out, since every comparison with NaN is false.
+//! The f64 test's own error is below 10⁻¹³ R², under every bound here. A
+//! lane is **ruled out** if one edge function is below −E and another above
+//! +E (the exact and the f64 edge functions then have strictly mixed signs),
+//! or if det's sign is certain (|det| > Δdet) and t = N / det certainly lies
+//! outside (tmin, tmax), each end rounded outwards to f32 and each product
+//! given 4u more. A lane is **certainly hit** if all three edge functions
+//! exceed E in magnitude with one sign and t certainly lies inside.
+//!
+//! NaN or infinite lanes (analytic primitives are stored as NaN,
+//! overflowing coordinates become infinite) are never decided, since every
+//! comparison with NaN is false; products whose underflow would shrink a
+//! bound get 10⁻³⁶ added. [`super::Bvh`] uses this filter only for scenes
+//! whose extent lies in [10⁻⁶, 10¹⁵], where no bound underflows.
 
 use glam::{DVec3, Vec4};
 
@@ -224,6 +236,143 @@ impl Ray4 {
             k: pre.k,
             e1: Vec4::splat((10.0001 * u * r) as f32),
             ez: Vec4::splat((3.0001 * u * r) as f32),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    //! The f32 test against the f64 test it filters for, on rays through
+    //! the shared vertex and the shared edges of triangle fans (where a
+    //! filter that is not conservative would open a crack), and the f64
+    //! test's own watertightness there.
+
+    use super::*;
+    use crate::bvh::triangle::intersect_triangle;
+    use proptest::prelude::*;
+
+    /// A closed fan of `n` triangles around `c` (consistent winding).
+    fn fan(c: DVec3, rim: &[DVec3]) -> Vec<[DVec3; 3]> {
+        (0..rim.len())
+            .map(|i| [c, rim[i], rim[(i + 1) % rim.len()]])
+            .collect()
+    }
+
+    /// Checks one ray against a fan: the f64 test hits some triangle when
+    /// `inside`, every triangle it hits is kept by the f32 test, and every
+    /// lane the f32 test finds certainly hit is hit.
+    fn check(tris: &[[DVec3; 3]], o: DVec3, d: DVec3, tmin: f64, tmax: f64, inside: bool) {
+        let pre = RayPre::new(o, d);
+        let extent = tris
+            .iter()
+            .flatten()
+            .fold(0.0f64, |m, p| m.max(p.abs().max_element()));
+        let r4 = Ray4::new(&pre, o.abs().max_element() + extent);
+        let span = Span4::new(tmin, tmax);
+        let mut any = false;
+        for group in tris.chunks(4) {
+            let mut lanes = [None; 4];
+            for (l, t) in group.iter().enumerate() {
+                lanes[l] = Some(*t);
+            }
+            let valid = (1u32 << group.len()) - 1;
+            let f32_with_t = Tri4::new(lanes).classify::<true>(&r4, &span);
+            let f32_edges = Tri4::new(lanes).classify::<false>(&r4, &span);
+            for (l, t) in group.iter().enumerate() {
+                let hit = intersect_triangle(&pre, t, tmin, tmax).is_some();
+                any |= hit;
+                let bit = 1 << l;
+                assert!(
+                    !hit || f32_with_t.test & bit != 0,
+                    "f32 (with t) ruled out a hit: {t:?} {o} {d}"
+                );
+                assert!(
+                    !hit || f32_edges.test & bit != 0,
+                    "f32 (edges) ruled out a hit: {t:?} {o} {d}"
+                );
+                assert!(
+                    f32_with_t.hits & valid & bit == 0 || hit,
+                    "f32 certain of a miss: {t:?} {o} {d}"
+                );
+            }
+        }
+        assert!(any || !inside, "leak through the fan at {o} + t {d}");
+    }
+
+    fn point(r: f64) -> impl Strategy<Value = DVec3> {
+        (-r..r, -r..r, -r..r).prop_map(|(x, y, z)| DVec3::new(x, y, z))
+    }
+
+    /// A point on a grid of 1/64: exact in f32 and f64, so rays hit
+    /// vertices and edges exactly.
+    fn grid(r: i32) -> impl Strategy<Value = DVec3> {
+        (-r..r, -r..r, -r..r).prop_map(|(x, y, z)| DVec3::new(x as f64, y as f64, z as f64) / 64.0)
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(400))]
+
+        #[test]
+        fn rays_through_fan_vertices_and_edges(
+            c in point(3.0),
+            rim in prop::collection::vec((0.2..2.0f64, 0.0..1.0f64), 6),
+            axes in (point(1.0), point(1.0)),
+            o in point(6.0),
+            s in 0.0..1.0f64,
+            far in 1.0..1e3f64,
+            log_delta in -9.0..-4.0f64,
+        ) {
+            let delta = 10f64.powf(log_delta);
+            let (a, b) = axes;
+            let n = a.cross(b);
+            prop_assume!(n.length() > 0.1);
+            let u = a.normalize();
+            let v = n.cross(u).normalize();
+            // Rim points at increasing angles: a star-shaped closed fan.
+            let rim: Vec<DVec3> = rim
+                .iter()
+                .enumerate()
+                .map(|(i, &(r, jitter))| {
+                    let phi = std::f64::consts::TAU * (i as f64 + 0.8 * jitter) / 6.0;
+                    c + r * (phi.cos() * u + phi.sin() * v)
+                })
+                .collect();
+            let tris = fan(c, &rim);
+            prop_assume!((o - c).dot(n).abs() > 1e-3);
+            // The shared vertex, points on the six shared edges, inside.
+            let mut targets = vec![c];
+            targets.extend(rim.iter().map(|&p| c + s * (p - c)));
+            for target in targets {
+                let d = target - o;
+                check(&tris, o, d, 1e-9, f64::INFINITY, true);
+                // The same ray as a segment ending just past the fan, and one
+                // ending just before it (t-interval decisions).
+                check(&tris, o, d, 1e-9, 1.0 + delta, true);
+                check(&tris, o, d, 1e-9, 1.0 - delta, false);
+                check(&tris, o, d, 1.0 - delta, f64::INFINITY, true);
+                check(&tris, o, d, 1.0 + delta, f64::INFINITY, false);
+                check(&tris, o, d * far, 1e-12, f64::INFINITY, true);
+            }
+        }
+
+        #[test]
+        fn grid_rays_through_grid_fans(
+            c in grid(128),
+            rim in prop::collection::vec(grid(128), 5),
+            o in grid(512),
+        ) {
+            // Not necessarily planar or star-shaped: only the f32 test's
+            // agreement with the f64 test is checked, on rays through the
+            // exact shared vertex and the exact midpoints of the spokes.
+            let tris = fan(c, &rim);
+            let mut targets = vec![c];
+            targets.extend(rim.iter().map(|&p| (c + p) * 0.5));
+            for target in targets {
+                let d = target - o;
+                prop_assume!(d.length() > 0.0);
+                check(&tris, o, d, 1e-9, f64::INFINITY, false);
+                check(&tris, o, d, 1e-9, 1.0, false);
+            }
         }
     }
 }
