@@ -6,18 +6,19 @@
 //! triangles of every planar quad, and one primitive per disk, sphere and
 //! cylinder. obvhs builds the binary tree (PLOC and reinsertion over the
 //! primitives' boxes, padded by 4·10⁻⁶ × the scene's extent); this module
-//! collapses it into nodes of four children with f32 boxes, and leaves of
+//! collapses it into nodes of eight children with f32 boxes, and leaves of
 //! up to four primitives stored as one [`Tri4`].
 //!
 //! A query ray is f64 (origin, non-unit direction, t in units of that
-//! direction). It is clipped in f64 to the scene's padded box and
-//! traversed as an f32 ray ([`traverse`]); each leaf is tested four
-//! triangles at once in f32 ([`tri4`]), and only the lanes that test cannot
-//! rule out are tested in f64 ([`triangle`], [`analytic`]), which gives
-//! every hit, t and barycentric coordinate. The f32 stages only ever skip
-//! what the f64 tests would miss, with stated error bounds (in [`traverse`]
-//! and [`tri4`]), so the answers are the f64 tests' own: those of brute
-//! force over every primitive.
+//! direction). It is traversed as an f32 ray ([`traverse`]: nearest child
+//! first for closest hits, first hit ends an occlusion query), clipped in
+//! f64 to the scene's box when it starts far outside; each leaf is tested
+//! four triangles at once in f32 ([`tri4`]), and only the lanes that test
+//! cannot decide are tested in f64 ([`triangle`], [`analytic`]), which
+//! gives every closest hit, its t and barycentric coordinates. The f32
+//! stages only ever decide what the f64 tests would decide the same way,
+//! with stated error bounds (in [`traverse`] and [`tri4`]), so the answers
+//! are the f64 tests' own: those of brute force over every primitive.
 //!
 //! # Robustness
 //!
