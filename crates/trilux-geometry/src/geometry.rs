@@ -290,8 +290,8 @@ impl Geometry {
             shading_normal: n,
             t: h.t,
         };
-        match self.bvh.prim(h.prim) {
-            &Prim::Tri {
+        match *self.bvh.prim(h.prim) {
+            Prim::Tri {
                 normal,
                 surface,
                 owner: TriOwner::Mesh { mesh, tri },
@@ -312,7 +312,7 @@ impl Geometry {
                     ..flat(surface, coord, normal)
                 }
             }
-            &Prim::Tri {
+            Prim::Tri {
                 normal,
                 surface,
                 owner: TriOwner::Quad { second, affine },
@@ -329,7 +329,7 @@ impl Geometry {
                 };
                 flat(surface, SurfaceCoord::Uv(uv), normal)
             }
-            &Prim::Analytic { index, .. } => {
+            Prim::Analytic { index, .. } => {
                 let (s, uv, n) = self.bvh.analytic(index).surface_at(o, d, h.t);
                 flat(s, SurfaceCoord::Uv(uv), n)
             }
