@@ -17,6 +17,7 @@
 //!
 //! Prints a Markdown table of Mrays/s and a last line `trilux/embree
 //! closest R1 shadow R2`: the two ratios on 2 threads on the 100k scene.
+//! A debug build (`cargo xtask` is one) runs the release build instead.
 
 #[allow(clippy::unwrap_used, clippy::expect_used)]
 #[path = "../../crates/trilux-geometry/benches/scenes/mod.rs"]
@@ -56,6 +57,12 @@ struct Timing {
 }
 
 pub fn main(args: &[String]) -> Result<()> {
+    // `cargo xtask` builds the debug profile: time optimised code only.
+    if cfg!(debug_assertions) {
+        let mut release = vec!["run", "--release", "--quiet", "-p", "xtask", "--", "rays"];
+        release.extend(args.iter().map(String::as_str));
+        return crate::run("cargo", &release);
+    }
     let mut count = 4_000_000usize;
     let mut with_mitsuba = true;
     let mut it = args.iter();
