@@ -295,5 +295,16 @@ fn print_table(cases: &[Case], ours: &[Vec<Timing>], embree: Option<&[Vec<Timing
             }
         }
     }
-    println!("trilux/embree closest {:.2} shadow {:.2}", last.0, last.1);
+    let ratio = |r: f64| {
+        if r.is_nan() {
+            "n/a".to_string()
+        } else {
+            format!("{r:.2}")
+        }
+    };
+    println!(
+        "trilux/embree closest {} shadow {}",
+        ratio(last.0),
+        ratio(last.1)
+    );
 }
