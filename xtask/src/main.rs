@@ -3,9 +3,11 @@
 //! the golden images); `cargo xtask color` checks trilux's colorimetry
 //! against colour-science; `cargo xtask golden` compares renders of every
 //! bundled scene with stored Mitsuba 3 references; `cargo xtask sweep`
-//! measures error against time.
+//! measures error against time; `cargo xtask rays` measures ray queries
+//! against Embree.
 
 mod golden;
+mod rays;
 mod sweep;
 
 use std::process::Command;
@@ -54,8 +56,9 @@ fn main() -> Result<()> {
         Some("color") => color::color(),
         Some("golden") => golden::main(&args[1..]),
         Some("sweep") => sweep::main(&args[1..]),
+        Some("rays") => rays::main(&args[1..]),
         _ => {
-            eprintln!("usage: cargo xtask ci | color | golden | sweep");
+            eprintln!("usage: cargo xtask ci | color | golden | sweep | rays");
             std::process::exit(2);
         }
     }

@@ -10,54 +10,11 @@ mod scenes;
 use std::hint::black_box;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use glam::{DVec2, DVec3};
+use glam::DVec3;
 use scenes::*;
-use trilux_geometry::{ElementForest, Geometry, Ray, SurfaceId};
+use trilux_geometry::{ElementForest, Geometry, Ray};
 
 const RAYS: usize = 200_000;
-
-/// Incoherent rays from random points inside the box in random directions,
-/// and segments between random pairs of such points.
-fn workload(geom: &Geometry, seed: u64) -> (Vec<Ray>, Vec<(DVec3, DVec3)>) {
-    let mut rng = Rng(seed);
-    let b = geom.bounds();
-    let (lo, hi) = (b.min + 0.05 * b.diagonal(), b.max - 0.05 * b.diagonal());
-    let rays = (0..RAYS)
-        .map(|_| Ray {
-            origin: rng.in_box(lo, hi),
-            dir: rng.direction(),
-        })
-        .collect();
-    let segs = (0..RAYS)
-        .map(|_| (rng.in_box(lo, hi), rng.in_box(lo, hi)))
-        .collect();
-    (rays, segs)
-}
-
-/// Gather-like rays: from points sampled on the surfaces, into their front
-/// hemisphere; shadow segments between points on two random surfaces.
-fn surface_workload(forest: &ElementForest, seed: u64) -> (Vec<Ray>, Vec<(DVec3, DVec3)>) {
-    let mut rng = Rng(seed);
-    let n = forest.geometry().surfaces().len();
-    let point = |rng: &mut Rng| {
-        let s = SurfaceId(((rng.next_f64() * n as f64) as usize).min(n - 1) as u32);
-        forest.sample_surface(s, DVec2::new(rng.next_f64(), rng.next_f64()))
-    };
-    let rays = (0..RAYS)
-        .map(|_| {
-            let s = point(&mut rng);
-            let d = rng.direction();
-            Ray {
-                origin: s.point,
-                dir: if d.dot(s.normal) < 0.0 { -d } else { d },
-            }
-        })
-        .collect();
-    let segs = (0..RAYS)
-        .map(|_| (point(&mut rng).point, point(&mut rng).point))
-        .collect();
-    (rays, segs)
-}
 
 fn bench_scene(
     c: &mut Criterion,
@@ -93,7 +50,7 @@ fn rays(c: &mut Criterion) {
         geom.surfaces().len(),
         t0.elapsed().as_secs_f64()
     );
-    let (r, s) = workload(&geom, 1);
+    let (r, s) = workload(&geom, RAYS, 1);
     let hits = r
         .iter()
         .filter(|ray| geom.intersect(ray, f64::INFINITY).is_some())
@@ -108,7 +65,7 @@ fn rays(c: &mut Criterion) {
         geom.primitive_count(),
         geom.surfaces().len()
     );
-    let (r, s) = surface_workload(&forest, 2);
+    let (r, s) = surface_workload(&forest, RAYS, 2);
     bench_scene(c, "cornell_box", geom, &r, &s);
 }
 

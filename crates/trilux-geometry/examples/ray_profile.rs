@@ -1,88 +1,121 @@
-//! Times closest-hit and occlusion queries on a ~100k-triangle scene (for
-//! profiling; the criterion bench `rays` is the record).
+//! Times closest-hit and occlusion queries on one thread, on the ray
+//! benchmark's scenes and workloads (for profiling with `perf record`; the
+//! record is `cargo xtask rays`).
 //!
-//! Run: `cargo run -p trilux-geometry --release --example ray_profile`
+//! Run: `cargo run -p trilux-geometry --release --example ray_profile [-- RAYS [sphere[N]|cornell] [closest|shadow]]`
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
-use glam::{DMat4, DVec3};
-use trilux_geometry::{Geometry, Ray, Shape, ShapeKind, TriangleMesh};
+#[path = "../benches/scenes/mod.rs"]
+mod scenes;
+
+use std::hint::black_box;
+use std::time::Instant;
+
+use trilux_geometry::{ElementForest, Geometry};
 
 fn main() -> Result<(), trilux_geometry::GeometryError> {
-    let n = 160u32;
-    let mut p = Vec::new();
-    for i in 0..=n {
-        let th = std::f64::consts::PI * i as f64 / n as f64;
-        for j in 0..=2 * n {
-            let ph = std::f64::consts::PI * j as f64 / n as f64;
-            p.push(DVec3::new(
-                th.sin() * ph.cos(),
-                th.sin() * ph.sin(),
-                th.cos(),
-            ));
-        }
-    }
-    let w = 2 * n + 1;
-    let mut t = Vec::new();
-    for i in 0..n {
-        for j in 0..2 * n {
-            let a = i * w + j;
-            t.push([a, a + w, a + w + 1]);
-            t.push([a, a + w + 1, a + 1]);
-        }
-    }
-    let shapes = [
-        Shape {
-            kind: ShapeKind::Mesh(TriangleMesh {
-                positions: p,
-                normals: None,
-                triangles: t,
-                face_normals: true,
-            }),
-            world_from_object: DMat4::IDENTITY,
-            flip_normals: false,
-        },
-        Shape {
-            kind: ShapeKind::Cube,
-            world_from_object: DMat4::from_scale(DVec3::splat(2.0)),
-            flip_normals: true,
-        },
-    ];
-    let t0 = std::time::Instant::now();
-    let g = Geometry::build(&shapes)?;
-    println!(
-        "build: {:.2} s, {} primitives, {} input surfaces",
-        t0.elapsed().as_secs_f64(),
-        g.primitive_count(),
-        g.surfaces().len()
-    );
-    let mut st = 7u64;
-    let mut rnd = || {
-        st ^= st << 13;
-        st ^= st >> 7;
-        st ^= st << 17;
-        (st >> 11) as f64 / (1u64 << 53) as f64
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let count: usize = args
+        .first()
+        .and_then(|a| a.parse().ok())
+        .unwrap_or(1_000_000);
+    let which = args.get(1).map_or("sphere", String::as_str);
+    let only = args.get(2).map_or("both", String::as_str);
+    let t0 = Instant::now();
+    let (geom, (rays, segs)) = if which == "cornell" {
+        let forest = ElementForest::new(Geometry::build_shared(&scenes::cornell_box())?);
+        let w = scenes::surface_workload(&forest, count, 2);
+        (forest.shared_geometry().clone(), w)
+    } else {
+        let n = which
+            .strip_prefix("sphere")
+            .and_then(|n| n.parse().ok())
+            .unwrap_or(160);
+        let geom = Geometry::build_shared(&scenes::sphere_in_box(n))?;
+        let w = scenes::workload(&geom, count, 1);
+        (geom, w)
     };
-    let count = 1_000_000;
-    let rays: Vec<Ray> = (0..count)
-        .map(|_| Ray {
-            origin: DVec3::new(3.6 * rnd() - 1.8, 3.6 * rnd() - 1.8, 3.6 * rnd() - 1.8),
-            dir: DVec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5),
-        })
-        .collect();
-    let t0 = std::time::Instant::now();
-    let hits = rays
-        .iter()
-        .filter(|r| g.intersect(r, f64::INFINITY).is_some())
-        .count();
     println!(
-        "closest hit: {:.0} ns/ray ({hits} hits)",
-        t0.elapsed().as_nanos() as f64 / count as f64
+        "{which}: {} primitives, built with the workload in {:.2} s; BVH {:?}",
+        geom.primitive_count(),
+        t0.elapsed().as_secs_f64(),
+        geom.bvh_stats()
     );
-    let t0 = std::time::Instant::now();
-    let occ = rays.iter().filter(|r| g.ray_occluded(r, 1.0)).count();
-    println!(
-        "occlusion:   {:.0} ns/ray ({occ} occluded)",
-        t0.elapsed().as_nanos() as f64 / count as f64
-    );
+    #[cfg(feature = "trace-stats")]
+    stats(&geom, &rays, &segs);
+    for _ in 0..3 {
+        let t0 = Instant::now();
+        let hits = rays
+            .iter()
+            .take(if only == "shadow" { 0 } else { count })
+            .filter(|r| black_box(geom.intersect(r, f64::INFINITY)).is_some())
+            .count();
+        let closest = t0.elapsed().as_nanos() as f64 / count as f64;
+        let t0 = Instant::now();
+        let occ = segs
+            .iter()
+            .take(if only == "closest" { 0 } else { count })
+            .filter(|&&(p, q)| black_box(geom.occluded(p, q)))
+            .count();
+        let shadow = t0.elapsed().as_nanos() as f64 / count as f64;
+        println!(
+            "closest hit {closest:.0} ns/ray ({hits} hits), occlusion {shadow:.0} ns/segment ({occ} occluded)"
+        );
+    }
+    // The batch calls (several rays in flight), on one thread.
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap();
+    for _ in 0..3 {
+        let t0 = Instant::now();
+        let hits: usize = pool.install(|| {
+            rays.chunks(1 << 16)
+                .take(if only == "shadow" { 0 } else { usize::MAX })
+                .map(|c| {
+                    geom.intersect_batch(c, f64::INFINITY)
+                        .iter()
+                        .flatten()
+                        .count()
+                })
+                .sum()
+        });
+        let closest = t0.elapsed().as_nanos() as f64 / count as f64;
+        let t0 = Instant::now();
+        let occ: usize = pool.install(|| {
+            segs.chunks(1 << 16)
+                .take(if only == "closest" { 0 } else { usize::MAX })
+                .map(|c| geom.occluded_batch(c).iter().filter(|&&o| o).count())
+                .sum()
+        });
+        let shadow = t0.elapsed().as_nanos() as f64 / count as f64;
+        println!(
+            "batch: closest hit {closest:.0} ns/ray ({hits} hits), occlusion {shadow:.0} ns/segment ({occ} occluded)"
+        );
+    }
     Ok(())
+}
+
+/// Traversal work per query (`--features trace-stats`).
+#[cfg(feature = "trace-stats")]
+fn stats(geom: &Geometry, rays: &[trilux_geometry::Ray], segs: &[(glam::DVec3, glam::DVec3)]) {
+    use trilux_geometry::trace_stats::take;
+    let per = |n: usize| take().map(|x| x as f64 / n as f64);
+    take();
+    rays.iter().for_each(|r| {
+        black_box(geom.intersect(r, f64::INFINITY));
+    });
+    let s = per(rays.len());
+    println!(
+        "closest: nodes {:.2} leaves {:.2} f64 hits {:.2} misses {:.2}",
+        s[0], s[1], s[2], s[3]
+    );
+    segs.iter().for_each(|&(p, q)| {
+        black_box(geom.occluded(p, q));
+    });
+    let s = per(segs.len());
+    println!(
+        "occluded: nodes {:.2} leaves {:.2} f64 hits {:.2} misses {:.2}",
+        s[0], s[1], s[2], s[3]
+    );
 }

@@ -206,10 +206,17 @@ impl Builder {
             Patch::Quad { p, normal },
             (false, false),
         )?;
-        for v in [[p[0], p[1], p[2]], [p[0], p[2], p[3]]] {
+        // Rectangles and cube faces are affine images of squares, so
+        // parallelograms up to rounding: (u, v) is then affine in the
+        // barycentrics of either half.
+        let scale = (p[1] - p[0]).abs().max((p[3] - p[0]).abs()).max_element();
+        let affine = (p[0] + p[2] - p[1] - p[3]).abs().max_element() <= 1e-12 * scale;
+        for (second, v) in [(false, [p[0], p[1], p[2]]), (true, [p[0], p[2], p[3]])] {
             self.prims.push(Prim::Tri {
                 v,
-                owner: TriOwner::Quad { surface },
+                normal,
+                surface,
+                owner: TriOwner::Quad { second, affine },
                 shape: self.shape,
             });
         }
@@ -396,6 +403,8 @@ impl Builder {
             if s != u32::MAX {
                 self.prims.push(Prim::Tri {
                     v: data.vertices(t as u32),
+                    normal: data.tri_normal[t],
+                    surface: s,
                     owner: TriOwner::Mesh {
                         mesh: mesh_id,
                         tri: t as u32,

@@ -69,6 +69,11 @@ impl ElementForest {
         &self.geometry
     }
 
+    /// The geometry, shared.
+    pub fn shared_geometry(&self) -> &Arc<Geometry> {
+        &self.geometry
+    }
+
     /// The root element of an input surface.
     #[inline]
     pub fn root(&self, surface: SurfaceId) -> ElementId {

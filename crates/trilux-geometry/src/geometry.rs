@@ -16,11 +16,14 @@ use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
 use crate::bounds::Bounds;
-use crate::bvh::{Bvh, Prim, PrimHit, TriOwner};
+use crate::bvh::{Bvh, Prim, PrimHit, QueryRay, TriOwner};
 use crate::chart::MeshData;
 use crate::ids::SurfaceId;
 use crate::patch::{Patch, inverse_bilinear};
 use crate::surface::{InputSurface, SurfaceCoord, SurfaceGeom, SurfacePoint};
+
+/// Queries per rayon task in the batch calls.
+const BATCH_CHUNK: usize = 64;
 
 /// Relative self-intersection epsilon (see the module docs).
 pub const RAY_EPSILON: f64 = 1e-9;
@@ -59,6 +62,19 @@ impl Hit {
     pub fn front_facing(&self, ray: &Ray) -> bool {
         ray.dir.dot(self.geometric_normal) < 0.0
     }
+}
+
+/// Size and build time of a scene's BVH.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BvhStats {
+    /// Inner nodes (eight children each).
+    pub nodes: usize,
+    /// Leaves (up to four primitives each).
+    pub leaves: usize,
+    /// Longest root-to-leaf path, in inner nodes.
+    pub depth: usize,
+    /// Wall-clock seconds of the build (binary tree, collapse, leaves).
+    pub build_seconds: f64,
 }
 
 /// The immutable geometry of a scene: input surfaces, meshes, BVH.
@@ -106,6 +122,18 @@ impl Geometry {
     /// quad, and one per disk, sphere and cylinder).
     pub fn primitive_count(&self) -> usize {
         self.bvh.len()
+    }
+
+    /// Size and build time of the BVH.
+    pub fn bvh_stats(&self) -> BvhStats {
+        self.bvh.stats()
+    }
+
+    /// Every triangle the ray queries test (mesh triangles and the two
+    /// halves of each planar quad; analytic shapes are not triangles), for
+    /// handing the same geometry to another ray tracer.
+    pub fn primitive_triangles(&self) -> Vec<[DVec3; 3]> {
+        self.bvh.triangles().collect()
     }
 
     /// The parametric patch of a surface (`None` for mesh charts).
@@ -170,10 +198,18 @@ impl Geometry {
         RAY_EPSILON * (o.abs().max_element() + self.extent)
     }
 
+    /// A query ray and its tmin (ε / |dir|); `None` for a ray that is not
+    /// finite or has a zero direction.
+    #[inline]
+    fn query(&self, ray: &Ray) -> Option<(QueryRay, f64)> {
+        let q = QueryRay::new(ray.origin, ray.dir)?;
+        Some((q, RAY_EPSILON * (q.omax + self.extent) / q.len))
+    }
+
     /// The closest hit along `ray` with ε < t < `t_max` (ε: module docs).
     pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<Hit> {
-        let tmin = self.ray_epsilon(ray.origin) / ray.dir.length();
-        let h = self.bvh.closest(ray.origin, ray.dir, tmin, t_max, None)?;
+        let (q, tmin) = self.query(ray)?;
+        let h = self.bvh.closest(&q, tmin, t_max, None)?;
         Some(self.make_hit(ray.origin, ray.dir, h))
     }
 
@@ -181,17 +217,15 @@ impl Geometry {
     /// that start on a surface and must see what lies on it, even
     /// coincident with it).
     pub fn intersect_ignoring(&self, ray: &Ray, t_max: f64, shape: u32) -> Option<Hit> {
-        let tmin = self.ray_epsilon(ray.origin) / ray.dir.length();
-        let h = self
-            .bvh
-            .closest(ray.origin, ray.dir, tmin, t_max, Some(shape))?;
+        let (q, tmin) = self.query(ray)?;
+        let h = self.bvh.closest(&q, tmin, t_max, Some(shape))?;
         Some(self.make_hit(ray.origin, ray.dir, h))
     }
 
     /// True if `ray` hits anything with ε < t < `t_max`.
     pub fn ray_occluded(&self, ray: &Ray, t_max: f64) -> bool {
-        let tmin = self.ray_epsilon(ray.origin) / ray.dir.length();
-        self.bvh.any(ray.origin, ray.dir, tmin, t_max, &mut None)
+        self.query(ray)
+            .is_some_and(|(q, tmin)| self.bvh.any(&q, tmin, t_max, &mut None))
     }
 
     /// True if something lies strictly between points `p` and `q`. Safe when
@@ -204,23 +238,14 @@ impl Geometry {
     /// two elements): `hint` carries the last occluder found from one call
     /// to the next and is tested first. Start with `None`.
     pub fn occluded_hint(&self, p: DVec3, q: DVec3, hint: &mut Option<u32>) -> bool {
-        let d = q - p;
-        let len = d.length();
-        if len <= 0.0 || !len.is_finite() {
-            return false;
-        }
-        let tmin = self.ray_epsilon(p) / len;
-        let tmax = 1.0 - self.ray_epsilon(q) / len;
-        if tmin >= tmax {
-            return false;
-        }
-        self.bvh.any(p, d, tmin, tmax, hint)
+        self.segment(p, q)
+            .is_some_and(|(r, tmin, tmax)| self.bvh.any(&r, tmin, tmax, hint))
     }
 
     /// [`Geometry::intersect`] for many rays, in parallel (rayon).
     pub fn intersect_batch(&self, rays: &[Ray], t_max: f64) -> Vec<Option<Hit>> {
         rays.par_iter()
-            .with_min_len(64)
+            .with_min_len(BATCH_CHUNK)
             .map(|r| self.intersect(r, t_max))
             .collect()
     }
@@ -229,9 +254,19 @@ impl Geometry {
     pub fn occluded_batch(&self, segments: &[(DVec3, DVec3)]) -> Vec<bool> {
         segments
             .par_iter()
-            .with_min_len(64)
+            .with_min_len(BATCH_CHUNK)
             .map(|&(p, q)| self.occluded(p, q))
             .collect()
+    }
+
+    /// The query ray and interval of segment (p, q) for
+    /// [`Geometry::occluded`]: `None` if there is nothing between them.
+    #[inline]
+    fn segment(&self, p: DVec3, q: DVec3) -> Option<(QueryRay, f64, f64)> {
+        let r = QueryRay::new(p, q - p)?;
+        let tmin = RAY_EPSILON * (r.omax + self.extent) / r.len;
+        let tmax = 1.0 - self.ray_epsilon(q) / r.len;
+        (tmin < tmax).then_some((r, tmin, tmax))
     }
 
     /// Brute force closest hit over every primitive, without the BVH: the
@@ -255,38 +290,47 @@ impl Geometry {
             shading_normal: n,
             t: h.t,
         };
-        match self.bvh.prim(h.prim) {
+        match *self.bvh.prim(h.prim) {
             Prim::Tri {
+                normal,
+                surface,
                 owner: TriOwner::Mesh { mesh, tri },
                 ..
             } => {
-                let m = &self.meshes[*mesh as usize];
+                let coord = SurfaceCoord::Triangle {
+                    index: tri,
+                    bary: h.bary,
+                };
+                let m = &self.meshes[mesh as usize];
+                let shading_normal = if m.shading_normals.is_some() {
+                    m.shading_normal(tri, h.bary)
+                } else {
+                    normal
+                };
                 Hit {
-                    shading_normal: m.shading_normal(*tri, h.bary),
-                    ..flat(
-                        m.tri_surface[*tri as usize],
-                        SurfaceCoord::Triangle {
-                            index: *tri,
-                            bary: h.bary,
-                        },
-                        m.tri_normal[*tri as usize],
-                    )
+                    shading_normal,
+                    ..flat(surface, coord, normal)
                 }
             }
             Prim::Tri {
-                owner: TriOwner::Quad { surface },
+                normal,
+                surface,
+                owner: TriOwner::Quad { second, affine },
                 ..
             } => {
-                let (uv, n) = match self.patch(SurfaceId(*surface)) {
-                    Some(Patch::Quad { p, normal }) => {
-                        (inverse_bilinear(p, *normal, point), *normal)
-                    }
-                    _ => (DVec2::ZERO, DVec3::Z),
+                let (b1, b2) = (h.bary.x, h.bary.y);
+                let uv = match (affine, second) {
+                    (true, false) => DVec2::new(b1 + b2, b2).clamp(DVec2::ZERO, DVec2::ONE),
+                    (true, true) => DVec2::new(b1, b1 + b2).clamp(DVec2::ZERO, DVec2::ONE),
+                    (false, _) => match self.patch(SurfaceId(surface)) {
+                        Some(Patch::Quad { p, normal }) => inverse_bilinear(p, *normal, point),
+                        _ => DVec2::ZERO,
+                    },
                 };
-                flat(*surface, SurfaceCoord::Uv(uv), n)
+                flat(surface, SurfaceCoord::Uv(uv), normal)
             }
             Prim::Analytic { index, .. } => {
-                let (s, uv, n) = self.bvh.analytic(*index).surface_at(o, d, h.t);
+                let (s, uv, n) = self.bvh.analytic(index).surface_at(o, d, h.t);
                 flat(s, SurfaceCoord::Uv(uv), n)
             }
         }

@@ -114,6 +114,8 @@ pub mod visibility;
 
 pub use bounds::Bounds;
 pub use burial::{BurialMap, BurialRequest};
+#[cfg(feature = "trace-stats")]
+pub use bvh::stats as trace_stats;
 pub use chart::{CHART_CONE_DEG, CHART_MAX_TRIANGLES, Piece};
 pub use element::{Element, ElementDomain};
 pub use error::{GeometryError, ShapeProblem};
@@ -124,7 +126,7 @@ pub use form_factor::{
     form_factor_batch, form_factor_front, point_form_factor, point_to_polygon,
     point_to_polygon_front,
 };
-pub use geometry::{Geometry, Hit, RAY_EPSILON, Ray};
+pub use geometry::{BvhStats, Geometry, Hit, RAY_EPSILON, Ray};
 pub use ids::{ElementId, SurfaceId};
 pub use sampling::SurfaceSample;
 pub use shape::{Shape, ShapeKind, TriangleMesh};

@@ -196,3 +196,35 @@ fn sampling_densities_are_finite_and_positive_everywhere() {
         }
     }
 }
+
+#[test]
+fn primitive_triangles_and_bvh_stats_describe_the_tree() {
+    let triangles = curved_sheet(4).1.len();
+    let g = scene();
+    let geom = g.geometry();
+    // 12 cube triangles, 2 for the rectangle, the sheet's own; the sphere,
+    // cylinder and disk are analytic.
+    assert_eq!(geom.primitive_triangles().len(), 12 + 2 + triangles);
+    assert_eq!(geom.primitive_count(), 12 + 2 + triangles + 3);
+    let s = geom.bvh_stats();
+    // Every primitive in a leaf of at most four.
+    assert!(4 * s.leaves >= geom.primitive_count(), "{s:?}");
+    assert!(
+        s.nodes >= 1 && s.depth >= 1 && s.build_seconds >= 0.0,
+        "{s:?}"
+    );
+}
+
+#[test]
+fn an_empty_scene_answers_every_query() {
+    let geom = trilux_geometry::Geometry::build(&[]).unwrap();
+    let ray = Ray {
+        origin: DVec3::ZERO,
+        dir: DVec3::X,
+    };
+    assert!(geom.intersect(&ray, f64::INFINITY).is_none());
+    assert!(!geom.ray_occluded(&ray, f64::INFINITY));
+    assert!(!geom.occluded(DVec3::ZERO, DVec3::ONE));
+    assert_eq!(geom.intersect_batch(&[ray; 3], 1.0), vec![None; 3]);
+    assert_eq!(geom.bvh_stats().leaves, 0);
+}

@@ -1,8 +1,9 @@
-//! Scenes shared by the benchmarks (generated, no files).
+//! Scenes and ray workloads shared by the benchmarks and `cargo xtask
+//! rays` (generated, no files).
 #![allow(dead_code)]
 
-use glam::{DMat4, DQuat, DVec3, DVec4};
-use trilux_geometry::{Shape, ShapeKind, TriangleMesh};
+use glam::{DMat4, DQuat, DVec2, DVec3, DVec4};
+use trilux_geometry::{ElementForest, Geometry, Ray, Shape, ShapeKind, SurfaceId, TriangleMesh};
 
 /// A UV-tessellated sphere of `n × 2n` quads (4n² triangles) of radius
 /// 1 inside a flipped cube [-2, 2]³.
@@ -94,6 +95,53 @@ pub fn cornell_box() -> Vec<Shape> {
             0.29,
         ),
     ]
+}
+
+/// Incoherent rays from random points inside the box in random directions,
+/// and segments between random pairs of such points.
+pub fn workload(geom: &Geometry, count: usize, seed: u64) -> (Vec<Ray>, Vec<(DVec3, DVec3)>) {
+    let mut rng = Rng(seed);
+    let b = geom.bounds();
+    let (lo, hi) = (b.min + 0.05 * b.diagonal(), b.max - 0.05 * b.diagonal());
+    let rays = (0..count)
+        .map(|_| Ray {
+            origin: rng.in_box(lo, hi),
+            dir: rng.direction(),
+        })
+        .collect();
+    let segs = (0..count)
+        .map(|_| (rng.in_box(lo, hi), rng.in_box(lo, hi)))
+        .collect();
+    (rays, segs)
+}
+
+/// Gather-like rays: from points sampled on the surfaces, into their front
+/// hemisphere; shadow segments between points on two random surfaces.
+pub fn surface_workload(
+    forest: &ElementForest,
+    count: usize,
+    seed: u64,
+) -> (Vec<Ray>, Vec<(DVec3, DVec3)>) {
+    let mut rng = Rng(seed);
+    let n = forest.geometry().surfaces().len();
+    let point = |rng: &mut Rng| {
+        let s = SurfaceId(((rng.next_f64() * n as f64) as usize).min(n - 1) as u32);
+        forest.sample_surface(s, DVec2::new(rng.next_f64(), rng.next_f64()))
+    };
+    let rays = (0..count)
+        .map(|_| {
+            let s = point(&mut rng);
+            let d = rng.direction();
+            Ray {
+                origin: s.point,
+                dir: if d.dot(s.normal) < 0.0 { -d } else { d },
+            }
+        })
+        .collect();
+    let segs = (0..count)
+        .map(|_| (point(&mut rng).point, point(&mut rng).point))
+        .collect();
+    (rays, segs)
 }
 
 /// A small deterministic generator (splitmix64).
