@@ -30,17 +30,19 @@
 //!   solution is read directly.
 //!
 //! [`Preview`] drops every random ray: the link sum with the links' own
-//! visibility at x_s, and for a glossy x_s one mirror-direction reading of
-//! the solution. A noise-free (not shadow-exact) view for walkthroughs.
+//! visibility at x_s, and for a glossy x_s the direct light by a fixed
+//! quadrature over the emitters plus one mirror-direction reading of the
+//! solution's reflected light. A noise-free (not shadow-exact) view for
+//! walkthroughs.
 //!
 //! [`link_sum`]: crate::link_sum
 
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 
 use crate::bands;
 use crate::gather::{FinalGather, GatherScene, GatherStats, SurfacePoint, power_heuristic};
 use crate::link_sum::LinkCache;
-use crate::sampler::{PixelSampler, dims};
+use crate::sampler::{PixelSampler, dims, hammersley};
 
 /// How the link sum at a point resolves partial visibility.
 #[derive(Clone, Copy, Debug)]
@@ -211,7 +213,8 @@ impl<S> LinkGather<'_, S> {
     {
         let scene = self.scene;
         let base = dims::GATHER + level * dims::PER_LEVEL;
-        let mut l = light_sample(scene, x, wo, w.sampler, base, w.stats);
+        let (pick, u) = (w.sampler.get1(base), w.sampler.get2(base + 1));
+        let mut l = light_sample(scene, x, wo, pick, u, true, w.stats);
         let Some(bs) = scene.sample_bsdf(x, wo, w.sampler.get2(base + 3)) else {
             return l;
         };
@@ -314,22 +317,44 @@ impl<S> Preview<'_, S> {
         {
             l = bands::add(l, bands::mul(rho, e));
         }
-        if scene.is_glossy(&xs, wo)
-            && let Some((wi, albedo)) = scene.mirror(&xs, wo)
-            && let Some(xd) = scene.intersect(xs.point, wi)
-        {
-            stats.gather_rays += 1;
-            let back = -wi;
-            let reflected = lambertian_at(scene, &xd, back, &mut caches.scratch, stats)
-                .map_or_else(
-                    || scene.reflected(&xd, &xs),
-                    |l| bands::add(l, scene.reflected_glossy(&xd, &xs)),
-                );
-            let incoming = bands::add(scene.emitted(&xd, back), reflected);
-            l = bands::add(l, bands::mul(albedo, incoming));
+        if scene.is_glossy(&xs, wo) {
+            l = bands::add(l, preview_direct(scene, &xs, wo, stats));
+            if let Some((wi, albedo)) = scene.mirror(&xs, wo)
+                && let Some(xd) = scene.intersect(xs.point, wi)
+            {
+                stats.gather_rays += 1;
+                let reflected = lambertian_at(scene, &xd, -wi, &mut caches.scratch, stats)
+                    .map_or_else(
+                        || scene.reflected(&xd, &xs),
+                        |l| bands::add(l, scene.reflected_glossy(&xd, &xs)),
+                    );
+                l = bands::add(l, bands::mul(albedo, reflected));
+            }
         }
         finite_or_dropped(l, stats)
     }
+}
+
+/// Light points per glossy preview hit.
+const PREVIEW_LIGHT_POINTS: u32 = 16;
+
+/// The direct light a glossy part at `x` reflects towards `wo`, by a fixed
+/// quadrature over the emitters (the same [`PREVIEW_LIGHT_POINTS`] points
+/// of a Hammersley set at every pixel: no noise, and highlights of rough
+/// lobes; a narrow lobe sees the points as separate glints).
+fn preview_direct<S: GatherScene<N>, const N: usize>(
+    scene: &S,
+    x: &SurfacePoint<S::Locator>,
+    wo: DVec3,
+    stats: &mut GatherStats,
+) -> [f64; N] {
+    let mut sum = bands::zero();
+    for k in 0..PREVIEW_LIGHT_POINTS {
+        let u = hammersley(k, PREVIEW_LIGHT_POINTS);
+        let pick = (0.5 + f64::from(k) * 0.618_033_988_749_895).fract();
+        sum = bands::add(sum, light_sample(scene, x, wo, pick, u, false, stats));
+    }
+    bands::scale(sum, 1.0 / f64::from(PREVIEW_LIGHT_POINTS))
 }
 
 /// ρ_d(xd) times the link sum at `xd` with the links' own visibility
@@ -350,17 +375,19 @@ fn lambertian_at<S: GatherScene<N>, const N: usize>(
         .map(|e| bands::mul(rho, e))
 }
 
-/// One light sample for the glossy part at `x` (fr_glossy only), weighted
-/// by the power heuristic against BSDF sampling.
+/// One light sample for the glossy part at `x` (fr_glossy only), from the
+/// emitter `pick` and the point `u` on it; weighted by the power heuristic
+/// against BSDF sampling when `mis`.
 fn light_sample<S: GatherScene<N>, const N: usize>(
     scene: &S,
     x: &SurfacePoint<S::Locator>,
     wo: DVec3,
-    sampler: &PixelSampler,
-    base: u32,
+    pick: f64,
+    u: DVec2,
+    mis: bool,
     stats: &mut GatherStats,
 ) -> [f64; N] {
-    let Some(ls) = scene.sample_light(x, sampler.get1(base), sampler.get2(base + 1)) else {
+    let Some(ls) = scene.sample_light(x, pick, u) else {
         return bands::zero();
     };
     let d = ls.point - x.point;
@@ -388,7 +415,11 @@ fn light_sample<S: GatherScene<N>, const N: usize>(
         return bands::zero();
     }
     let pdf_light = ls.pdf_area * dist2 / cos_light;
-    let w = power_heuristic(pdf_light, scene.bsdf_pdf(x, wo, wi));
+    let w = if mis {
+        power_heuristic(pdf_light, scene.bsdf_pdf(x, wo, wi))
+    } else {
+        1.0
+    };
     bands::scale(bands::mul(f, ls.radiance), w / pdf_light)
 }
 

@@ -126,6 +126,19 @@ pub fn parse_target_error(text: &str) -> Result<f64, String> {
     }
 }
 
+/// An exposure in stops, within ±64 (2^64 already turns any radiance
+/// trilux accepts into white or black).
+pub fn parse_exposure(text: &str) -> Result<f64, String> {
+    let v: f64 = text
+        .parse()
+        .map_err(|_| format!("{} is not a number", quoted(text)))?;
+    if v.is_finite() && v.abs() <= 64.0 {
+        Ok(v)
+    } else {
+        Err(format!("{v} is not within ±64 stops"))
+    }
+}
+
 /// A field of view in (0, 180) degrees.
 pub fn parse_fov(text: &str) -> Result<f64, String> {
     let v: f64 = text

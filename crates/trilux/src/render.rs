@@ -11,8 +11,8 @@ use trilux_render::{
 };
 
 use crate::options::{
-    LookAt, SolveOptions, parse_film_edge, parse_fov, parse_lookat, parse_spp, parse_target_error,
-    parse_threads,
+    LookAt, SolveOptions, parse_exposure, parse_film_edge, parse_fov, parse_lookat, parse_spp,
+    parse_target_error, parse_threads,
 };
 use crate::output::{Outputs, stats_json};
 use crate::progress::Bars;
@@ -52,6 +52,10 @@ pub struct RenderArgs {
     /// Also write an sRGB-encoded PNG.
     #[arg(long)]
     pub png: Option<PathBuf>,
+    /// The PNG's exposure in stops: values scaled by 2^stops before
+    /// clamping to [0, 1] (the EXR keeps the radiance).
+    #[arg(long, default_value_t = 0.0, value_parser = parse_exposure, allow_hyphen_values = true)]
+    pub exposure: f64,
     /// Write solve and render statistics as JSON.
     #[arg(long)]
     pub stats: Option<PathBuf>,
@@ -197,7 +201,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         .context("the render produced no image")?;
     let mut files = vec![image.exr_bytes()?];
     if args.png.is_some() {
-        files.push(image.png_bytes(0.0)?);
+        files.push(image.png_bytes(args.exposure)?);
     }
     if args.stats.is_some() {
         let render = outcome.render.as_ref();

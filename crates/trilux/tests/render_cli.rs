@@ -148,6 +148,11 @@ fn unknown_option_is_a_usage_error() {
         &["--spp", "0"][..],
         &["--threads", "0"][..],
         &["--convergence", "2"][..],
+        &["--target-error", "0"][..],
+        &["--target-error", "1.5"][..],
+        &["--exposure", "nan"][..],
+        &["--exposure", "100"][..],
+        &["--gather", "rays"][..],
     ] {
         let mut args = vec!["render", "/no/such/scene.xml"];
         args.extend(bad);
@@ -156,4 +161,43 @@ fn unknown_option_is_a_usage_error() {
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert!(!stderr.contains("/no/such/scene.xml:"), "{bad:?}: {stderr}");
     }
+}
+
+/// `--exposure` scales the PNG by 2^stops before the sRGB curve: the
+/// furnace's radiance 2.0 at −2 stops is 0.5, sRGB-encoded
+/// 1.055 · 0.5^(1/2.4) − 0.055 = 0.7354, code 188 (the preview is within
+/// 2 % of 2.0 on every pixel, ±2.4 codes at that slope; at 0 stops every
+/// pixel clips to 255, which is what −2 stops avoids).
+#[test]
+fn exposure_scales_the_png() {
+    let dir = folder("exposure");
+    let furnace = scene("furnace.xml");
+    let codes = |stops: &str| {
+        let png = dir.join(format!("f{stops}.png"));
+        let mut args = vec!["render", furnace.as_str()];
+        let exr = dir.join("f.exr");
+        args.extend(["-o", s(&exr), "--png", s(&png), "--preview"]);
+        args.extend(&SMALL[..4]);
+        args.extend(["--quality", "draft", "--exposure", stops]);
+        let out = trilux(&args);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let decoder =
+            png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&png).unwrap()));
+        let mut reader = decoder.read_info().unwrap();
+        let mut buf = vec![0; reader.output_buffer_size().unwrap()];
+        let info = reader.next_frame(&mut buf).unwrap();
+        buf.truncate(info.buffer_size());
+        buf
+    };
+    let expected = (1.055 * 0.5f64.powf(1.0 / 2.4) - 0.055) * 255.0;
+    let dark = codes("-2");
+    assert!(
+        dark.iter().all(|&c| (f64::from(c) - expected).abs() <= 3.0),
+        "{dark:?}"
+    );
+    assert!(codes("0").iter().all(|&c| c == 255));
 }
