@@ -214,6 +214,32 @@ impl<'a, const N: usize, S: RadianceSolution<N>> SolvedScene<'a, N, S> {
             coord: p.locator.coord,
         }
     }
+
+    /// The link sum at `at`, seen from `side`, in the leaf `leaf`.
+    fn link_sum_at(
+        &self,
+        at: &SurfacePoint<HitLocator>,
+        side: Side,
+        leaf: ElementId,
+        visibility: LinkVisibility<'_>,
+        cache: &mut crate::link_sum::LinkCache<N>,
+        stats: &mut GatherStats,
+    ) -> Spectrum<N> {
+        let receiver = crate::link_sum::Receiver {
+            x: at.point,
+            n: at.locator.shading_normal * side.sign(),
+            coord: at.locator.coord,
+            leaf: FaceElement::new(leaf, side),
+        };
+        crate::link_sum::link_sum(
+            self.solution,
+            &self.links,
+            &receiver,
+            visibility,
+            cache,
+            stats,
+        )
+    }
 }
 
 impl<const N: usize, S: RadianceSolution<N>> GatherScene<N> for SolvedScene<'_, N, S> {
@@ -355,26 +381,11 @@ impl<const N: usize, S: RadianceSolution<N>> GatherScene<N> for SolvedScene<'_, 
             return None;
         }
         let side = viewer_side(at, wo);
-        let receiver = crate::link_sum::Receiver {
-            x: at.point,
-            n: at.locator.shading_normal * side.sign(),
-            coord: at.locator.coord,
-            leaf: FaceElement::new(
-                self.solution
-                    .forest()
-                    .locate(at.locator.surface, at.locator.coord),
-                side,
-            ),
-        };
-        let sum = crate::link_sum::link_sum(
-            self.solution,
-            &self.links,
-            &receiver,
-            visibility,
-            cache,
-            stats,
-        );
-        Some(sum.0)
+        let leaf = self
+            .solution
+            .forest()
+            .locate(at.locator.surface, at.locator.coord);
+        Some(self.link_sum_at(at, side, leaf, visibility, cache, stats).0)
     }
 
     fn near_correction(
@@ -397,21 +408,7 @@ impl<const N: usize, S: RadianceSolution<N>> GatherScene<N> for SolvedScene<'_, 
             e = forest.element(c).parent;
         };
         let rho = self.bsdf(at).diffuse_albedo(side);
-        let receiver = crate::link_sum::Receiver {
-            x: at.point,
-            n: at.locator.shading_normal * side.sign(),
-            coord: at.locator.coord,
-            leaf: FaceElement::new(leaf, side),
-        };
-        let visibility = LinkVisibility::Secondary;
-        let sum = crate::link_sum::link_sum(
-            self.solution,
-            &self.links,
-            &receiver,
-            visibility,
-            cache,
-            stats,
-        );
+        let sum = self.link_sum_at(at, side, leaf, LinkVisibility::Secondary, cache, stats);
         let face = FaceId::new(at.locator.surface, side);
         let le = match side {
             Side::Front => self.scene.emission()[at.locator.shape as usize],
