@@ -13,8 +13,8 @@ use trilux_brdf::{Bsdf, BsdfParams, Distribution, RoughConductorParams};
 use trilux_color::ColorParam;
 use trilux_render::camera::look_at;
 use trilux_render::{
-    BsdfSample, Camera, ExtraBounce, FovAxis, GatherScene, LightSample, ReconstructionFilter,
-    RenderSettings, SurfacePoint, render_image,
+    BsdfSample, Camera, Estimator, ExtraBounce, FovAxis, GatherScene, LightSample,
+    ReconstructionFilter, RenderSettings, SurfacePoint, render_image,
 };
 
 /// Floor z = 0 with a glossy BSDF (normal +z: world = local frame) under a
@@ -121,6 +121,66 @@ impl GatherScene<3> for GlossyFloor {
     }
     fn lobe_solid_angle(&self, _: &SurfacePoint<u8>, _: DVec3) -> f64 {
         0.1
+    }
+    fn is_glossy(&self, at: &SurfacePoint<u8>, _: DVec3) -> bool {
+        at.locator == 0
+    }
+    fn glossy_cos(&self, at: &SurfacePoint<u8>, wi: DVec3, wo: DVec3) -> [f64; 3] {
+        self.bsdf_cos(at, wi, wo)
+    }
+}
+
+/// The preview's fixed 16-point quadrature of a glossy floor's direct
+/// light against brute force, for lobes wide enough that 16 points over
+/// the light resolve them (α ≥ 0.3; docs/rendering.md says a narrow lobe
+/// sees the points as separate glints). Tolerance 5 %: the preview's stated
+/// accuracy for rough lobes; it has no noise, so the bound is the
+/// quadrature's error alone.
+#[test]
+fn preview_glossy_direct_light_matches_brute_force() {
+    for (dist, alpha, target) in [
+        (Distribution::Beckmann, 0.3, DVec3::new(0.6, -0.1, 0.0)),
+        (Distribution::Ggx, 0.5, DVec3::new(1.2, 0.4, 0.0)),
+        (Distribution::Ggx, 0.8, DVec3::new(-0.4, 0.9, 0.0)),
+    ] {
+        let params = BsdfParams::RoughConductor(RoughConductorParams {
+            distribution: dist,
+            alpha,
+            eta_k: None,
+            specular_reflectance: ColorParam::Float(0.9),
+        });
+        let scene = GlossyFloor {
+            bsdf: Bsdf::new(&params).unwrap(),
+            s: 0.3,
+            h: 1.0,
+            le: 4.0,
+        };
+        let eye = DVec3::new(target.x * 2.0 + 0.4, target.y * 2.0 - 0.3, 0.9);
+        let cam = Camera::new(
+            look_at(eye, target, DVec3::Z).unwrap(),
+            0.01,
+            FovAxis::X,
+            1,
+            1,
+        )
+        .unwrap();
+        let settings = RenderSettings {
+            spp: 1,
+            filter: ReconstructionFilter::Box,
+            estimator: Estimator::Preview,
+            ..Default::default()
+        };
+        let (img, _) = render_image::<_, 3>(&scene, &cam, &settings, |l| *l, |_, _| {}).unwrap();
+        let expected = scene.brute_force(target, (eye - target).normalize());
+        let got = img.get(0, 0)[0] as f64;
+        assert!(
+            expected > 0.05,
+            "{dist:?} {alpha}: {expected} too dark to test"
+        );
+        assert!(
+            (got - expected).abs() < 0.05 * expected,
+            "{dist:?} α={alpha}: preview {got}, brute force {expected}"
+        );
     }
 }
 
