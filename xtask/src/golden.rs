@@ -106,7 +106,17 @@ pub struct TriluxRun {
     pub convergence_ratio: f64,
 }
 
-/// Solves and renders `scenes/NAME.xml` (see [`TriluxRun`]).
+/// The scene file of a reference: `scenes/NAME.xml`, `.gltf` or `.glb`.
+pub fn scene_path(name: &str) -> PathBuf {
+    ["xml", "gltf", "glb"]
+        .iter()
+        .map(|ext| root().join(format!("scenes/{name}.{ext}")))
+        .find(|p| p.exists())
+        .unwrap_or_else(|| root().join(format!("scenes/{name}.xml")))
+}
+
+/// Solves and renders `scenes/NAME.xml` (or `.gltf`, `.glb`; see
+/// [`TriluxRun`]).
 pub fn render_trilux(
     name: &str,
     width: u32,
@@ -115,7 +125,7 @@ pub fn render_trilux(
     spp: u32,
     extra: ExtraBounce,
 ) -> Result<TriluxRun> {
-    let path = root().join(format!("scenes/{name}.xml"));
+    let path = scene_path(name);
     let scene = trilux_scene::load(&path).map_err(|e| anyhow::anyhow!("{e}"))?;
     let quality = match quality {
         "draft" => Quality::Draft,

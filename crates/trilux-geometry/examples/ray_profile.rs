@@ -37,6 +37,7 @@ fn main() -> Result<(), trilux_geometry::GeometryError> {
                 normals: None,
                 triangles: t,
                 face_normals: true,
+                texcoords: None,
             }),
             world_from_object: DMat4::IDENTITY,
             flip_normals: false,
