@@ -218,6 +218,8 @@ class Converter:
             bsdf = '<bsdf type="twosided">' + bsdf + "</bsdf>"
         strength = ext.get("KHR_materials_emissive_strength", {}).get("emissiveStrength", 1.0)
         e = np.array(m.get("emissiveFactor", [0, 0, 0]), float) * strength
+        if e.max() > 0 and m.get("doubleSided"):
+            raise SystemExit(f"material {index}: a double-sided emissive material is refused")
         emitter = ('<emitter type="area">' + rgb("radiance", e) + "</emitter>") if e.max() > 0 else ""
         return bsdf, emitter
 

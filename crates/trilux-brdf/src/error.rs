@@ -46,6 +46,8 @@ pub enum BrdfError {
     #[error("a texture stands for no parameter of its material ({0})")]
     TextureSlot(String),
     /// A textured side with more than one roughconductor.
-    #[error("a textured material may have at most one roughconductor on each side (its glossy part must be one lobe whose weight varies)")]
+    #[error(
+        "a textured material may have at most one roughconductor on each side (its glossy part must be one lobe whose weight varies)"
+    )]
     TexturedConductors,
 }

@@ -115,7 +115,11 @@ impl Texture {
                 texels: texels.len(),
             });
         }
-        if texels.iter().flatten().any(|v| !(v.is_finite() && *v >= 0.0)) {
+        if texels
+            .iter()
+            .flatten()
+            .any(|v| !(v.is_finite() && *v >= 0.0))
+        {
             return Err(BrdfError::TextureValue);
         }
         let mut sum = [0.0f64; 3];
@@ -253,7 +257,12 @@ mod tests {
         // i = −20..−9).
         let mitsuba = [1, 0, 0, 1, 2, 2, 1, 0, 0, 1, 2, 2];
         for (k, expected) in mitsuba.into_iter().enumerate() {
-            assert_eq!(Wrap::Mirror.apply(k as i64 - 20, 3), expected, "i {}", k as i64 - 20);
+            assert_eq!(
+                Wrap::Mirror.apply(k as i64 - 20, 3),
+                expected,
+                "i {}",
+                k as i64 - 20
+            );
         }
     }
 
@@ -283,7 +292,14 @@ mod tests {
     fn refuses_bad_texels() {
         assert!(Texture::new(2, 2, vec![[0.0; 3]; 3], [Wrap::Repeat; 2], Filter::Nearest).is_err());
         assert!(
-            Texture::new(1, 1, vec![[f32::NAN; 3]], [Wrap::Repeat; 2], Filter::Nearest).is_err()
+            Texture::new(
+                1,
+                1,
+                vec![[f32::NAN; 3]],
+                [Wrap::Repeat; 2],
+                Filter::Nearest
+            )
+            .is_err()
         );
     }
 }

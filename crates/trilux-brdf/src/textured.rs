@@ -197,10 +197,12 @@ fn compile<const N: usize>(
         Some(Value::Slot(i))
     };
     Ok(match p {
-        BsdfParams::Diffuse { reflectance } => Node::Diffuse(match slot(SlotKind::Reflectance, path, used) {
-            Some(v) => v,
-            None => Value::Const(color(reflectance, "diffuse reflectance")?),
-        }),
+        BsdfParams::Diffuse { reflectance } => {
+            Node::Diffuse(match slot(SlotKind::Reflectance, path, used) {
+                Some(v) => v,
+                None => Value::Const(color(reflectance, "diffuse reflectance")?),
+            })
+        }
         BsdfParams::RoughConductor(rc) => {
             Node::Conductor(match slot(SlotKind::SpecularReflectance, path, used) {
                 Some(v) => v,
@@ -265,7 +267,12 @@ fn set_nominal(p: &mut BsdfParams, path: &[Branch], kind: SlotKind, value: [f64;
         (BsdfParams::TwoSided { front, .. }, Some((Branch::Front, rest))) => {
             set_nominal(front, rest, kind, value)?;
         }
-        (BsdfParams::TwoSided { back: Some(back), .. }, Some((Branch::Back, rest))) => {
+        (
+            BsdfParams::TwoSided {
+                back: Some(back), ..
+            },
+            Some((Branch::Back, rest)),
+        ) => {
             set_nominal(back, rest, kind, value)?;
         }
         _ => return None,
@@ -290,8 +297,9 @@ impl<const N: usize> TexturedBsdf<N> {
         let mut params = params.clone();
         for (i, slot) in slots.iter().enumerate() {
             let nominal = slot_value(slot, slot.texture.mean());
-            set_nominal(&mut params, &slot.path, slot.kind, nominal)
-                .ok_or_else(|| BrdfError::TextureSlot(format!("{:?} at {:?}", slots[i].kind, slots[i].path)))?;
+            set_nominal(&mut params, &slot.path, slot.kind, nominal).ok_or_else(|| {
+                BrdfError::TextureSlot(format!("{:?} at {:?}", slots[i].kind, slots[i].path))
+            })?;
         }
         let params = &params;
         let bsdf = Bsdf::new(params)?;
@@ -305,7 +313,10 @@ impl<const N: usize> TexturedBsdf<N> {
                 };
                 (Some(f), Some(b))
             }
-            other => (Some(compile(other, &mut Vec::new(), &slots, &mut used)?), None),
+            other => (
+                Some(compile(other, &mut Vec::new(), &slots, &mut used)?),
+                None,
+            ),
         };
         if let Some(i) = used.iter().position(|u| !u) {
             return Err(BrdfError::TextureSlot(format!(
@@ -602,10 +613,24 @@ mod tests {
             second: Box::new(blend(0.5, 0.5, 0.5)),
         };
         assert_eq!(
-            TexturedBsdf::<3>::new(&two_conductors, vec![slot(vec![Branch::First, Branch::First], SlotKind::Reflectance, 1.0)]).err(),
+            TexturedBsdf::<3>::new(
+                &two_conductors,
+                vec![slot(
+                    vec![Branch::First, Branch::First],
+                    SlotKind::Reflectance,
+                    1.0
+                )]
+            )
+            .err(),
             Some(BrdfError::TexturedConductors)
         );
-        assert!(TexturedBsdf::<3>::new(&blend(0.5, 0.5, 0.5), vec![slot(vec![Branch::Second], SlotKind::Reflectance, 1.0)]).is_err());
+        assert!(
+            TexturedBsdf::<3>::new(
+                &blend(0.5, 0.5, 0.5),
+                vec![slot(vec![Branch::Second], SlotKind::Reflectance, 1.0)]
+            )
+            .is_err()
+        );
         assert_eq!(
             TexturedBsdf::<20>::new(&blend(0.5, 0.5, 0.5), one()).err(),
             Some(BrdfError::TexturedSpectral)

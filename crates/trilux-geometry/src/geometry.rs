@@ -174,7 +174,9 @@ impl Geometry {
     /// them).
     pub fn texcoord(&self, surface: SurfaceId, coord: SurfaceCoord) -> Option<DVec2> {
         match (&self.surfaces[surface.index()].geom, coord) {
-            (SurfaceGeom::Patch(_), SurfaceCoord::Uv(uv)) => Some(uv.clamp(DVec2::ZERO, DVec2::ONE)),
+            (SurfaceGeom::Patch(_), SurfaceCoord::Uv(uv)) => {
+                Some(uv.clamp(DVec2::ZERO, DVec2::ONE))
+            }
             (SurfaceGeom::Chart { mesh, .. }, SurfaceCoord::Triangle { index, bary }) => {
                 let m = &self.meshes[*mesh as usize];
                 let t = m.triangles.get(index as usize)?;

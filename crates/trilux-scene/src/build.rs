@@ -13,14 +13,14 @@ use trilux_color::ColorParam;
 use crate::camera::{Camera, FovAxis, ReconstructionFilter, default_fov};
 use crate::error::{Result, SceneError};
 use crate::material::{TextureCollector, build_bsdf, check_color};
+use crate::meshes::Requests;
 use crate::props::Props;
 use crate::resolve::Resolved;
 use crate::scene::{AreaEmitter, Scene, SceneShape};
-use crate::meshes::Requests;
 use crate::shape::{MeshRequest, build_shape};
 use crate::textures::TextureRequest;
-use trilux_geometry::ShapeKind;
 use crate::xml::Element;
+use trilux_geometry::ShapeKind;
 
 /// Builds the scene from the resolved tree. `path` is the scene file. OBJ
 /// shapes come with empty meshes and, beside the scene, the requests to

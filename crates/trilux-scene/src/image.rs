@@ -14,8 +14,8 @@
 
 use trilux_brdf::{Filter, Texture, Wrap};
 
-use crate::limits::MAX_TEXTURE_TEXELS;
 pub use crate::limits::MAX_IMAGE_BYTES;
+use crate::limits::MAX_TEXTURE_TEXELS;
 
 /// How a texture is looked up and whether its values are sRGB-encoded.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -43,7 +43,9 @@ pub enum ImageError {
         reason: String,
     },
     /// Too many texels.
-    #[error("image of {width} × {height} texels is beyond the limit of {MAX_TEXTURE_TEXELS} texels (docs/limits.md)")]
+    #[error(
+        "image of {width} × {height} texels is beyond the limit of {MAX_TEXTURE_TEXELS} texels (docs/limits.md)"
+    )]
     TooLarge {
         /// Width.
         width: u64,
@@ -122,10 +124,12 @@ fn decode_png(bytes: &[u8]) -> Result<Decoded, ImageError> {
     let header = decoder.read_header_info().map_err(err)?;
     check_size(header.width, header.height)?;
     let mut reader = decoder.read_info().map_err(err)?;
-    let size = reader.output_buffer_size().ok_or_else(|| ImageError::Decode {
-        format: "PNG",
-        reason: "the image's size overflows".into(),
-    })?;
+    let size = reader
+        .output_buffer_size()
+        .ok_or_else(|| ImageError::Decode {
+            format: "PNG",
+            reason: "the image's size overflows".into(),
+        })?;
     let mut buf = vec![0; size];
     let frame = reader.next_frame(&mut buf).map_err(err)?;
     let channels = frame.color_type.samples();
@@ -165,5 +169,11 @@ fn decode_jpeg(bytes: &[u8]) -> Result<Decoded, ImageError> {
             reason: "the decoded image has the wrong size".into(),
         });
     }
-    Ok((width, height, 3, pixels.into_iter().map(u16::from).collect(), 255))
+    Ok((
+        width,
+        height,
+        3,
+        pixels.into_iter().map(u16::from).collect(),
+        255,
+    ))
 }

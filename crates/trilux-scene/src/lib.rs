@@ -77,7 +77,10 @@ pub fn load(path: impl AsRef<Path>) -> Result<Scene, SceneError> {
 /// glTF file, `camera` names the camera to use (a camera's or its node's
 /// name; the first one otherwise). An XML scene has one `<sensor>`: naming
 /// a camera for it is an error.
-pub fn open_with_camera(path: impl AsRef<Path>, camera: Option<&str>) -> Result<Pending, SceneError> {
+pub fn open_with_camera(
+    path: impl AsRef<Path>,
+    camera: Option<&str>,
+) -> Result<Pending, SceneError> {
     let path = path.as_ref();
     if gltf::is_gltf(path) {
         return gltf::open(path, camera);
@@ -90,7 +93,9 @@ pub fn open_with_camera(path: impl AsRef<Path>, camera: Option<&str>) -> Result<
                 col: 1,
                 pointer: None,
             },
-            format!("--camera \"{name}\" chooses among a glTF file's cameras; this XML scene has one <sensor>"),
+            format!(
+                "--camera \"{name}\" chooses among a glTF file's cameras; this XML scene has one <sensor>"
+            ),
         ));
     }
     open(path)

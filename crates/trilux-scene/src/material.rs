@@ -178,7 +178,11 @@ fn no_other_objects(props: &Props<'_>) -> Result<()> {
     match props.objects.iter().find(|o| o.tag != "texture") {
         Some(o) => Err(SceneError::at(
             &o.loc,
-            format!("{} cannot contain {}", props.owner().describe(), o.describe()),
+            format!(
+                "{} cannot contain {}",
+                props.owner().describe(),
+                o.describe()
+            ),
         )),
         None => Ok(()),
     }
@@ -230,7 +234,10 @@ fn bitmap(e: &Element, kind: SlotKind, tex: &TextureCollector<'_>) -> Result<Tex
     let props = Props::new(e)?;
     props.no_objects()?;
     let filename = props.string("filename")?.ok_or_else(|| {
-        SceneError::at(&e.loc, "<texture type=\"bitmap\"> needs <string name=\"filename\">")
+        SceneError::at(
+            &e.loc,
+            "<texture type=\"bitmap\"> needs <string name=\"filename\">",
+        )
     })?;
     let choice = |name: &str, options: &[&str]| -> Result<Option<String>> {
         match props.string(name)? {

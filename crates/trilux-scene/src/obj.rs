@@ -241,11 +241,16 @@ fn bad_face_index(bytes: &[u8]) -> Option<i64> {
         match kind(line) {
             Some(k @ 0..=2) => so_far[k] += 1,
             Some(_) => {
-                let Ok(text) = std::str::from_utf8(line) else { continue };
+                let Ok(text) = std::str::from_utf8(line) else {
+                    continue;
+                };
                 for vertex in text.split_ascii_whitespace().skip(1) {
                     for (k, part) in vertex.split('/').take(3).enumerate() {
                         let Ok(n) = part.parse::<i64>() else { continue };
-                        if n == 0 || n > total[k] || (n < 0 && n.unsigned_abs() > so_far[k].unsigned_abs()) {
+                        if n == 0
+                            || n > total[k]
+                            || (n < 0 && n.unsigned_abs() > so_far[k].unsigned_abs())
+                        {
                             return Some(n);
                         }
                     }
@@ -296,7 +301,10 @@ mod tests {
             // (tobj wraps it around and then overflows doubling it), even
             // though more `vt` lines follow.
             (format!("{QUAD}f 1/-4 2/-2 3/-1\nvt 0 1\n"), Some(-4)),
-            (format!("{QUAD}f 1/4611686018427387904 2/2 3/3\n"), Some(4_611_686_018_427_387_904)),
+            (
+                format!("{QUAD}f 1/4611686018427387904 2/2 3/3\n"),
+                Some(4_611_686_018_427_387_904),
+            ),
             (format!("{QUAD}f 0 2 3\n"), Some(0)),
             (format!("{QUAD}f 1 2 \\\n 4\n"), Some(4)),
             (format!("{QUAD}f -3/-3 -2/-2 -1/-1\n"), None),

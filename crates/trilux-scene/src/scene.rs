@@ -109,7 +109,7 @@ impl Scene {
                 file: self.path.as_path().into(),
                 line: 1,
                 col: 1,
-        pointer: None,
+                pointer: None,
             },
         }
     }

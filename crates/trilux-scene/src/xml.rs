@@ -194,7 +194,7 @@ impl Context<'_, '_> {
             file: self.file.clone(),
             line: pos.row,
             col: pos.col,
-        pointer: None,
+            pointer: None,
         }
     }
 

@@ -665,10 +665,7 @@ impl<const N: usize> RefineContext<'_, N> {
         };
         // A textured j: its glossy part is g(j) times the nominal one.
         let (fr, texture_variation) = match self.textures {
-            Some(t) => (
-                fr * t.glossy(sj, j),
-                t.glossy_variation(self.forest, sj, j),
-            ),
+            Some(t) => (fr * t.glossy(sj, j), t.glossy_variation(self.forest, sj, j)),
             None => (fr, 0.0),
         };
         let gathered = known.unshot * fr * (PI * known.tij.t / aj);
@@ -685,9 +682,7 @@ impl<const N: usize> RefineContext<'_, N> {
         let (spread, driver) = self.fr_variation(bsdf, i, j, k);
         // fr's spread over the three elements, and over j the texture's.
         let spread = match self.textures {
-            Some(t) => {
-                spread * t.glossy(sj, j).max_value() + fr.max_value() * texture_variation
-            }
+            Some(t) => spread * t.glossy(sj, j).max_value() + fr.max_value() * texture_variation,
             None => spread,
         };
         let driver = if texture_variation > 0.0 && spread > 0.0 {

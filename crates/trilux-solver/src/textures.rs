@@ -122,7 +122,10 @@ fn fill<const N: usize>(
             Sided::from_fn(|side| {
                 let area = |c: ElementId| {
                     let a = exposed_area[side][c.index()];
-                    if kids.iter().any(|(k, _)| exposed_area[side][k.index()] > 0.0) {
+                    if kids
+                        .iter()
+                        .any(|(k, _)| exposed_area[side][k.index()] > 0.0)
+                    {
                         a
                     } else {
                         forest.element(c).area

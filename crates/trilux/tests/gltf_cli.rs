@@ -51,7 +51,11 @@ fn base64(bytes: &[u8]) -> String {
     const A: &[u8] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
     let mut out = String::new();
     for chunk in bytes.chunks(3) {
-        let b = [chunk[0], *chunk.get(1).unwrap_or(&0), *chunk.get(2).unwrap_or(&0)];
+        let b = [
+            chunk[0],
+            *chunk.get(1).unwrap_or(&0),
+            *chunk.get(2).unwrap_or(&0),
+        ];
         let n = (u32::from(b[0]) << 16) | (u32::from(b[1]) << 8) | u32::from(b[2]);
         for k in 0..4 {
             if k <= chunk.len() {
@@ -80,12 +84,22 @@ fn assert_refused_file(name: &str, path: &Path, pointer: &str, what: &str) {
     for args in [vec!["info", p], vec!["render", p, "-o", o]] {
         let out = trilux(&args);
         let stderr = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(out.status.code(), Some(1), "{name}: status; stderr {stderr}");
+        assert_eq!(
+            out.status.code(),
+            Some(1),
+            "{name}: status; stderr {stderr}"
+        );
         assert!(out.stdout.is_empty(), "{name}: no output");
         assert_eq!(stderr.lines().count(), 1, "{name}: one line: {stderr}");
         let prefix = format!("error: {p}:{pointer}");
-        assert!(stderr.starts_with(&prefix), "{name}: {stderr:?} should start with {prefix:?}");
-        assert!(stderr.contains(what), "{name}: {stderr:?} should say {what:?}");
+        assert!(
+            stderr.starts_with(&prefix),
+            "{name}: {stderr:?} should start with {prefix:?}"
+        );
+        assert!(
+            stderr.contains(what),
+            "{name}: {stderr:?} should say {what:?}"
+        );
         assert!(!image.exists(), "{name}: no image is written");
     }
 }
@@ -96,7 +110,11 @@ fn a_valid_triangle_loads() {
     let path = dir.join("tri.gltf");
     std::fs::write(&path, serde_json::to_vec(&triangle(|_| {})).unwrap()).unwrap();
     let out = trilux(&["info", path.to_str().unwrap(), "--json"]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["shapes"], 1);
     // glTF's default material: white, metallic 1: a rough conductor.
@@ -105,8 +123,14 @@ fn a_valid_triangle_loads() {
 
 #[test]
 fn unknown_required_extension() {
-    let j = triangle(|j| j["extensionsRequired"] = serde_json::json!(["KHR_draco_mesh_compression"]));
-    assert_refused("required", &j, "/extensionsRequired", "KHR_draco_mesh_compression");
+    let j =
+        triangle(|j| j["extensionsRequired"] = serde_json::json!(["KHR_draco_mesh_compression"]));
+    assert_refused(
+        "required",
+        &j,
+        "/extensionsRequired",
+        "KHR_draco_mesh_compression",
+    );
 }
 
 #[test]
@@ -118,14 +142,24 @@ fn missing_buffer_file() {
 #[test]
 fn short_buffer() {
     let j = triangle(|j| j["buffers"][0]["byteLength"] = 4000.into());
-    assert_refused("short-buffer", &j, "/buffers/0", "fewer than its byteLength");
+    assert_refused(
+        "short-buffer",
+        &j,
+        "/buffers/0",
+        "fewer than its byteLength",
+    );
 }
 
 #[test]
 fn out_of_range_index() {
     // An accessor index past the end: the gltf crate's validation.
     let j = triangle(|j| j["meshes"][0]["primitives"][0]["indices"] = 7.into());
-    assert_refused("index", &j, "/meshes/0/primitives/0/indices", "invalid glTF");
+    assert_refused(
+        "index",
+        &j,
+        "/meshes/0/primitives/0/indices",
+        "invalid glTF",
+    );
     // A vertex index past the vertex count: ours.
     let dir = folder("gltf-vertex-index");
     let mut j = triangle(|_| {});
@@ -133,10 +167,16 @@ fn out_of_range_index() {
     let payload = uri.split(',').nth(1).unwrap();
     let mut bin = decode64(payload);
     bin[40..42].copy_from_slice(&9u16.to_le_bytes());
-    j["buffers"][0]["uri"] = format!("data:application/octet-stream;base64,{}", base64(&bin)).into();
+    j["buffers"][0]["uri"] =
+        format!("data:application/octet-stream;base64,{}", base64(&bin)).into();
     let path = dir.join("vertex-index.gltf");
     std::fs::write(&path, serde_json::to_vec(&j).unwrap()).unwrap();
-    assert_refused_file("vertex-index", &path, "/accessors/1", "index 9 is out of range for 3 vertices");
+    assert_refused_file(
+        "vertex-index",
+        &path,
+        "/accessors/1",
+        "index 9 is out of range for 3 vertices",
+    );
 }
 
 fn decode64(s: &str) -> Vec<u8> {
@@ -160,7 +200,8 @@ fn nan_in_an_accessor() {
     let uri = j["buffers"][0]["uri"].as_str().unwrap().to_string();
     let mut bin = decode64(uri.split(',').nth(1).unwrap());
     bin[12..16].copy_from_slice(&f32::NAN.to_le_bytes());
-    j["buffers"][0]["uri"] = format!("data:application/octet-stream;base64,{}", base64(&bin)).into();
+    j["buffers"][0]["uri"] =
+        format!("data:application/octet-stream;base64,{}", base64(&bin)).into();
     assert_refused("nan", &j, "/accessors/0", "not a finite number");
 }
 
@@ -191,7 +232,12 @@ fn punctual_lights_are_refused_by_name() {
             {"name": "lamp", "extensions": {"KHR_lights_punctual": {"light": 0}}}
         ]);
     });
-    assert_refused("light", &j, "/nodes/2/extensions/KHR_lights_punctual", "point light \"Desk lamp\"");
+    assert_refused(
+        "light",
+        &j,
+        "/nodes/2/extensions/KHR_lights_punctual",
+        "point light \"Desk lamp\"",
+    );
 }
 
 #[test]
@@ -212,7 +258,10 @@ fn malformed_json_and_truncated_glb() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1));
     assert_eq!(stderr.lines().count(), 1, "{stderr}");
-    assert!(stderr.contains("bad.gltf") && stderr.contains("malformed glTF JSON"), "{stderr}");
+    assert!(
+        stderr.contains("bad.gltf") && stderr.contains("malformed glTF JSON"),
+        "{stderr}"
+    );
     let glb = std::fs::read(scenes().join("product-shot.glb")).unwrap();
     let cut = dir.join("cut.glb");
     std::fs::write(&cut, &glb[..glb.len() / 2]).unwrap();
@@ -220,14 +269,21 @@ fn malformed_json_and_truncated_glb() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{stderr}");
     assert_eq!(stderr.lines().count(), 1, "{stderr}");
-    assert!(stderr.starts_with(&format!("error: {}:", cut.display())), "{stderr}");
+    assert!(
+        stderr.starts_with(&format!("error: {}:", cut.display())),
+        "{stderr}"
+    );
 }
 
 fn info_json(path: &Path, extra: &[&str]) -> serde_json::Value {
     let mut args = vec!["info", path.to_str().unwrap(), "--json"];
     args.extend_from_slice(extra);
     let out = trilux(&args);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     serde_json::from_slice(&out.stdout).unwrap()
 }
 
@@ -248,14 +304,20 @@ fn info_json_of_a_glb_has_the_xml_keys() {
     assert_eq!(glb["emitters"], 1);
     assert_eq!(glb["mode"], "rgb");
     // The first camera, "front": at (0, 1.6, 3.5), 45° vertically.
-    assert_eq!(glb["camera"]["origin"], serde_json::json!([0.0, 1.600000023841858, 3.5]));
+    assert_eq!(
+        glb["camera"]["origin"],
+        serde_json::json!([0.0, 1.600000023841858, 3.5])
+    );
     assert!((glb["camera"]["fov"].as_f64().unwrap() - 45.0).abs() < 1e-4);
     assert_eq!(glb["camera"]["fov_axis"], "y");
     // The softbox: radiance 10 over 2 m × 2 m, one-sided: π · 4 · 10 W.
     let power = glb["emitted_power"].as_array().unwrap();
     for p in power {
         let expected = std::f64::consts::PI * 4.0 * 10.0;
-        assert!((p.as_f64().unwrap() - expected).abs() < 1e-4 * expected, "{power:?}");
+        assert!(
+            (p.as_f64().unwrap() - expected).abs() < 1e-4 * expected,
+            "{power:?}"
+        );
     }
 }
 
@@ -268,5 +330,8 @@ fn camera_by_name() {
     let out = trilux(&["info", p.to_str().unwrap(), "--camera", "side"]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1));
-    assert!(stderr.contains("no camera named \"side\"") && stderr.contains("front, top"), "{stderr}");
+    assert!(
+        stderr.contains("no camera named \"side\"") && stderr.contains("front, top"),
+        "{stderr}"
+    );
 }

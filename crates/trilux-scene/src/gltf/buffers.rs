@@ -81,7 +81,8 @@ pub(crate) fn relative_path(folder: &Path, uri: &str) -> std::result::Result<Pat
             i += 1;
         }
     }
-    let name = String::from_utf8(out).map_err(|_| "a URI that is not UTF-8 once decoded".to_string())?;
+    let name =
+        String::from_utf8(out).map_err(|_| "a URI that is not UTF-8 once decoded".to_string())?;
     Ok(folder.join(name))
 }
 
@@ -122,7 +123,10 @@ impl Buffers {
         }
         let bytes: Arc<[u8]> = match buffer.source() {
             gltf::buffer::Source::Bin => self.blob.clone().ok_or_else(|| {
-                self.at(index, "the buffer has no uri and the file has no binary chunk")
+                self.at(
+                    index,
+                    "the buffer has no uri and the file has no binary chunk",
+                )
             })?,
             gltf::buffer::Source::Uri(uri) => match data_uri(uri) {
                 Some(r) => Arc::from(r.map_err(|m| self.at(index, m))?),
@@ -162,7 +166,9 @@ impl Buffers {
     pub fn view(&mut self, view: &gltf::buffer::View<'_>) -> Result<Arc<[u8]>> {
         let bytes = self.get(&view.buffer())?;
         let (start, len) = (view.offset(), view.length());
-        let end = start.checked_add(len).filter(|&e| e <= view.buffer().length());
+        let end = start
+            .checked_add(len)
+            .filter(|&e| e <= view.buffer().length());
         match end {
             Some(end) => Ok(Arc::from(&bytes[start..end])),
             None => Err(SceneError::at(

@@ -20,7 +20,9 @@
 //! the way to write Mitsuba's `diffuse` in glTF), or the `roughconductor`
 //! alone when D̂ = 0 (a metal). `doubleSided` wraps it in `twosided`.
 //! Emission: `emissiveFactor × KHR_materials_emissive_strength` is the
-//! radiance of an area emitter on the front side.
+//! radiance of an area emitter on the front side; an emissive material that
+//! is also `doubleSided` is refused (glTF would have it emit on both sides,
+//! and trilux's area emitters emit on the front only).
 //!
 //! Refused (one error naming the material): `metallicRoughnessTexture`,
 //! `emissiveTexture`, the textures of `KHR_materials_specular`,
@@ -81,8 +83,14 @@ pub(crate) fn map(file: &Arc<Path>, m: &gltf::Material<'_>) -> Result<Mapped> {
         None => "/materials (the default material)".into(),
     };
     let at = |suffix: &str, msg: String| {
-        let name = m.name().map(|n| format!("material \"{n}\": ")).unwrap_or_default();
-        SceneError::at(&SourceLocation::json(file, format!("{base}{suffix}")), format!("{name}{msg}"))
+        let name = m
+            .name()
+            .map(|n| format!("material \"{n}\": "))
+            .unwrap_or_default();
+        SceneError::at(
+            &SourceLocation::json(file, format!("{base}{suffix}")),
+            format!("{name}{msg}"),
+        )
     };
     refuse_unsupported(m, &at)?;
     let pbr = m.pbr_metallic_roughness();
@@ -91,10 +99,18 @@ pub(crate) fn map(file: &Arc<Path>, m: &gltf::Material<'_>) -> Result<Mapped> {
     let metal = f64::from(pbr.metallic_factor()).clamp(0.0, 1.0);
     let rough = f64::from(pbr.roughness_factor()).clamp(0.0, 1.0);
     let (sf, sc) = match m.specular() {
-        Some(s) => (f64::from(s.specular_factor()), s.specular_color_factor().map(f64::from)),
+        Some(s) => (
+            f64::from(s.specular_factor()),
+            s.specular_color_factor().map(f64::from),
+        ),
         None => (1.0, [1.0; 3]),
     };
-    if !(b.iter().all(|v| v.is_finite()) && metal.is_finite() && rough.is_finite() && sf.is_finite() && sc.iter().all(|v| v.is_finite())) {
+    if !(b.iter().all(|v| v.is_finite())
+        && metal.is_finite()
+        && rough.is_finite()
+        && sf.is_finite()
+        && sc.iter().all(|v| v.is_finite()))
+    {
         return Err(at("", "a factor is not a finite number".into()));
     }
     let f0 = sc.map(|c| (0.04 * c).clamp(0.0, 1.0) * sf.clamp(0.0, 1.0));
@@ -139,7 +155,12 @@ pub(crate) fn map(file: &Arc<Path>, m: &gltf::Material<'_>) -> Result<Mapped> {
     };
     let (bsdf, mut types) = if s_hat <= 0.0 {
         add(vec![], SlotKind::Reflectance, d_scale, [0.0; 3]);
-        (BsdfParams::Diffuse { reflectance: ColorParam::Rgb(d_scale) }, vec!["diffuse"])
+        (
+            BsdfParams::Diffuse {
+                reflectance: ColorParam::Rgb(d_scale),
+            },
+            vec!["diffuse"],
+        )
     } else if d_hat <= 0.0 {
         add(vec![], SlotKind::SpecularReflectance, s_scale, s_offset);
         let s = std::array::from_fn(|c| s_offset[c] + s_scale[c]);
@@ -153,7 +174,9 @@ pub(crate) fn map(file: &Arc<Path>, m: &gltf::Material<'_>) -> Result<Mapped> {
         let s = std::array::from_fn(|c| (so[c] + ss[c]).min(1.0));
         let blend = BsdfParams::Blend {
             weight: w,
-            first: Box::new(BsdfParams::Diffuse { reflectance: ColorParam::Rgb(d.map(|c| c.min(1.0))) }),
+            first: Box::new(BsdfParams::Diffuse {
+                reflectance: ColorParam::Rgb(d.map(|c| c.min(1.0))),
+            }),
             second: Box::new(conductor(s)),
         };
         (blend, vec!["blendbsdf", "diffuse", "roughconductor"])
@@ -163,7 +186,10 @@ pub(crate) fn map(file: &Arc<Path>, m: &gltf::Material<'_>) -> Result<Mapped> {
         for t in &mut textures {
             t.path.insert(0, Branch::Front);
         }
-        BsdfParams::TwoSided { front: Box::new(bsdf), back: None }
+        BsdfParams::TwoSided {
+            front: Box::new(bsdf),
+            back: None,
+        }
     } else {
         bsdf
     };
@@ -180,11 +206,33 @@ type At<'a> = dyn Fn(&str, String) -> SceneError + 'a;
 fn refuse_unsupported(m: &gltf::Material<'_>, at: &At<'_>) -> Result<()> {
     let pbr = m.pbr_metallic_roughness();
     let refused = [
-        (pbr.metallic_roughness_texture().is_some(), "/pbrMetallicRoughness/metallicRoughnessTexture", "metallicRoughnessTexture is not supported (trilux's materials have one roughness and one metallic value; bake them into the factors)"),
-        (m.emissive_texture().is_some(), "/emissiveTexture", "emissiveTexture is not supported (trilux's area emitters have one radiance per shape)"),
-        (m.normal_texture().is_some(), "/normalTexture", "normalTexture is not supported (trilux shades with the mesh's own normals)"),
-        (m.specular().is_some_and(|s| s.specular_texture().is_some() || s.specular_color_texture().is_some()), "/extensions/KHR_materials_specular", "the textures of KHR_materials_specular are not supported (only its factors)"),
-        (m.alpha_mode() != gltf::material::AlphaMode::Opaque, "/alphaMode", "alphaMode MASK and BLEND are not supported (trilux's surfaces are opaque)"),
+        (
+            pbr.metallic_roughness_texture().is_some(),
+            "/pbrMetallicRoughness/metallicRoughnessTexture",
+            "metallicRoughnessTexture is not supported (trilux's materials have one roughness and one metallic value; bake them into the factors)",
+        ),
+        (
+            m.emissive_texture().is_some(),
+            "/emissiveTexture",
+            "emissiveTexture is not supported (trilux's area emitters have one radiance per shape)",
+        ),
+        (
+            m.normal_texture().is_some(),
+            "/normalTexture",
+            "normalTexture is not supported (trilux shades with the mesh's own normals)",
+        ),
+        (
+            m.specular().is_some_and(|s| {
+                s.specular_texture().is_some() || s.specular_color_texture().is_some()
+            }),
+            "/extensions/KHR_materials_specular",
+            "the textures of KHR_materials_specular are not supported (only its factors)",
+        ),
+        (
+            m.alpha_mode() != gltf::material::AlphaMode::Opaque,
+            "/alphaMode",
+            "alphaMode MASK and BLEND are not supported (trilux's surfaces are opaque)",
+        ),
     ];
     for (is, suffix, message) in refused {
         if is {
@@ -198,12 +246,28 @@ fn emission(m: &gltf::Material<'_>, at: &At<'_>) -> Result<Option<ColorParam>> {
     let strength = f64::from(m.emissive_strength().unwrap_or(1.0));
     let e = m.emissive_factor().map(|v| f64::from(v) * strength);
     if !e.iter().all(|v| v.is_finite() && *v >= 0.0) {
-        return Err(at("/emissiveFactor", "emitted radiance must be finite and non-negative".into()));
+        return Err(at(
+            "/emissiveFactor",
+            "emitted radiance must be finite and non-negative".into(),
+        ));
     }
     if let Some(v) = e.iter().find(|v| **v > crate::limits::MAX_RADIANCE) {
-        return Err(at("/emissiveFactor", format!("radiance {v:e} is beyond the limit {:e} (docs/limits.md)", crate::limits::MAX_RADIANCE)));
+        return Err(at(
+            "/emissiveFactor",
+            format!(
+                "radiance {v:e} is beyond the limit {:e} (docs/limits.md)",
+                crate::limits::MAX_RADIANCE
+            ),
+        ));
     }
-    Ok(e.iter().any(|&v| v > 0.0).then_some(ColorParam::Rgb(e)))
+    let emits = e.iter().any(|&v| v > 0.0);
+    if emits && m.double_sided() {
+        return Err(at(
+            "/doubleSided",
+            "a double-sided emissive material is not supported: trilux's area emitters emit on their front side only (make the material single-sided, or give each side its own primitive)".into(),
+        ));
+    }
+    Ok(emits.then_some(ColorParam::Rgb(e)))
 }
 
 /// The image, sampling and place of a texture reference.
@@ -214,7 +278,13 @@ fn texture_info(
     location: SourceLocation,
 ) -> Result<(usize, Sampling, SourceLocation)> {
     if t.tex_coord() != 0 {
-        return Err(at(suffix, format!("texCoord {} is not supported (only TEXCOORD_0)", t.tex_coord())));
+        return Err(at(
+            suffix,
+            format!(
+                "texCoord {} is not supported (only TEXCOORD_0)",
+                t.tex_coord()
+            ),
+        ));
     }
     if t.texture_transform().is_some() {
         return Err(at(suffix, "KHR_texture_transform is not supported".into()));
@@ -234,5 +304,13 @@ fn texture_info(
         Some(gltf::texture::MagFilter::Nearest) => Filter::Nearest,
         _ => Filter::Bilinear,
     };
-    Ok((texture.source().index(), Sampling { wrap: [ws, wt], filter, raw: false }, location))
+    Ok((
+        texture.source().index(),
+        Sampling {
+            wrap: [ws, wt],
+            filter,
+            raw: false,
+        },
+        location,
+    ))
 }

@@ -149,7 +149,12 @@ impl Walk<'_> {
         let i = node.index();
         let here = format!("/nodes/{i}");
         if depth > MAX_NODE_DEPTH {
-            return Err(self.at(here, format!("the node hierarchy is deeper than {MAX_NODE_DEPTH} levels (docs/limits.md)")));
+            return Err(self.at(
+                here,
+                format!(
+                    "the node hierarchy is deeper than {MAX_NODE_DEPTH} levels (docs/limits.md)"
+                ),
+            ));
         }
         if !self.seen.insert(i) || self.seen.len() > MAX_GLTF_NODES {
             return Err(self.at(here, "the node is reached twice (glTF's nodes form disjoint trees), or the scene has too many nodes"));
@@ -177,14 +182,20 @@ impl Walk<'_> {
         if let Some(c) = node.camera() {
             match c.projection() {
                 gltf::camera::Projection::Perspective(p) => self.cameras.push(CameraNode {
-                    names: [c.name().map(str::to_string), node.name().map(str::to_string)],
+                    names: [
+                        c.name().map(str::to_string),
+                        node.name().map(str::to_string),
+                    ],
                     node: i,
                     yfov: f64::from(p.yfov()),
                     aspect: p.aspect_ratio().map(f64::from),
                     world,
                 }),
                 gltf::camera::Projection::Orthographic(_) => {
-                    return Err(self.at(format!("/cameras/{}", c.index()), "orthographic cameras are not supported (only perspective)"));
+                    return Err(self.at(
+                        format!("/cameras/{}", c.index()),
+                        "orthographic cameras are not supported (only perspective)",
+                    ));
                 }
             }
         }
@@ -208,15 +219,29 @@ impl Walk<'_> {
     ) -> Result<()> {
         let here = format!("/meshes/{}/primitives/{}", mesh.index(), p.index());
         if p.mode() != gltf::mesh::Mode::Triangles {
-            return Err(self.at(format!("{here}/mode"), format!("primitive mode {:?} is not supported (only TRIANGLES)", p.mode())));
+            return Err(self.at(
+                format!("{here}/mode"),
+                format!(
+                    "primitive mode {:?} is not supported (only TRIANGLES)",
+                    p.mode()
+                ),
+            ));
         }
-        let positions = p
-            .get(&gltf::Semantic::Positions)
-            .ok_or_else(|| self.at(format!("{here}/attributes"), "the primitive has no POSITION"))?;
+        let positions = p.get(&gltf::Semantic::Positions).ok_or_else(|| {
+            self.at(
+                format!("{here}/attributes"),
+                "the primitive has no POSITION",
+            )
+        })?;
         let corners = p.indices().map_or(positions.count(), |a| a.count());
         self.triangles += corners / 3;
         if self.triangles > MAX_GLTF_TRIANGLES {
-            return Err(self.at(here, format!("the scene places more than {MAX_GLTF_TRIANGLES} triangles (docs/limits.md)")));
+            return Err(self.at(
+                here,
+                format!(
+                    "the scene places more than {MAX_GLTF_TRIANGLES} triangles (docs/limits.md)"
+                ),
+            ));
         }
         let material = p.material();
         let key = material.index();
@@ -232,13 +257,19 @@ impl Walk<'_> {
         };
         let shape = self.shapes.len();
         let location = SourceLocation::json(self.file, format!("/nodes/{}", node.index()));
-        let emitter = mapped.emission.clone().map(|radiance: ColorParam| AreaEmitter {
-            radiance,
-            location: SourceLocation::json(
-                self.file,
-                format!("/materials/{}/emissiveFactor", key.map_or("-".into(), |k| k.to_string())),
-            ),
-        });
+        let emitter = mapped
+            .emission
+            .clone()
+            .map(|radiance: ColorParam| AreaEmitter {
+                radiance,
+                location: SourceLocation::json(
+                    self.file,
+                    format!(
+                        "/materials/{}/emissiveFactor",
+                        key.map_or("-".into(), |k| k.to_string())
+                    ),
+                ),
+            });
         self.textures
             .extend(mapped.textures.iter().map(|t| (shape, t.clone())));
         let bsdf: BsdfParams = mapped.bsdf.clone();
@@ -283,7 +314,14 @@ fn choose_camera(
                         .collect();
                     SceneError::at(
                         &SourceLocation::json(file, "/cameras"),
-                        format!("no camera named \"{n}\" (the scene's cameras: {})", if known.is_empty() { "none".into() } else { known.join(", ") }),
+                        format!(
+                            "no camera named \"{n}\" (the scene's cameras: {})",
+                            if known.is_empty() {
+                                "none".into()
+                            } else {
+                                known.join(", ")
+                            }
+                        ),
                     )
                 })?,
         ),
@@ -296,7 +334,10 @@ fn camera(file: &Arc<Path>, c: &CameraNode) -> Result<Camera> {
     let err = |m: String| SceneError::at(&location, m);
     let fov = c.yfov.to_degrees();
     if !(fov > 0.0 && fov < 180.0) {
-        return Err(err(format!("yfov must lie strictly between 0 and π, found {}", c.yfov)));
+        return Err(err(format!(
+            "yfov must lie strictly between 0 and π, found {}",
+            c.yfov
+        )));
     }
     // Scale removed: each axis of the node's rotation normalised.
     let l = DMat3::from_mat4(c.world);
@@ -306,12 +347,17 @@ fn camera(file: &Arc<Path>, c: &CameraNode) -> Result<Camera> {
         || axes[0].dot(axes[2]).abs() > 1e-3
         || axes[1].dot(axes[2]).abs() > 1e-3
     {
-        return Err(err("the camera's node transform is singular or shears".into()));
+        return Err(err(
+            "the camera's node transform is singular or shears".into()
+        ));
     }
     let origin = c.world.w_axis.truncate();
     let largest = origin.abs().max_element();
     if !trilux_geometry::limits::within(largest) {
-        return Err(err(format!("the camera's position: {}", trilux_geometry::limits::beyond(largest))));
+        return Err(err(format!(
+            "the camera's position: {}",
+            trilux_geometry::limits::beyond(largest)
+        )));
     }
     // glTF: looks down −z, +x right; Mitsuba: down +z, +x left.
     let world_from_camera = DMat4::from_cols(
@@ -322,7 +368,9 @@ fn camera(file: &Arc<Path>, c: &CameraNode) -> Result<Camera> {
     );
     let width = 768u32;
     let height = match c.aspect {
-        Some(a) if a.is_finite() && a > 0.0 => ((f64::from(width) / a).round() as u32).clamp(1, crate::limits::MAX_FILM_EDGE),
+        Some(a) if a.is_finite() && a > 0.0 => {
+            ((f64::from(width) / a).round() as u32).clamp(1, crate::limits::MAX_FILM_EDGE)
+        }
         Some(a) => return Err(err(format!("aspectRatio must be positive, found {a}"))),
         None => 576,
     };
@@ -357,7 +405,11 @@ impl GltfMeshes {
             let describe = format!("mesh {} primitive {}", placed.mesh, placed.primitive);
             check_area(&shape.shape, &shape.location, &describe)?;
         }
-        let folder: PathBuf = self.file.parent().map(Path::to_path_buf).unwrap_or_default();
+        let folder: PathBuf = self
+            .file
+            .parent()
+            .map(Path::to_path_buf)
+            .unwrap_or_default();
         let mut images: HashMap<usize, ImageSource> = HashMap::new();
         let mut out = Vec::with_capacity(self.textures.len());
         for (shape, t) in &self.textures {
@@ -385,8 +437,18 @@ impl GltfMeshes {
         Ok(out)
     }
 
-    fn image_source(&self, buffers: &mut Buffers, folder: &Path, index: usize) -> Result<ImageSource> {
-        let at = |m: String| SceneError::at(&SourceLocation::json(&self.file, format!("/images/{index}")), m);
+    fn image_source(
+        &self,
+        buffers: &mut Buffers,
+        folder: &Path,
+        index: usize,
+    ) -> Result<ImageSource> {
+        let at = |m: String| {
+            SceneError::at(
+                &SourceLocation::json(&self.file, format!("/images/{index}")),
+                m,
+            )
+        };
         let image = self
             .document
             .images()
@@ -415,16 +477,22 @@ impl GltfMeshes {
         let pos = accessor::read(&self.file, buffers, &pos_acc, Kind::Vec3, "POSITION")?;
         let n = pos.len() / 3;
         if n > MAX_OBJ_VERTICES {
-            return Err(at(format!("{n} vertices; the limit is {MAX_OBJ_VERTICES} (docs/limits.md)")));
+            return Err(at(format!(
+                "{n} vertices; the limit is {MAX_OBJ_VERTICES} (docs/limits.md)"
+            )));
         }
-        let mut attribute = |s: gltf::Semantic, kind: Kind, name: &str, width: usize| -> Result<Option<Vec<f64>>> {
-            let Some(a) = get(s) else { return Ok(None) };
-            let v = accessor::read(&self.file, buffers, &a, kind, name)?;
-            if v.len() != n * width {
-                return Err(at(format!("{name} has {} elements but POSITION has {n}", v.len() / width)));
-            }
-            Ok(Some(v))
-        };
+        let mut attribute =
+            |s: gltf::Semantic, kind: Kind, name: &str, width: usize| -> Result<Option<Vec<f64>>> {
+                let Some(a) = get(s) else { return Ok(None) };
+                let v = accessor::read(&self.file, buffers, &a, kind, name)?;
+                if v.len() != n * width {
+                    return Err(at(format!(
+                        "{name} has {} elements but POSITION has {n}",
+                        v.len() / width
+                    )));
+                }
+                Ok(Some(v))
+            };
         let normals = attribute(gltf::Semantic::Normals, Kind::Vec3, "NORMAL", 3)?;
         let texcoords = attribute(gltf::Semantic::TexCoords(0), Kind::Vec2, "TEXCOORD_0", 2)?;
         let indices: Vec<u32> = match p.indices() {
@@ -441,10 +509,16 @@ impl GltfMeshes {
             None => (0..n as u32).collect(),
         };
         if indices.len() % 3 != 0 || indices.is_empty() {
-            return Err(at(format!("{} vertex indices do not make whole triangles", indices.len())));
+            return Err(at(format!(
+                "{} vertex indices do not make whole triangles",
+                indices.len()
+            )));
         }
         if indices.len() / 3 > MAX_OBJ_TRIANGLES {
-            return Err(at(format!("{} triangles; the limit is {MAX_OBJ_TRIANGLES} (docs/limits.md)", indices.len() / 3)));
+            return Err(at(format!(
+                "{} triangles; the limit is {MAX_OBJ_TRIANGLES} (docs/limits.md)",
+                indices.len() / 3
+            )));
         }
         let world = placed.world;
         let normal_matrix = DMat3::from_mat4(world).inverse().transpose();
@@ -461,8 +535,12 @@ impl GltfMeshes {
             positions,
             face_normals: normals.is_none(),
             normals,
-            triangles: indices.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect(),
-            texcoords: texcoords.map(|v| v.chunks_exact(2).map(|c| DVec2::new(c[0], c[1])).collect()),
+            triangles: indices
+                .chunks_exact(3)
+                .map(|t| [t[0], t[1], t[2]])
+                .collect(),
+            texcoords: texcoords
+                .map(|v| v.chunks_exact(2).map(|c| DVec2::new(c[0], c[1])).collect()),
         })
     }
 }
