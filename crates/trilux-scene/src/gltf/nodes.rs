@@ -342,7 +342,7 @@ fn camera(file: &Arc<Path>, c: &CameraNode) -> Result<Camera> {
     // Scale removed: each axis of the node's rotation normalised.
     let l = DMat3::from_mat4(c.world);
     let axes = [l.x_axis, l.y_axis, l.z_axis].map(|a| a.normalize_or_zero());
-    if axes.iter().any(|a| *a == DVec3::ZERO)
+    if axes.contains(&DVec3::ZERO)
         || axes[0].dot(axes[1]).abs() > 1e-3
         || axes[0].dot(axes[2]).abs() > 1e-3
         || axes[1].dot(axes[2]).abs() > 1e-3
@@ -508,7 +508,7 @@ impl GltfMeshes {
             }
             None => (0..n as u32).collect(),
         };
-        if indices.len() % 3 != 0 || indices.is_empty() {
+        if !indices.len().is_multiple_of(3) || indices.is_empty() {
             return Err(at(format!(
                 "{} vertex indices do not make whole triangles",
                 indices.len()
