@@ -25,6 +25,10 @@ Relative RMSE, the definition used here and by `cargo xtask golden`:
                         / sum_{pixels p not masked, channels c} r_pc^2 )
 (the RMS error normalised by the RMS of the reference).
 
+glTF scenes (scenes/NAME.gltf, scenes/NAME.glb) are first converted by
+scripts/gltf_to_mitsuba.py (the mapping trilux uses, docs/gltf.md) into a
+temporary folder, and that Mitsuba scene is rendered.
+
 Variant: `llvm_ad_spectral` when the scene has a <spectrum> with
 wavelength:value pairs (the scene is spectral in trilux too: README, "Scene format"),
 else `llvm_ad_rgb`. Both output linear sRGB.
@@ -132,11 +136,19 @@ def main():
         raise SystemExit("--spp must be an even multiple of --pass-spp")
     passes = args.spp // args.pass_spp
 
-    paths = sorted(glob.glob(os.path.join(args.scenes, "*.xml")))
+    paths = sorted(p for ext in ("xml", "gltf", "glb")
+                   for p in glob.glob(os.path.join(args.scenes, f"*.{ext}")))
     if args.only:
-        paths = [p for p in paths if os.path.basename(p)[:-4] in args.only]
-    for path in paths:
-        name = os.path.basename(path)[:-4]
+        paths = [p for p in paths if os.path.splitext(os.path.basename(p))[0] in args.only]
+    for source in paths:
+        name, ext = os.path.splitext(os.path.basename(source))
+        path = source
+        if ext in (".gltf", ".glb"):
+            sys.path.insert(0, os.path.join(ROOT, "scripts"))
+            import tempfile
+            import gltf_to_mitsuba
+            mi.set_variant("scalar_rgb")
+            path = gltf_to_mitsuba.convert(source, tempfile.mkdtemp(prefix=f"trilux-{name}-"))
         variant = "llvm_ad_spectral" if is_spectral(path) else "llvm_ad_rgb"
         mi.set_variant(variant)
         print(f"{name}: {variant}, {args.res}x{args.res}, {args.spp} spp", flush=True)
@@ -169,7 +181,7 @@ def main():
         write_exr(os.path.join(args.out, f"{name}.mask.exr"),
                   np.repeat(mask[:, :, None].astype(np.float32), 3, axis=2))
         info = {
-            "scene": f"scenes/{name}.xml",
+            "scene": f"scenes/{name}{ext}",
             "mitsuba": mi.__version__,
             "variant": variant,
             "integrator": f"path, max_depth {args.max_depth}",

@@ -124,9 +124,18 @@ pub struct TriluxRun {
     pub convergence_ratio: f64,
 }
 
+/// The scene file of a reference: `scenes/NAME.xml`, `.gltf` or `.glb`.
+pub fn scene_path(name: &str) -> PathBuf {
+    ["xml", "gltf", "glb"]
+        .iter()
+        .map(|ext| root().join(format!("scenes/{name}.{ext}")))
+        .find(|p| p.exists())
+        .unwrap_or_else(|| root().join(format!("scenes/{name}.xml")))
+}
+
 /// Runs `spec` (see [`TriluxSpec`]).
 pub fn run_trilux(spec: &TriluxSpec<'_>) -> Result<TriluxRun> {
-    let path = root().join(format!("scenes/{}.xml", spec.name));
+    let path = scene_path(spec.name);
     let scene = trilux_scene::load(&path).map_err(|e| anyhow::anyhow!("{e}"))?;
     let camera = scene.camera.as_ref().context("the scene has no camera")?;
     let render = spec.render.map(|tweak| {

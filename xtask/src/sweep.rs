@@ -205,7 +205,7 @@ fn trilux_points(r: &Reference, grid: &Grid, out: &Path) -> Result<Vec<Point>> {
 
 /// Mitsuba's points of one scene.
 fn mitsuba_points(r: &Reference, grid: &Grid, out: &Path) -> Result<Vec<Point>> {
-    let scene = root().join(format!("scenes/{}.xml", r.name));
+    let scene = crate::golden::scene_path(&r.name);
     let mut points = Vec::new();
     for &spp in &grid.mitsuba_spps {
         let exr = out.join(format!("{}-mitsuba-{spp}.exr", r.name));

@@ -22,4 +22,32 @@ pub enum BrdfError {
     /// `twosided` may only appear at the top of a material, as in Mitsuba.
     #[error("twosided may not be nested inside another BSDF")]
     NestedTwoSided,
+    /// A texture's texel count does not match its size.
+    #[error("a texture of {width} × {height} texels cannot hold {texels}")]
+    TextureSize {
+        /// Width.
+        width: u32,
+        /// Height.
+        height: u32,
+        /// Texels given.
+        texels: usize,
+    },
+    /// A texel is negative or not finite.
+    #[error("a texture has a texel that is negative or not a finite number")]
+    TextureValue,
+    /// Textures are RGB: a solve in spectral bands would upsample every
+    /// lookup.
+    #[error("textured materials need RGB mode (--mode rgb): textures are RGB images")]
+    TexturedSpectral,
+    /// More textures on one material than it takes.
+    #[error("a material takes at most 4 textures (MAX_SLOTS), found {0}")]
+    TooManyTextures(usize),
+    /// A texture stands for no parameter of its material.
+    #[error("a texture stands for no parameter of its material ({0})")]
+    TextureSlot(String),
+    /// A textured side with more than one roughconductor.
+    #[error(
+        "a textured material may have at most one roughconductor on each side (its glossy part must be one lobe whose weight varies)"
+    )]
+    TexturedConductors,
 }

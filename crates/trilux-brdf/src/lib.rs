@@ -21,6 +21,11 @@
 //! - [`fresnel`]: conductor Fresnel from η and k.
 //! - [`albedo`]: [`AlbedoTable`], the directional albedo tabulated per
 //!   degree for frequent use.
+//! - [`texture`]: bitmap textures ([`Texture`]) with Mitsuba 3's
+//!   bilinear and nearest lookups and wrap modes.
+//! - [`textured`]: materials whose Lambertian reflectance and glossy weight
+//!   vary over a surface ([`TexturedBsdf`], [`TextureSlot`]) and the
+//!   material at one point ([`Shading`]).
 //! - [`area`]: area reflectance R(I→J→K) = π F_JI fr (paper Eq. 5) and the
 //!   BRDF variation estimate over three elements (docs/solver.md,
 //!   "Refinement").
@@ -38,6 +43,8 @@ pub mod lobe;
 pub mod microfacet;
 pub mod params;
 pub mod special;
+pub mod texture;
+pub mod textured;
 
 pub use albedo::AlbedoTable;
 pub use area::{AreaReflectance, BrdfVariation, ElementPoints, area_reflectance, brdf_variation};
@@ -45,4 +52,6 @@ pub use bsdf::{Bsdf, BsdfSample};
 pub use error::BrdfError;
 pub use frame::Frame;
 pub use params::{BsdfParams, Distribution, RoughConductorParams};
+pub use texture::{Filter, Texture, Wrap};
+pub use textured::{Branch, PointParts, Shading, SlotKind, SlotValues, TextureSlot, TexturedBsdf};
 pub use trilux_geometry::Side;

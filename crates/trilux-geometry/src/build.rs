@@ -521,6 +521,10 @@ fn world_mesh(mesh: &TriangleMesh, xf: &Affine, sign: f64) -> Result<MeshData, S
         tri_area,
         tri_surface: vec![u32::MAX; mesh.triangles.len()],
         sign,
+        texcoords: mesh
+            .texcoords
+            .clone()
+            .filter(|t| t.len() == mesh.positions.len()),
     })
 }
 

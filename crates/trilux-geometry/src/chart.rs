@@ -73,6 +73,8 @@ pub(crate) struct MeshData {
     pub tri_surface: Vec<u32>,
     /// +1 or −1 (flip_normals), applied to shading normals.
     pub sign: f64,
+    /// Per-vertex texture coordinates, when the mesh has them.
+    pub texcoords: Option<Vec<DVec2>>,
 }
 
 impl MeshData {

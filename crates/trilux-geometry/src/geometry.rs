@@ -193,6 +193,29 @@ impl Geometry {
         }
     }
 
+    /// The texture coordinates (u, v) at `coord`: for a mesh chart, its
+    /// vertices' texture coordinates interpolated barycentrically (`None`
+    /// for a mesh without them); for a parametric surface, its own (u, v),
+    /// which for a `rectangle` is Mitsuba's (x/2 + 1/2, y/2 + 1/2) in
+    /// object space (other parametric shapes have their own pieces'
+    /// (u, v), which are not Mitsuba's: the scene layer refuses textures on
+    /// them).
+    pub fn texcoord(&self, surface: SurfaceId, coord: SurfaceCoord) -> Option<DVec2> {
+        match (&self.surfaces[surface.index()].geom, coord) {
+            (SurfaceGeom::Patch(_), SurfaceCoord::Uv(uv)) => {
+                Some(uv.clamp(DVec2::ZERO, DVec2::ONE))
+            }
+            (SurfaceGeom::Chart { mesh, .. }, SurfaceCoord::Triangle { index, bary }) => {
+                let m = &self.meshes[*mesh as usize];
+                let t = m.triangles.get(index as usize)?;
+                let uv = m.texcoords.as_ref()?;
+                let [a, b, c] = t.map(|i| uv[i as usize]);
+                Some(a * (1.0 - bary.x - bary.y) + b * bary.x + c * bary.y)
+            }
+            _ => None,
+        }
+    }
+
     #[inline]
     fn ray_epsilon(&self, o: DVec3) -> f64 {
         RAY_EPSILON * (o.abs().max_element() + self.extent)

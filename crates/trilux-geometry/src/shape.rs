@@ -3,7 +3,7 @@
 //! These are plain data: the scene loader builds them, and the geometry layer
 //! turns them into input surfaces (parametric pieces and mesh charts).
 
-use glam::{DMat4, DVec3};
+use glam::{DMat4, DVec2, DVec3};
 use serde::{Deserialize, Serialize};
 
 /// One `<shape>` of the scene, with its object-to-world transform.
@@ -59,4 +59,9 @@ pub struct TriangleMesh {
     pub triangles: Vec<[u32; 3]>,
     /// Mitsuba's `face_normals`: ignore vertex normals when shading.
     pub face_normals: bool,
+    /// Per-vertex texture coordinates (u, v), if the mesh has them: v = 0
+    /// is the first (top) row of an image, as in glTF and as Mitsuba keeps
+    /// them once its OBJ loader has flipped `vt`.
+    #[serde(default)]
+    pub texcoords: Option<Vec<DVec2>>,
 }

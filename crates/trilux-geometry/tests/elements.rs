@@ -242,6 +242,7 @@ fn bad_shapes_are_errors_naming_the_shape() {
                     normals: Some(vec![DVec3::Z]),
                     triangles: vec![[0, 1, 2]],
                     face_normals: false,
+                    texcoords: None,
                 }),
                 world_from_object: DMat4::IDENTITY,
                 flip_normals: false,

@@ -58,6 +58,7 @@ fn hits_match_mitsuba() {
                             normals: None,
                             triangles,
                             face_normals: true,
+                            texcoords: None,
                         })
                     }
                     other => panic!("unknown shape {other}"),

@@ -128,7 +128,7 @@ pub fn prepare<const N: usize>(scene: &Scene) -> Result<Arc<PreparedScene<N>>, R
         bsdfs: &bsdfs,
         emission: &emission,
     };
-    PreparedScene::new(&desc)
+    PreparedScene::new_textured(&desc, &scene.texture_slots())
         .map(Arc::new)
         .map_err(|e| located(scene, &e).into())
 }

@@ -6,7 +6,8 @@
 //! - Rays: `Geometry::intersect` (exact for analytic shapes, its own
 //!   self-intersection epsilon), shadow rays `Geometry::occluded`.
 //! - Materials: `Bsdf<N>` in the shading frame of the hit (z = shading
-//!   normal on the front side); it reflects on the viewer's side (black from
+//!   normal on the front side), textured ones at the hit's texture
+//!   coordinates (`PreparedScene::shading`); it reflects on the viewer's side (black from
 //!   the back unless `twosided`), as in Mitsuba.
 //! - Emitters: one-sided Lambertian area emitters on the front side. Light
 //!   sampling picks an emitting input surface with probability ∝ its area ×
@@ -25,7 +26,7 @@
 use std::sync::Arc;
 
 use glam::{DVec2, DVec3};
-use trilux_brdf::{Bsdf, Frame};
+use trilux_brdf::{Bsdf, Frame, Shading};
 use trilux_color::Spectrum;
 use trilux_geometry::{
     ElementForest, ElementId, FaceElement, FaceId, Geometry, Ray, Side, SurfaceCoord, SurfaceId,
@@ -204,8 +205,11 @@ impl<'a, const N: usize, S: RadianceSolution<N>> SolvedScene<'a, N, S> {
         self.scene.geometry()
     }
 
-    fn bsdf(&self, at: &SurfacePoint<HitLocator>) -> &Bsdf<N> {
-        self.scene.material(at.locator.shape as usize)
+    /// The material at the hit (a textured one evaluated at the hit's
+    /// texture coordinates).
+    fn bsdf(&self, at: &SurfacePoint<HitLocator>) -> Shading<'_, N> {
+        let l = &at.locator;
+        self.scene.shading(l.shape as usize, l.surface, l.coord)
     }
 
     fn site(p: &SurfacePoint<HitLocator>, side: Side) -> SurfaceSite {

@@ -12,36 +12,42 @@ use trilux_color::ColorParam;
 
 use crate::camera::{Camera, FovAxis, ReconstructionFilter, default_fov};
 use crate::error::{Result, SceneError};
-use crate::material::{build_bsdf, check_color};
+use crate::material::{TextureCollector, build_bsdf, check_color};
+use crate::meshes::Requests;
 use crate::props::Props;
 use crate::resolve::Resolved;
 use crate::scene::{AreaEmitter, Scene, SceneShape};
 use crate::shape::{MeshRequest, build_shape};
+use crate::textures::TextureRequest;
 use crate::xml::Element;
+use trilux_geometry::ShapeKind;
 
 /// Builds the scene from the resolved tree. `path` is the scene file. OBJ
 /// shapes come with empty meshes and, beside the scene, the requests to
 /// read them (shape index, request).
-pub(crate) fn build(resolved: Resolved, path: &Path) -> Result<(Scene, Vec<(usize, MeshRequest)>)> {
+pub(crate) fn build(resolved: Resolved, path: &Path) -> Result<(Scene, Requests)> {
     let scene_el = &resolved.scene;
     scene_el.check_attrs(&["version"])?;
     let folder = path.parent().unwrap_or(Path::new("."));
     let mut shapes = Vec::new();
-    let mut meshes = Vec::new();
+    let mut requests = Requests::default();
     let mut camera: Option<(Camera, &Element)> = None;
     let mut integrator: Option<&Element> = None;
     let mut max_depth = None;
     for e in &scene_el.children {
         match e.tag.as_str() {
             "shape" => {
-                let (shape, request) = scene_shape(e, folder)?;
-                meshes.extend(request.map(|r| (shapes.len(), r)));
+                let (shape, request, textures) = scene_shape(e, folder)?;
+                requests.meshes.extend(request.map(|r| (shapes.len(), r)));
+                requests
+                    .textures
+                    .extend(textures.into_iter().map(|t| (shapes.len(), t)));
                 shapes.push(shape);
             }
             "bsdf" => {
                 // A definition: built once here so that errors in unused
                 // definitions are reported too.
-                build_bsdf(e)?;
+                build_bsdf(e, &mut TextureCollector::new(folder))?;
             }
             "sensor" => {
                 if let Some((_, first)) = &camera {
@@ -104,7 +110,7 @@ pub(crate) fn build(resolved: Resolved, path: &Path) -> Result<(Scene, Vec<(usiz
         spectral,
         bsdf_counts: resolved.bsdf_counts,
     };
-    Ok((scene, meshes))
+    Ok((scene, requests))
 }
 
 /// True when some colour of the BSDF is a sampled spectrum.
@@ -127,10 +133,13 @@ fn bsdf_is_sampled(b: &BsdfParams) -> bool {
     }
 }
 
-fn scene_shape(e: &Element, folder: &Path) -> Result<(SceneShape, Option<MeshRequest>)> {
+type ShapeRequests = (SceneShape, Option<MeshRequest>, Vec<TextureRequest>);
+
+fn scene_shape(e: &Element, folder: &Path) -> Result<ShapeRequests> {
     e.check_attrs(&["type", "id", "name"])?;
     let props = Props::new(e)?;
     let mut bsdf = None;
+    let mut textures = TextureCollector::new(folder);
     let mut emitter = None;
     for o in &props.objects {
         match o.tag.as_str() {
@@ -138,7 +147,7 @@ fn scene_shape(e: &Element, folder: &Path) -> Result<(SceneShape, Option<MeshReq
                 if bsdf.is_some() {
                     return Err(SceneError::at(&o.loc, "a <shape> takes at most one <bsdf>"));
                 }
-                bsdf = Some(build_bsdf(o)?);
+                bsdf = Some(build_bsdf(o, &mut textures)?);
             }
             "emitter" => {
                 if emitter.is_some() {
@@ -159,14 +168,26 @@ fn scene_shape(e: &Element, folder: &Path) -> Result<(SceneShape, Option<MeshReq
     }
     let (shape, request) = build_shape(&props, folder)?;
     props.finish()?;
+    if !textures.requests.is_empty()
+        && !matches!(shape.kind, ShapeKind::Rectangle | ShapeKind::Mesh(_))
+    {
+        return Err(SceneError::at(
+            &e.loc,
+            format!(
+                "{} has a textured material, but only rectangle and obj shapes have texture coordinates here",
+                e.describe()
+            ),
+        ));
+    }
     let shape = SceneShape {
         id: e.attr("id").map(|a| a.value.clone()),
         shape,
         bsdf: bsdf.unwrap_or_default(),
         emitter,
+        textures: Vec::new(),
         location: e.loc.clone(),
     };
-    Ok((shape, request))
+    Ok((shape, request, textures.requests))
 }
 
 fn area_emitter(e: &Element) -> Result<AreaEmitter> {

@@ -17,11 +17,29 @@ pub struct SourceLocation {
     pub line: u32,
     /// Column in characters, counting from 1.
     pub col: u32,
+    /// In a JSON file (glTF), the place as a JSON path instead of a line
+    /// and column (`/materials/2/pbrMetallicRoughness`).
+    pub pointer: Option<Arc<str>>,
+}
+
+impl SourceLocation {
+    /// The place `pointer` (a JSON path) in `file`.
+    pub fn json(file: &Arc<Path>, pointer: impl Into<String>) -> Self {
+        SourceLocation {
+            file: Arc::clone(file),
+            line: 0,
+            col: 0,
+            pointer: Some(Arc::from(pointer.into())),
+        }
+    }
 }
 
 impl fmt::Display for SourceLocation {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}:{}:{}", self.file.display(), self.line, self.col)
+        match &self.pointer {
+            Some(p) => write!(f, "{}:{p}", self.file.display()),
+            None => write!(f, "{}:{}:{}", self.file.display(), self.line, self.col),
+        }
     }
 }
 

@@ -5,7 +5,12 @@
 //! `glam`, `roxmltree` and `tobj`.
 //! File formats live only here; the solver and the renderer never parse.
 //!
-//! The loader reads the subset of Mitsuba 3's XML listed in the README with Mitsuba's semantics and defaults, and refuses
+//! Two formats load into the same model: glTF 2.0 (`.gltf`, `.glb`: the
+//! [`gltf`] module, with its material mapping in docs/gltf.md) and the
+//! Mitsuba 3 XML subset below. Textures (PNG, JPEG: [`image`]) are read
+//! with the meshes, last ([`textures`]).
+//!
+//! The XML loader reads the subset of Mitsuba 3's XML listed in the README with Mitsuba's semantics and defaults, and refuses
 //! anything else with an error that displays as `FILE:LINE:COL: what is
 //! wrong`. Like Mitsuba's parser it works in stages:
 //!
@@ -15,9 +20,9 @@
 //! 3. `build`: typed parameters (`props`, `value`, [`transform`]) → the
 //!    model: shapes ([`shape`]), materials (`material`), area lights and the
 //!    camera ([`camera`]).
-//! 4. [`meshes`]: the OBJ files the shapes name ([`obj`]), read last, so
-//!    that a command can check the camera and its options against the
-//!    [`Pending`] scene first ([`open`]).
+//! 4. [`meshes`]: the OBJ files the shapes name ([`obj`]) and the
+//!    textures' images, read last, so that a command can check the camera
+//!    and its options against the [`Pending`] scene first ([`open`]).
 //!
 //! Before all of it, the file must be a regular file of UTF-8 text
 //! (`text`); every stage is bounded ([`limits`], docs/limits.md).
@@ -36,6 +41,8 @@
 mod build;
 pub mod camera;
 pub mod error;
+pub mod gltf;
+pub mod image;
 pub mod limits;
 mod material;
 pub mod meshes;
@@ -45,6 +52,7 @@ mod resolve;
 pub mod scene;
 pub mod shape;
 mod text;
+mod textures;
 pub mod transform;
 mod value;
 mod xml;
@@ -59,9 +67,44 @@ pub use scene::{AreaEmitter, Scene, SceneShape};
 pub use shape::surface_area;
 pub use transform::LookAt;
 
-/// Loads a scene file (Mitsuba 3 XML subset).
+/// Loads a scene file (Mitsuba 3 XML subset, or glTF 2.0 by its `.gltf`
+/// or `.glb` extension).
 pub fn load(path: impl AsRef<Path>) -> Result<Scene, SceneError> {
     load_with_params(path, &[])
+}
+
+/// Reads and checks a scene file, all but its meshes and textures; for a
+/// glTF file, `camera` names the camera to use (a camera's or its node's
+/// name; the first one otherwise). An XML scene has one `<sensor>`: naming
+/// a camera for it is an error.
+pub fn open_with_camera(
+    path: impl AsRef<Path>,
+    camera: Option<&str>,
+) -> Result<Pending, SceneError> {
+    let path = path.as_ref();
+    if gltf::is_gltf(path) {
+        return gltf::open(path, camera);
+    }
+    if let Some(name) = camera {
+        return Err(SceneError::at(
+            &SourceLocation {
+                file: Arc::from(path),
+                line: 1,
+                col: 1,
+                pointer: None,
+            },
+            format!(
+                "--camera \"{name}\" chooses among a glTF file's cameras; this XML scene has one <sensor>"
+            ),
+        ));
+    }
+    open(path)
+}
+
+/// Reads a glTF or GLB file from bytes in memory; `path` names it in errors
+/// and anchors relative URIs (for fuzzing and tests).
+pub fn open_gltf_bytes(bytes: &[u8], path: impl AsRef<Path>) -> Result<Pending, SceneError> {
+    gltf::open_bytes(bytes, &Arc::from(path.as_ref()), None)
 }
 
 /// Loads a scene file with values for its `$name` parameters (they override
@@ -84,6 +127,15 @@ pub fn open_with_params(
     params: &[(String, String)],
 ) -> Result<Pending, SceneError> {
     let path = path.as_ref();
+    if gltf::is_gltf(path) {
+        if !params.is_empty() {
+            return Err(SceneError::at(
+                &SourceLocation::json(&Arc::from(path), "/"),
+                "$name parameters are for Mitsuba XML scenes, not glTF",
+            ));
+        }
+        return gltf::open(path, None);
+    }
     let bytes = trilux_files::read_limited(path, limits::MAX_SCENE_BYTES).map_err(|source| {
         SceneError::Read {
             path: path.to_path_buf(),
@@ -113,6 +165,6 @@ fn open_str(text: &str, path: &Path, params: &[(String, String)]) -> Result<Pend
     let file: Arc<Path> = Arc::from(path);
     let tree = xml::parse(text, &file, params)?;
     let resolved = resolve::resolve(&tree)?;
-    let (scene, meshes) = build::build(resolved, path)?;
-    Ok(Pending::new(scene, meshes))
+    let (scene, requests) = build::build(resolved, path)?;
+    Ok(Pending::new(scene, requests))
 }

@@ -75,3 +75,30 @@ pub fn check_film(width: u32, height: u32) -> Result<(), String> {
 
 /// Largest emitted radiance (1e20 in any band).
 pub use trilux_color::MAX_RADIANCE;
+
+/// Largest image file a texture reads (256 MiB).
+pub const MAX_IMAGE_BYTES: u64 = 256 << 20;
+
+/// Most texels of one texture (2^25 = 33.5 M, e.g. 8192 × 4096): trilux
+/// keeps 12 bytes a texel (linear RGB, 32-bit floats), 400 MB at the limit.
+pub const MAX_TEXTURE_TEXELS: u64 = 1 << 25;
+
+/// Most texels of all the textures of one scene (2^26, 800 MB).
+pub const MAX_SCENE_TEXELS: u64 = 1 << 26;
+
+/// Largest `.glb` file, and largest buffer file a `.gltf` names (1 GiB).
+pub const MAX_GLB_BYTES: u64 = 1 << 30;
+
+/// Most bytes of all the buffers of one glTF file (2 GiB).
+pub const MAX_GLTF_BUFFER_BYTES: u64 = 2 << 30;
+
+/// Most triangles of all the mesh instances of one glTF scene (8 million:
+/// a mesh placed by many nodes counts once for each).
+pub const MAX_GLTF_TRIANGLES: usize = 8_000_000;
+
+/// Deepest glTF node hierarchy (the loader recurses once a level).
+pub const MAX_NODE_DEPTH: usize = 64;
+
+/// Most node instances a glTF scene places (a node reached twice is
+/// refused: glTF's node graph is a set of disjoint trees).
+pub const MAX_GLTF_NODES: usize = 1_000_000;

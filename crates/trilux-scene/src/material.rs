@@ -8,40 +8,94 @@
 //! | `blendbsdf` | `weight` (required, in \[0, 1\]), two nested BSDFs |
 //! | `twosided` | one nested BSDF (both sides) or two (front, back) |
 //!
+//! Textures: `<texture type="bitmap" name="...">` (Mitsuba's `bitmap`:
+//! `filename`, `filter_type` `bilinear` | `nearest`, `wrap_mode` `repeat` |
+//! `mirror` | `clamp`, `raw`) as the `reflectance` of `diffuse`, the
+//! `specular_reflectance` of `roughconductor` and the `weight` of
+//! `blendbsdf`; the image is read when the scene is finished
+//! ([`crate::textures`]).
+//!
 //! Refused: other plugins, anisotropic roughness (`alpha_u` ≠ `alpha_v`),
-//! named conductor materials, textures, `alpha` ≤ 0, negative or NaN values,
-//! and reflectances above 1 (they would create energy and keep the solver
-//! from converging; Mitsuba renders them, trilux refuses them).
+//! named conductor materials, other textures, `alpha` ≤ 0, negative or NaN
+//! values, and reflectances above 1 (they would create energy and keep the
+//! solver from converging; Mitsuba renders them, trilux refuses them).
 
-use trilux_brdf::{BsdfParams, Distribution, RoughConductorParams};
+use std::path::Path;
+
+use trilux_brdf::{Branch, BsdfParams, Distribution, Filter, RoughConductorParams, SlotKind, Wrap};
 use trilux_color::ColorParam;
 
 use crate::error::{Result, SceneError, SourceLocation};
+use crate::image::Sampling;
 use crate::props::Props;
+use crate::textures::{ImageSource, TextureRequest};
 use crate::xml::Element;
 
+/// The textures found while building one material, with the path to the
+/// BSDF being built.
+pub(crate) struct TextureCollector<'f> {
+    folder: &'f Path,
+    path: Vec<Branch>,
+    /// The textures found.
+    pub requests: Vec<TextureRequest>,
+}
+
+impl<'f> TextureCollector<'f> {
+    /// A collector for one material; image names resolve against `folder`.
+    pub fn new(folder: &'f Path) -> Self {
+        TextureCollector {
+            folder,
+            path: Vec::new(),
+            requests: Vec::new(),
+        }
+    }
+
+    fn nested(&mut self, branch: Branch, e: &Element) -> Result<BsdfParams> {
+        self.path.push(branch);
+        let b = build_nested(e, self);
+        self.path.pop();
+        b
+    }
+}
+
 /// Builds the BSDF of a `<bsdf>` element (references already resolved).
-pub(crate) fn build_bsdf(e: &Element) -> Result<BsdfParams> {
+pub(crate) fn build_bsdf(e: &Element, tex: &mut TextureCollector<'_>) -> Result<BsdfParams> {
     e.check_attrs(&["type", "id", "name"])?;
     let props = Props::new(e)?;
     let bsdf = match e.plugin_type()? {
         "diffuse" => {
-            props.no_objects()?;
-            let reflectance = reflectance(&props, "reflectance", 0.5)?;
+            let textured = texture(&props, "reflectance", SlotKind::Reflectance, tex)?;
+            no_other_objects(&props)?;
+            let reflectance = if textured {
+                ColorParam::Float(0.5)
+            } else {
+                reflectance(&props, "reflectance", 0.5)?
+            };
             BsdfParams::Diffuse { reflectance }
         }
         "roughconductor" => {
-            props.no_objects()?;
-            BsdfParams::RoughConductor(rough_conductor(&props)?)
+            let textured = texture(
+                &props,
+                "specular_reflectance",
+                SlotKind::SpecularReflectance,
+                tex,
+            )?;
+            no_other_objects(&props)?;
+            BsdfParams::RoughConductor(rough_conductor(&props, textured)?)
         }
         "blendbsdf" => {
+            let textured = texture(&props, "weight", SlotKind::Weight, tex)?;
             let [first, second] = nested::<2>(&props, "exactly two nested BSDFs")?;
-            let weight = props.float("weight")?.ok_or_else(|| {
-                SceneError::at(
-                    &e.loc,
-                    "<bsdf type=\"blendbsdf\"> needs a <float name=\"weight\">",
-                )
-            })?;
+            let weight = match props.float("weight")? {
+                _ if textured => 0.5,
+                Some(w) => w,
+                None => {
+                    return Err(SceneError::at(
+                        &e.loc,
+                        "<bsdf type=\"blendbsdf\"> needs a <float name=\"weight\"> or a <texture name=\"weight\">",
+                    ));
+                }
+            };
             if !(0.0..=1.0).contains(&weight) {
                 return Err(SceneError::at(
                     &props.loc("weight"),
@@ -50,18 +104,18 @@ pub(crate) fn build_bsdf(e: &Element) -> Result<BsdfParams> {
             }
             BsdfParams::Blend {
                 weight,
-                first: Box::new(build_bsdf(first)?),
-                second: Box::new(build_bsdf(second)?),
+                first: Box::new(tex.nested(Branch::First, first)?),
+                second: Box::new(tex.nested(Branch::Second, second)?),
             }
         }
         "twosided" => match props.objects.as_slice() {
             [front] => BsdfParams::TwoSided {
-                front: Box::new(build_nested(front)?),
+                front: Box::new(tex.nested(Branch::Front, front)?),
                 back: None,
             },
             [front, back] => BsdfParams::TwoSided {
-                front: Box::new(build_nested(front)?),
-                back: Some(Box::new(build_nested(back)?)),
+                front: Box::new(tex.nested(Branch::Front, front)?),
+                back: Some(Box::new(tex.nested(Branch::Back, back)?)),
             },
             _ => {
                 return Err(SceneError::at(
@@ -83,20 +137,26 @@ pub(crate) fn build_bsdf(e: &Element) -> Result<BsdfParams> {
     Ok(bsdf)
 }
 
-fn build_nested(e: &Element) -> Result<BsdfParams> {
+fn build_nested(e: &Element, tex: &mut TextureCollector<'_>) -> Result<BsdfParams> {
     if e.tag != "bsdf" {
         return Err(SceneError::at(
             &e.loc,
             format!("expected a nested <bsdf>, found {}", e.describe()),
         ));
     }
-    build_bsdf(e)
+    build_bsdf(e, tex)
 }
 
-/// Exactly `N` nested `<bsdf>` elements.
+/// Exactly `N` nested `<bsdf>` elements (a `<texture>` is the caller's).
 fn nested<'a, const N: usize>(props: &Props<'a>, what: &str) -> Result<[&'a Element; N]> {
     let owner = props.owner();
-    for o in &props.objects {
+    let bsdfs: Vec<&Element> = props
+        .objects
+        .iter()
+        .copied()
+        .filter(|o| o.tag != "texture")
+        .collect();
+    for o in &bsdfs {
         if o.tag != "bsdf" {
             return Err(SceneError::at(
                 &o.loc,
@@ -104,15 +164,114 @@ fn nested<'a, const N: usize>(props: &Props<'a>, what: &str) -> Result<[&'a Elem
             ));
         }
     }
-    <[&Element; N]>::try_from(props.objects.as_slice()).map_err(|_| {
+    <[&Element; N]>::try_from(bsdfs.as_slice()).map_err(|_| {
         SceneError::at(
             &owner.loc,
-            format!(
-                "{} needs {what}, found {}",
-                owner.describe(),
-                props.objects.len()
-            ),
+            format!("{} needs {what}, found {}", owner.describe(), bsdfs.len()),
         )
+    })
+}
+
+/// Refuses nested objects other than `<texture>`s (which [`texture`] has
+/// checked).
+fn no_other_objects(props: &Props<'_>) -> Result<()> {
+    match props.objects.iter().find(|o| o.tag != "texture") {
+        Some(o) => Err(SceneError::at(
+            &o.loc,
+            format!(
+                "{} cannot contain {}",
+                props.owner().describe(),
+                o.describe()
+            ),
+        )),
+        None => Ok(()),
+    }
+}
+
+/// The `<texture name="{name}">` of the BSDF, if it has one, recorded in
+/// `tex`; any other `<texture>` is an error.
+fn texture(
+    props: &Props<'_>,
+    name: &str,
+    kind: SlotKind,
+    tex: &mut TextureCollector<'_>,
+) -> Result<bool> {
+    let mut found = false;
+    for o in props.objects.iter().filter(|o| o.tag == "texture") {
+        let named = o.attr("name").map(|a| a.value.as_str());
+        if named != Some(name) || found {
+            return Err(SceneError::at(
+                &o.loc,
+                format!(
+                    "{} takes one texture, as \"{name}\" (found {})",
+                    props.owner().describe(),
+                    named.map_or("one without a name".to_string(), |n| format!("\"{n}\""))
+                ),
+            ));
+        }
+        if props.has(name) {
+            return Err(SceneError::at(
+                &o.loc,
+                format!("\"{name}\" is given both as a value and as a texture"),
+            ));
+        }
+        tex.requests.push(bitmap(o, kind, tex)?);
+        found = true;
+    }
+    Ok(found)
+}
+
+/// A `<texture type="bitmap">` (Mitsuba's defaults: bilinear, repeat, sRGB).
+fn bitmap(e: &Element, kind: SlotKind, tex: &TextureCollector<'_>) -> Result<TextureRequest> {
+    e.check_attrs(&["type", "id", "name"])?;
+    let t = e.plugin_type()?;
+    if t != "bitmap" {
+        return Err(SceneError::at(
+            &e.required("type")?.loc,
+            format!("unknown texture plugin \"{t}\" (only \"bitmap\")"),
+        ));
+    }
+    let props = Props::new(e)?;
+    props.no_objects()?;
+    let filename = props.string("filename")?.ok_or_else(|| {
+        SceneError::at(
+            &e.loc,
+            "<texture type=\"bitmap\"> needs <string name=\"filename\">",
+        )
+    })?;
+    let choice = |name: &str, options: &[&str]| -> Result<Option<String>> {
+        match props.string(name)? {
+            Some(v) if !options.contains(&v.as_str()) => Err(SceneError::at(
+                &props.loc(name),
+                format!("unknown {name} \"{v}\" ({})", options.join(", ")),
+            )),
+            v => Ok(v),
+        }
+    };
+    let filter = match choice("filter_type", &["bilinear", "nearest"])?.as_deref() {
+        Some("nearest") => Filter::Nearest,
+        _ => Filter::Bilinear,
+    };
+    let wrap = match choice("wrap_mode", &["repeat", "mirror", "clamp"])?.as_deref() {
+        Some("mirror") => Wrap::Mirror,
+        Some("clamp") => Wrap::Clamp,
+        _ => Wrap::Repeat,
+    };
+    let raw = props.boolean("raw")?.unwrap_or(false);
+    let location = props.loc("filename");
+    props.finish()?;
+    Ok(TextureRequest {
+        path: tex.path.clone(),
+        kind,
+        source: ImageSource::File(tex.folder.join(filename)),
+        sampling: Sampling {
+            wrap: [wrap; 2],
+            filter,
+            raw,
+        },
+        scale: [1.0; 3],
+        offset: [0.0; 3],
+        location,
     })
 }
 
@@ -149,7 +308,7 @@ pub(crate) fn check_color(
     Ok(())
 }
 
-fn rough_conductor(props: &Props<'_>) -> Result<RoughConductorParams> {
+fn rough_conductor(props: &Props<'_>, textured: bool) -> Result<RoughConductorParams> {
     let distribution = match props.string("distribution")?.as_deref() {
         None | Some("beckmann") => Distribution::Beckmann,
         Some("ggx") => Distribution::Ggx,
@@ -224,7 +383,11 @@ fn rough_conductor(props: &Props<'_>) -> Result<RoughConductorParams> {
             k.unwrap_or(ColorParam::Float(1.0)),
         )),
     };
-    let specular_reflectance = reflectance(props, "specular_reflectance", 1.0)?;
+    let specular_reflectance = if textured {
+        ColorParam::Float(1.0)
+    } else {
+        reflectance(props, "specular_reflectance", 1.0)?
+    };
     props.ignore(&["sample_visible"]);
     Ok(RoughConductorParams {
         distribution,

@@ -1,41 +1,76 @@
-//! Stage 5 of loading: the OBJ files a scene names, read only once the
-//! whole scene file is checked.
+//! Stage 5 of loading: the files a scene names — OBJ meshes, glTF
+//! buffers, texture images — read only once the whole scene file is
+//! checked.
 //!
 //! A [`Pending`] scene is everything the scene file says, its meshes still
-//! empty: a command checks its camera, film and options against it before
-//! it spends the time (and memory) of reading meshes ([`Pending::finish`]).
+//! empty and its textures unread: a command checks its camera, film and
+//! options against it before it spends the time (and memory) of reading
+//! them ([`Pending::finish`]).
 
 use crate::error::{Result, SceneError};
+use crate::gltf::GltfMeshes;
 use crate::obj::load_obj;
 use crate::scene::Scene;
 use crate::shape::{MeshRequest, check_area};
+use crate::textures::{TextureCache, TextureRequest};
 use trilux_geometry::ShapeKind;
 
-/// A loaded scene whose OBJ meshes are not read yet (module docs).
+/// What a scene still has to read, by shape index.
+#[derive(Debug, Default)]
+pub(crate) struct Requests {
+    /// OBJ meshes.
+    pub meshes: Vec<(usize, MeshRequest)>,
+    /// Textures of materials.
+    pub textures: Vec<(usize, TextureRequest)>,
+    /// The meshes of a glTF file (its buffers are read by `finish`).
+    pub gltf: Option<GltfMeshes>,
+}
+
+/// A loaded scene whose meshes and textures are not read yet (module
+/// docs).
 #[derive(Debug)]
 pub struct Pending {
     scene: Scene,
-    meshes: Vec<(usize, MeshRequest)>,
+    requests: Requests,
 }
 
 impl Pending {
-    pub(crate) fn new(scene: Scene, meshes: Vec<(usize, MeshRequest)>) -> Self {
-        Pending { scene, meshes }
+    pub(crate) fn new(scene: Scene, requests: Requests) -> Self {
+        Pending { scene, requests }
     }
 
-    /// The scene as the file states it; OBJ shapes have empty meshes.
+    /// The scene as the file states it; mesh shapes have empty meshes.
     pub fn scene(&self) -> &Scene {
         &self.scene
     }
 
-    /// Reads every OBJ file; errors point at the file name in the scene.
+    /// Reads every mesh and texture; errors point at the place in the
+    /// scene that names the file.
     pub fn finish(mut self) -> Result<Scene> {
-        for (index, request) in self.meshes {
+        for (index, request) in self.requests.meshes {
             let mesh = load_obj(&request.path, request.face_normals)
                 .map_err(|e| SceneError::at(&request.filename, e.to_string()))?;
             let shape = &mut self.scene.shapes[index].shape;
             shape.kind = ShapeKind::Mesh(mesh);
             check_area(shape, &request.shape, "<shape type=\"obj\">")?;
+        }
+        let mut cache = TextureCache::default();
+        let mut textures = self.requests.textures;
+        if let Some(gltf) = self.requests.gltf {
+            textures.extend(gltf.finish(&mut self.scene)?);
+        }
+        for (index, request) in &textures {
+            let slot = cache.slot(request)?;
+            let shape = &mut self.scene.shapes[*index];
+            if let ShapeKind::Mesh(m) = &shape.shape.kind
+                && m.texcoords.is_none()
+            {
+                return Err(SceneError::at(
+                    &request.location,
+                    "this texture's shape has no texture coordinates (OBJ vt, glTF TEXCOORD_0)",
+                ));
+            }
+            shape.textures.push(slot);
         }
         Ok(self.scene)
     }

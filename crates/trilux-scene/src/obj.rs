@@ -1,6 +1,7 @@
 //! Wavefront OBJ meshes (`<shape type="obj">`), read with `tobj`.
 //!
-//! Polygons are triangulated as fans; vertices are shared when they share
+//! Texture coordinates (`vt`) are kept when every vertex has them, with v
+//! flipped as Mitsuba's loader flips it. Polygons are triangulated as fans; vertices are shared when they share
 //! position, texture and normal indices (as Mitsuba's own OBJ loader keys
 //! them). Materials (`mtllib`) are ignored, as Mitsuba ignores them.
 //!
@@ -18,7 +19,7 @@ use std::path::Path;
 
 use crate::limits::MAX_OBJ_BYTES;
 
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 use trilux_geometry::TriangleMesh;
 
 /// Why an OBJ file could not be read (the caller adds the scene location).
@@ -87,6 +88,12 @@ pub fn parse_obj(bytes: &[u8], path: &Path, face_normals: bool) -> Result<Triang
             vertices: positions,
         });
     }
+    if let Some(index) = bad_face_index(bytes) {
+        return Err(ObjError::Parse {
+            path: path.to_path_buf(),
+            reason: format!("a face refers to vertex index {index}, which no vertex line has"),
+        });
+    }
     let options = tobj::LoadOptions {
         single_index: true,
         triangulate: true,
@@ -116,6 +123,8 @@ pub fn parse_obj(bytes: &[u8], path: &Path, face_normals: bool) -> Result<Triang
     };
     let mut normals = Vec::new();
     let mut all_have_normals = true;
+    let mut texcoords = Vec::new();
+    let mut all_have_texcoords = true;
     for model in &models {
         let m = &model.mesh;
         let base = mesh.positions.len() as u32;
@@ -135,6 +144,17 @@ pub fn parse_obj(bytes: &[u8], path: &Path, face_normals: bool) -> Result<Triang
             all_have_normals = false;
             normals.extend(std::iter::repeat_n(DVec3::ZERO, count));
         }
+        // Mitsuba's OBJ loader flips v (v = 0 is an image's bottom row in
+        // OBJ, its top row in trilux and Mitsuba).
+        if m.texcoords.len() / 2 == count {
+            texcoords.extend(
+                m.texcoords
+                    .chunks_exact(2)
+                    .map(|t| DVec2::new(f64::from(t[0]), 1.0 - f64::from(t[1]))),
+            );
+        } else {
+            all_have_texcoords = false;
+        }
         for t in m.indices.chunks_exact(3) {
             mesh.triangles.push([base + t[0], base + t[1], base + t[2]]);
         }
@@ -144,11 +164,15 @@ pub fn parse_obj(bytes: &[u8], path: &Path, face_normals: bool) -> Result<Triang
             path: path.to_path_buf(),
         });
     }
-    if !mesh.positions.iter().all(|p| p.is_finite()) || !normals.iter().all(|n| n.is_finite()) {
+    if !mesh.positions.iter().all(|p| p.is_finite())
+        || !normals.iter().all(|n| n.is_finite())
+        || !texcoords.iter().all(|t| t.is_finite())
+    {
         return Err(ObjError::NotFinite {
             path: path.to_path_buf(),
         });
     }
+    mesh.texcoords = (all_have_texcoords && !texcoords.is_empty()).then_some(texcoords);
     mesh.normals = if face_normals {
         None
     } else if all_have_normals {
@@ -172,6 +196,70 @@ fn count_lines(bytes: &[u8]) -> (usize, usize) {
         }
     }
     (faces, positions)
+}
+
+/// The first face index that refers to no vertex line (`v`, `vt` or `vn`):
+/// a positive index above the file's count of its kind, or a negative
+/// (relative) one reaching before the first line of its kind so far.
+/// tobj computes such indices with unchecked arithmetic (a relative index
+/// before the start wraps around, and an index past 2^62 overflows when
+/// doubled), so they are refused before it sees them. Lines continued
+/// with a trailing backslash are joined, as tobj joins them.
+fn bad_face_index(bytes: &[u8]) -> Option<i64> {
+    let mut logical: Vec<Vec<u8>> = Vec::new();
+    let mut joining = false;
+    for line in bytes.split(|&b| b == b'\n') {
+        let line = line.strip_suffix(b"\r").unwrap_or(line);
+        let (body, continued) = match line.strip_suffix(b"\\") {
+            Some(body) => (body, true),
+            None => (line, false),
+        };
+        match logical.last_mut() {
+            Some(last) if joining => last.extend_from_slice(body),
+            _ => logical.push(body.to_vec()),
+        }
+        joining = continued;
+    }
+    let kind = |line: &[u8]| -> Option<usize> {
+        let text = std::str::from_utf8(line).ok()?;
+        match text.split_ascii_whitespace().next()? {
+            "v" => Some(0),
+            "vt" => Some(1),
+            "vn" => Some(2),
+            "f" => Some(3),
+            _ => None,
+        }
+    };
+    let mut total = [0i64; 3];
+    for line in &logical {
+        if let Some(k @ 0..=2) = kind(line) {
+            total[k] += 1;
+        }
+    }
+    let mut so_far = [0i64; 3];
+    for line in &logical {
+        match kind(line) {
+            Some(k @ 0..=2) => so_far[k] += 1,
+            Some(_) => {
+                let Ok(text) = std::str::from_utf8(line) else {
+                    continue;
+                };
+                for vertex in text.split_ascii_whitespace().skip(1) {
+                    for (k, part) in vertex.split('/').take(3).enumerate() {
+                        let Ok(n) = part.parse::<i64>() else { continue };
+                        if n == 0
+                            || n > total[k]
+                            || (n < 0 && n.unsigned_abs() > so_far[k].unsigned_abs())
+                        {
+                            return Some(n);
+                        }
+                    }
+                }
+            }
+            None => {}
+        }
+    }
+    None
 }
 
 /// Angle-weighted smooth vertex normals (Mitsuba's `recompute_vertex_normals`).
@@ -198,4 +286,34 @@ pub fn vertex_normals(positions: &[DVec3], triangles: &[[u32; 3]]) -> Vec<DVec3>
             if n == DVec3::ZERO { DVec3::Z } else { n }
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const QUAD: &str = "v 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\n";
+
+    #[test]
+    fn face_indices_that_name_no_vertex_are_refused_before_tobj() {
+        let cases = [
+            // A relative texture index reaching before the first `vt`
+            // (tobj wraps it around and then overflows doubling it), even
+            // though more `vt` lines follow.
+            (format!("{QUAD}f 1/-4 2/-2 3/-1\nvt 0 1\n"), Some(-4)),
+            (
+                format!("{QUAD}f 1/4611686018427387904 2/2 3/3\n"),
+                Some(4_611_686_018_427_387_904),
+            ),
+            (format!("{QUAD}f 0 2 3\n"), Some(0)),
+            (format!("{QUAD}f 1 2 \\\n 4\n"), Some(4)),
+            (format!("{QUAD}f -3/-3 -2/-2 -1/-1\n"), None),
+            (format!("{QUAD}f 1/1 2/2 3/3\n"), None),
+        ];
+        for (text, bad) in &cases {
+            assert_eq!(bad_face_index(text.as_bytes()), *bad, "{text:?}");
+            let parsed = parse_obj(text.as_bytes(), Path::new("t.obj"), false);
+            assert_eq!(parsed.is_err(), bad.is_some(), "{text:?}: {parsed:?}");
+        }
+    }
 }

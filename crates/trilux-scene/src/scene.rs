@@ -5,7 +5,7 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 use serde::Serialize;
-use trilux_brdf::BsdfParams;
+use trilux_brdf::{BsdfParams, TextureSlot};
 use trilux_color::{ColorParam, Mode};
 use trilux_geometry::{Geometry, Shape};
 
@@ -34,6 +34,10 @@ pub struct SceneShape {
     pub bsdf: BsdfParams,
     /// The area light on it, if any.
     pub emitter: Option<AreaEmitter>,
+    /// The textures of its material (empty for a uniform one); `bsdf`
+    /// holds placeholders for the parameters they stand for.
+    #[serde(skip)]
+    pub textures: Vec<TextureSlot>,
     /// Where the `<shape>` is written.
     #[serde(skip)]
     pub location: SourceLocation,
@@ -81,6 +85,12 @@ impl Scene {
         self.shapes.iter().map(|s| s.bsdf.clone()).collect()
     }
 
+    /// Every shape's textures (empty lists for uniform materials), in shape
+    /// order.
+    pub fn texture_slots(&self) -> Vec<Vec<TextureSlot>> {
+        self.shapes.iter().map(|s| s.textures.clone()).collect()
+    }
+
     /// Every shape's emitted radiance (`None` without an emitter), in shape
     /// order.
     pub fn emitter_radiance(&self) -> Vec<Option<ColorParam>> {
@@ -99,6 +109,7 @@ impl Scene {
                 file: self.path.as_path().into(),
                 line: 1,
                 col: 1,
+                pointer: None,
             },
         }
     }

@@ -16,6 +16,7 @@ pub(crate) fn decode<'a>(bytes: &'a [u8], path: &Path) -> Result<&'a str> {
             file: Arc::from(path),
             line,
             col,
+            pointer: None,
         };
         SceneError::at(&location, message)
     };

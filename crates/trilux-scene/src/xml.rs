@@ -102,6 +102,7 @@ pub(crate) fn parse(text: &str, file: &Arc<Path>, params: &[(String, String)]) -
             file: file.clone(),
             line: pos.row,
             col: pos.col,
+            pointer: None,
         };
         if matches!(e, roxmltree::Error::NodesLimitReached) {
             return SceneError::at(
@@ -193,6 +194,7 @@ impl Context<'_, '_> {
             file: self.file.clone(),
             line: pos.row,
             col: pos.col,
+            pointer: None,
         }
     }
 

@@ -80,16 +80,21 @@ impl<const N: usize> Solver<N> {
         }
         let to_light = incidence.and_then(Incidence::direction)?;
         let covered = self.hemisphere_coverage(l.face, l.j);
+        // A textured j reflects g(j) times the nominal glossy part.
+        let g = self
+            .textures
+            .as_ref()
+            .map_or(Spectrum::splat(1.0), |t| t.glossy(l.face, l.j));
         if covered >= CLOSED_COVERAGE {
             let normal = self.forest.element(l.j).normal * l.face.side().sign();
             let wi = Frame::from_normal(normal).to_local(to_light);
             let glossy_albedo = self.albedo[face.shape].albedo(wi) - face.rho_d;
-            Some((arrived * glossy_albedo * covered.min(1.0)).max(Spectrum::zero()))
+            Some((arrived * glossy_albedo * g * covered.min(1.0)).max(Spectrum::zero()))
         } else {
             // An open hemisphere: the share of the lobe that meets a stored
             // receiver (a narrow lobe need not miss the open part in
             // proportion).
-            Some(arrived * self.covered_lobe(l.face, to_light, l.j))
+            Some(arrived * self.covered_lobe(l.face, to_light, l.j) * g)
         }
     }
 

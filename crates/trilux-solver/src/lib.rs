@@ -17,6 +17,8 @@
 //!   and never escaping), refused before the solve.
 //! - `throughput`: T = A F V per element pair, cached (paper §4.6).
 //! - `radiosity`: two-point radiance of Lambertian parts, push-pull.
+//! - `textures`: each element's texture average (ρ_d and the glossy
+//!   ratio g of textured materials), pushed as irradiance.
 //! - `interaction`: interaction hierarchies (paper §3.2), flux-weighted
 //!   push-pull (§4.4, §5.6), point lookup (§4.5).
 //! - `refine`: RefineAndLink with its three subdivision cases (§3.2.2, §4.3).
@@ -47,6 +49,7 @@ mod shot;
 pub mod solution;
 pub mod solver;
 pub mod stats;
+mod textures;
 mod throughput;
 
 pub use error::SolverError;

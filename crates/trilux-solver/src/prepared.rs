@@ -11,9 +11,9 @@ use std::io::Write;
 use std::sync::Arc;
 
 use thiserror::Error;
-use trilux_brdf::{BrdfError, Bsdf, BsdfParams};
+use trilux_brdf::{BrdfError, Bsdf, BsdfParams, Shading, TextureSlot, TexturedBsdf};
 use trilux_color::{ColorError, ColorParam, Spectrum};
-use trilux_geometry::{Geometry, GeometryError, Shape};
+use trilux_geometry::{Geometry, GeometryError, Shape, SurfaceCoord, SurfaceId};
 
 /// What light transport needs of a scene, as plain data: per shape its
 /// geometry, its material and its area emitter's radiance (if any).
@@ -66,6 +66,12 @@ pub enum PrepareError {
         /// Index of the shape.
         shape: usize,
     },
+    /// A shape's textures need texture coordinates it does not have.
+    #[error("shape {shape}: its material has textures but the shape has no texture coordinates")]
+    NoTexcoords {
+        /// Index of the shape.
+        shape: usize,
+    },
     /// The three per-shape lists differ in length.
     #[error("{shapes} shapes but {bsdfs} materials and {emission} emitter entries")]
     Lengths {
@@ -96,6 +102,9 @@ impl PrepareError {
                 "emitted radiance beyond 1e30 in some band, or a flux that overflows (docs/limits.md)"
                     .into()
             }
+            PrepareError::NoTexcoords { .. } => {
+                "its material has textures but the shape has no texture coordinates".into()
+            }
             PrepareError::Lengths { .. } | PrepareError::Hash(_) => self.to_string(),
         }
     }
@@ -117,7 +126,8 @@ impl PrepareError {
             PrepareError::Material { shape, .. }
             | PrepareError::Emission { shape, .. }
             | PrepareError::BadEmission { shape }
-            | PrepareError::FluxOverflow { shape } => Some(*shape),
+            | PrepareError::FluxOverflow { shape }
+            | PrepareError::NoTexcoords { shape } => Some(*shape),
             PrepareError::Lengths { .. } | PrepareError::Hash(_) => None,
         }
     }
@@ -128,6 +138,8 @@ impl PrepareError {
 pub struct PreparedScene<const N: usize> {
     geometry: Arc<Geometry>,
     materials: Vec<Bsdf<N>>,
+    /// The textured materials, by shape (`None` for uniform ones).
+    textured: Vec<Option<TexturedBsdf<N>>>,
     emission: Vec<Spectrum<N>>,
     hash: u64,
 }
@@ -135,6 +147,17 @@ pub struct PreparedScene<const N: usize> {
 impl<const N: usize> PreparedScene<N> {
     /// Builds the geometry, every material and every emitter.
     pub fn new(desc: &SceneDescription<'_>) -> Result<Self, PrepareError> {
+        Self::new_textured(desc, &[])
+    }
+
+    /// [`PreparedScene::new`] with the textures of each shape's material
+    /// (`textures` is empty, or holds one list per shape; an empty list
+    /// means no textures). A textured material replaces the shape's
+    /// material by its nominal one (`trilux_brdf::textured`).
+    pub fn new_textured(
+        desc: &SceneDescription<'_>,
+        textures: &[Vec<TextureSlot>],
+    ) -> Result<Self, PrepareError> {
         let n = desc.shapes.len();
         if desc.bsdfs.len() != n || desc.emission.len() != n {
             return Err(PrepareError::Lengths {
@@ -143,8 +166,15 @@ impl<const N: usize> PreparedScene<N> {
                 emission: desc.emission.len(),
             });
         }
+        if !textures.is_empty() && textures.len() != n {
+            return Err(PrepareError::Lengths {
+                shapes: n,
+                bsdfs: textures.len(),
+                emission: desc.emission.len(),
+            });
+        }
         let geometry = Geometry::build_shared(desc.shapes)?;
-        let materials = desc
+        let mut materials: Vec<Bsdf<N>> = desc
             .bsdfs
             .iter()
             .enumerate()
@@ -159,12 +189,38 @@ impl<const N: usize> PreparedScene<N> {
             .map(|(shape, e)| emitted(shape, e.as_ref()))
             .collect::<Result<_, _>>()?;
         check_flux(&geometry, &emission)?;
+        let textured = textured_materials(desc, textures, &geometry)?;
+        for (m, t) in materials.iter_mut().zip(&textured) {
+            if let Some(t) = t {
+                *m = t.bsdf().clone();
+            }
+        }
         Ok(PreparedScene {
             geometry,
             materials,
+            textured,
             emission,
-            hash: content_hash(desc, N)?,
+            hash: content_hash(desc, textures, N)?,
         })
+    }
+
+    /// The textured material of a shape (`None` when it is uniform).
+    pub fn textured(&self, shape: usize) -> Option<&TexturedBsdf<N>> {
+        self.textured.get(shape).and_then(Option::as_ref)
+    }
+
+    /// True when some material has textures.
+    pub fn has_textures(&self) -> bool {
+        self.textured.iter().any(Option::is_some)
+    }
+
+    /// The material of `shape` at `coord` of its input surface `surface`:
+    /// a textured material evaluated at the point's texture coordinates.
+    pub fn shading(&self, shape: usize, surface: SurfaceId, coord: SurfaceCoord) -> Shading<'_, N> {
+        match (self.textured(shape), self.geometry.texcoord(surface, coord)) {
+            (Some(t), Some(uv)) => t.at(uv),
+            _ => Shading::uniform(&self.materials[shape]),
+        }
     }
 
     /// The geometry, shared.
@@ -192,6 +248,35 @@ impl<const N: usize> PreparedScene<N> {
     pub fn content_hash(&self) -> u64 {
         self.hash
     }
+}
+
+/// The textured material of every shape that has textures; a shape with
+/// textures must have texture coordinates.
+fn textured_materials<const N: usize>(
+    desc: &SceneDescription<'_>,
+    textures: &[Vec<TextureSlot>],
+    geometry: &Geometry,
+) -> Result<Vec<Option<TexturedBsdf<N>>>, PrepareError> {
+    let mut out = Vec::with_capacity(desc.shapes.len());
+    for shape in 0..desc.shapes.len() {
+        let slots = textures.get(shape).filter(|s| !s.is_empty());
+        let Some(slots) = slots else {
+            out.push(None);
+            continue;
+        };
+        let has_uv = match &desc.shapes[shape].kind {
+            trilux_geometry::ShapeKind::Mesh(m) => m.texcoords.is_some(),
+            trilux_geometry::ShapeKind::Rectangle => true,
+            _ => false,
+        };
+        if !has_uv || geometry.surfaces_of_shape(shape as u32).is_empty() {
+            return Err(PrepareError::NoTexcoords { shape });
+        }
+        let t = TexturedBsdf::new(&desc.bsdfs[shape], slots.clone())
+            .map_err(|source| PrepareError::Material { shape, source })?;
+        out.push(Some(t));
+    }
+    Ok(out)
 }
 
 /// One shape's emitted radiance as `N` bands (zero without an emitter).
@@ -264,9 +349,17 @@ impl Write for Fnv1a {
     }
 }
 
-fn content_hash(desc: &SceneDescription<'_>, bands: usize) -> Result<u64, PrepareError> {
+fn content_hash(
+    desc: &SceneDescription<'_>,
+    textures: &[Vec<TextureSlot>],
+    bands: usize,
+) -> Result<u64, PrepareError> {
     let mut h = Fnv1a::new();
     serde_json::to_writer(&mut h, &(desc.shapes, desc.bsdfs, desc.emission, bands))
         .map_err(PrepareError::Hash)?;
+    // Scenes without textures keep the hash they always had.
+    if textures.iter().any(|t| !t.is_empty()) {
+        serde_json::to_writer(&mut h, textures).map_err(PrepareError::Hash)?;
+    }
     Ok(h.0)
 }

@@ -11,6 +11,17 @@
 use trilux_color::Spectrum;
 use trilux_geometry::{ElementForest, ElementId, Side, Sided};
 
+use crate::textures::ElementTextures;
+
+/// What one push-pull reads.
+#[derive(Clone, Copy)]
+struct Down<'a, const N: usize> {
+    forest: &'a ElementForest,
+    side: Side,
+    exposed_area: &'a [f64],
+    textures: Option<&'a ElementTextures<N>>,
+}
+
 /// Per-element radiance of the two faces of every element.
 #[derive(Clone, Debug)]
 pub(crate) struct ElementRadiance<const N: usize> {
@@ -40,24 +51,37 @@ impl<const N: usize> ElementRadiance<N> {
     /// `trilux_geometry::burial`). For Lambertian radiance that area weight
     /// *is* the flux weight (flux = π A L whatever the orientation), so
     /// pulling over curved, non-coplanar children conserves flux exactly.
+    /// On a textured face the gathered radiance is scaled by ρ_d(child) /
+    /// ρ_d(parent) on its way down (`textures`: the irradiance is pushed).
     pub fn push_pull(
         &mut self,
         forest: &ElementForest,
         root: ElementId,
         side: Side,
         exposed_area: &[f64],
+        textures: Option<&ElementTextures<N>>,
     ) {
-        self.push_pull_rec(forest, root, side, Spectrum::zero(), exposed_area);
+        let down = Down {
+            forest,
+            side,
+            exposed_area,
+            textures,
+        };
+        self.push_pull_rec(&down, root, Spectrum::zero());
     }
 
     fn push_pull_rec(
         &mut self,
-        forest: &ElementForest,
+        down_ctx: &Down<'_, N>,
         e: ElementId,
-        s: Side,
         from_above: Spectrum<N>,
-        exposed_area: &[f64],
     ) -> (Spectrum<N>, Spectrum<N>) {
+        let Down {
+            forest,
+            side: s,
+            exposed_area,
+            textures,
+        } = *down_ctx;
         let i = e.index();
         let down = from_above + self.gathered[s][i];
         self.gathered[s][i] = Spectrum::zero();
@@ -77,7 +101,11 @@ impl<const N: usize> ElementRadiance<N> {
                     } else {
                         0.0
                     };
-                    let (cl, cdl) = self.push_pull_rec(forest, c, s, down, exposed_area);
+                    let pushed = match textures {
+                        Some(t) => down * t.push_ratio(s, e, c),
+                        None => down,
+                    };
+                    let (cl, cdl) = self.push_pull_rec(down_ctx, c, pushed);
                     l += cl * w;
                     dl += cdl * w;
                 }

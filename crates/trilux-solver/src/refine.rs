@@ -37,6 +37,7 @@ use crate::faces::TransportFace;
 use crate::interaction::{Hierarchy, Node, Split};
 use crate::radiosity::ElementRadiance;
 use crate::settings::{SolverSettings, Transport};
+use crate::textures::ElementTextures;
 use crate::throughput::{Throughput, ThroughputCache, compute_throughput};
 
 /// What a sender sends: its unshot radiance δL (a shot), or its final
@@ -234,6 +235,8 @@ pub(crate) struct RefineContext<'a, const N: usize> {
     pub interior: &'a [[DVec3; 4]],
     /// Exposed area of every element's faces, `[back][element]`.
     pub exposed_area: &'a Sided<Vec<f64>>,
+    /// ρ_d and g of textured elements (`crate::textures`).
+    pub textures: Option<&'a ElementTextures<N>>,
 }
 
 /// Point-to-disc estimate of F_{a→b} (Hanrahan, Salzman & Aupperle 1991): b seen from a's
@@ -660,6 +663,11 @@ impl<const N: usize> RefineContext<'_, N> {
             self.split_across_plane(task, i, j, n, known, straddle_k);
             return;
         };
+        // A textured j: its glossy part is g(j) times the nominal one.
+        let (fr, texture_variation) = match self.textures {
+            Some(t) => (fr * t.glossy(sj, j), t.glossy_variation(self.forest, sj, j)),
+            None => (fr, 0.0),
+        };
         let gathered = known.unshot * fr * (PI * known.tij.t / aj);
         let link = NodeLink {
             hierarchy: task.h_index,
@@ -672,6 +680,16 @@ impl<const N: usize> RefineContext<'_, N> {
             return;
         }
         let (spread, driver) = self.fr_variation(bsdf, i, j, k);
+        // fr's spread over the three elements, and over j the texture's.
+        let spread = match self.textures {
+            Some(t) => spread * t.glossy(sj, j).max_value() + fr.max_value() * texture_variation,
+            None => spread,
+        };
+        let driver = if texture_variation > 0.0 && spread > 0.0 {
+            Driver::J
+        } else {
+            driver
+        };
         let (fji, _) = self.ff_estimates(sj.of(j), si.of(i));
         let errors = TripleErrors {
             brdf: PI * fji * spread / self.settings.fr_eps,

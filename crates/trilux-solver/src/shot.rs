@@ -44,6 +44,7 @@ macro_rules! refine_context {
             points: &$s.points,
             interior: &$s.interior,
             exposed_area: &$s.exposed_area,
+            textures: $s.textures.as_ref(),
         }
     };
 }
@@ -199,8 +200,13 @@ impl<const N: usize> Solver<N> {
                 let phi = std::mem::take(&mut self.face_flux[face]);
                 let root = self.forest.root(face.surface());
                 let side = face.side();
-                self.field
-                    .push_pull(&self.forest, root, side, &self.exposed_area[side]);
+                self.field.push_pull(
+                    &self.forest,
+                    root,
+                    side,
+                    &self.exposed_area[side],
+                    self.textures.as_ref(),
+                );
                 Some((phi, Sending::Radiosity(face)))
             }
             Source::Stored(index) => {
@@ -456,7 +462,11 @@ impl<const N: usize> Solver<N> {
     /// (never beyond what arrived). Returns the ρ_d used.
     fn receive_lambertian(&mut self, l: &PairLink<N>, shot_scale: Spectrum<N>) -> Spectrum<N> {
         let face = &self.faces[l.face];
-        let rho_d = (face.rho_d * self.shading_factor(l.i, l.j)).min(Spectrum::splat(1.0));
+        let rho = match &self.textures {
+            Some(t) => t.rho(l.face, l.j).unwrap_or(face.rho_d),
+            None => face.rho_d,
+        };
+        let rho_d = (rho * self.shading_factor(l.i, l.j)).min(Spectrum::splat(1.0));
         let side = l.face.side();
         let aj = self.exposed_area[side][l.j.index()];
         if !rho_d.is_black() && aj > 0.0 {

@@ -38,6 +38,7 @@ use crate::radiosity::ElementRadiance;
 use crate::settings::SolverSettings;
 use crate::solution::Solution;
 use crate::stats::SolveStats;
+use crate::textures::ElementTextures;
 use crate::throughput::{ThroughputCache, compute_throughput};
 
 /// Progress after each shot, for progress bars (the solver never prints).
@@ -102,6 +103,9 @@ pub struct Solver<const N: usize> {
     pub(crate) points: Vec<[DVec3; 5]>,
     /// The centres of every element's 2×2 quadrants.
     pub(crate) interior: Vec<[DVec3; 4]>,
+    /// ρ_d and g of the elements of textured faces (`None` without
+    /// textures).
+    pub(crate) textures: Option<ElementTextures<N>>,
 }
 
 /// Exposed area A × (exposed share) of every element's two faces: leaves
@@ -271,6 +275,12 @@ impl<const N: usize> Solver<N> {
         let warnings = clamp_reflectances(&mut faces);
         let burial = probe_burial(&forest, &faces, &depth_of);
         let exposed_area = exposed_areas(&forest, burial.as_ref());
+        let textures = ElementTextures::new(&forest, &scene, &exposed_area);
+        if textures.is_some() && settings.transport != crate::settings::Transport::TwoPoint {
+            return Err(SolverError::Settings(
+                "textured materials need two-point transport (the uniform transport is for ablation only)".into(),
+            ));
+        }
         let partners = eligible_pairs(&forest, &faces);
         let vis = Visibility::new(&forest, burial.as_ref());
         let hierarchies = root_interactions(&vis, &faces, &partners, settings.visibility_samples);
@@ -312,6 +322,7 @@ impl<const N: usize> Solver<N> {
             stats,
             points,
             interior,
+            textures,
         })
     }
 
@@ -408,8 +419,13 @@ impl<const N: usize> Solver<N> {
         for (face, _) in self.faces.iter() {
             let root = self.forest.root(face.surface());
             let side = face.side();
-            self.field
-                .push_pull(&self.forest, root, side, &self.exposed_area[side]);
+            self.field.push_pull(
+                &self.forest,
+                root,
+                side,
+                &self.exposed_area[side],
+                self.textures.as_ref(),
+            );
         }
         // Pushing makes pending energy part of δL again; the residual keys
         // already count it.

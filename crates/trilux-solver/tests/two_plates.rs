@@ -185,3 +185,89 @@ fn glossy_receiver_one_bounce() {
         "solver flux {got} vs brute force {reference}"
     );
 }
+
+/// The diffuse receiver of [`diffuse_receiver_one_bounce`] with a texture
+/// that varies across it: reflectance 0.2 on one half and 0.8 on the other
+/// (a 2 × 1 bitmap, nearest, clamped). The configuration is symmetric about
+/// the line between the halves, so each half's mean point form factor is
+/// the whole square's, F = 0.199825 (closed form (a)): after one bounce the
+/// two halves' mean radiances are 0.2 Le F and 0.8 Le F, and the halves
+/// across the other axis both 0.5 Le F. A solve that took the texture's
+/// mean for every element would give 0.5 Le F everywhere.
+#[test]
+fn textured_receiver_one_bounce_resolves_the_texture() {
+    use std::sync::Arc;
+    use trilux_brdf::{Filter, SlotKind, Texture, TextureSlot, Wrap};
+    use trilux_solver::PreparedScene;
+
+    let shapes = vec![
+        square(DVec3::new(0.0, 0.0, 1.0), true),
+        square(DVec3::ZERO, false),
+    ];
+    let bsdfs = vec![
+        black(),
+        BsdfParams::Diffuse {
+            reflectance: ColorParam::Float(0.5),
+        },
+    ];
+    let emission = vec![Some(ColorParam::Float(1.0)), None];
+    let input = SceneDescription {
+        shapes: &shapes,
+        bsdfs: &bsdfs,
+        emission: &emission,
+    };
+    let texture = Texture::new(
+        2,
+        1,
+        vec![[0.2; 3], [0.8; 3]],
+        [Wrap::Clamp; 2],
+        Filter::Nearest,
+    )
+    .unwrap();
+    let slot = TextureSlot {
+        path: vec![],
+        kind: SlotKind::Reflectance,
+        texture: Arc::new(texture),
+        scale: [1.0; 3],
+        offset: [0.0; 3],
+    };
+    let prepared = PreparedScene::<3>::new_textured(&input, &[vec![], vec![slot]]).unwrap();
+    let solution = Solver::new(Arc::new(prepared), one_bounce_settings())
+        .expect("builds")
+        .solve(|_| {});
+    // Means over the halves u < ½, u > ½, v < ½, v > ½ of a fine grid.
+    let g = 64;
+    let mut halves = [0.0; 4];
+    for a in 0..g {
+        for b in 0..g {
+            let uv = DVec2::new((a as f64 + 0.5) / g as f64, (b as f64 + 0.5) / g as f64);
+            let site = SurfaceSite::new(SurfaceId(1), Side::Front, SurfaceCoord::Uv(uv));
+            let l = solution.lambertian_radiance(&site)[1];
+            halves[usize::from(uv.x > 0.5)] += l;
+            halves[2 + usize::from(uv.y > 0.5)] += l;
+        }
+    }
+    let halves = halves.map(|s| s / (g * g / 2) as f64);
+    eprintln!(
+        "textured plate: halves u {:?}, v {:?}",
+        &halves[..2],
+        &halves[2..]
+    );
+    let f = 0.199825;
+    // The texture varies along one of the square's axes (which one, and in
+    // which direction, is the rectangle's uv convention): that axis's
+    // halves hold 0.2 F and 0.8 F, the other's 0.5 F each.
+    let (across, along) = if (halves[0] - halves[1]).abs() > (halves[2] - halves[3]).abs() {
+        ([halves[0], halves[1]], [halves[2], halves[3]])
+    } else {
+        ([halves[2], halves[3]], [halves[0], halves[1]])
+    };
+    let (lo, hi) = (across[0].min(across[1]), across[0].max(across[1]));
+    for (got, rho) in [(lo, 0.2), (hi, 0.8), (along[0], 0.5), (along[1], 0.5)] {
+        let expected = rho * f;
+        assert!(
+            (got - expected).abs() <= 0.01 * expected,
+            "half mean {got} vs {expected} (halves {halves:?})"
+        );
+    }
+}

@@ -16,8 +16,12 @@ use crate::power::emitted_power;
 /// Arguments of `trilux info`.
 #[derive(Debug, Args)]
 pub struct InfoArgs {
-    /// The scene file (Mitsuba 3 XML subset).
+    /// The scene file (Mitsuba 3 XML subset, or glTF 2.0: .gltf, .glb).
     pub scene: PathBuf,
+    /// The glTF camera to show (a camera's or its node's name; default: the
+    /// first).
+    #[arg(long)]
+    pub camera: Option<String>,
     /// Print a JSON object instead of text.
     #[arg(long)]
     pub json: bool,
@@ -53,7 +57,7 @@ struct CameraJson {
 
 /// Runs `trilux info`.
 pub fn run(args: &InfoArgs) -> Result<()> {
-    let scene = trilux_scene::load(&args.scene)?;
+    let scene = trilux_scene::open_with_camera(&args.scene, args.camera.as_deref())?.finish()?;
     let mode = match args.mode {
         Some(ModeArg::Rgb) => Mode::Rgb,
         Some(ModeArg::Spectral) => Mode::Spectral,
@@ -125,14 +129,21 @@ fn print_text(scene: &Scene, info: &InfoJson) {
             ShapeKind::Disk => "disk".to_string(),
             ShapeKind::Sphere { .. } => "sphere".to_string(),
             ShapeKind::Cylinder { .. } => "cylinder".to_string(),
-            ShapeKind::Mesh(m) => format!("obj ({} triangles)", m.triangles.len()),
+            ShapeKind::Mesh(m) => format!("mesh ({} triangles)", m.triangles.len()),
+        };
+        let textures = match s.textures.len() {
+            0 => String::new(),
+            n => format!(", {n} texture{}", if n == 1 { "" } else { "s" }),
+        };
+        let at = match &s.location.pointer {
+            Some(p) => p.to_string(),
+            None => format!("line {}", s.location.line),
         };
         println!(
-            "  shape {i:3} {:16} {kind:24} area {:.6}{}  (line {})",
+            "  shape {i:3} {:16} {kind:24} area {:.6}{}{textures}  ({at})",
             s.id.as_deref().unwrap_or("-"),
             trilux_scene::surface_area(&s.shape),
             if s.emitter.is_some() { ", emitter" } else { "" },
-            s.location.line
         );
     }
 }

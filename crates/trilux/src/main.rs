@@ -45,7 +45,7 @@ enum Command {
     Solve(solve::SolveArgs),
     /// Render a view of a scene by final gathering (solving first, or from
     /// a saved solution).
-    Render(render::RenderArgs),
+    Render(Box<render::RenderArgs>),
 }
 
 /// The bundled default scene (the Cornell box): `scenes/cornell-box.xml`

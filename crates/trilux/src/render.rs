@@ -43,8 +43,12 @@ pub enum GatherArg {
 /// Arguments of `trilux render`.
 #[derive(Debug, Args)]
 pub struct RenderArgs {
-    /// The scene file (Mitsuba 3 XML subset).
+    /// The scene file (Mitsuba 3 XML subset, or glTF 2.0: .gltf, .glb).
     pub scene: PathBuf,
+    /// The glTF camera to render from (a camera's or its node's name;
+    /// default: the first camera of the scene).
+    #[arg(long)]
+    pub camera: Option<String>,
     /// Output EXR (linear sRGB). Default: out/<scene name>.exr (the folder
     /// is made when missing).
     #[arg(short = 'o', long = "output")]
@@ -162,10 +166,15 @@ impl RenderArgs {
 pub fn run(args: &RenderArgs) -> Result<()> {
     crate::set_threads(args.threads);
     let outputs = args.plan_outputs()?;
-    let pending = trilux_scene::open(&args.scene)?;
+    let pending = trilux_scene::open_with_camera(&args.scene, args.camera.as_deref())?;
     let camera = pending.scene().camera.as_ref().with_context(|| {
+        let what = if trilux_scene::gltf::is_gltf(&args.scene) {
+            "perspective camera"
+        } else {
+            "<sensor>"
+        };
         format!(
-            "{}: the scene has no <sensor> to render from",
+            "{}: the scene has no {what} to render from",
             args.scene.display()
         )
     })?;

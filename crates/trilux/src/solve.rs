@@ -14,7 +14,7 @@ use crate::progress::Bars;
 /// Arguments of `trilux solve`.
 #[derive(Debug, Args)]
 pub struct SolveArgs {
-    /// The scene file (Mitsuba 3 XML subset).
+    /// The scene file (Mitsuba 3 XML subset, or glTF 2.0: .gltf, .glb).
     pub scene: PathBuf,
     /// Where to write the solution.
     #[arg(short = 'o', long = "output")]

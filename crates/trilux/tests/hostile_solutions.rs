@@ -24,8 +24,10 @@ fn with_valid_header(mut bytes: Vec<u8>) -> Vec<u8> {
     bytes
 }
 
-fn setup() -> (PathBuf, PathBuf, Vec<u8>) {
-    let dir = folder("solutions");
+/// A solved furnace in its own folder `name` (each test has its own: the
+/// tests of this file run in parallel, and `folder` empties the folder).
+fn setup(name: &str) -> (PathBuf, PathBuf, Vec<u8>) {
+    let dir = folder(name);
     let scene = dir.join("scene.xml");
     std::fs::write(&scene, furnace("0.5", "1.0", 1.0)).unwrap();
     let sol = dir.join("good.sol");
@@ -67,7 +69,7 @@ fn assert_solution_refused(dir: &Path, scene: &Path, bytes: &[u8], what: &str) {
 
 #[test]
 fn corrupted_payloads_under_valid_headers_are_refused() {
-    let (dir, scene, good) = setup();
+    let (dir, scene, good) = setup("solutions");
     let stats_len = u64::from_le_bytes(good[HEADER..HEADER + 8].try_into().unwrap()) as usize;
     let depths = HEADER + 8 + stats_len + 4;
     let mut deep = good.clone();
@@ -114,7 +116,7 @@ fn corrupted_payloads_under_valid_headers_are_refused() {
 
 #[test]
 fn a_solution_that_is_not_a_regular_file_is_refused_unread() {
-    let (dir, scene, _) = setup();
+    let (dir, scene, _) = setup("solutions-irregular");
     let fifo = dir.join("fifo.sol");
     assert!(
         Command::new("mkfifo")

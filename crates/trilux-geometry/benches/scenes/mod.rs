@@ -36,6 +36,7 @@ pub fn sphere_in_box(n: u32) -> Vec<Shape> {
                 normals: None,
                 triangles: t,
                 face_normals: true,
+                texcoords: None,
             }),
             world_from_object: DMat4::IDENTITY,
             flip_normals: false,

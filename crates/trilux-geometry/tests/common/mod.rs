@@ -80,6 +80,7 @@ pub fn mesh(positions: Vec<DVec3>, triangles: Vec<[u32; 3]>, m: DMat4) -> Shape 
             normals: None,
             triangles,
             face_normals: false,
+            texcoords: None,
         }),
         world_from_object: m,
         flip_normals: false,

@@ -1,0 +1,639 @@
+//! Textured materials: a BSDF whose Lambertian reflectance and glossy
+//! weight vary over a surface ([`TexturedBsdf`]), and the material at one
+//! point ([`Shading`]).
+//!
+//! A texture stands for one parameter of a [`BsdfParams`] tree
+//! ([`TextureSlot`]): the `reflectance` of a `diffuse`, the
+//! `specular_reflectance` of a `roughconductor` or the `weight` of a
+//! `blendbsdf`, found by its [`Branch`] path from the top of the tree. The
+//! parameter's value at a point is `offset + scale ⊙ texture(u, v)`
+//! (a weight takes the luminance); the tree itself holds the *nominal*
+//! value, the one at the texture's mean, so that [`Bsdf::new`] of the
+//! tree is the material on average.
+//!
+//! Every supported parameter enters the BRDF linearly, so one side of a
+//! textured material at a point x is
+//!
+//! ```text
+//! fr(x; wi, wo) = ρ_d(x)/π + g(x) ⊙ fr_glossy(wi, wo)
+//! ```
+//!
+//! with ρ_d(x) its Lambertian reflectance and g(x) the ratio of its glossy
+//! weight to the nominal one (per band), provided each side has at most one
+//! `roughconductor` (checked by [`TexturedBsdf::new`]): the microfacet
+//! lobe's shape never varies, only how much of it there is. The solver
+//! takes ρ_d and g of each element's average slot values; the renderer
+//! takes them at each hit.
+
+use std::sync::Arc;
+
+use glam::{DVec2, DVec3};
+use serde::Serialize;
+use trilux_color::{ColorParam, Role, Spectrum};
+use trilux_geometry::{Side, Sided};
+
+use crate::bsdf::{Bsdf, BsdfSample};
+use crate::error::BrdfError;
+use crate::params::BsdfParams;
+use crate::texture::{Texture, luminance};
+
+/// One step from a BSDF to a BSDF nested in it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub enum Branch {
+    /// The front BSDF of a `twosided` (both sides when it has one only).
+    Front,
+    /// The back BSDF of a `twosided` with two.
+    Back,
+    /// The first BSDF of a `blendbsdf`.
+    First,
+    /// The second BSDF of a `blendbsdf`.
+    Second,
+}
+
+/// Which parameter a texture stands for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub enum SlotKind {
+    /// `reflectance` of a `diffuse`.
+    Reflectance,
+    /// `specular_reflectance` of a `roughconductor`.
+    SpecularReflectance,
+    /// `weight` of a `blendbsdf` (the texture's luminance).
+    Weight,
+}
+
+/// A texture standing for one parameter of a material (module docs).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct TextureSlot {
+    /// The path from the top of the material to the BSDF that has the
+    /// parameter.
+    pub path: Vec<Branch>,
+    /// The parameter.
+    pub kind: SlotKind,
+    /// The image.
+    #[serde(serialize_with = "texture_summary")]
+    pub texture: Arc<Texture>,
+    /// value = offset + scale ⊙ texture (per RGB channel).
+    pub scale: [f64; 3],
+    /// See `scale`.
+    pub offset: [f64; 3],
+}
+
+fn texture_summary<S: serde::Serializer>(t: &Arc<Texture>, s: S) -> Result<S::Ok, S::Error> {
+    t.as_ref().serialize(s)
+}
+
+impl TextureSlot {
+    /// The slot's linear RGB value for the texture value `rgb`.
+    pub fn value(&self, rgb: [f64; 3]) -> [f64; 3] {
+        std::array::from_fn(|c| self.offset[c] + self.scale[c] * rgb[c])
+    }
+
+    /// The slot's value at the texture's mean, within the parameter's
+    /// range: the nominal value.
+    pub fn nominal(&self) -> [f64; 3] {
+        slot_value(self, self.texture.mean())
+    }
+}
+
+/// Most textures one material takes.
+pub const MAX_SLOTS: usize = 4;
+
+/// The values of a material's slots at a point (or averaged over an
+/// element), in slot order: RGB for colours, the luminance in every
+/// channel for weights.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SlotValues(pub [[f64; 3]; MAX_SLOTS]);
+
+/// One side's Lambertian reflectance ρ_d and glossy ratio g at a point.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PointParts<const N: usize> {
+    /// ρ_d (fr_d = ρ_d/π).
+    pub rho: Spectrum<N>,
+    /// The glossy weight over the nominal one, per band.
+    pub glossy: Spectrum<N>,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+enum Value<const N: usize> {
+    Const(Spectrum<N>),
+    Slot(usize),
+}
+
+#[derive(Clone, Debug, PartialEq)]
+enum Node<const N: usize> {
+    Diffuse(Value<N>),
+    Conductor(Value<N>),
+    Blend {
+        weight: Value<N>,
+        first: Box<Node<N>>,
+        second: Box<Node<N>>,
+    },
+}
+
+impl<const N: usize> Node<N> {
+    fn value(v: &Value<N>, slots: &[Spectrum<N>]) -> Spectrum<N> {
+        match v {
+            Value::Const(s) => *s,
+            Value::Slot(i) => slots[*i],
+        }
+    }
+
+    /// (ρ_d, glossy weight) of this side for the slot values.
+    fn parts(&self, slots: &[Spectrum<N>]) -> (Spectrum<N>, Spectrum<N>) {
+        match self {
+            Node::Diffuse(v) => (Self::value(v, slots), Spectrum::zero()),
+            Node::Conductor(v) => (Spectrum::zero(), Self::value(v, slots)),
+            Node::Blend {
+                weight,
+                first,
+                second,
+            } => {
+                let w = Self::value(weight, slots);
+                let one_minus = Spectrum::splat(1.0) - w;
+                let (r1, g1) = first.parts(slots);
+                let (r2, g2) = second.parts(slots);
+                (r1 * one_minus + r2 * w, g1 * one_minus + g2 * w)
+            }
+        }
+    }
+
+    fn conductors(&self) -> usize {
+        match self {
+            Node::Diffuse(_) => 0,
+            Node::Conductor(_) => 1,
+            Node::Blend { first, second, .. } => first.conductors() + second.conductors(),
+        }
+    }
+}
+
+/// A material with textures (module docs): its nominal [`Bsdf`], and
+/// how its slots make ρ_d and g at a point.
+#[derive(Clone, Debug)]
+pub struct TexturedBsdf<const N: usize> {
+    bsdf: Bsdf<N>,
+    sides: Sided<Option<Node<N>>>,
+    slots: Vec<TextureSlot>,
+    nominal_glossy: Sided<Spectrum<N>>,
+}
+
+fn color<const N: usize>(c: &ColorParam, what: &'static str) -> Result<Spectrum<N>, BrdfError> {
+    c.to_spectrum::<N>(Role::Reflectance)
+        .map_err(|source| BrdfError::Color { what, source })
+}
+
+/// The compiled side of `p` at `path`; `slots` found on the way are
+/// replaced by their indices.
+fn compile<const N: usize>(
+    p: &BsdfParams,
+    path: &mut Vec<Branch>,
+    slots: &[TextureSlot],
+    used: &mut [bool],
+) -> Result<Node<N>, BrdfError> {
+    let slot = |kind: SlotKind, path: &[Branch], used: &mut [bool]| {
+        let i = slots
+            .iter()
+            .position(|s| s.kind == kind && s.path.as_slice() == path)?;
+        used[i] = true;
+        Some(Value::Slot(i))
+    };
+    Ok(match p {
+        BsdfParams::Diffuse { reflectance } => {
+            Node::Diffuse(match slot(SlotKind::Reflectance, path, used) {
+                Some(v) => v,
+                None => Value::Const(color(reflectance, "diffuse reflectance")?),
+            })
+        }
+        BsdfParams::RoughConductor(rc) => {
+            Node::Conductor(match slot(SlotKind::SpecularReflectance, path, used) {
+                Some(v) => v,
+                None => Value::Const(color(
+                    &rc.specular_reflectance,
+                    "roughconductor specular_reflectance",
+                )?),
+            })
+        }
+        BsdfParams::Blend {
+            weight,
+            first,
+            second,
+        } => {
+            let w = match slot(SlotKind::Weight, path, used) {
+                Some(v) => v,
+                None => Value::Const(Spectrum::splat(*weight)),
+            };
+            path.push(Branch::First);
+            let first = compile(first, path, slots, used)?;
+            path.pop();
+            path.push(Branch::Second);
+            let second = compile(second, path, slots, used)?;
+            path.pop();
+            Node::Blend {
+                weight: w,
+                first: Box::new(first),
+                second: Box::new(second),
+            }
+        }
+        BsdfParams::TwoSided { .. } => return Err(BrdfError::NestedTwoSided),
+    })
+}
+
+/// A slot's value for texture value `rgb`, within its parameter's range
+/// ([0, 1]; a weight is the luminance).
+fn slot_value(s: &TextureSlot, rgb: [f64; 3]) -> [f64; 3] {
+    let v = s.value(rgb).map(|c| c.max(0.0));
+    match s.kind {
+        SlotKind::Weight => [luminance(v).clamp(0.0, 1.0); 3],
+        SlotKind::Reflectance | SlotKind::SpecularReflectance => v.map(|c| c.min(1.0)),
+    }
+}
+
+/// Writes `value` into the parameter `kind` of the BSDF at `path`
+/// (`None` when there is no such parameter).
+fn set_nominal(p: &mut BsdfParams, path: &[Branch], kind: SlotKind, value: [f64; 3]) -> Option<()> {
+    match (p, path.split_first()) {
+        (BsdfParams::Diffuse { reflectance }, None) if kind == SlotKind::Reflectance => {
+            *reflectance = ColorParam::Rgb(value);
+        }
+        (BsdfParams::RoughConductor(rc), None) if kind == SlotKind::SpecularReflectance => {
+            rc.specular_reflectance = ColorParam::Rgb(value);
+        }
+        (BsdfParams::Blend { weight, .. }, None) if kind == SlotKind::Weight => *weight = value[0],
+        (BsdfParams::Blend { first, .. }, Some((Branch::First, rest))) => {
+            set_nominal(first, rest, kind, value)?;
+        }
+        (BsdfParams::Blend { second, .. }, Some((Branch::Second, rest))) => {
+            set_nominal(second, rest, kind, value)?;
+        }
+        (BsdfParams::TwoSided { front, .. }, Some((Branch::Front, rest))) => {
+            set_nominal(front, rest, kind, value)?;
+        }
+        (
+            BsdfParams::TwoSided {
+                back: Some(back), ..
+            },
+            Some((Branch::Back, rest)),
+        ) => {
+            set_nominal(back, rest, kind, value)?;
+        }
+        _ => return None,
+    }
+    Some(())
+}
+
+impl<const N: usize> TexturedBsdf<N> {
+    /// The material `params` with the textures `slots` (each textured
+    /// parameter's value in `params` is replaced by its nominal value). Refused: more than [`MAX_SLOTS`]
+    /// slots, a slot whose path or kind names no parameter, a side with
+    /// textures and more than one `roughconductor`, and band counts other
+    /// than 3 (textures are RGB; a spectral solve would upsample every
+    /// lookup).
+    pub fn new(params: &BsdfParams, slots: Vec<TextureSlot>) -> Result<Self, BrdfError> {
+        if N != 3 {
+            return Err(BrdfError::TexturedSpectral);
+        }
+        if slots.len() > MAX_SLOTS {
+            return Err(BrdfError::TooManyTextures(slots.len()));
+        }
+        let mut params = params.clone();
+        for (i, slot) in slots.iter().enumerate() {
+            let nominal = slot_value(slot, slot.texture.mean());
+            set_nominal(&mut params, &slot.path, slot.kind, nominal).ok_or_else(|| {
+                BrdfError::TextureSlot(format!("{:?} at {:?}", slots[i].kind, slots[i].path))
+            })?;
+        }
+        let params = &params;
+        let bsdf = Bsdf::new(params)?;
+        let mut used = vec![false; slots.len()];
+        let (front, back) = match params {
+            BsdfParams::TwoSided { front, back } => {
+                let f = compile(front, &mut vec![Branch::Front], &slots, &mut used)?;
+                let b = match back {
+                    Some(b) => compile(b, &mut vec![Branch::Back], &slots, &mut used)?,
+                    None => f.clone(),
+                };
+                (Some(f), Some(b))
+            }
+            other => (
+                Some(compile(other, &mut Vec::new(), &slots, &mut used)?),
+                None,
+            ),
+        };
+        if let Some(i) = used.iter().position(|u| !u) {
+            return Err(BrdfError::TextureSlot(format!(
+                "{:?} at {:?}",
+                slots[i].kind, slots[i].path
+            )));
+        }
+        let sides = Sided { front, back };
+        for (_, node) in sides.iter() {
+            if node.as_ref().is_some_and(|n| n.conductors() > 1) {
+                return Err(BrdfError::TexturedConductors);
+            }
+        }
+        let mut t = TexturedBsdf {
+            bsdf,
+            sides,
+            slots,
+            nominal_glossy: Sided::from_fn(|_| Spectrum::zero()),
+        };
+        let nominal = t.nominal_values();
+        t.nominal_glossy = Sided::from_fn(|side| {
+            t.sides[side]
+                .as_ref()
+                .map_or(Spectrum::zero(), |n| n.parts(&t.spectra(&nominal)).1)
+        });
+        Ok(t)
+    }
+
+    /// The nominal material (every textured parameter at the texture's
+    /// mean).
+    pub fn bsdf(&self) -> &Bsdf<N> {
+        &self.bsdf
+    }
+
+    /// The textures.
+    pub fn slots(&self) -> &[TextureSlot] {
+        &self.slots
+    }
+
+    /// The slot values at the textures' means.
+    pub fn nominal_values(&self) -> SlotValues {
+        let mut v = [[0.0; 3]; MAX_SLOTS];
+        for (i, s) in self.slots.iter().enumerate() {
+            v[i] = self.slot_value(i, s.texture.mean());
+        }
+        SlotValues(v)
+    }
+
+    fn slot_value(&self, i: usize, rgb: [f64; 3]) -> [f64; 3] {
+        slot_value(&self.slots[i], rgb)
+    }
+
+    /// Every slot's value at texture coordinates `uv`.
+    pub fn values_at(&self, uv: DVec2) -> SlotValues {
+        let mut v = [[0.0; 3]; MAX_SLOTS];
+        for (i, s) in self.slots.iter().enumerate() {
+            v[i] = self.slot_value(i, s.texture.eval(uv));
+        }
+        SlotValues(v)
+    }
+
+    fn spectra(&self, v: &SlotValues) -> [Spectrum<N>; MAX_SLOTS] {
+        // N = 3 (checked by `new`): RGB is the spectrum.
+        v.0.map(|rgb| Spectrum::from_fn(|b| rgb.get(b).copied().unwrap_or(0.0)))
+    }
+
+    /// ρ_d and g of both sides for slot values `v` (a point's, or an
+    /// element's average).
+    pub fn parts(&self, v: &SlotValues) -> Sided<PointParts<N>> {
+        let spectra = self.spectra(v);
+        Sided::from_fn(|side| match &self.sides[side] {
+            None => PointParts {
+                rho: Spectrum::zero(),
+                glossy: Spectrum::zero(),
+            },
+            Some(node) => {
+                let (rho, gw) = node.parts(&spectra);
+                let nominal = self.nominal_glossy[side];
+                let glossy = Spectrum::from_fn(|b| {
+                    if nominal[b] > 0.0 {
+                        gw[b] / nominal[b]
+                    } else {
+                        0.0
+                    }
+                });
+                PointParts { rho, glossy }
+            }
+        })
+    }
+
+    /// The material at texture coordinates `uv`.
+    pub fn at(&self, uv: DVec2) -> Shading<'_, N> {
+        Shading {
+            bsdf: &self.bsdf,
+            parts: Some(self.parts(&self.values_at(uv))),
+        }
+    }
+}
+
+/// The material at one point: a [`Bsdf`], with the point's ρ_d and g when
+/// the material is textured (module docs). Its methods are [`Bsdf`]'s.
+#[derive(Clone, Debug)]
+pub struct Shading<'a, const N: usize> {
+    bsdf: &'a Bsdf<N>,
+    parts: Option<Sided<PointParts<N>>>,
+}
+
+impl<'a, const N: usize> Shading<'a, N> {
+    /// An untextured material, the same everywhere.
+    pub fn uniform(bsdf: &'a Bsdf<N>) -> Self {
+        Shading { bsdf, parts: None }
+    }
+
+    /// The nominal material with the parts `parts` (an element's).
+    pub fn with_parts(bsdf: &'a Bsdf<N>, parts: Sided<PointParts<N>>) -> Self {
+        Shading {
+            bsdf,
+            parts: Some(parts),
+        }
+    }
+
+    /// The side that reflects towards viewer `wo` when light comes from
+    /// `wi` (local frame), if any.
+    fn reflecting(wi: DVec3, wo: DVec3) -> Option<Side> {
+        match Side::of_local(wo)? {
+            Side::Front if wi.z > 0.0 => Some(Side::Front),
+            Side::Back if wi.z < 0.0 => Some(Side::Back),
+            _ => None,
+        }
+    }
+
+    /// fr(wi, wo), without the cosine.
+    pub fn eval(&self, wi: DVec3, wo: DVec3) -> Spectrum<N> {
+        let Some(parts) = &self.parts else {
+            return self.bsdf.eval(wi, wo);
+        };
+        match Self::reflecting(wi, wo) {
+            Some(side) if !self.bsdf.is_black(side) => {
+                let p = parts[side];
+                p.rho * std::f64::consts::FRAC_1_PI + self.bsdf.eval_glossy(wi, wo) * p.glossy
+            }
+            _ => Spectrum::zero(),
+        }
+    }
+
+    /// The non-Lambertian part of fr(wi, wo).
+    pub fn eval_glossy(&self, wi: DVec3, wo: DVec3) -> Spectrum<N> {
+        let g = self.bsdf.eval_glossy(wi, wo);
+        match (&self.parts, Side::of_local(wo)) {
+            (Some(parts), Some(side)) => g * parts[side].glossy,
+            _ => g,
+        }
+    }
+
+    /// The Lambertian reflectance ρ_d on `side`.
+    pub fn diffuse_albedo(&self, side: Side) -> Spectrum<N> {
+        match &self.parts {
+            Some(parts) if !self.bsdf.is_black(side) => parts[side].rho,
+            Some(_) => Spectrum::zero(),
+            None => self.bsdf.diffuse_albedo(side),
+        }
+    }
+
+    /// True when `side` has a non-Lambertian part.
+    pub fn has_glossy(&self, side: Side) -> bool {
+        self.bsdf.has_glossy(side)
+    }
+
+    /// The smallest roughness α of a conductor part of `side`.
+    pub fn min_alpha(&self, side: Side) -> Option<f64> {
+        self.bsdf.min_alpha(side)
+    }
+
+    /// Samples wi for viewer `wo` from the nominal material's density,
+    /// weighted by this point's fr (see [`Bsdf::sample`]).
+    pub fn sample(&self, wo: DVec3, u: DVec2) -> Option<BsdfSample<N>> {
+        let s = self.bsdf.sample(wo, u)?;
+        if self.parts.is_none() {
+            return Some(s);
+        }
+        let weight = self.eval(s.wi, wo) * (s.wi.z.abs() / s.pdf);
+        weight.is_finite().then_some(BsdfSample { weight, ..s })
+    }
+
+    /// The density of [`Shading::sample`] (the nominal material's).
+    pub fn pdf(&self, wo: DVec3, wi: DVec3) -> f64 {
+        self.bsdf.pdf(wo, wi)
+    }
+
+    /// Directional albedo for viewer `wo`: ρ_d + g ⊙ the nominal glossy
+    /// albedo.
+    pub fn albedo(&self, wo: DVec3) -> Spectrum<N> {
+        let a = self.bsdf.albedo(wo);
+        match (&self.parts, Side::of_local(wo)) {
+            (Some(parts), Some(side)) => {
+                let glossy = (a - self.bsdf.diffuse_albedo(side)).max(Spectrum::zero());
+                self.diffuse_albedo(side) + glossy * parts[side].glossy
+            }
+            _ => a,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::params::{Distribution, RoughConductorParams};
+    use crate::texture::{Filter, Wrap};
+
+    fn checker() -> Arc<Texture> {
+        // 2 × 1: black, white.
+        Arc::new(
+            Texture::new(
+                2,
+                1,
+                vec![[0.0; 3], [1.0; 3]],
+                [Wrap::Repeat; 2],
+                Filter::Nearest,
+            )
+            .unwrap(),
+        )
+    }
+
+    fn blend(weight: f64, rho: f64, s: f64) -> BsdfParams {
+        BsdfParams::Blend {
+            weight,
+            first: Box::new(BsdfParams::Diffuse {
+                reflectance: ColorParam::Float(rho),
+            }),
+            second: Box::new(BsdfParams::RoughConductor(RoughConductorParams {
+                distribution: Distribution::Ggx,
+                alpha: 0.3,
+                eta_k: None,
+                specular_reflectance: ColorParam::Float(s),
+            })),
+        }
+    }
+
+    fn slot(path: Vec<Branch>, kind: SlotKind, scale: f64) -> TextureSlot {
+        TextureSlot {
+            path,
+            kind,
+            texture: checker(),
+            scale: [scale; 3],
+            offset: [0.0; 3],
+        }
+    }
+
+    /// A textured point is the untextured material with the texture's value
+    /// written in: ρ_d, fr and the albedo agree with `Bsdf` built from the
+    /// point's parameters.
+    #[test]
+    fn a_point_is_the_material_with_its_values() {
+        let slots = vec![
+            slot(vec![Branch::First], SlotKind::Reflectance, 0.8),
+            slot(vec![Branch::Second], SlotKind::SpecularReflectance, 0.6),
+        ];
+        // Nominal: the mean 0.5 of the texture times the scale.
+        let t: TexturedBsdf<3> = TexturedBsdf::new(&blend(0.4, 0.4, 0.3), slots).unwrap();
+        let white = DVec2::new(0.75, 0.5);
+        let black = DVec2::new(0.25, 0.5);
+        let direct: Bsdf<3> = Bsdf::new(&blend(0.4, 0.8, 0.6)).unwrap();
+        let at = t.at(white);
+        let (wi, wo) = (
+            DVec3::new(0.3, 0.1, 0.9).normalize(),
+            DVec3::new(-0.2, 0.0, 1.0).normalize(),
+        );
+        let (a, b) = (at.eval(wi, wo), direct.eval(wi, wo));
+        assert!((a.0[0] - b.0[0]).abs() < 1e-12 * b.0[0], "{a:?} {b:?}");
+        assert!((at.diffuse_albedo(Side::Front).0[1] - 0.6 * 0.8).abs() < 1e-12);
+        let (a, b) = (at.albedo(wo), direct.albedo(wo));
+        assert!((a.0[2] - b.0[2]).abs() < 1e-9, "{a:?} {b:?}");
+        let dark = t.at(black);
+        assert_eq!(dark.eval(wi, wo), Spectrum::zero());
+        assert!(dark.eval(-wi, wo).is_black(), "no transmission");
+    }
+
+    #[test]
+    fn weight_textures_move_light_between_parts() {
+        let slots = vec![slot(Vec::new(), SlotKind::Weight, 1.0)];
+        let t: TexturedBsdf<3> = TexturedBsdf::new(&blend(0.5, 0.5, 1.0), slots).unwrap();
+        let p = t.parts(&t.values_at(DVec2::new(0.75, 0.0)));
+        assert_eq!(p.front.rho, Spectrum::zero());
+        assert!((p.front.glossy.0[0] - 2.0).abs() < 1e-12);
+        assert_eq!(p.back.rho, Spectrum::zero());
+    }
+
+    #[test]
+    fn refuses_what_it_cannot_represent() {
+        let one = || vec![slot(vec![Branch::First], SlotKind::Reflectance, 1.0)];
+        let two_conductors = BsdfParams::Blend {
+            weight: 0.5,
+            first: Box::new(blend(0.5, 0.5, 0.5)),
+            second: Box::new(blend(0.5, 0.5, 0.5)),
+        };
+        assert_eq!(
+            TexturedBsdf::<3>::new(
+                &two_conductors,
+                vec![slot(
+                    vec![Branch::First, Branch::First],
+                    SlotKind::Reflectance,
+                    1.0
+                )]
+            )
+            .err(),
+            Some(BrdfError::TexturedConductors)
+        );
+        assert!(
+            TexturedBsdf::<3>::new(
+                &blend(0.5, 0.5, 0.5),
+                vec![slot(vec![Branch::Second], SlotKind::Reflectance, 1.0)]
+            )
+            .is_err()
+        );
+        assert_eq!(
+            TexturedBsdf::<20>::new(&blend(0.5, 0.5, 0.5), one()).err(),
+            Some(BrdfError::TexturedSpectral)
+        );
+    }
+}

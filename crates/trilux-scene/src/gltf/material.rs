@@ -1,0 +1,316 @@
+//! glTF materials → trilux BSDFs: the mapping of `pbrMetallicRoughness`
+//! (docs/gltf.md gives it with its reasons; `scripts/gltf_to_mitsuba.py`
+//! writes the same Mitsuba BSDFs).
+//!
+//! With base colour B = baseColorFactor ⊙ baseColorTexture (sRGB-decoded),
+//! metallic m, roughness r, and the dielectric's reflectance at normal
+//! incidence F0 = min(0.04 · specularColorFactor, 1) · specularFactor
+//! (`KHR_materials_specular`; 0.04 without it), F = max(F0):
+//!
+//! ```text
+//! diffuse part   D = (1 − m)(1 − F) · B          (Lambertian, ρ_d)
+//! specular part  S = (1 − m) · F0 + m · B        (GGX, α = max(r², 0.01),
+//!                                                 Fresnel 1 × S)
+//! ```
+//!
+//! D + S ≤ 1 in every channel. With D̂ and Ŝ the largest channel of each
+//! over the factors (textures are at most 1), the material is
+//! `blendbsdf(weight w = Ŝ/(D̂ + Ŝ), diffuse(D/(1 − w)), roughconductor(S/w))`,
+//! or `diffuse(D)` alone when Ŝ = 0 (`specularFactor` 0 on a dielectric,
+//! the way to write Mitsuba's `diffuse` in glTF), or the `roughconductor`
+//! alone when D̂ = 0 (a metal). `doubleSided` wraps it in `twosided`.
+//! Emission: `emissiveFactor × KHR_materials_emissive_strength` is the
+//! radiance of an area emitter on the front side; an emissive material that
+//! is also `doubleSided` is refused (glTF would have it emit on both sides,
+//! and trilux's area emitters emit on the front only).
+//!
+//! Refused (one error naming the material): `metallicRoughnessTexture`,
+//! `emissiveTexture`, the textures of `KHR_materials_specular`,
+//! `KHR_texture_transform`, texture coordinates other than `TEXCOORD_0`,
+//! `alphaMode` other than `OPAQUE`, and `normalTexture` (a shading normal
+//! per texel, which trilux's element normals cannot follow).
+//! `occlusionTexture` is ignored: it approximates, for real-time engines,
+//! the shadowing that a global illumination solve computes.
+
+use std::path::Path;
+use std::sync::Arc;
+
+use trilux_brdf::{Branch, BsdfParams, Distribution, Filter, RoughConductorParams, SlotKind, Wrap};
+use trilux_color::ColorParam;
+
+use crate::error::{Result, SceneError, SourceLocation};
+use crate::image::Sampling;
+
+/// The smallest GGX α a glTF roughness maps to (roughness 0.1): smoother
+/// surfaces are mirrors that no element-based solve can resolve.
+pub const MIN_ALPHA: f64 = 0.01;
+
+/// A texture of a mapped material, its image not read yet.
+#[derive(Clone, Debug)]
+pub(crate) struct TextureUse {
+    /// Where it enters the BSDF.
+    pub path: Vec<Branch>,
+    /// Which parameter.
+    pub kind: SlotKind,
+    /// The glTF image.
+    pub image: usize,
+    /// Its sampler.
+    pub sampling: Sampling,
+    /// value = offset + scale ⊙ texture.
+    pub scale: [f64; 3],
+    /// See `scale`.
+    pub offset: [f64; 3],
+    /// `/materials/i/pbrMetallicRoughness/baseColorTexture`.
+    pub location: SourceLocation,
+}
+
+/// A glTF material as trilux takes it.
+#[derive(Clone, Debug)]
+pub(crate) struct Mapped {
+    pub bsdf: BsdfParams,
+    pub textures: Vec<TextureUse>,
+    /// Emitted radiance (front side), if the material emits.
+    pub emission: Option<ColorParam>,
+    /// The BSDF types used, for `bsdf_counts`.
+    pub types: Vec<&'static str>,
+}
+
+/// Maps one material (`None`: glTF's default material, white, metallic 1,
+/// roughness 1).
+pub(crate) fn map(file: &Arc<Path>, m: &gltf::Material<'_>) -> Result<Mapped> {
+    let base = match m.index() {
+        Some(i) => format!("/materials/{i}"),
+        None => "/materials (the default material)".into(),
+    };
+    let at = |suffix: &str, msg: String| {
+        let name = m
+            .name()
+            .map(|n| format!("material \"{n}\": "))
+            .unwrap_or_default();
+        SceneError::at(
+            &SourceLocation::json(file, format!("{base}{suffix}")),
+            format!("{name}{msg}"),
+        )
+    };
+    refuse_unsupported(m, &at)?;
+    let pbr = m.pbr_metallic_roughness();
+    let f = pbr.base_color_factor();
+    let b = [f[0], f[1], f[2]].map(|v| f64::from(v).clamp(0.0, 1.0));
+    let metal = f64::from(pbr.metallic_factor()).clamp(0.0, 1.0);
+    let rough = f64::from(pbr.roughness_factor()).clamp(0.0, 1.0);
+    let (sf, sc) = match m.specular() {
+        Some(s) => (
+            f64::from(s.specular_factor()),
+            s.specular_color_factor().map(f64::from),
+        ),
+        None => (1.0, [1.0; 3]),
+    };
+    if !(b.iter().all(|v| v.is_finite())
+        && metal.is_finite()
+        && rough.is_finite()
+        && sf.is_finite()
+        && sc.iter().all(|v| v.is_finite()))
+    {
+        return Err(at("", "a factor is not a finite number".into()));
+    }
+    let f0 = sc.map(|c| (0.04 * c).clamp(0.0, 1.0) * sf.clamp(0.0, 1.0));
+    let fmax = f0.iter().copied().fold(0.0, f64::max);
+    let bmax = b.iter().copied().fold(0.0, f64::max);
+    let d_scale = b.map(|c| (1.0 - metal) * (1.0 - fmax) * c);
+    let s_scale = b.map(|c| metal * c);
+    let s_offset = f0.map(|c| (1.0 - metal) * c);
+    let d_hat = (1.0 - metal) * (1.0 - fmax) * bmax;
+    let s_hat = (0..3).map(|c| s_offset[c] + s_scale[c]).fold(0.0, f64::max);
+    let base_texture = pbr
+        .base_color_texture()
+        .map(|t| {
+            let suffix = "/pbrMetallicRoughness/baseColorTexture";
+            let location = SourceLocation::json(file, format!("{base}{suffix}"));
+            texture_info(&t, &at, suffix, location)
+        })
+        .transpose()?;
+    let conductor = |spec: [f64; 3]| {
+        BsdfParams::RoughConductor(RoughConductorParams {
+            distribution: Distribution::Ggx,
+            alpha: (rough * rough).max(MIN_ALPHA),
+            eta_k: None,
+            specular_reflectance: ColorParam::Rgb(spec),
+        })
+    };
+    let mut textures = Vec::new();
+    let mut add = |path: Vec<Branch>, kind, scale: [f64; 3], offset: [f64; 3]| {
+        if let Some((image, sampling, location)) = &base_texture
+            && scale.iter().any(|&s| s > 0.0)
+        {
+            textures.push(TextureUse {
+                path,
+                kind,
+                image: *image,
+                sampling: *sampling,
+                scale,
+                offset,
+                location: location.clone(),
+            });
+        }
+    };
+    let (bsdf, mut types) = if s_hat <= 0.0 {
+        add(vec![], SlotKind::Reflectance, d_scale, [0.0; 3]);
+        (
+            BsdfParams::Diffuse {
+                reflectance: ColorParam::Rgb(d_scale),
+            },
+            vec!["diffuse"],
+        )
+    } else if d_hat <= 0.0 {
+        add(vec![], SlotKind::SpecularReflectance, s_scale, s_offset);
+        let s = std::array::from_fn(|c| s_offset[c] + s_scale[c]);
+        (conductor(s), vec!["roughconductor"])
+    } else {
+        let w = s_hat / (d_hat + s_hat);
+        let d = d_scale.map(|c| c / (1.0 - w));
+        let (ss, so) = (s_scale.map(|c| c / w), s_offset.map(|c| c / w));
+        add(vec![Branch::First], SlotKind::Reflectance, d, [0.0; 3]);
+        add(vec![Branch::Second], SlotKind::SpecularReflectance, ss, so);
+        let s = std::array::from_fn(|c| (so[c] + ss[c]).min(1.0));
+        let blend = BsdfParams::Blend {
+            weight: w,
+            first: Box::new(BsdfParams::Diffuse {
+                reflectance: ColorParam::Rgb(d.map(|c| c.min(1.0))),
+            }),
+            second: Box::new(conductor(s)),
+        };
+        (blend, vec!["blendbsdf", "diffuse", "roughconductor"])
+    };
+    let bsdf = if m.double_sided() {
+        types.push("twosided");
+        for t in &mut textures {
+            t.path.insert(0, Branch::Front);
+        }
+        BsdfParams::TwoSided {
+            front: Box::new(bsdf),
+            back: None,
+        }
+    } else {
+        bsdf
+    };
+    Ok(Mapped {
+        bsdf,
+        textures,
+        emission: emission(m, &at)?,
+        types,
+    })
+}
+
+type At<'a> = dyn Fn(&str, String) -> SceneError + 'a;
+
+fn refuse_unsupported(m: &gltf::Material<'_>, at: &At<'_>) -> Result<()> {
+    let pbr = m.pbr_metallic_roughness();
+    let refused = [
+        (
+            pbr.metallic_roughness_texture().is_some(),
+            "/pbrMetallicRoughness/metallicRoughnessTexture",
+            "metallicRoughnessTexture is not supported (trilux's materials have one roughness and one metallic value; bake them into the factors)",
+        ),
+        (
+            m.emissive_texture().is_some(),
+            "/emissiveTexture",
+            "emissiveTexture is not supported (trilux's area emitters have one radiance per shape)",
+        ),
+        (
+            m.normal_texture().is_some(),
+            "/normalTexture",
+            "normalTexture is not supported (trilux shades with the mesh's own normals)",
+        ),
+        (
+            m.specular().is_some_and(|s| {
+                s.specular_texture().is_some() || s.specular_color_texture().is_some()
+            }),
+            "/extensions/KHR_materials_specular",
+            "the textures of KHR_materials_specular are not supported (only its factors)",
+        ),
+        (
+            m.alpha_mode() != gltf::material::AlphaMode::Opaque,
+            "/alphaMode",
+            "alphaMode MASK and BLEND are not supported (trilux's surfaces are opaque)",
+        ),
+    ];
+    for (is, suffix, message) in refused {
+        if is {
+            return Err(at(suffix, message.into()));
+        }
+    }
+    Ok(())
+}
+
+fn emission(m: &gltf::Material<'_>, at: &At<'_>) -> Result<Option<ColorParam>> {
+    let strength = f64::from(m.emissive_strength().unwrap_or(1.0));
+    let e = m.emissive_factor().map(|v| f64::from(v) * strength);
+    if !e.iter().all(|v| v.is_finite() && *v >= 0.0) {
+        return Err(at(
+            "/emissiveFactor",
+            "emitted radiance must be finite and non-negative".into(),
+        ));
+    }
+    if let Some(v) = e.iter().find(|v| **v > crate::limits::MAX_RADIANCE) {
+        return Err(at(
+            "/emissiveFactor",
+            format!(
+                "radiance {v:e} is beyond the limit {:e} (docs/limits.md)",
+                crate::limits::MAX_RADIANCE
+            ),
+        ));
+    }
+    let emits = e.iter().any(|&v| v > 0.0);
+    if emits && m.double_sided() {
+        return Err(at(
+            "/doubleSided",
+            "a double-sided emissive material is not supported: trilux's area emitters emit on their front side only (make the material single-sided, or give each side its own primitive)".into(),
+        ));
+    }
+    Ok(emits.then_some(ColorParam::Rgb(e)))
+}
+
+/// The image, sampling and place of a texture reference.
+fn texture_info(
+    t: &gltf::texture::Info<'_>,
+    at: &At<'_>,
+    suffix: &str,
+    location: SourceLocation,
+) -> Result<(usize, Sampling, SourceLocation)> {
+    if t.tex_coord() != 0 {
+        return Err(at(
+            suffix,
+            format!(
+                "texCoord {} is not supported (only TEXCOORD_0)",
+                t.tex_coord()
+            ),
+        ));
+    }
+    if t.texture_transform().is_some() {
+        return Err(at(suffix, "KHR_texture_transform is not supported".into()));
+    }
+    let texture = t.texture();
+    let sampler = texture.sampler();
+    let wrap = |w: gltf::texture::WrappingMode| match w {
+        gltf::texture::WrappingMode::Repeat => Wrap::Repeat,
+        gltf::texture::WrappingMode::MirroredRepeat => Wrap::Mirror,
+        gltf::texture::WrappingMode::ClampToEdge => Wrap::Clamp,
+    };
+    let (ws, wt) = (wrap(sampler.wrap_s()), wrap(sampler.wrap_t()));
+    if ws != wt {
+        return Err(at(suffix, "a sampler with different wrapS and wrapT is not supported (Mitsuba's bitmap has one wrap_mode)".into()));
+    }
+    let filter = match sampler.mag_filter() {
+        Some(gltf::texture::MagFilter::Nearest) => Filter::Nearest,
+        _ => Filter::Bilinear,
+    };
+    Ok((
+        texture.source().index(),
+        Sampling {
+            wrap: [ws, wt],
+            filter,
+            raw: false,
+        },
+        location,
+    ))
+}

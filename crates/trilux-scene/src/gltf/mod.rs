@@ -1,0 +1,172 @@
+//! glTF 2.0 scenes (`.gltf` with its buffers and images beside it, or one
+//! `.glb`) into the same [`Scene`] as the Mitsuba XML subset, with the
+//! `gltf` crate's JSON parsing and validation (indices in range, required
+//! fields) and without its `import` feature: buffers and images are
+//! resolved here, with bounded reads ([`buffers`]).
+//!
+//! Stages, as for XML:
+//! 1. [`open`]: the file (bounded), its JSON validated, required extensions
+//!    checked, the default scene's node hierarchy walked ([`nodes`]): every
+//!    mesh primitive of every node becomes one shape (one input-surface
+//!    chart set per primitive, as an OBJ), its material mapped
+//!    ([`material`]), the camera chosen. Nothing large is read yet.
+//! 2. [`GltfMeshes::finish`] (from [`crate::Pending::finish`]): the buffers
+//!    are read, the accessors checked and read ([`accessor`]), each mesh
+//!    put into world space (so a mirroring node keeps glTF's winding rule),
+//!    and the textures requested.
+//!
+//! Errors name the file and the JSON path: `scene.gltf:/meshes/0/primitives/1/mode: ...`.
+
+mod accessor;
+mod buffers;
+mod material;
+mod nodes;
+
+use std::path::Path;
+use std::sync::Arc;
+
+use crate::error::{Result, SceneError, SourceLocation};
+use crate::limits::{MAX_GLB_BYTES, MAX_SCENE_BYTES};
+use crate::meshes::{Pending, Requests};
+
+pub(crate) use nodes::GltfMeshes;
+
+/// Extensions a file may require (others in `extensionsRequired` are
+/// refused; others only used are ignored, as the glTF specification
+/// allows).
+pub const SUPPORTED_EXTENSIONS: [&str; 2] =
+    ["KHR_materials_specular", "KHR_materials_emissive_strength"];
+
+/// True when `path` names a glTF file (`.gltf` or `.glb`, any case).
+pub fn is_gltf(path: &Path) -> bool {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("gltf") || e.eq_ignore_ascii_case("glb"))
+}
+
+/// Reads and checks a glTF file, all but its buffers and images; `camera`
+/// names the camera to use (a camera's or its node's name), else the first
+/// one in the scene.
+pub(crate) fn open(path: &Path, camera: Option<&str>) -> Result<Pending> {
+    let file: Arc<Path> = Arc::from(path);
+    let glb = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("glb"));
+    let limit = if glb { MAX_GLB_BYTES } else { MAX_SCENE_BYTES };
+    let bytes = trilux_files::read_limited(path, limit).map_err(|source| SceneError::Read {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    open_bytes(&bytes, &file, camera)
+}
+
+/// [`open`] on the bytes of a glTF or GLB file; `file` names it in errors
+/// and anchors relative URIs.
+pub(crate) fn open_bytes(bytes: &[u8], file: &Arc<Path>, camera: Option<&str>) -> Result<Pending> {
+    let gltf = parse(bytes, file)?;
+    if let Some(ext) = gltf
+        .document
+        .extensions_required()
+        .find(|e| !SUPPORTED_EXTENSIONS.contains(e))
+    {
+        return Err(SceneError::at(
+            &SourceLocation::json(file, "/extensionsRequired"),
+            format!(
+                "the file requires extension {ext}, which trilux does not support (supported: {})",
+                SUPPORTED_EXTENSIONS.join(", ")
+            ),
+        ));
+    }
+    let (scene, meshes) = nodes::build(file, gltf, camera)?;
+    Ok(Pending::new(
+        scene,
+        Requests {
+            gltf: Some(meshes),
+            ..Requests::default()
+        },
+    ))
+}
+
+/// A `gltf` crate error as one located line.
+/// The document, validated by the `gltf` crate after the one check its
+/// validation needs first: it indexes each primitive's POSITION accessor
+/// before checking that the accessor exists (and panics where not).
+fn parse(bytes: &[u8], file: &Arc<Path>) -> Result<gltf::Gltf> {
+    let unchecked =
+        gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| parse_error(file, e))?;
+    let json = unchecked.document.as_json();
+    for (m, mesh) in json.meshes.iter().enumerate() {
+        for (k, primitive) in mesh.primitives.iter().enumerate() {
+            for (semantic, index) in &primitive.attributes {
+                if index.value() >= json.accessors.len() {
+                    let name = match semantic {
+                        gltf::json::validation::Checked::Valid(s) => s.to_string(),
+                        gltf::json::validation::Checked::Invalid => "an attribute".into(),
+                    };
+                    return Err(SceneError::at(
+                        &SourceLocation::json(
+                            file,
+                            format!("/meshes/{m}/primitives/{k}/attributes"),
+                        ),
+                        format!(
+                            "{name} names accessor {}, which does not exist",
+                            index.value()
+                        ),
+                    ));
+                }
+            }
+        }
+    }
+    let blob = unchecked.blob;
+    let document = gltf::Document::from_json(unchecked.document.into_json())
+        .map_err(|e| parse_error(file, e))?;
+    Ok(gltf::Gltf { document, blob })
+}
+
+fn parse_error(file: &Arc<Path>, e: gltf::Error) -> SceneError {
+    match e {
+        gltf::Error::Validation(errors) => {
+            let (path, error) = match errors.first() {
+                Some((p, e)) => (pointer(&p.to_string()), e.to_string()),
+                None => ("/".into(), "invalid".into()),
+            };
+            let more = match errors.len() {
+                0 | 1 => String::new(),
+                n => format!(" (and {} more problems)", n - 1),
+            };
+            SceneError::at(
+                &SourceLocation::json(file, path),
+                format!("invalid glTF: {error}{more}"),
+            )
+        }
+        gltf::Error::Deserialize(e) => SceneError::at(
+            &SourceLocation {
+                file: Arc::clone(file),
+                line: e.line() as u32,
+                col: e.column() as u32,
+                pointer: None,
+            },
+            format!("malformed glTF JSON: {e}"),
+        ),
+        gltf::Error::Binary(e) => SceneError::at(
+            &SourceLocation::json(file, "/"),
+            format!("malformed GLB file: {e:?}"),
+        ),
+        other => SceneError::at(&SourceLocation::json(file, "/"), other.to_string()),
+    }
+}
+
+/// The `gltf` crate's path (`meshes[0].primitives[1].mode`) as a JSON
+/// pointer (`/meshes/0/primitives/1/mode`).
+fn pointer(path: &str) -> String {
+    let mut out = String::from("/");
+    for c in path.chars() {
+        match c {
+            '.' | '[' => out.push('/'),
+            ']' | '"' => {}
+            c => out.push(c),
+        }
+    }
+    out.replace("//", "/")
+}

@@ -1,0 +1,559 @@
+//! The glTF node hierarchy → shapes and a camera, and (at finish) the
+//! meshes and textures of those shapes.
+//!
+//! - **Transforms**: a node's `matrix` or `translation`/`rotation`/`scale`,
+//!   composed from the scene's roots down (column vectors, parent × child).
+//!   A node reached twice is refused (glTF's node graph is a set of
+//!   disjoint trees), and so is a hierarchy deeper than [`MAX_NODE_DEPTH`].
+//! - **Meshes**: every primitive of a node's mesh is one shape whose
+//!   vertices are put into world space (normals by the inverse transpose),
+//!   so that the winding rule of glTF (counter-clockwise in world space is
+//!   the front, whatever the determinant) is the one trilux's meshes use.
+//!   Only `TRIANGLES` (mode 4) is taken. Without `NORMAL` the mesh is
+//!   flat-shaded (glTF's rule); `TEXCOORD_0` is kept when present.
+//! - **Cameras**: perspective only; glTF's camera looks down −z with +y up,
+//!   Mitsuba's (trilux's) down +z with +x to the left, so the camera's
+//!   world transform is the node's (its scale removed) times diag(−1, 1,
+//!   −1). `yfov` is the vertical field of view; the film is 768 pixels wide
+//!   and as high as `aspectRatio` makes it (576 without one).
+//! - **Lights** (`KHR_lights_punctual`): refused, naming the light. A point,
+//!   spot or directional light is a delta: the hierarchical solve shoots
+//!   from surfaces, and a sphere small enough to stand in for it would
+//!   need a radiance millions of times any surface's, whose flux no
+//!   element-sized link resolves (model the lamp as an emissive mesh).
+
+use std::collections::{BTreeMap, HashMap, HashSet};
+use std::fmt;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use glam::{DMat3, DMat4, DVec2, DVec3};
+use trilux_brdf::BsdfParams;
+use trilux_color::ColorParam;
+use trilux_geometry::{Shape, ShapeKind, TriangleMesh};
+
+use super::accessor::{self, Kind};
+use super::buffers::{Buffers, data_uri, relative_path};
+use super::material::{Mapped, TextureUse, map};
+use crate::camera::{Camera, FovAxis, ReconstructionFilter};
+use crate::error::{Result, SceneError, SourceLocation};
+use crate::limits::{
+    MAX_GLTF_NODES, MAX_GLTF_TRIANGLES, MAX_NODE_DEPTH, MAX_OBJ_TRIANGLES, MAX_OBJ_VERTICES,
+};
+use crate::scene::{AreaEmitter, Scene, SceneShape};
+use crate::shape::check_area;
+use crate::textures::{ImageSource, TextureRequest};
+
+/// One mesh primitive placed by a node: read at finish.
+#[derive(Clone, Debug)]
+struct Placed {
+    shape: usize,
+    mesh: usize,
+    primitive: usize,
+    world: DMat4,
+}
+
+/// What [`GltfMeshes::finish`] reads: the document, its binary chunk, the
+/// placed primitives and the textures of their materials.
+pub(crate) struct GltfMeshes {
+    file: Arc<Path>,
+    document: gltf::Document,
+    blob: Option<Vec<u8>>,
+    placed: Vec<Placed>,
+    textures: Vec<(usize, TextureUse)>,
+}
+
+impl fmt::Debug for GltfMeshes {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("GltfMeshes")
+            .field("file", &self.file)
+            .field("placed", &self.placed)
+            .field("textures", &self.textures.len())
+            .finish()
+    }
+}
+
+/// The scene of `gltf` (its default scene, else its first) with `camera`.
+pub(crate) fn build(
+    file: &Arc<Path>,
+    gltf: gltf::Gltf,
+    camera: Option<&str>,
+) -> Result<(Scene, GltfMeshes)> {
+    let doc = &gltf.document;
+    let at = |p: String, m: String| SceneError::at(&SourceLocation::json(file, p), m);
+    let root = doc
+        .default_scene()
+        .or_else(|| doc.scenes().next())
+        .ok_or_else(|| at("/scenes".into(), "the file has no scene".into()))?;
+    let mut walk = Walk {
+        file,
+        shapes: Vec::new(),
+        placed: Vec::new(),
+        textures: Vec::new(),
+        cameras: Vec::new(),
+        materials: HashMap::new(),
+        bsdf_counts: BTreeMap::new(),
+        seen: HashSet::new(),
+        triangles: 0,
+    };
+    for node in root.nodes() {
+        walk.node(&node, DMat4::IDENTITY, 1)?;
+    }
+    let camera = choose_camera(file, &walk.cameras, camera)?;
+    let scene = Scene {
+        path: file.to_path_buf(),
+        shapes: walk.shapes,
+        camera,
+        max_depth: None,
+        spectral: false,
+        bsdf_counts: walk.bsdf_counts,
+    };
+    let meshes = GltfMeshes {
+        file: Arc::clone(file),
+        document: gltf.document,
+        blob: gltf.blob,
+        placed: walk.placed,
+        textures: walk.textures,
+    };
+    Ok((scene, meshes))
+}
+
+/// The state of the node walk.
+struct Walk<'f> {
+    file: &'f Arc<Path>,
+    shapes: Vec<SceneShape>,
+    placed: Vec<Placed>,
+    textures: Vec<(usize, TextureUse)>,
+    /// (camera name, node name, node index, camera, world transform).
+    cameras: Vec<CameraNode>,
+    materials: HashMap<Option<usize>, Mapped>,
+    bsdf_counts: BTreeMap<String, usize>,
+    seen: HashSet<usize>,
+    triangles: usize,
+}
+
+struct CameraNode {
+    names: [Option<String>; 2],
+    node: usize,
+    yfov: f64,
+    aspect: Option<f64>,
+    world: DMat4,
+}
+
+impl Walk<'_> {
+    fn at(&self, p: String, m: impl Into<String>) -> SceneError {
+        SceneError::at(&SourceLocation::json(self.file, p), m)
+    }
+
+    fn node(&mut self, node: &gltf::Node<'_>, parent: DMat4, depth: usize) -> Result<()> {
+        let i = node.index();
+        let here = format!("/nodes/{i}");
+        if depth > MAX_NODE_DEPTH {
+            return Err(self.at(
+                here,
+                format!(
+                    "the node hierarchy is deeper than {MAX_NODE_DEPTH} levels (docs/limits.md)"
+                ),
+            ));
+        }
+        if !self.seen.insert(i) || self.seen.len() > MAX_GLTF_NODES {
+            return Err(self.at(here, "the node is reached twice (glTF's nodes form disjoint trees), or the scene has too many nodes"));
+        }
+        let m = node.transform().matrix();
+        let local = DMat4::from_cols_array_2d(&m.map(|c| c.map(f64::from)));
+        if !local.is_finite() {
+            return Err(self.at(here, "the node's transform has a number that is not finite"));
+        }
+        let world = parent * local;
+        if let Some(light) = node.light() {
+            let kind = match light.kind() {
+                gltf::khr_lights_punctual::Kind::Directional => "directional",
+                gltf::khr_lights_punctual::Kind::Point => "point",
+                gltf::khr_lights_punctual::Kind::Spot { .. } => "spot",
+            };
+            return Err(self.at(
+                format!("{here}/extensions/KHR_lights_punctual"),
+                format!(
+                    "{kind} light {} (KHR_lights_punctual) is refused: trilux solves light between surfaces, and a punctual light has none (model the lamp as a mesh with an emissive material)",
+                    light.name().map_or(format!("#{}", light.index()), |n| format!("\"{n}\""))
+                ),
+            ));
+        }
+        if let Some(c) = node.camera() {
+            match c.projection() {
+                gltf::camera::Projection::Perspective(p) => self.cameras.push(CameraNode {
+                    names: [
+                        c.name().map(str::to_string),
+                        node.name().map(str::to_string),
+                    ],
+                    node: i,
+                    yfov: f64::from(p.yfov()),
+                    aspect: p.aspect_ratio().map(f64::from),
+                    world,
+                }),
+                gltf::camera::Projection::Orthographic(_) => {
+                    return Err(self.at(
+                        format!("/cameras/{}", c.index()),
+                        "orthographic cameras are not supported (only perspective)",
+                    ));
+                }
+            }
+        }
+        if let Some(mesh) = node.mesh() {
+            for p in mesh.primitives() {
+                self.primitive(node, &mesh, &p, world)?;
+            }
+        }
+        for child in node.children() {
+            self.node(&child, world, depth + 1)?;
+        }
+        Ok(())
+    }
+
+    fn primitive(
+        &mut self,
+        node: &gltf::Node<'_>,
+        mesh: &gltf::Mesh<'_>,
+        p: &gltf::Primitive<'_>,
+        world: DMat4,
+    ) -> Result<()> {
+        let here = format!("/meshes/{}/primitives/{}", mesh.index(), p.index());
+        if p.mode() != gltf::mesh::Mode::Triangles {
+            return Err(self.at(
+                format!("{here}/mode"),
+                format!(
+                    "primitive mode {:?} is not supported (only TRIANGLES)",
+                    p.mode()
+                ),
+            ));
+        }
+        let positions = p.get(&gltf::Semantic::Positions).ok_or_else(|| {
+            self.at(
+                format!("{here}/attributes"),
+                "the primitive has no POSITION",
+            )
+        })?;
+        let corners = p.indices().map_or(positions.count(), |a| a.count());
+        self.triangles += corners / 3;
+        if self.triangles > MAX_GLTF_TRIANGLES {
+            return Err(self.at(
+                here,
+                format!(
+                    "the scene places more than {MAX_GLTF_TRIANGLES} triangles (docs/limits.md)"
+                ),
+            ));
+        }
+        let material = p.material();
+        let key = material.index();
+        if !self.materials.contains_key(&key) {
+            let mapped = map(self.file, &material)?;
+            for t in &mapped.types {
+                *self.bsdf_counts.entry((*t).to_string()).or_default() += 1;
+            }
+            self.materials.insert(key, mapped);
+        }
+        let Some(mapped) = self.materials.get(&key) else {
+            return Ok(());
+        };
+        let shape = self.shapes.len();
+        let location = SourceLocation::json(self.file, format!("/nodes/{}", node.index()));
+        let emitter = mapped
+            .emission
+            .clone()
+            .map(|radiance: ColorParam| AreaEmitter {
+                radiance,
+                location: SourceLocation::json(
+                    self.file,
+                    format!(
+                        "/materials/{}/emissiveFactor",
+                        key.map_or("-".into(), |k| k.to_string())
+                    ),
+                ),
+            });
+        self.textures
+            .extend(mapped.textures.iter().map(|t| (shape, t.clone())));
+        let bsdf: BsdfParams = mapped.bsdf.clone();
+        self.shapes.push(SceneShape {
+            id: node.name().or(mesh.name()).map(str::to_string),
+            shape: Shape {
+                kind: ShapeKind::Mesh(TriangleMesh::default()),
+                world_from_object: DMat4::IDENTITY,
+                flip_normals: false,
+            },
+            bsdf,
+            emitter,
+            textures: Vec::new(),
+            location,
+        });
+        self.placed.push(Placed {
+            shape,
+            mesh: mesh.index(),
+            primitive: p.index(),
+            world,
+        });
+        Ok(())
+    }
+}
+
+/// The camera named `name` (a camera's or its node's name), else the first.
+fn choose_camera(
+    file: &Arc<Path>,
+    cameras: &[CameraNode],
+    name: Option<&str>,
+) -> Result<Option<Camera>> {
+    let chosen = match name {
+        None => cameras.first(),
+        Some(n) => Some(
+            cameras
+                .iter()
+                .find(|c| c.names.iter().flatten().any(|x| x == n))
+                .ok_or_else(|| {
+                    let known: Vec<String> = cameras
+                        .iter()
+                        .filter_map(|c| c.names.iter().flatten().next().cloned())
+                        .collect();
+                    SceneError::at(
+                        &SourceLocation::json(file, "/cameras"),
+                        format!(
+                            "no camera named \"{n}\" (the scene's cameras: {})",
+                            if known.is_empty() {
+                                "none".into()
+                            } else {
+                                known.join(", ")
+                            }
+                        ),
+                    )
+                })?,
+        ),
+    };
+    chosen.map(|c| camera(file, c)).transpose()
+}
+
+fn camera(file: &Arc<Path>, c: &CameraNode) -> Result<Camera> {
+    let location = SourceLocation::json(file, format!("/nodes/{}", c.node));
+    let err = |m: String| SceneError::at(&location, m);
+    let fov = c.yfov.to_degrees();
+    if !(fov > 0.0 && fov < 180.0) {
+        return Err(err(format!(
+            "yfov must lie strictly between 0 and π, found {}",
+            c.yfov
+        )));
+    }
+    // Scale removed: each axis of the node's rotation normalised.
+    let l = DMat3::from_mat4(c.world);
+    let axes = [l.x_axis, l.y_axis, l.z_axis].map(|a| a.normalize_or_zero());
+    if axes.contains(&DVec3::ZERO)
+        || axes[0].dot(axes[1]).abs() > 1e-3
+        || axes[0].dot(axes[2]).abs() > 1e-3
+        || axes[1].dot(axes[2]).abs() > 1e-3
+    {
+        return Err(err(
+            "the camera's node transform is singular or shears".into()
+        ));
+    }
+    let origin = c.world.w_axis.truncate();
+    let largest = origin.abs().max_element();
+    if !trilux_geometry::limits::within(largest) {
+        return Err(err(format!(
+            "the camera's position: {}",
+            trilux_geometry::limits::beyond(largest)
+        )));
+    }
+    // glTF: looks down −z, +x right; Mitsuba: down +z, +x left.
+    let world_from_camera = DMat4::from_cols(
+        (-axes[0]).extend(0.0),
+        axes[1].extend(0.0),
+        (-axes[2]).extend(0.0),
+        origin.extend(1.0),
+    );
+    let width = 768u32;
+    let height = match c.aspect {
+        Some(a) if a.is_finite() && a > 0.0 => {
+            ((f64::from(width) / a).round() as u32).clamp(1, crate::limits::MAX_FILM_EDGE)
+        }
+        Some(a) => return Err(err(format!("aspectRatio must be positive, found {a}"))),
+        None => 576,
+    };
+    Ok(Camera {
+        origin,
+        target: origin - axes[2],
+        up: axes[1],
+        world_from_camera,
+        fov,
+        fov_axis: FovAxis::Y,
+        width,
+        height,
+        rfilter: ReconstructionFilter::Gaussian,
+        sample_count: 4,
+        location,
+    })
+}
+
+impl GltfMeshes {
+    /// Reads every placed primitive's mesh into `scene` and returns the
+    /// texture requests of their materials.
+    pub fn finish(self, scene: &mut Scene) -> Result<Vec<(usize, TextureRequest)>> {
+        let mut buffers = Buffers::new(
+            Arc::clone(&self.file),
+            self.blob.clone(),
+            self.document.buffers().count(),
+        );
+        for placed in &self.placed {
+            let mesh = self.read_mesh(&mut buffers, placed)?;
+            let shape = &mut scene.shapes[placed.shape];
+            shape.shape.kind = ShapeKind::Mesh(mesh);
+            let describe = format!("mesh {} primitive {}", placed.mesh, placed.primitive);
+            check_area(&shape.shape, &shape.location, &describe)?;
+        }
+        let folder: PathBuf = self
+            .file
+            .parent()
+            .map(Path::to_path_buf)
+            .unwrap_or_default();
+        let mut images: HashMap<usize, ImageSource> = HashMap::new();
+        let mut out = Vec::with_capacity(self.textures.len());
+        for (shape, t) in &self.textures {
+            let source = match images.get(&t.image) {
+                Some(s) => s.clone(),
+                None => {
+                    let s = self.image_source(&mut buffers, &folder, t.image)?;
+                    images.insert(t.image, s.clone());
+                    s
+                }
+            };
+            out.push((
+                *shape,
+                TextureRequest {
+                    path: t.path.clone(),
+                    kind: t.kind,
+                    source,
+                    sampling: t.sampling,
+                    scale: t.scale,
+                    offset: t.offset,
+                    location: t.location.clone(),
+                },
+            ));
+        }
+        Ok(out)
+    }
+
+    fn image_source(
+        &self,
+        buffers: &mut Buffers,
+        folder: &Path,
+        index: usize,
+    ) -> Result<ImageSource> {
+        let at = |m: String| {
+            SceneError::at(
+                &SourceLocation::json(&self.file, format!("/images/{index}")),
+                m,
+            )
+        };
+        let image = self
+            .document
+            .images()
+            .nth(index)
+            .ok_or_else(|| at("no such image".into()))?;
+        // `Image::source` unwraps what the crate's validation lets through:
+        // a buffer view without a mimeType, an image with neither source.
+        let json = &self.document.as_json().images[index];
+        match (&json.buffer_view, &json.uri, &json.mime_type) {
+            (Some(view), _, _) if view.value() >= self.document.views().len() => {
+                return Err(at(format!("bufferView {} does not exist", view.value())));
+            }
+            (Some(_), _, None) => {
+                return Err(at("an image in a bufferView needs a mimeType".into()));
+            }
+            (None, None, _) => return Err(at("an image needs a uri or a bufferView".into())),
+            _ => {}
+        }
+        Ok(match image.source() {
+            gltf::image::Source::View { view, .. } => ImageSource::Bytes(buffers.view(&view)?),
+            gltf::image::Source::Uri { uri, .. } => match data_uri(uri) {
+                Some(r) => ImageSource::Bytes(Arc::from(r.map_err(|m| at(m.into()))?)),
+                None => ImageSource::File(relative_path(folder, uri).map_err(at)?),
+            },
+        })
+    }
+
+    fn read_mesh(&self, buffers: &mut Buffers, placed: &Placed) -> Result<TriangleMesh> {
+        let here = format!("/meshes/{}/primitives/{}", placed.mesh, placed.primitive);
+        let at = |m: String| SceneError::at(&SourceLocation::json(&self.file, here.clone()), m);
+        let p = self
+            .document
+            .meshes()
+            .nth(placed.mesh)
+            .and_then(|m| m.primitives().nth(placed.primitive))
+            .ok_or_else(|| at("no such primitive".into()))?;
+        let get = |s: gltf::Semantic| p.get(&s);
+        let pos_acc = get(gltf::Semantic::Positions).ok_or_else(|| at("no POSITION".into()))?;
+        let pos = accessor::read(&self.file, buffers, &pos_acc, Kind::Vec3, "POSITION")?;
+        let n = pos.len() / 3;
+        if n > MAX_OBJ_VERTICES {
+            return Err(at(format!(
+                "{n} vertices; the limit is {MAX_OBJ_VERTICES} (docs/limits.md)"
+            )));
+        }
+        let mut attribute =
+            |s: gltf::Semantic, kind: Kind, name: &str, width: usize| -> Result<Option<Vec<f64>>> {
+                let Some(a) = get(s) else { return Ok(None) };
+                let v = accessor::read(&self.file, buffers, &a, kind, name)?;
+                if v.len() != n * width {
+                    return Err(at(format!(
+                        "{name} has {} elements but POSITION has {n}",
+                        v.len() / width
+                    )));
+                }
+                Ok(Some(v))
+            };
+        let normals = attribute(gltf::Semantic::Normals, Kind::Vec3, "NORMAL", 3)?;
+        let texcoords = attribute(gltf::Semantic::TexCoords(0), Kind::Vec2, "TEXCOORD_0", 2)?;
+        let indices: Vec<u32> = match p.indices() {
+            Some(a) => {
+                let v = accessor::read(&self.file, buffers, &a, Kind::Index, "indices")?;
+                if let Some(bad) = v.iter().find(|&&i| i as usize >= n) {
+                    return Err(SceneError::at(
+                        &SourceLocation::json(&self.file, format!("/accessors/{}", a.index())),
+                        format!("indices: index {bad} is out of range for {n} vertices"),
+                    ));
+                }
+                v.into_iter().map(|i| i as u32).collect()
+            }
+            None => (0..n as u32).collect(),
+        };
+        if !indices.len().is_multiple_of(3) || indices.is_empty() {
+            return Err(at(format!(
+                "{} vertex indices do not make whole triangles",
+                indices.len()
+            )));
+        }
+        if indices.len() / 3 > MAX_OBJ_TRIANGLES {
+            return Err(at(format!(
+                "{} triangles; the limit is {MAX_OBJ_TRIANGLES} (docs/limits.md)",
+                indices.len() / 3
+            )));
+        }
+        let world = placed.world;
+        let normal_matrix = DMat3::from_mat4(world).inverse().transpose();
+        let positions = pos
+            .chunks_exact(3)
+            .map(|c| world.transform_point3(DVec3::new(c[0], c[1], c[2])))
+            .collect();
+        let normals = normals.map(|v| {
+            v.chunks_exact(3)
+                .map(|c| (normal_matrix * DVec3::new(c[0], c[1], c[2])).normalize_or(DVec3::Z))
+                .collect()
+        });
+        Ok(TriangleMesh {
+            positions,
+            face_normals: normals.is_none(),
+            normals,
+            triangles: indices
+                .chunks_exact(3)
+                .map(|t| [t[0], t[1], t[2]])
+                .collect(),
+            texcoords: texcoords
+                .map(|v| v.chunks_exact(2).map(|c| DVec2::new(c[0], c[1])).collect()),
+        })
+    }
+}

@@ -1,0 +1,103 @@
+//! Textures a scene asks for, read last: each request names its image (a
+//! file, or bytes of a glTF buffer), how it is looked up, and the material
+//! parameter it stands for (a [`TextureSlot`]). [`Pending::finish`]
+//! reads and decodes them ([`crate::image`]), each image once however many
+//! materials use it, within [`MAX_SCENE_TEXELS`] for the whole scene.
+//!
+//! [`Pending::finish`]: crate::Pending::finish
+
+use std::collections::HashMap;
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use trilux_brdf::{Branch, SlotKind, Texture, TextureSlot};
+
+use crate::error::{Result, SceneError, SourceLocation};
+use crate::image::{MAX_IMAGE_BYTES, Sampling, decode};
+use crate::limits::MAX_SCENE_TEXELS;
+
+/// Where an image's bytes are.
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+pub(crate) enum ImageSource {
+    /// A file (relative names already joined to the scene's folder).
+    File(PathBuf),
+    /// Bytes already in memory (a glTF `data:` URI or buffer view).
+    Bytes(Arc<[u8]>),
+}
+
+/// A texture of one material parameter, not read yet.
+#[derive(Clone, Debug)]
+pub(crate) struct TextureRequest {
+    /// The BSDF that has the parameter, from the top of the material.
+    pub path: Vec<Branch>,
+    /// The parameter.
+    pub kind: SlotKind,
+    /// The image.
+    pub source: ImageSource,
+    /// Its lookups.
+    pub sampling: Sampling,
+    /// value = offset + scale ⊙ texture.
+    pub scale: [f64; 3],
+    /// See `scale`.
+    pub offset: [f64; 3],
+    /// Where the texture is named, for errors.
+    pub location: SourceLocation,
+}
+
+/// Decoded images, by source and lookup, and the texels they hold.
+#[derive(Default)]
+pub(crate) struct TextureCache {
+    images: HashMap<(ImageSource, Sampling), Arc<Texture>>,
+    texels: u64,
+}
+
+impl TextureCache {
+    /// The slot a request stands for, its image read and decoded once.
+    pub fn slot(&mut self, request: &TextureRequest) -> Result<TextureSlot> {
+        let key = (request.source.clone(), request.sampling);
+        let texture = match self.images.get(&key) {
+            Some(t) => Arc::clone(t),
+            None => {
+                let t = Arc::new(read(request)?);
+                self.texels += u64::from(t.width()) * u64::from(t.height());
+                if self.texels > MAX_SCENE_TEXELS {
+                    return Err(SceneError::at(
+                        &request.location,
+                        format!(
+                            "the scene's textures hold more than {MAX_SCENE_TEXELS} texels in all (docs/limits.md)"
+                        ),
+                    ));
+                }
+                self.images.insert(key, Arc::clone(&t));
+                t
+            }
+        };
+        Ok(TextureSlot {
+            path: request.path.clone(),
+            kind: request.kind,
+            texture,
+            scale: request.scale,
+            offset: request.offset,
+        })
+    }
+}
+
+fn read(request: &TextureRequest) -> Result<Texture> {
+    let at = |m: String| SceneError::at(&request.location, m);
+    match &request.source {
+        ImageSource::File(path) => {
+            let bytes = trilux_files::read_limited(path, MAX_IMAGE_BYTES)
+                .map_err(|e| at(format!("cannot read image {}: {e}", path.display())))?;
+            decode(&bytes, request.sampling).map_err(|e| at(format!("{}: {e}", path.display())))
+        }
+        ImageSource::Bytes(bytes) => {
+            if bytes.len() as u64 > MAX_IMAGE_BYTES {
+                return Err(at(format!(
+                    "image of {} bytes is beyond the limit of {MAX_IMAGE_BYTES} bytes (docs/limits.md)",
+                    bytes.len()
+                )));
+            }
+            decode(bytes, request.sampling).map_err(|e| at(e.to_string()))
+        }
+    }
+}

@@ -1,0 +1,505 @@
+//! The glTF loader, element by element: node hierarchies with TRS and
+//! matrix transforms, indexed and non-indexed triangles, normals and
+//! texture coordinates, the material mapping of docs/gltf.md
+//! (`pbrMetallicRoughness`, `KHR_materials_specular`, `doubleSided`),
+//! emissive materials with `KHR_materials_emissive_strength`, perspective
+//! cameras (the first or one by name), base colour textures, and
+//! `KHR_lights_punctual` refused by name. Expected values are worked out by
+//! hand from the glTF specification and the mapping.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test may panic
+
+use std::path::{Path, PathBuf};
+
+use glam::DVec3;
+use serde_json::{Value, json};
+use trilux_brdf::{BsdfParams, Distribution, SlotKind};
+use trilux_color::ColorParam;
+use trilux_geometry::ShapeKind;
+use trilux_scene::{FovAxis, Scene, SceneError};
+
+fn base64(bytes: &[u8]) -> String {
+    const A: &[u8] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    let mut out = String::new();
+    for chunk in bytes.chunks(3) {
+        let b = [
+            chunk[0],
+            *chunk.get(1).unwrap_or(&0),
+            *chunk.get(2).unwrap_or(&0),
+        ];
+        let n = (u32::from(b[0]) << 16) | (u32::from(b[1]) << 8) | u32::from(b[2]);
+        for k in 0..4 {
+            if k <= chunk.len() {
+                out.push(A[((n >> (18 - 6 * k)) & 63) as usize] as char);
+            } else {
+                out.push('=');
+            }
+        }
+    }
+    out
+}
+
+/// A glTF document under construction: one buffer of f32 / u32 data.
+#[derive(Default)]
+struct Doc {
+    bin: Vec<u8>,
+    accessors: Vec<Value>,
+    views: Vec<Value>,
+}
+
+impl Doc {
+    fn accessor(&mut self, floats: &[f32], ints: &[u32], kind: &str) -> usize {
+        while !self.bin.len().is_multiple_of(4) {
+            self.bin.push(0);
+        }
+        let start = self.bin.len();
+        let (count, component) = if ints.is_empty() {
+            for f in floats {
+                self.bin.extend_from_slice(&f.to_le_bytes());
+            }
+            let width = match kind {
+                "VEC2" => 2,
+                "VEC3" => 3,
+                _ => 1,
+            };
+            (floats.len() / width, 5126)
+        } else {
+            for i in ints {
+                self.bin.extend_from_slice(&i.to_le_bytes());
+            }
+            (ints.len(), 5125)
+        };
+        self.views
+            .push(json!({"buffer": 0, "byteOffset": start, "byteLength": self.bin.len() - start}));
+        let mut a = json!({"bufferView": self.views.len() - 1, "componentType": component,
+                           "count": count, "type": kind});
+        if kind == "VEC3" {
+            let mut lo = [f32::MAX; 3];
+            let mut hi = [f32::MIN; 3];
+            for v in floats.chunks(3) {
+                for c in 0..3 {
+                    lo[c] = lo[c].min(v[c]);
+                    hi[c] = hi[c].max(v[c]);
+                }
+            }
+            a["min"] = json!(lo);
+            a["max"] = json!(hi);
+        }
+        self.accessors.push(a);
+        self.accessors.len() - 1
+    }
+
+    /// The JSON with `rest` merged in (meshes, nodes, scenes, materials...).
+    fn json(self, mut rest: Value) -> Value {
+        rest["asset"] = json!({"version": "2.0"});
+        rest["accessors"] = Value::Array(self.accessors);
+        rest["bufferViews"] = Value::Array(self.views);
+        rest["buffers"] = json!([{"byteLength": self.bin.len(),
+            "uri": format!("data:application/octet-stream;base64,{}", base64(&self.bin))}]);
+        rest
+    }
+}
+
+/// One triangle (0,0,0), (1,0,0), (0,1,0), indexed, with a normal +z and
+/// texture coordinates; returns (positions, normals, uvs, indices).
+fn triangle(doc: &mut Doc) -> Value {
+    let p = doc.accessor(&[0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0], &[], "VEC3");
+    let n = doc.accessor(&[0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0], &[], "VEC3");
+    let t = doc.accessor(&[0.0, 0.0, 1.0, 0.0, 0.0, 1.0], &[], "VEC2");
+    let i = doc.accessor(&[], &[0, 1, 2], "SCALAR");
+    json!({"attributes": {"POSITION": p, "NORMAL": n, "TEXCOORD_0": t}, "indices": i})
+}
+
+fn folder(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("gltf-{name}"));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn load_in(dir: &Path, json: &Value) -> Result<Scene, SceneError> {
+    let path = dir.join("scene.gltf");
+    std::fs::write(&path, serde_json::to_vec(json).unwrap()).unwrap();
+    trilux_scene::load(&path)
+}
+
+fn load(name: &str, json: &Value) -> Result<Scene, SceneError> {
+    load_in(&folder(name), json)
+}
+
+fn mesh(scene: &Scene, i: usize) -> &trilux_geometry::TriangleMesh {
+    match &scene.shapes[i].shape.kind {
+        ShapeKind::Mesh(m) => m,
+        other => panic!("shape {i} is {other:?}"),
+    }
+}
+
+fn close(a: DVec3, b: DVec3) -> bool {
+    (a - b).abs().max_element() < 1e-6
+}
+
+fn rgb(c: &ColorParam) -> [f64; 3] {
+    match c {
+        ColorParam::Rgb(v) => *v,
+        ColorParam::Float(v) => [*v; 3],
+        other => panic!("{other:?}"),
+    }
+}
+
+fn near3(a: [f64; 3], b: [f64; 3]) -> bool {
+    (0..3).all(|c| (a[c] - b[c]).abs() < 1e-6)
+}
+
+#[test]
+fn trs_and_matrix_transforms_compose_parent_times_child() {
+    let mut doc = Doc::default();
+    let prim = triangle(&mut doc);
+    let h = std::f64::consts::FRAC_1_SQRT_2 as f32;
+    let j = doc.json(json!({
+        "scene": 0,
+        "scenes": [{"nodes": [0, 2]}],
+        "meshes": [{"primitives": [prim]}],
+        "nodes": [
+            // Parent: translation (1, 2, 3); child: a quarter turn about z
+            // and scale 2: x ↦ T · R · S · x.
+            {"translation": [1.0, 2.0, 3.0], "children": [1]},
+            {"mesh": 0, "rotation": [0.0, 0.0, h, h], "scale": [2.0, 2.0, 2.0]},
+            // A column-major matrix: x scaled by 2, then translated by (5, 0, 0).
+            {"mesh": 0, "matrix": [2.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0,
+                                   0.0, 0.0, 1.0, 0.0, 5.0, 0.0, 0.0, 1.0]}
+        ]
+    }));
+    let scene = load("trs", &j).unwrap();
+    assert_eq!(scene.shapes.len(), 2);
+    let a = mesh(&scene, 0);
+    // (1,0,0) → scaled (2,0,0) → turned (0,2,0) → moved (1,4,3).
+    let expected = [
+        DVec3::new(1.0, 2.0, 3.0),
+        DVec3::new(1.0, 4.0, 3.0),
+        DVec3::new(-1.0, 2.0, 3.0),
+    ];
+    for (p, e) in a.positions.iter().zip(expected) {
+        assert!(close(*p, e), "{p} vs {e}");
+    }
+    let b = mesh(&scene, 1);
+    let expected = [
+        DVec3::new(5.0, 0.0, 0.0),
+        DVec3::new(7.0, 0.0, 0.0),
+        DVec3::new(5.0, 1.0, 0.0),
+    ];
+    for (p, e) in b.positions.iter().zip(expected) {
+        assert!(close(*p, e), "{p} vs {e}");
+    }
+    // Normals +z stay +z under both (rotation about z; scale along x).
+    for m in [a, b] {
+        for n in m.normals.as_ref().unwrap() {
+            assert!(close(*n, DVec3::Z), "{n}");
+        }
+        assert!(!m.face_normals);
+        assert_eq!(m.triangles, vec![[0, 1, 2]]);
+    }
+}
+
+#[test]
+fn normals_follow_the_inverse_transpose() {
+    let mut doc = Doc::default();
+    let p = doc.accessor(&[0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0], &[], "VEC3");
+    let s = std::f32::consts::FRAC_1_SQRT_2;
+    let n = doc.accessor(&[s, s, 0.0, s, s, 0.0, s, s, 0.0], &[], "VEC3");
+    let j = doc.json(json!({
+        "scenes": [{"nodes": [0]}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": p, "NORMAL": n}}]}],
+        "nodes": [{"mesh": 0, "scale": [2.0, 1.0, 1.0]}]
+    }));
+    let scene = load("normals", &j).unwrap();
+    // diag(2,1,1)^-T (1,1,0)/√2 ∝ (1/2, 1, 0), normalised: (1, 2, 0)/√5.
+    let e = DVec3::new(1.0, 2.0, 0.0) / 5f64.sqrt();
+    for n in mesh(&scene, 0).normals.as_ref().unwrap() {
+        assert!(close(*n, e), "{n} vs {e}");
+    }
+}
+
+#[test]
+fn non_indexed_triangles_without_normals_are_flat_and_keep_their_uvs() {
+    let mut doc = Doc::default();
+    #[rustfmt::skip]
+    let p = doc.accessor(&[
+        0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 1.0, 0.0,
+        0.0, 0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 1.0, 0.0,
+    ], &[], "VEC3");
+    let t = doc.accessor(
+        &[0.0, 1.0, 1.0, 1.0, 1.0, 0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0],
+        &[],
+        "VEC2",
+    );
+    let j = doc.json(json!({
+        "scenes": [{"nodes": [0]}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": p, "TEXCOORD_0": t}, "mode": 4}]}],
+        "nodes": [{"mesh": 0}]
+    }));
+    let scene = load("flat", &j).unwrap();
+    let m = mesh(&scene, 0);
+    assert_eq!(m.triangles, vec![[0, 1, 2], [3, 4, 5]]);
+    assert!(m.face_normals && m.normals.is_none());
+    let uv = m.texcoords.as_ref().unwrap();
+    assert_eq!(uv.len(), 6);
+    assert!((uv[2].x - 1.0).abs() < 1e-12 && uv[2].y.abs() < 1e-12);
+}
+
+/// A one-triangle scene whose primitive has material `material` (or none).
+fn with_material(material: Option<Value>) -> Value {
+    let mut doc = Doc::default();
+    let mut prim = triangle(&mut doc);
+    let mut rest = json!({
+        "scenes": [{"nodes": [0]}],
+        "nodes": [{"mesh": 0}],
+        "extensionsUsed": ["KHR_materials_specular", "KHR_materials_emissive_strength"]
+    });
+    if let Some(m) = material {
+        prim["material"] = 0.into();
+        rest["materials"] = json!([m]);
+    }
+    rest["meshes"] = json!([{"primitives": [prim]}]);
+    doc.json(rest)
+}
+
+fn conductor(b: &BsdfParams) -> (f64, [f64; 3]) {
+    match b {
+        BsdfParams::RoughConductor(c) => {
+            assert_eq!(c.distribution, Distribution::Ggx);
+            assert!(c.eta_k.is_none(), "material none: Fresnel 1");
+            (c.alpha, rgb(&c.specular_reflectance))
+        }
+        other => panic!("{other:?}"),
+    }
+}
+
+#[test]
+fn the_default_material_is_a_white_rough_metal() {
+    // glTF's default: base colour 1, metallic 1, roughness 1: S = B = 1,
+    // D = 0, α = 1.
+    let scene = load("default-material", &with_material(None)).unwrap();
+    let (alpha, s) = conductor(&scene.shapes[0].bsdf);
+    assert!((alpha - 1.0).abs() < 1e-12);
+    assert!(near3(s, [1.0; 3]), "{s:?}");
+}
+
+#[test]
+fn a_dielectric_is_a_blend_of_diffuse_and_a_rough_conductor() {
+    let m = json!({"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.25, 0.1, 1.0],
+                   "metallicFactor": 0.0, "roughnessFactor": 0.5}});
+    let scene = load("dielectric", &with_material(Some(m))).unwrap();
+    // F0 = 0.04: D = 0.96 B = (0.48, 0.24, 0.096), S = 0.04; D̂ = 0.48,
+    // Ŝ = 0.04, w = 0.04 / 0.52; inner diffuse D / (1 − w) = D · 0.52/0.48,
+    // inner conductor S / w = 0.52; α = 0.5² = 0.25.
+    let BsdfParams::Blend {
+        weight,
+        first,
+        second,
+    } = &scene.shapes[0].bsdf
+    else {
+        panic!("{:?}", scene.shapes[0].bsdf)
+    };
+    assert!((weight - 0.04 / 0.52).abs() < 1e-9, "{weight}");
+    let BsdfParams::Diffuse { reflectance } = first.as_ref() else {
+        panic!("{first:?}")
+    };
+    assert!(
+        near3(rgb(reflectance), [0.52, 0.26, 0.104]),
+        "{reflectance:?}"
+    );
+    let (alpha, s) = conductor(second);
+    assert!((alpha - 0.25).abs() < 1e-9);
+    assert!(near3(s, [0.52; 3]), "{s:?}");
+    // The blend's total reflectance at normal incidence is D + S.
+    let total: Vec<f64> = (0..3)
+        .map(|c| (1.0 - weight) * rgb(reflectance)[c] + weight * s[c])
+        .collect();
+    assert!(
+        near3([total[0], total[1], total[2]], [0.52, 0.28, 0.136]),
+        "{total:?}"
+    );
+}
+
+#[test]
+fn specular_factor_zero_is_lambertian_and_double_sided_is_twosided() {
+    let m = json!({"pbrMetallicRoughness": {"baseColorFactor": [0.7, 0.6, 0.5, 1.0], "metallicFactor": 0.0},
+                   "doubleSided": true,
+                   "extensions": {"KHR_materials_specular": {"specularFactor": 0.0}}});
+    let scene = load("lambert", &with_material(Some(m))).unwrap();
+    let BsdfParams::TwoSided { front, back: None } = &scene.shapes[0].bsdf else {
+        panic!("{:?}", scene.shapes[0].bsdf)
+    };
+    let BsdfParams::Diffuse { reflectance } = front.as_ref() else {
+        panic!("{front:?}")
+    };
+    assert!(near3(rgb(reflectance), [0.7, 0.6, 0.5]), "{reflectance:?}");
+    assert_eq!(scene.bsdf_counts.get("twosided"), Some(&1));
+}
+
+#[test]
+fn a_metal_is_a_rough_conductor_with_its_base_colour_and_smallest_alpha() {
+    let m = json!({"pbrMetallicRoughness": {"baseColorFactor": [0.9, 0.6, 0.3, 1.0],
+                   "metallicFactor": 1.0, "roughnessFactor": 0.05}});
+    let scene = load("metal", &with_material(Some(m))).unwrap();
+    let (alpha, s) = conductor(&scene.shapes[0].bsdf);
+    // 0.05² = 0.0025 is below the smallest α taken, 0.01.
+    assert!((alpha - 0.01).abs() < 1e-12, "{alpha}");
+    assert!(near3(s, [0.9, 0.6, 0.3]), "{s:?}");
+}
+
+#[test]
+fn emission_is_factor_times_strength_on_the_front() {
+    let m = json!({"pbrMetallicRoughness": {"baseColorFactor": [0.0, 0.0, 0.0, 1.0], "metallicFactor": 0.0},
+                   "emissiveFactor": [1.0, 0.5, 0.25],
+                   "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 4.0},
+                                  "KHR_materials_specular": {"specularFactor": 0.0}}});
+    let scene = load("emissive", &with_material(Some(m))).unwrap();
+    let e = scene.shapes[0].emitter.as_ref().expect("an emitter");
+    assert!(near3(rgb(&e.radiance), [4.0, 2.0, 1.0]), "{:?}", e.radiance);
+    // A material that does not emit makes no emitter.
+    let scene = load("not-emissive", &with_material(Some(json!({})))).unwrap();
+    assert!(scene.shapes[0].emitter.is_none());
+}
+
+fn with_cameras() -> Value {
+    let mut doc = Doc::default();
+    let prim = triangle(&mut doc);
+    let h = std::f64::consts::FRAC_1_SQRT_2 as f32;
+    doc.json(json!({
+        "scenes": [{"nodes": [0, 1, 2]}],
+        "meshes": [{"primitives": [prim]}],
+        "cameras": [
+            {"name": "wide", "type": "perspective", "perspective": {"yfov": 0.5, "aspectRatio": 2.0, "znear": 0.1}},
+            {"type": "perspective", "perspective": {"yfov": 1.0, "znear": 0.1}}
+        ],
+        "nodes": [
+            {"mesh": 0},
+            {"camera": 0, "translation": [0.0, 1.0, 5.0]},
+            // A quarter turn about y: glTF's −z view direction becomes −x.
+            {"name": "side", "camera": 1, "translation": [3.0, 0.0, 0.0], "rotation": [0.0, h, 0.0, h]}
+        ]
+    }))
+}
+
+#[test]
+fn the_first_perspective_camera_or_one_by_name() {
+    let scene = load("cameras", &with_cameras()).unwrap();
+    let c = scene.camera.as_ref().unwrap();
+    assert!(close(c.origin, DVec3::new(0.0, 1.0, 5.0)));
+    assert!(close((c.target - c.origin).normalize(), DVec3::NEG_Z));
+    assert!(close(c.up, DVec3::Y));
+    assert!((c.fov - 0.5f64.to_degrees()).abs() < 1e-4, "{}", c.fov);
+    assert_eq!(c.fov_axis, FovAxis::Y);
+    assert_eq!((c.width, c.height), (768, 384));
+
+    let dir = folder("cameras-named");
+    let path = dir.join("scene.gltf");
+    std::fs::write(&path, serde_json::to_vec(&with_cameras()).unwrap()).unwrap();
+    for name in ["side", "wide"] {
+        let scene = trilux_scene::open_with_camera(&path, Some(name))
+            .unwrap()
+            .finish()
+            .unwrap();
+        let c = scene.camera.unwrap();
+        if name == "side" {
+            // By its node's name; no aspect ratio: 768 × 576.
+            assert!(close(c.origin, DVec3::new(3.0, 0.0, 0.0)));
+            assert!(
+                close((c.target - c.origin).normalize(), DVec3::NEG_X),
+                "{}",
+                c.target
+            );
+            assert_eq!((c.width, c.height), (768, 576));
+        } else {
+            assert!(close(c.origin, DVec3::new(0.0, 1.0, 5.0)));
+        }
+    }
+    let err = trilux_scene::open_with_camera(&path, Some("top"))
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("no camera named \"top\""), "{err}");
+}
+
+#[test]
+fn a_base_colour_texture_is_decoded_from_srgb() {
+    let dir = folder("texture");
+    let ramp = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/textures/ramp.png");
+    std::fs::copy(ramp, dir.join("ramp.png")).unwrap();
+    let m = json!({"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1.0], "metallicFactor": 0.0,
+                   "baseColorTexture": {"index": 0}},
+                   "extensions": {"KHR_materials_specular": {"specularFactor": 0.0}}});
+    let mut j = with_material(Some(m));
+    j["images"] = json!([{"uri": "ramp.png"}]);
+    j["samplers"] = json!([{"wrapS": 33071, "wrapT": 33071}]);
+    j["textures"] = json!([{"source": 0, "sampler": 0}]);
+    let scene = load_in(&dir, &j).unwrap();
+    let slots = &scene.shapes[0].textures;
+    assert_eq!(slots.len(), 1);
+    let slot = &slots[0];
+    assert_eq!(slot.kind, SlotKind::Reflectance);
+    assert!(near3(slot.scale, [0.5; 3]) && near3(slot.offset, [0.0; 3]));
+    // ramp.png (scripts/make_gltf_scenes.py): 32 columns of grey
+    // round(255 k / 31); the mean of their sRGB decodings (IEC 61966-2-1).
+    let decode = |v: f64| {
+        if v <= 0.04045 {
+            v / 12.92
+        } else {
+            ((v + 0.055) / 1.055).powf(2.4)
+        }
+    };
+    let mean = (0..32)
+        .map(|k| decode((255.0 * k as f64 / 31.0).round() / 255.0))
+        .sum::<f64>()
+        / 32.0;
+    let got = slot.texture.mean();
+    assert!(
+        (got[0] - mean).abs() < 1e-5 && (got[2] - mean).abs() < 1e-5,
+        "{got:?} vs {mean}"
+    );
+}
+
+#[test]
+fn punctual_lights_are_refused_naming_the_light() {
+    let mut j = with_material(None);
+    j["extensionsUsed"] = json!(["KHR_lights_punctual"]);
+    j["extensions"] = json!({"KHR_lights_punctual": {"lights": [
+        {"type": "directional", "color": [1.0, 1.0, 1.0]},
+        {"name": "Sun", "type": "spot", "spot": {}}
+    ]}});
+    j["nodes"] = json!([{"mesh": 0}, {"extensions": {"KHR_lights_punctual": {"light": 1}}}]);
+    j["scenes"] = json!([{"nodes": [0, 1]}]);
+    let err = load("light", &j).unwrap_err().to_string();
+    assert!(
+        err.contains("/nodes/1/extensions/KHR_lights_punctual"),
+        "{err}"
+    );
+    assert!(
+        err.contains("spot light \"Sun\"") && err.contains("emissive"),
+        "{err}"
+    );
+    assert_eq!(err.lines().count(), 1);
+}
+
+/// The `gltf` crate's validation indexes a primitive's POSITION accessor
+/// before checking that it exists: an out-of-range one must be a located
+/// error, not a panic (found by tests/fuzz_gltf.rs).
+#[test]
+fn an_attribute_naming_a_missing_accessor_is_located() {
+    let mut j = with_material(None);
+    j["meshes"][0]["primitives"][0]["attributes"]["POSITION"] = 99.into();
+    let err = load("missing-accessor", &j).unwrap_err().to_string();
+    assert!(err.contains("/meshes/0/primitives/0/attributes"), "{err}");
+    assert!(err.contains("accessor 99"), "{err}");
+}
+
+/// An image in a buffer view without a mimeType (the crate unwraps it).
+#[test]
+fn an_image_without_its_mime_type_is_located() {
+    let mut j = with_material(Some(json!({
+        "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}
+    })));
+    j["textures"] = json!([{"source": 0}]);
+    j["images"] = json!([{"bufferView": 0}]);
+    let err = load("image-mime", &j).unwrap_err().to_string();
+    assert!(err.contains("/images/0"), "{err}");
+}
