@@ -3,10 +3,18 @@
 //! the golden images); `cargo xtask color` checks trilux's colorimetry
 //! against colour-science; `cargo xtask golden` compares renders of every
 //! bundled scene with stored Mitsuba 3 references; `cargo xtask sweep`
-//! measures error against time.
+//! measures error against time; `cargo xtask scale` measures solve cost
+//! against scene size on generated scenes.
 
+mod counting_alloc;
 mod golden;
+mod scale;
+mod scale_scenes;
 mod sweep;
+
+/// Counts the process's allocations (the peak memory `scale` reports).
+#[global_allocator]
+static ALLOCATOR: counting_alloc::Counting = counting_alloc::Counting;
 
 use std::process::Command;
 
@@ -54,8 +62,9 @@ fn main() -> Result<()> {
         Some("color") => color::color(),
         Some("golden") => golden::main(&args[1..]),
         Some("sweep") => sweep::main(&args[1..]),
+        Some("scale") => scale::main(&args[1..]),
         _ => {
-            eprintln!("usage: cargo xtask ci | color | golden | sweep");
+            eprintln!("usage: cargo xtask ci | color | golden | sweep | scale");
             std::process::exit(2);
         }
     }

@@ -70,6 +70,13 @@ pub(crate) enum Sender<'a, const N: usize> {
         /// Unshot or final radiance.
         sent: Sent,
     },
+    /// A glossy face's far field (`cluster_transport`): the unshot
+    /// radiance it sends towards each receiving surface, by surface (zero
+    /// for surfaces outside its far blocks).
+    Far {
+        /// δL towards every input surface.
+        by_surface: &'a [Spectrum<N>],
+    },
 }
 
 impl<const N: usize> Sender<'_, N> {
@@ -92,6 +99,10 @@ impl<const N: usize> Sender<'_, N> {
                     Sent::Final => node.radiance,
                 }
             }
+            Sender::Far { by_surface } => by_surface
+                .get(forest.element(j).surface.index())
+                .copied()
+                .unwrap_or_else(Spectrum::zero),
         }
     }
 }
@@ -234,6 +245,20 @@ pub(crate) struct RefineContext<'a, const N: usize> {
     pub interior: &'a [[DVec3; 4]],
     /// Exposed area of every element's faces, `[back][element]`.
     pub exposed_area: &'a Sided<Vec<f64>>,
+    /// The cluster hierarchy and every face's cut (`cluster_transport`).
+    pub clusters: &'a crate::cluster_transport::Clusters,
+}
+
+impl<'a, const N: usize> RefineContext<'a, N> {
+    /// What far links read.
+    pub fn far(&self) -> crate::cluster_transport::FarContext<'a> {
+        crate::cluster_transport::FarContext {
+            forest: self.forest,
+            tree: &self.clusters.tree,
+            exposed_area: self.exposed_area,
+            burial: self.visibility.burial(),
+        }
+    }
 }
 
 /// Point-to-disc estimate of F_{a→b} (Hanrahan, Salzman & Aupperle 1991): b seen from a's
@@ -603,7 +628,18 @@ impl<const N: usize> RefineContext<'_, N> {
         i: FaceElement,
         j: FaceElement,
     ) -> Option<Incidence<N>> {
-        let tij = self.throughput(j, i);
+        self.incidence_with(sender, i, j, self.throughput(j, i))
+    }
+
+    /// [`Self::incidence`] with T_ij already known (a pair link's own: a
+    /// far link's T is the cluster estimate, not the pair's exact one).
+    pub fn incidence_with(
+        &self,
+        sender: &Sender<'_, N>,
+        i: FaceElement,
+        j: FaceElement,
+        tij: Throughput,
+    ) -> Option<Incidence<N>> {
         if tij.t <= 0.0 {
             return None;
         }

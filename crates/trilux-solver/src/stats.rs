@@ -52,6 +52,14 @@ pub struct SolveStats {
     /// a fraction of what arrived there (band minimum). Negative would mean
     /// an element reflected more than it received.
     pub min_element_absorbed: f64,
+    /// Peak bytes of the solver's arenas over the solve: element trees and
+    /// their radiance, interaction nodes, the links of the largest shot,
+    /// the throughput cache, the cluster hierarchy and the gather links
+    /// (summed sizes, `Solver::arena_bytes`; not the process's whole
+    /// allocation, which `cargo xtask scale` measures with a counting
+    /// allocator).
+    #[serde(default)]
+    pub peak_memory_bytes: u64,
     /// Warnings (e.g. a Lambertian reflectance above 1 clamped).
     pub warnings: Vec<String>,
 }
