@@ -102,6 +102,88 @@ fn run_case(case: Case, settings: &SolverSettings, dir: &std::path::Path) -> Res
     })
 }
 
+/// Solves `case` with clustering on and off (default quality) and prints,
+/// per input surface face that reflects light, the ratio of its mean
+/// Lambertian radiance with clustering to without, area-weighted
+/// statistics of those ratios, and the escaped share of the emitted flux
+/// (a closed room: light lost to estimation error).
+fn compare(case: Case, dir: &std::path::Path) -> Result<()> {
+    use trilux_geometry::{FaceId, Side};
+    use trilux_solver::{SceneDescription, Solver};
+    let path = write_case(case, dir)?;
+    let scene = trilux_scene::load(&path).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let (shapes, bsdfs, emission) = (
+        scene.geometry_shapes(),
+        scene.bsdf_params(),
+        scene.emitter_radiance(),
+    );
+    let desc = SceneDescription {
+        shapes: &shapes,
+        bsdfs: &bsdfs,
+        emission: &emission,
+    };
+    let mut solutions = Vec::new();
+    for clustering in [true, false] {
+        let mut settings = SolverSettings::preset(Quality::Default);
+        settings.clustering = clustering;
+        let start = Instant::now();
+        let solver =
+            Solver::<3>::from_description(&desc, settings).map_err(|e| anyhow::anyhow!("{e}"))?;
+        let solution = solver.solve(|_| {});
+        let s = solution.stats();
+        let escaped: f64 = s.escaped_flux.iter().sum::<f64>() / s.emitted_flux.iter().sum::<f64>();
+        eprintln!(
+            "{}: clustering {clustering}: {:.2} s, {} shots, escaped {:.4} %",
+            case.name(),
+            start.elapsed().as_secs_f64(),
+            s.shots,
+            100.0 * escaped
+        );
+        solutions.push(solution);
+    }
+    let geom = solutions[0].forest().geometry();
+    let (mut worst, mut sum_w, mut sum_wr, mut sum_wr2) = (1.0f64, 0.0, 0.0, 0.0);
+    let mut big_worst = 1.0f64;
+    for s in 0..geom.surfaces().len() as u32 {
+        let surface = trilux_geometry::SurfaceId(s);
+        let area = geom.surface(surface).area();
+        let face = FaceId::new(surface, Side::Front);
+        let (a, b) = (
+            solutions[0].surface_mean_radiance(face).sum(),
+            solutions[1].surface_mean_radiance(face).sum(),
+        );
+        if b <= 1e-9 {
+            continue;
+        }
+        let r = a / b;
+        if (r - 1.0).abs() > 0.05 && std::env::var("SCALE_DEBUG").is_ok() {
+            let sf = geom.surface(surface);
+            eprintln!(
+                "  surface {s} shape {} piece {} area {area:.3} centre {:?}: {a:.4} vs {b:.4}",
+                sf.shape,
+                sf.piece,
+                sf.bounds.centre()
+            );
+        }
+        if (r - 1.0).abs() > (worst - 1.0).abs() {
+            worst = r;
+        }
+        if area > 1.0 && (r - 1.0).abs() > (big_worst - 1.0).abs() {
+            big_worst = r;
+        }
+        sum_w += area;
+        sum_wr += area * r;
+        sum_wr2 += area * r * r;
+    }
+    let mean = sum_wr / sum_w;
+    let sd = (sum_wr2 / sum_w - mean * mean).max(0.0).sqrt();
+    println!(
+        "{}: surface mean radiance, clustered / unclustered: area-weighted mean {mean:.4}, sd {sd:.4}, worst face {worst:.4}, worst face above 1 m² {big_worst:.4}",
+        case.name()
+    );
+    Ok(())
+}
+
 fn table(rows: &[Row]) -> String {
     let mut t = String::from(
         "| case | input surfaces | seconds | shots | links | interactions | gather links | peak memory (MB) | solver arenas (MB) | CR |\n|---|---|---|---|---|---|---|---|---|---|\n",
@@ -139,6 +221,12 @@ pub fn main(args: &[String]) -> Result<()> {
             "--meshes" => cases.extend(list(it.next())?.into_iter().map(Case::Meshes)),
             "--grid" => cases.extend(list(it.next())?.into_iter().map(Case::Grid)),
             "--curtain" => cases.push(Case::Curtain),
+            "--compare" => {
+                for n in list(it.next())? {
+                    compare(Case::Boxes(n), &root().join("target/scale/scenes"))?;
+                }
+                return Ok(());
+            }
             "--quality" => {
                 quality = it
                     .next()

@@ -24,12 +24,14 @@
 //! **A far link** carries the light of A's root towards every member face
 //! of C at once. For member face f (the side of f's surface that A's
 //! centre is in front of), T_Af = A_A F̂(A → f) V_AC, with F̂ the
-//! point-to-disc form factor from A's centre (HSA91; accurate to O(θ²)
-//! for a far pair) over f's exposed area, and V_AC the visible fraction
+//! point-to-disc form factor (HSA91) from A's four quadrant centres,
+//! averaged, to a disc of f's exposed area at f's centre, and V_AC the visible fraction
 //! between A and the cluster as a whole, from [`CLUSTER_RAYS`] stratified
 //! segments from A to points of C's members (area-weighted; a segment with
 //! a buried end counts as blocked, as in `Visibility`). Each member then
-//! receives an ordinary pair link i → root(f), so that the receiving side
+//! receives an ordinary pair link i → root(f), except faces that see only
+//! their own shape (the inside of a closed box, [`is_enclosed`]), which a
+//! cluster-wide visible fraction cannot tell from the outside, so that the receiving side
 //! (Lambertian share, three-point links into glossy hierarchies, the
 //! ledger) is the paper's, unchanged.
 //!
@@ -65,7 +67,7 @@ pub(crate) const FAR_ANGLE: f64 = 0.25;
 
 /// θ_A: the largest angle a sender may subtend from a far cluster (its
 /// light is taken from its centre).
-pub(crate) const SENDER_ANGLE: f64 = 0.5;
+pub(crate) const SENDER_ANGLE: f64 = 0.35;
 
 /// Shadow segments per far block.
 pub(crate) const CLUSTER_RAYS: u32 = 16;
@@ -102,12 +104,68 @@ pub(crate) struct Cut {
     pub far: Vec<FarBlock>,
 }
 
-/// Everything clustering reads: the tree, and every face's cut (empty far
-/// lists when clustering is off).
+/// Everything clustering reads: the tree, every face's cut (empty far
+/// lists when clustering is off) and which faces are enclosed.
 #[derive(Clone, Debug)]
 pub(crate) struct Clusters {
     pub tree: ClusterTree,
     pub cuts: PerFace<Cut>,
+    /// Faces that see only their own shape (the inside of a closed box):
+    /// no far link reaches them. A far link's visible fraction is one
+    /// number for the whole cluster, which cannot tell the outside of a
+    /// box from its inside.
+    pub enclosed: PerFace<bool>,
+}
+
+/// Directions (about a face's normal) of the enclosure probe: the normal
+/// and two rings of 8 at 35° and 70°.
+fn probe_directions(n: DVec3) -> impl Iterator<Item = DVec3> {
+    let (t, b) = n.any_orthonormal_pair();
+    std::iter::once(n).chain([35f64, 70.0].into_iter().flat_map(move |deg| {
+        let (sin, cos) = deg.to_radians().sin_cos();
+        (0..8).map(move |k| {
+            let phi = f64::from(k) * std::f64::consts::FRAC_PI_4 + deg.to_radians();
+            cos * n + sin * (phi.cos() * t + phi.sin() * b)
+        })
+    }))
+}
+
+/// True when every probe ray from the centre and the four quadrant centres
+/// of face `f`'s root, into its hemisphere, meets its own shape (the
+/// inside of a closed solid).
+pub(crate) fn is_enclosed(forest: &ElementForest, f: FaceId) -> bool {
+    let geom = forest.geometry();
+    let surface = geom.surface(f.surface());
+    let root = forest.root(f.surface());
+    let eps = 1e-7 * geom.extent();
+    [
+        (0.5, 0.5),
+        (0.25, 0.25),
+        (0.75, 0.25),
+        (0.25, 0.75),
+        (0.75, 0.75),
+    ]
+    .into_iter()
+    .all(|(u, v)| {
+        let p = forest.sample_element(root, DVec2::new(u, v));
+        let n = p.normal * f.side().sign();
+        probe_directions(n).all(|d| {
+            let ray = trilux_geometry::Ray {
+                origin: p.point + n * eps,
+                dir: d,
+            };
+            let own = surface.shape;
+            geom.intersect(&ray, f64::INFINITY).is_some_and(|h| {
+                let shape = geom.surface(h.surface).shape;
+                // A shape coincident with the own one (a box's bottom
+                // on the floor) may be met first at the same distance.
+                shape == own
+                    || geom
+                        .intersect_ignoring(&ray, h.t + 1e-6 * geom.extent(), shape)
+                        .is_some_and(|g| geom.surface(g.surface).shape == own)
+            })
+        })
+    })
 }
 
 impl Clusters {
@@ -193,6 +251,7 @@ pub(crate) struct FarContext<'a> {
     pub tree: &'a ClusterTree,
     pub exposed_area: &'a Sided<Vec<f64>>,
     pub burial: Option<&'a BurialMap>,
+    pub enclosed: &'a PerFace<bool>,
 }
 
 /// One member face of a far block as a sender sees it.
@@ -231,17 +290,30 @@ impl FarContext<'_> {
         if aa <= 0.0 {
             return;
         }
-        let na = ea.normal * a.side.sign();
+        // The sender's four quadrant centres (its midpoint rule): a centre
+        // alone misjudges receivers seen near grazing.
+        let quads = [(0.25, 0.25), (0.75, 0.25), (0.25, 0.75), (0.75, 0.75)].map(|(u, v)| {
+            let p = self.forest.sample_element(a.element, DVec2::new(u, v));
+            (p.point, p.normal * a.side.sign())
+        });
         for &s in self.tree.members_of(c) {
             let root = self.forest.root(s);
             let er = self.forest.element(root);
             // The side of s that faces A's centre.
             let side = Side::from_back((ea.centre - er.centre).dot(er.normal) < 0.0);
+            if self.enclosed[FaceId::new(s, side)] {
+                continue;
+            }
             let area = self.exposed_area[side][root.index()];
             if area <= 0.0 {
                 continue;
             }
-            let ff = disc(ea.centre, na, er.centre, er.normal * side.sign(), area);
+            let nf = er.normal * side.sign();
+            let ff = 0.25
+                * quads
+                    .iter()
+                    .map(|&(p, n)| disc(p, n, er.centre, nf, area))
+                    .sum::<f64>();
             if ff > 0.0 {
                 f(FarMember {
                     face: FaceId::new(s, side),

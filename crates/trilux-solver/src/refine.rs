@@ -257,6 +257,7 @@ impl<'a, const N: usize> RefineContext<'a, N> {
             tree: &self.clusters.tree,
             exposed_area: self.exposed_area,
             burial: self.visibility.burial(),
+            enclosed: &self.clusters.enclosed,
         }
     }
 }

@@ -249,7 +249,19 @@ fn clusters_and_partners<const N: usize>(
     );
     let partners = eligible_pairs(forest, faces, &candidates);
     let cuts = PerFace::from(cuts);
-    (Clusters { tree, cuts }, partners)
+    let enclosed = PerFace::from(
+        ids.par_iter()
+            .map(|&f| clustering && crate::cluster_transport::is_enclosed(forest, f))
+            .collect::<Vec<_>>(),
+    );
+    (
+        Clusters {
+            tree,
+            cuts,
+            enclosed,
+        },
+        partners,
+    )
 }
 
 /// The far field of every glossy face that has far blocks.
@@ -265,6 +277,7 @@ fn far_fields<const N: usize>(
         tree: &clusters.tree,
         exposed_area,
         burial,
+        enclosed: &clusters.enclosed,
     };
     let ids: Vec<FaceId> = faces.iter().map(|(f, _)| f).collect();
     let fields: Vec<Option<FarField<N>>> = ids
