@@ -561,6 +561,8 @@ impl<const N: usize> Solver<N> {
         let residual = self.residual();
         let stats = &mut self.stats;
         stats.gather_links = links.len();
+        stats.far_blocks = self.clusters.cuts.values().map(|c| c.far.len()).sum();
+        stats.far_fields = self.far.values().flatten().count();
         stats.elements = self.used.iter().filter(|&&u| u).count();
         stats.interactions = self
             .hierarchies
