@@ -12,8 +12,10 @@
 //! memory) against input surfaces, one series per kind of case.
 //!
 //! `cargo xtask scale [--boxes 4,16,64,256] [--meshes 4,16,64,256]
-//! [--grid 20000,200000] [--curtain] [--quality Q] [--no-clustering]
-//! [--plot FILE.svg] [--out DIR]`.
+//! [--grid 20000,200000] [--curtain] [--facets AROUND,ALONG] [--scene
+//! FILE.xml]... [--quality Q] [--no-clustering] [--plot FILE.svg] [--out
+//! DIR]`, or `--compare 4,16` (clustered against unclustered surface
+//! means on the boxes rooms).
 
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -66,9 +68,24 @@ fn list(s: Option<&String>) -> Result<Vec<u32>> {
 /// Runs one case.
 fn run_case(case: Case, settings: &SolverSettings, dir: &std::path::Path) -> Result<Row> {
     let path = write_case(case, dir)?;
+    let mut row = run_file(&path, settings)?;
+    row.case = case.name();
+    row.kind = match case {
+        Case::Boxes(_) => "boxes",
+        Case::Meshes(_) => "meshes",
+        Case::Grid(_) => "grid",
+        Case::Curtain => "curtain",
+        Case::Facets(..) => "facets",
+    }
+    .into();
+    Ok(row)
+}
+
+/// Runs one scene file.
+fn run_file(path: &std::path::Path, settings: &SolverSettings) -> Result<Row> {
     counting_alloc::reset_peak();
     let start = Instant::now();
-    let scene = trilux_scene::load(&path).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let scene = trilux_scene::load(path).map_err(|e| anyhow::anyhow!("{e}"))?;
     let plan = Plan {
         mode: scene.mode(),
         solver: settings.clone(),
@@ -77,18 +94,32 @@ fn run_case(case: Case, settings: &SolverSettings, dir: &std::path::Path) -> Res
         solution_file: false,
         render: None,
     };
-    let outcome = Observer::quiet(|o| trilux_render::pipeline::run(&scene, &plan, o))?;
+    // Progress every 2 000 shots, so that a long case shows where it is.
+    let mut on_shot = |p: &trilux_solver::Progress| {
+        if p.shots % 2000 == 0 {
+            eprintln!(
+                "  {} shots, CR {:.4}, {} interactions, {:.0} s",
+                p.shots,
+                p.convergence_ratio,
+                p.interactions,
+                start.elapsed().as_secs_f64()
+            );
+        }
+    };
+    let observer = Observer {
+        solve: &mut on_shot,
+        render: &|_, _| {},
+    };
+    let outcome = trilux_render::pipeline::run(&scene, &plan, observer)?;
     let seconds = start.elapsed().as_secs_f64();
     let s = &outcome.solve;
-    let kind = match case {
-        Case::Boxes(_) => "boxes",
-        Case::Meshes(_) => "meshes",
-        Case::Grid(_) => "grid",
-        Case::Curtain => "curtain",
-    };
+    let name = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
     Ok(Row {
-        case: case.name(),
-        kind: kind.into(),
+        case: name,
+        kind: "file".into(),
         input_surfaces: s.input_surfaces,
         seconds,
         shots: s.shots,
@@ -210,6 +241,7 @@ fn table(rows: &[Row]) -> String {
 /// `cargo xtask scale` (module docs).
 pub fn main(args: &[String]) -> Result<()> {
     let mut cases = Vec::new();
+    let mut rows_extra: Vec<PathBuf> = Vec::new();
     let mut quality = Quality::Default;
     let mut clustering = true;
     let mut plot: Option<PathBuf> = None;
@@ -221,6 +253,17 @@ pub fn main(args: &[String]) -> Result<()> {
             "--meshes" => cases.extend(list(it.next())?.into_iter().map(Case::Meshes)),
             "--grid" => cases.extend(list(it.next())?.into_iter().map(Case::Grid)),
             "--curtain" => cases.push(Case::Curtain),
+            "--facets" => {
+                let v = list(it.next())?;
+                if v.len() != 2 {
+                    bail!("--facets needs AROUND,ALONG");
+                }
+                cases.push(Case::Facets(v[0], v[1]));
+            }
+            "--scene" => {
+                let p = PathBuf::from(it.next().context("--scene needs a file")?);
+                rows_extra.push(p);
+            }
             "--compare" => {
                 for n in list(it.next())? {
                     compare(Case::Boxes(n), &root().join("target/scale/scenes"))?;
@@ -258,6 +301,14 @@ pub fn main(args: &[String]) -> Result<()> {
             row.shots,
             row.links,
             row.peak_bytes as f64 / 1e6
+        );
+        rows.push(row);
+    }
+    for p in rows_extra {
+        let row = run_file(&p, &settings)?;
+        eprintln!(
+            "scale: {} ({} surfaces): {:.2} s",
+            row.case, row.input_surfaces, row.seconds
         );
         rows.push(row);
     }

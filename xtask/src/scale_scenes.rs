@@ -28,6 +28,9 @@ pub enum Case {
     Grid(u32),
     /// The curtain room.
     Curtain,
+    /// paper-scene2 with its cylinder as `around` × `along` planar
+    /// rectangles (the paper's Table 4, fine planar version).
+    Facets(u32, u32),
 }
 
 impl Case {
@@ -38,6 +41,7 @@ impl Case {
             Case::Meshes(n) => format!("meshes-{n}"),
             Case::Grid(t) => format!("grid-{t}"),
             Case::Curtain => "curtain".into(),
+            Case::Facets(a, b) => format!("paper-scene2-facets-{}", a * b),
         }
     }
 }
@@ -256,9 +260,62 @@ fn write(path: &Path, text: &str) -> Result<()> {
     std::fs::write(path, text).with_context(|| format!("writing {}", path.display()))
 }
 
+/// paper-scene2 (scenes/paper-scene2.xml) with the cylinder replaced by
+/// `around` × `along` flat rectangles, each the chord facet of the
+/// cylinder between two meridians (outward normals, like Mitsuba's
+/// cylinder).
+fn facets_xml(around: u32, along: u32) -> Result<String> {
+    let path = crate::golden::root().join("scenes/paper-scene2.xml");
+    let text =
+        std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
+    let start = text
+        .find("    <!-- The glossy cylinder")
+        .context("paper-scene2.xml has no cylinder comment")?;
+    let end = text[start..]
+        .find("</shape>")
+        .map(|e| start + e + "</shape>".len())
+        .context("paper-scene2.xml has no cylinder shape")?;
+    let (x0, x1, yc, r) = (-1.1f64, 1.1f64, 0.45f64, 0.45f64);
+    let mut facets = format!(
+        "    <!-- The glossy cylinder as {around} x {along} planar facets (flat, chords of the circle). -->\n"
+    );
+    let half_w = r * (std::f64::consts::PI / f64::from(around)).sin();
+    let dist = r * (std::f64::consts::PI / f64::from(around)).cos();
+    let half_l = 0.5 * (x1 - x0) / f64::from(along);
+    for a in 0..around {
+        let phi = 2.0 * std::f64::consts::PI * (f64::from(a) + 0.5) / f64::from(around);
+        // Outward normal (0, cos φ, sin φ) and tangent (0, sin φ, −cos φ),
+        // so that x̂ × t = n (a right-handed frame).
+        let (n, t) = ([0.0, phi.cos(), phi.sin()], [0.0, phi.sin(), -phi.cos()]);
+        for b in 0..along {
+            let cx = x0 + (2.0 * f64::from(b) + 1.0) * half_l;
+            let c = [cx, yc + dist * n[1], dist * n[2]];
+            // Row-major 4 × 4: columns x̂·half_l, t·half_w, n, c.
+            let _ = writeln!(
+                facets,
+                r#"    <shape type="rectangle"><transform name="to_world"><matrix value="{} 0 0 {} 0 {} {} {} 0 {} {} {} 0 0 0 1"/></transform><ref id="glossy"/></shape>"#,
+                half_l,
+                c[0],
+                t[1] * half_w,
+                n[1],
+                c[1],
+                t[2] * half_w,
+                n[2],
+                c[2]
+            );
+        }
+    }
+    Ok(format!("{}{}{}", &text[..start], facets, &text[end..]))
+}
+
 /// Writes the case's scene (and meshes) into `dir`; returns the scene file.
 pub fn write_case(case: Case, dir: &Path) -> Result<PathBuf> {
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    if let Case::Facets(a, b) = case {
+        let path = dir.join(format!("{}.xml", case.name()));
+        write(&path, &facets_xml(a, b)?)?;
+        return Ok(path);
+    }
     let mut x = String::from(HEADER);
     let mut rng = Rng(0xC0FF_EE00);
     match case {
@@ -308,6 +365,7 @@ pub fn write_case(case: Case, dir: &Path) -> Result<PathBuf> {
                 r#"    <shape type="obj"><string name="filename" value="{file}"/><boolean name="face_normals" value="true"/><ref id="object"/></shape>"#
             );
         }
+        Case::Facets(..) => {}
         Case::Curtain => {
             sensor(&mut x, [4.6, 1.8, 3.7], [1.0, 1.0, 1.4], 70.0);
             diffuse(&mut x, "wall", [0.7, 0.68, 0.62]);

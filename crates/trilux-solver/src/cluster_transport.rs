@@ -65,6 +65,9 @@ use crate::refine::PairLink;
 /// its sender.
 pub(crate) const FAR_ANGLE: f64 = 0.25;
 
+/// θ for an emitter's cut (see [`cut_of`]).
+pub(crate) const EMITTER_FAR_ANGLE: f64 = 0.1;
+
 /// θ_A: the largest angle a sender may subtend from a far cluster (its
 /// light is taken from its centre).
 pub(crate) const SENDER_ANGLE: f64 = 0.35;
@@ -115,6 +118,10 @@ pub(crate) struct Clusters {
     /// number for the whole cluster, which cannot tell the outside of a
     /// box from its inside.
     pub enclosed: PerFace<bool>,
+    /// Face elements that a crossing cuts off in part
+    /// (`trilux_geometry::crossing`; not a matter of clustering, but read
+    /// by refinement beside it).
+    pub partly_cut: Sided<Vec<bool>>,
 }
 
 /// Directions (about a face's normal) of the enclosure probe: the normal
@@ -191,28 +198,37 @@ fn sphere(forest: &ElementForest, s: SurfaceId) -> (DVec3, f64) {
 }
 
 /// True when cluster `c` is far from a sender bounded by (`ca`, `ra`).
-fn is_far(tree: &ClusterTree, c: ClusterId, ca: DVec3, ra: f64) -> bool {
+fn is_far(tree: &ClusterTree, c: ClusterId, ca: DVec3, ra: f64, angle: f64) -> bool {
     let n = &tree.nodes[c as usize];
     let d = (n.centre - ca).length();
-    d > ra + n.radius && n.radius <= FAR_ANGLE * (d - ra) && ra <= SENDER_ANGLE * d
+    d > ra + n.radius && n.radius <= angle * (d - ra) && ra <= SENDER_ANGLE * d
 }
 
 /// The cut of face `a` (module docs). With `clustering` off, every other
-/// face is a near candidate.
+/// face is a near candidate. An emitter's cut uses [`EMITTER_FAR_ANGLE`]:
+/// direct light is the largest transfer of a scene, so its far links
+/// (whose relative error grows like the angle squared) must be tighter
+/// (Smits et al.'s bound is the sender's flux times the kernel's).
 pub(crate) fn cut_of(
     forest: &ElementForest,
     tree: &ClusterTree,
     a: FaceId,
     planar: Option<(DVec3, DVec3)>,
     clustering: bool,
+    emitter: bool,
 ) -> Cut {
+    let angle = if emitter {
+        EMITTER_FAR_ANGLE
+    } else {
+        FAR_ANGLE
+    };
     let mut cut = Cut::default();
     let own = a.surface();
     let (ca, ra) = sphere(forest, own);
     if tree.nodes.is_empty() {
         return cut;
     }
-    let mut stack = vec![0 as ClusterId];
+    let mut stack: Vec<ClusterId> = vec![0];
     while let Some(c) = stack.pop() {
         let node = &tree.nodes[c as usize];
         // A cluster wholly behind a planar sender's face gets nothing.
@@ -222,7 +238,7 @@ pub(crate) fn cut_of(
             continue;
         }
         let holds_own = tree.contains(c, own);
-        if clustering && !holds_own && is_far(tree, c, ca, ra) {
+        if clustering && !holds_own && is_far(tree, c, ca, ra, angle) {
             cut.far.push(FarBlock {
                 cluster: c,
                 visibility: OnceLock::new(),

@@ -107,6 +107,31 @@ impl<const N: usize> Sender<'_, N> {
     }
 }
 
+/// How many times the rays a pair with a partly buried or cut-off element
+/// gets (see `RefineContext::throughput`).
+const CUT_OFF_VISIBILITY: u32 = 9;
+
+/// The shadow rays for a pair: `base`, or [`CUT_OFF_VISIBILITY`]× that
+/// when an element of the pair is partly cut off by a crossing (see
+/// `RefineContext::throughput`).
+pub(crate) fn visibility_samples_for(
+    partly_cut: &Sided<Vec<bool>>,
+    pair: [FaceElement; 2],
+    base: u32,
+) -> u32 {
+    let cut = |e: FaceElement| {
+        partly_cut[e.side]
+            .get(e.element.index())
+            .copied()
+            .unwrap_or(false)
+    };
+    if pair.into_iter().any(cut) {
+        base * CUT_OFF_VISIBILITY
+    } else {
+        base
+    }
+}
+
 /// Largest relative error, from the sender's unshot radiance varying over
 /// it, that a pair link may carry (see `RefineContext::sender_varies`).
 const SENDER_VARIATION: f64 = 0.01;
@@ -299,13 +324,18 @@ impl<const N: usize> RefineContext<'_, N> {
         let up = |s: FaceElement| self.forest.element(s.element).parent.map(|p| s.with(p));
         let visible = up(a).is_some_and(|pa| parent_visible(pa, b))
             || up(b).is_some_and(|pb| parent_visible(a, pb));
-        let t = compute_throughput(
-            &self.visibility,
-            a,
-            b,
+        // Segments that end on a buried or cut-off part count as blocked,
+        // which leaves the visible fraction of an element pair that is
+        // partly cut off (a floor element across a wall that crosses it) a
+        // ratio of two noisy sums, biased low by a few per cent at 16 rays
+        // (docs/solver.md, "Crossings"): such pairs of crossed surfaces get
+        // [`CUT_OFF_VISIBILITY`]× the rays.
+        let samples = visibility_samples_for(
+            &self.clusters.partly_cut,
+            [a, b],
             self.settings.visibility_samples,
-            visible,
         );
+        let t = compute_throughput(&self.visibility, a, b, samples, visible);
         self.cache.insert(a, b, t);
         t
     }
@@ -677,7 +707,7 @@ impl<const N: usize> RefineContext<'_, N> {
         };
         let node = &task.h.nodes[n as usize];
         debug_assert_eq!(node.from, j);
-        let (k, tjk, vjk) = (node.to, node.t, node.v);
+        let (k, tjk, vjk, spread_jk) = (node.to, node.t, node.v, node.spread);
         if tjk <= 0.0 {
             self.retry_unseen_node(task, i, j, n, known);
             return;
@@ -714,7 +744,7 @@ impl<const N: usize> RefineContext<'_, N> {
             brdf: PI * fji * spread / self.settings.fr_eps,
             // The same oracle as stage 1, for the flux this node will carry
             // on: how much the point form factor F(y → j) varies over y in k.
-            ff: self.throughput(task.h.to.of(k), sj.of(j)).spread / self.settings.ff_eps,
+            ff: spread_jk / self.settings.ff_eps,
             partial: (vjk > 0.0 && vjk < 1.0) || straddle_k,
             driver,
         };

@@ -197,13 +197,15 @@ fn clamp_reflectances<const N: usize>(faces: &mut PerFace<TransportFace<N>>) -> 
 }
 
 /// The buried parts of every face that sends light (the floor under a
-/// box): visibility treats them as blocked, and radiance is spread over
-/// the exposed area only (`trilux_geometry::burial`).
+/// box) and the parts that a crossing cuts off from the light:
+/// visibility treats them as blocked, and radiance is spread over the
+/// exposed area only (`trilux_geometry::burial`, `crossing`). Returns the
+/// map, and the map of burial alone.
 fn probe_burial<const N: usize>(
     forest: &ElementForest,
     faces: &PerFace<TransportFace<N>>,
     depth_of: &[u32],
-) -> Option<BurialMap> {
+) -> (Option<BurialMap>, Option<BurialMap>) {
     let requests: Vec<BurialRequest> = faces
         .iter()
         .filter(|(_, f)| !f.is_absorber())
@@ -212,8 +214,40 @@ fn probe_burial<const N: usize>(
             resolution: 2u32.pow(depth_of[face.surface().index()] + 1).min(256),
         })
         .collect();
-    let map = BurialMap::probe(forest.geometry(), &requests);
-    (!map.is_empty()).then_some(map)
+    let light = trilux_geometry::LightFaces {
+        emitters: faces
+            .iter()
+            .filter(|(_, f)| !f.emission.is_black())
+            .map(|(face, _)| face)
+            .collect(),
+        senders: PerFace::from(faces.values().map(|f| !f.is_absorber()).collect::<Vec<_>>()),
+    };
+    let plain = BurialMap::probe(forest.geometry(), &requests);
+    let crossed = trilux_geometry::crossing::crossed_faces(forest.geometry());
+    let map = if crossed.contains(&true) {
+        BurialMap::probe_with_light(forest.geometry(), &requests, Some(&light))
+    } else {
+        plain.clone()
+    };
+    let nonempty = |m: BurialMap| (!m.is_empty()).then_some(m);
+    (nonempty(map), nonempty(plain))
+}
+
+/// The face elements that a crossing cuts off in part (less exposed with
+/// the crossing probe than with burial alone, but not wholly cut off).
+fn partly_cut(
+    exposed: &Sided<Vec<f64>>,
+    forest: &ElementForest,
+    plain: Option<&BurialMap>,
+) -> Sided<Vec<bool>> {
+    let without = exposed_areas(forest, plain);
+    Sided::from_fn(|side| {
+        exposed[side]
+            .iter()
+            .zip(&without[side])
+            .map(|(&a, &b)| a > 0.0 && a < 0.999 * b)
+            .collect()
+    })
 }
 
 /// The cluster hierarchy, every face's cut and its near partners (the
@@ -239,7 +273,14 @@ fn clusters_and_partners<const N: usize>(
             let planar = s
                 .is_planar()
                 .then(|| (root.centre, root.normal * f.side().sign()));
-            cut_of(forest, &tree, f, planar, clustering)
+            cut_of(
+                forest,
+                &tree,
+                f,
+                planar,
+                clustering,
+                !faces[f].emission.is_black(),
+            )
         })
         .collect();
     let candidates = PerFace::from(
@@ -259,6 +300,7 @@ fn clusters_and_partners<const N: usize>(
             tree,
             cuts,
             enclosed,
+            partly_cut: Sided::from_fn(|_| Vec::new()),
         },
         partners,
     )
@@ -299,7 +341,7 @@ fn root_interactions<const N: usize>(
     vis: &Visibility<'_>,
     faces: &PerFace<TransportFace<N>>,
     partners: &PerFace<Vec<FaceId>>,
-    visibility_samples: u32,
+    samples: impl Fn([FaceElement; 2]) -> u32 + Sync,
 ) -> Vec<Hierarchy<N>> {
     let forest = vis.forest();
     let mut roots = Vec::new();
@@ -316,7 +358,8 @@ fn root_interactions<const N: usize>(
     roots
         .par_iter()
         .map(|&(a, b)| {
-            let t = compute_throughput(vis, root_of(b), root_of(a), visibility_samples, false);
+            let pair = [root_of(b), root_of(a)];
+            let t = compute_throughput(vis, pair[0], pair[1], samples(pair), false);
             Hierarchy::new(a, b, root_of(a).element, root_of(b).element, t)
         })
         .collect()
@@ -353,12 +396,20 @@ impl<const N: usize> Solver<N> {
             settings.transport,
         );
         let warnings = clamp_reflectances(&mut faces);
-        let burial = probe_burial(&forest, &faces, &depth_of);
+        let (burial, plain) = probe_burial(&forest, &faces, &depth_of);
         let exposed_area = exposed_areas(&forest, burial.as_ref());
-        let (clusters, partners) = clusters_and_partners(&forest, &faces, &settings);
+        let (mut clusters, partners) = clusters_and_partners(&forest, &faces, &settings);
+        clusters.partly_cut = partly_cut(&exposed_area, &forest, plain.as_ref());
         let far = far_fields(&forest, &faces, &clusters, &exposed_area, burial.as_ref());
         let vis = Visibility::new(&forest, burial.as_ref());
-        let hierarchies = root_interactions(&vis, &faces, &partners, settings.visibility_samples);
+        let samples = |pair| {
+            crate::refine::visibility_samples_for(
+                &clusters.partly_cut,
+                pair,
+                settings.visibility_samples,
+            )
+        };
+        let hierarchies = root_interactions(&vis, &faces, &partners, samples);
         let (field, face_flux, emitted) = emission(&forest, &faces, &exposed_area);
         let stats = initial_stats::<N>(&forest, &depth_of, hierarchies.len(), warnings);
         let count = forest.element_count() as u32;

@@ -453,6 +453,7 @@ fn read_node<const N: usize>(r: &mut In<'_>, elements: u32) -> Result<Node<N>, B
         split,
         t,
         v: 1.0,
+        spread: 0.0,
         radiance,
         unshot: Spectrum::zero(),
         gathered: Spectrum::zero(),
