@@ -96,7 +96,7 @@ fn run_file(path: &std::path::Path, settings: &SolverSettings) -> Result<Row> {
     };
     // Progress every 2 000 shots, so that a long case shows where it is.
     let mut on_shot = |p: &trilux_solver::Progress| {
-        if p.shots % 2000 == 0 {
+        if p.shots.is_multiple_of(2000) {
             eprintln!(
                 "  {} shots, CR {:.4}, {} interactions, {:.0} s",
                 p.shots,
