@@ -4,11 +4,19 @@
 //! against colour-science; `cargo xtask golden` compares renders of every
 //! bundled scene with stored Mitsuba 3 references; `cargo xtask sweep`
 //! measures error against time; `cargo xtask rays` measures ray queries
-//! against Embree.
+//! against Embree; `cargo xtask scale` measures solve cost against scene
+//! size on generated scenes.
 
+mod counting_alloc;
 mod golden;
 mod rays;
+mod scale;
+mod scale_scenes;
 mod sweep;
+
+/// Counts the process's allocations (the peak memory `scale` reports).
+#[global_allocator]
+static ALLOCATOR: counting_alloc::Counting = counting_alloc::Counting;
 
 use std::process::Command;
 
@@ -57,8 +65,9 @@ fn main() -> Result<()> {
         Some("golden") => golden::main(&args[1..]),
         Some("sweep") => sweep::main(&args[1..]),
         Some("rays") => rays::main(&args[1..]),
+        Some("scale") => scale::main(&args[1..]),
         _ => {
-            eprintln!("usage: cargo xtask ci | color | golden | sweep | rays");
+            eprintln!("usage: cargo xtask ci | color | golden | sweep | rays | scale");
             std::process::exit(2);
         }
     }

@@ -22,6 +22,12 @@
 //! A face seen through a gap wider than `reach` stays exposed: the light
 //! that enters the gap is then resolved by visibility, as everywhere else.
 //!
+//! **Crossings** ([`crate::crossing`], [`BurialMap::probe_with_light`]):
+//! on a face that another surface crosses, the parts the crossing cuts off
+//! from the light (outside a room whose floor runs past its walls, inside
+//! a box sunk into the floor) are marked in the same grid, with the same
+//! consequences.
+//!
 //! **Resolution.** A parametric surface's face gets an R × R grid of cells
 //! in (u, v), refined 4 × 4 along the outlines of buried regions; a chart's
 //! face one probe per midpoint sub-triangle (4 per triangle).
@@ -31,6 +37,7 @@ use std::collections::HashMap;
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
+use crate::crossing::{LightFaces, Reach, crossed_faces};
 use crate::element::ElementDomain;
 use crate::face::{FaceElement, FaceId, PerFace};
 use crate::forest::ElementForest;
@@ -89,11 +96,39 @@ impl BurialMap {
     /// Probes the requested faces for buried parts (module docs), in
     /// parallel.
     pub fn probe(geom: &Geometry, requests: &[BurialRequest]) -> BurialMap {
+        Self::probe_with_light(geom, requests, None)
+    }
+
+    /// [`BurialMap::probe`], and with `light` the parts of crossed faces
+    /// that a crossing cuts off from the light are marked as buried too
+    /// ([`crate::crossing`]).
+    pub fn probe_with_light(
+        geom: &Geometry,
+        requests: &[BurialRequest],
+        light: Option<&LightFaces>,
+    ) -> BurialMap {
         let mut faces = PerFace::from_fn(geom.surfaces().len(), |_| None);
+        let crossed = match light {
+            Some(_) => crossed_faces(geom),
+            None => Vec::new(),
+        };
+        let reach = light.map(|light| Reach {
+            geom,
+            light,
+            crossed: &crossed,
+        });
         let probed: Vec<(FaceId, FaceBurial)> = requests
             .par_iter()
             .filter(|r| r.face.surface().index() < geom.surfaces().len())
-            .map(|r| (r.face, probe_face(geom, r)))
+            .map(|r| {
+                let cut = reach.as_ref().filter(|_| {
+                    crossed
+                        .get(r.face.surface().index())
+                        .copied()
+                        .unwrap_or(false)
+                });
+                (r.face, probe_face(geom, r, cut))
+            })
             .collect();
         for (face, f) in probed {
             faces[face] = Some(f);
@@ -177,9 +212,9 @@ impl BurialMap {
 
 /// Probes one face: a grid over (u, v) for parametric surfaces, four
 /// probes per triangle for charts.
-fn probe_face(geom: &Geometry, r: &BurialRequest) -> FaceBurial {
+fn probe_face(geom: &Geometry, r: &BurialRequest, reach: Option<&Reach<'_>>) -> FaceBurial {
     match &geom.surface(r.face.surface()).geom {
-        SurfaceGeom::Patch(_) => probe_grid(geom, r),
+        SurfaceGeom::Patch(_) => probe_grid(geom, r, reach),
         SurfaceGeom::Chart { mesh, .. } => probe_triangles(geom, r.face, *mesh),
     }
 }
@@ -193,17 +228,22 @@ fn cell_centre(i: u32, j: u32, res: u32) -> DVec2 {
 /// cells meet (a box's outline), FINE × FINE probes per cell, so that the
 /// cells straddling the outline, which send light into the box from their
 /// covered part, are few.
-fn probe_grid(geom: &Geometry, r: &BurialRequest) -> FaceBurial {
+fn probe_grid(geom: &Geometry, r: &BurialRequest, reach: Option<&Reach<'_>>) -> FaceBurial {
     const FINE: u32 = 4;
     let surface = r.face.surface();
     let s = geom.surface(surface);
     let sign = r.face.side().sign();
     let coarse = r.resolution.clamp(1, 256);
     // Cells are about sqrt(area)/res across.
+    let cut_off = reach;
     let reach = s.area.sqrt() / coarse as f64;
     let probe_uv = |uv: DVec2| {
         geom.surface_point(surface, SurfaceCoord::Uv(uv))
-            .is_some_and(|p| probe(geom, p.point, p.normal * sign, s.shape, reach))
+            .is_some_and(|p| {
+                let n = p.normal * sign;
+                probe(geom, p.point, n, s.shape, reach)
+                    || cut_off.is_some_and(|c| !c.is_lit(p.point, n))
+            })
     };
     let first: Vec<bool> = (0..coarse * coarse)
         .map(|c| probe_uv(cell_centre(c % coarse, c / coarse, coarse)))

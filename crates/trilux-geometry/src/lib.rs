@@ -84,6 +84,9 @@
 //!   clusters), face to face ([`FaceElement`]).
 //! - [`burial`]: the parts of faces that another shape covers (the floor
 //!   under a box), probed once into a [`BurialMap`].
+//! - [`crossing`]: parts of crossed faces (a floor running past the walls,
+//!   a box sunk into the floor) cut off from the light, marked in the
+//!   burial map.
 //! - [`visibility`]: visible fractions from stratified shadow segments
 //!   ([`Visibility`], which takes the burial map explicitly).
 //! - `quadrature`, `sequence` and `transform` (private): integration rules,
@@ -95,6 +98,7 @@ pub mod build;
 pub mod burial;
 mod bvh;
 pub mod chart;
+pub mod crossing;
 pub mod element;
 pub mod error;
 pub mod face;
@@ -117,6 +121,7 @@ pub use burial::{BurialMap, BurialRequest};
 #[cfg(feature = "trace-stats")]
 pub use bvh::stats as trace_stats;
 pub use chart::{CHART_CONE_DEG, CHART_MAX_TRIANGLES, Piece};
+pub use crossing::LightFaces;
 pub use element::{Element, ElementDomain};
 pub use error::{GeometryError, ShapeProblem};
 pub use face::{FaceElement, FaceId, PerFace, Side, Sided};

@@ -40,6 +40,11 @@ impl<'a> Visibility<'a> {
         self.forest
     }
 
+    /// The burial map segments are checked against, if any.
+    pub fn burial(&self) -> Option<&'a BurialMap> {
+        self.burial
+    }
+
     /// Visible fraction between `a` and `b` from `samples` shadow segments
     /// (at most 65 536), counting the segments between the two faces that
     /// face each other (module docs).

@@ -87,15 +87,18 @@ fn probe_points(forest: &ElementForest, surface: SurfaceId, sign: f64) -> Vec<(D
     out
 }
 
-/// Which pairs of faces can exchange light: a face that sees itself with
-/// itself, and sender face `a` and receiver face `b` of different input
-/// surfaces such that some point of `b` lies in front of `a` and some point
-/// of `a` in front of `b`, both as seen by the same pair of points. Exact
-/// for planar surfaces (probing the corners and interior suffices: the
-/// conditions are linear), a dense probe for curved ones.
+/// Which pairs of faces can exchange light, among each face's near
+/// candidates (`cluster_transport::Cut::near`; every other face when
+/// clustering is off): a face that sees itself with itself, and sender
+/// face `a` and receiver face `b` of different input surfaces such that
+/// some point of `b` lies in front of `a` and some point of `a` in front of
+/// `b`, both as seen by the same pair of points. Exact for planar surfaces
+/// (probing the corners and interior suffices: the conditions are
+/// linear), a dense probe for curved ones.
 pub(crate) fn eligible_pairs<const N: usize>(
     forest: &ElementForest,
     faces: &PerFace<TransportFace<N>>,
+    candidates: &PerFace<Vec<FaceId>>,
 ) -> PerFace<Vec<FaceId>> {
     use rayon::prelude::*;
     let ids: Vec<FaceId> = faces.iter().map(|(f, _)| f).collect();
@@ -112,7 +115,7 @@ pub(crate) fn eligible_pairs<const N: usize>(
             if faces[a].is_absorber() {
                 return out;
             }
-            for &b in &ids {
+            for &b in &candidates[a] {
                 if b.surface() == a.surface() {
                     continue;
                 }

@@ -83,6 +83,12 @@ impl GatherLinks {
         self.links.len()
     }
 
+    /// Bytes held (row starts and links).
+    pub fn bytes(&self) -> usize {
+        self.offsets.capacity() * std::mem::size_of::<u32>()
+            + self.links.capacity() * std::mem::size_of::<GatherLink>()
+    }
+
     /// True when there are none.
     pub fn is_empty(&self) -> bool {
         self.links.is_empty()
@@ -160,7 +166,9 @@ impl<const N: usize> Solver<N> {
                 .iter()
                 .map(|&r| (root, r, self.forest.root(r.surface())))
                 .collect();
-            links(&ctx, &sender, face, &pairs, |_, _| LinkSource::Face(face))
+            let mut out = links(&ctx, &sender, face, &pairs, |_, _| LinkSource::Face(face));
+            out.extend(far_gather_links(&ctx, &self.field, face, f));
+            out
         });
         let pairs: Vec<(u64, GatherLink)> = from_faces.collect();
         GatherLinks::from_pairs(self.forest.element_count(), pairs)
@@ -202,6 +210,42 @@ fn links<const N: usize>(
             (l.face.of(l.j).key(), link)
         })
         .collect()
+}
+
+/// The gather links of one Lambertian sender face towards the members of
+/// its far blocks (`cluster_transport`): the cluster links expanded at
+/// link time into one link per member face, from the sender's root
+/// element, with the block's visible fraction. So the renderer's links
+/// still cover every sender of every receiving element exactly once.
+fn far_gather_links<const N: usize>(
+    ctx: &RefineContext<'_, N>,
+    field: &crate::radiosity::ElementRadiance<N>,
+    face: FaceId,
+    f: &TransportFace<N>,
+) -> Vec<(u64, GatherLink)> {
+    let far = ctx.far();
+    let root = ctx.forest.root(face.surface());
+    let sent = field.radiance[face.side()][root.index()] + f.emission;
+    let mut out = Vec::new();
+    if sent.is_black() {
+        return out;
+    }
+    for block in &ctx.clusters.cuts[face].far {
+        let v = far.block_visibility(face.of(root), block);
+        if v <= 0.0 {
+            continue;
+        }
+        far.members(face.of(root), block.cluster, |m| {
+            let link = GatherLink {
+                sender: root,
+                sender_face: face,
+                source: LinkSource::Face(face),
+                visibility: v as f32,
+            };
+            out.push((m.face.of(ctx.forest.root(m.face.surface())).key(), link));
+        });
+    }
+    out
 }
 
 /// The final radiance a link's sender sends (L + Le for a face, L_IJ for a

@@ -140,7 +140,9 @@ impl<const N: usize> Solver<N> {
                     hit.surface,
                     trilux_geometry::Side::from_back(!hit.front_facing(&ray)),
                 );
-                if !self.stored_pairs.contains(&(face, hit_face)) {
+                if !self.stored_pairs.contains(&(face, hit_face))
+                    && !self.far_reaches(face, hit.surface)
+                {
                     continue;
                 }
                 let f = bsdf.eval_glossy(to_bsdf(wi), smp.wi);
@@ -148,6 +150,13 @@ impl<const N: usize> Solver<N> {
             }
         }
         sum * (1.0 / f64::from(grid * grid))
+    }
+
+    /// True when `face`'s far field sends to surface `s`.
+    fn far_reaches(&self, face: FaceId, s: trilux_geometry::SurfaceId) -> bool {
+        self.far[face].is_some()
+            && crate::cluster_transport::block_of(&self.clusters.tree, &self.clusters.cuts[face], s)
+                .is_some()
     }
 
     /// Σ over the face's stored hierarchies of T(j, K) / A_j: the
@@ -168,6 +177,15 @@ impl<const N: usize> Solver<N> {
         for h in self.hierarchies.iter().flatten().filter(|h| h.from == face) {
             let k = h.to.of(h.nodes[0].to);
             t += compute_throughput(&vis, k, face.of(j), self.settings.visibility_samples, false).t;
+        }
+        // The far field's receivers (their T is over the whole face's
+        // exposed area, so T / A is its share of the hemisphere).
+        if let Some(field) = &self.far[face] {
+            let root = self.forest.root(face.surface());
+            let area = self.exposed_area[face.side()][root.index()];
+            if area > 0.0 {
+                t += a * field.throughput() / area;
+            }
         }
         let c = t / a;
         if let Ok(mut cache) = self.coverage.lock() {

@@ -50,6 +50,12 @@ pub(crate) struct Node<const N: usize> {
     pub t: f64,
     /// Visible fraction measured for this node's own elements.
     pub v: f64,
+    /// The spread of the point form factor F(y → I) over y in J for this
+    /// node's own elements (the stage-2 oracle's form-factor error; kept
+    /// so that refinement need not look it up again). Not saved: a loaded
+    /// solution never refines.
+    #[serde(skip)]
+    pub spread: f64,
     /// Current radiance estimate L_IJ.
     pub radiance: Spectrum<N>,
     /// Unshot radiance δL_IJ.
@@ -85,6 +91,7 @@ impl<const N: usize> Hierarchy<N> {
                 split: Split::None,
                 t: t.t,
                 v: t.v,
+                spread: t.spread,
                 radiance: Spectrum::zero(),
                 unshot: Spectrum::zero(),
                 gathered: Spectrum::zero(),
@@ -134,6 +141,7 @@ impl<const N: usize> Hierarchy<N> {
                 split: Split::None,
                 t: th.t,
                 v: th.v,
+                spread: th.spread,
                 radiance: parent.radiance,
                 unshot: parent.unshot * scale,
                 gathered: Spectrum::zero(),

@@ -13,6 +13,10 @@
 //! - [`settings`]: FFErr, FrErr, MinArea, the photometric threshold, CR
 //!   target, quality presets, two-point or uniform transport.
 //! - `faces`: the faces of input surfaces that send and receive light.
+//! - `cluster`: the cluster hierarchy above the input surfaces (Smits,
+//!   Arvo & Greenberg 1994); `cluster_transport`: each face's cut through
+//!   it, far links to clusters and the far fields of glossy faces
+//!   (Christensen et al. 1997).
 //! - `divergence`: scenes with no finite solution (light never absorbed
 //!   and never escaping), refused before the solve.
 //! - `throughput`: T = A F V per element pair, cached (paper §4.6).
@@ -34,6 +38,8 @@
 // Band loops index several per-band arrays in step.
 #![allow(clippy::needless_range_loop)]
 
+mod cluster;
+mod cluster_transport;
 mod divergence;
 pub mod error;
 mod faces;

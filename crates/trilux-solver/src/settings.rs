@@ -69,6 +69,16 @@ pub struct SolverSettings {
     pub visibility_samples: u32,
     /// Two-point for Lambertian parts, or the paper's uniform treatment.
     pub transport: Transport,
+    /// Clustering above the input surfaces (`cluster`, docs/solver.md,
+    /// "Clustering"): transport to distant groups of input surfaces at
+    /// once. On in every preset; off for ablation and for the analytic
+    /// tests that check the paper's algorithm alone.
+    #[serde(default = "clustering_default")]
+    pub clustering: bool,
+}
+
+fn clustering_default() -> bool {
+    true
 }
 
 impl SolverSettings {
@@ -85,6 +95,7 @@ impl SolverSettings {
                 flux_eps: 1e-4,
                 visibility_samples: 9,
                 transport: Transport::TwoPoint,
+                clustering: true,
             },
             Quality::Default => SolverSettings {
                 convergence: 0.999,
@@ -96,6 +107,7 @@ impl SolverSettings {
                 flux_eps: 1e-5,
                 visibility_samples: 16,
                 transport: Transport::TwoPoint,
+                clustering: true,
             },
             Quality::High => SolverSettings {
                 convergence: 0.9999,
@@ -107,12 +119,14 @@ impl SolverSettings {
                 flux_eps: 1e-6,
                 visibility_samples: 25,
                 transport: Transport::TwoPoint,
+                clustering: true,
             },
         }
     }
 
     /// Overrides single settings from `TRILUX_MAX_DEPTH`, `TRILUX_FF_EPS`,
-    /// `TRILUX_FR_EPS`, `TRILUX_FLUX_EPS` and `TRILUX_VISIBILITY_SAMPLES`
+    /// `TRILUX_FR_EPS`, `TRILUX_FLUX_EPS`, `TRILUX_VISIBILITY_SAMPLES` and
+    /// `TRILUX_CLUSTERING` (`true` or `false`)
     /// as `lookup` returns them (the examples pass `std::env::var`): a way
     /// to run experiments on one parameter at a time. The message names
     /// the variable that does not parse.
@@ -134,6 +148,9 @@ impl SolverSettings {
         }
         if let Some(v) = lookup("TRILUX_VISIBILITY_SAMPLES") {
             self.visibility_samples = parse("TRILUX_VISIBILITY_SAMPLES", &v)?;
+        }
+        if let Some(v) = lookup("TRILUX_CLUSTERING") {
+            self.clustering = parse("TRILUX_CLUSTERING", &v)?;
         }
         self.validate()
     }

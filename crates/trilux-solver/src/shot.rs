@@ -22,6 +22,7 @@ use rayon::prelude::*;
 use trilux_color::Spectrum;
 use trilux_geometry::{ElementId, FaceId, Visibility};
 
+use crate::cluster_transport::{FarField, far_links};
 use crate::interaction::Hierarchy;
 use crate::refine::{
     Incidence, NodeLink, PairLink, PairShot, RefineContext, Sender, Sent, TripleTask,
@@ -45,6 +46,7 @@ macro_rules! refine_context {
             interior: &$s.interior,
             exposed_area: &$s.exposed_area,
             textures: $s.textures.as_ref(),
+            clusters: &$s.clusters,
         }
     };
 }
@@ -66,6 +68,13 @@ pub(crate) enum Sending<const N: usize> {
         hierarchy: Hierarchy<N>,
         is_self: bool,
     },
+    /// A glossy face's far field (`cluster_transport`), taken out of the
+    /// solver while it sends (nothing it sends to can send back within
+    /// the shot), with its unshot radiance by receiving surface.
+    Far {
+        field: FarField<N>,
+        by_surface: Vec<Spectrum<N>>,
+    },
 }
 
 impl<const N: usize> Sending<N> {
@@ -74,6 +83,7 @@ impl<const N: usize> Sending<N> {
         match self {
             Sending::Radiosity(f) => *f,
             Sending::Stored { hierarchy, .. } => hierarchy.from,
+            Sending::Far { field, .. } => field.face,
         }
     }
 }
@@ -153,6 +163,7 @@ impl<const N: usize> Solver<N> {
             Sending::Stored { hierarchy, .. } => {
                 vec![(hierarchy.nodes[0].from, hierarchy.to, hierarchy.nodes[0].to)]
             }
+            Sending::Far { .. } => Vec::new(),
         };
         let (pair_links, incidences, stage_two) = {
             let (ctx, hierarchies) = self.split_for_shot();
@@ -167,8 +178,10 @@ impl<const N: usize> Solver<N> {
                     hierarchy,
                     sent: Sent::Unshot,
                 },
+                Sending::Far { by_surface, .. } => Sender::Far { by_surface },
             };
-            let pair_links = stage_one(&ctx.refine, &sender, send_face, &pairs);
+            let mut pair_links = stage_one(&ctx.refine, &sender, send_face, &pairs);
+            pair_links.extend(far_stage_one(&ctx.refine, ctx.field, &sending));
             let incidences = incidences(&ctx.refine, &sender, send_face, &pair_links);
             let stage_two = stage_two(
                 &ctx.refine,
@@ -230,6 +243,19 @@ impl<const N: usize> Solver<N> {
                     is_self,
                 };
                 Some((phi, sending))
+            }
+            Source::Far(face) => {
+                let mut field = self.far[face].take()?;
+                let phi = std::mem::take(&mut field.unshot_flux);
+                let mut by_surface =
+                    vec![Spectrum::zero(); self.forest.geometry().surfaces().len()];
+                let tree = &self.clusters.tree;
+                for b in &field.blocks {
+                    for &s in tree.members_of(b.cluster) {
+                        by_surface[s.index()] = b.unshot;
+                    }
+                }
+                Some((phi, Sending::Far { field, by_surface }))
             }
         }
     }
@@ -312,6 +338,13 @@ impl<const N: usize> Solver<N> {
                 hierarchy.clear_unshot();
                 self.hierarchies[index as usize] = Some(hierarchy);
             }
+            Sending::Far { mut field, .. } => {
+                for b in &mut field.blocks {
+                    b.unshot = Spectrum::zero();
+                }
+                let face = field.face;
+                self.far[face] = Some(field);
+            }
         }
     }
 }
@@ -334,12 +367,41 @@ fn incidences<const N: usize>(
     pair_links
         .par_iter()
         .map(|l| {
+            let tij = crate::throughput::Throughput {
+                t: l.t,
+                v: 1.0,
+                f: 0.0,
+                spread: 0.0,
+            };
             ctx.faces[l.face]
                 .stored
-                .then(|| ctx.incidence(sender, send_face.of(l.i), l.face.of(l.j)))
+                .then(|| ctx.incidence_with(sender, send_face.of(l.i), l.face.of(l.j), tij))
                 .flatten()
         })
         .collect()
+}
+
+/// Phase 2, far part: pair links from the source to the members of its
+/// far blocks (`cluster_transport`): from a face's root with its unshot
+/// radiance, or from a far field with each block's own.
+fn far_stage_one<const N: usize>(
+    ctx: &RefineContext<'_, N>,
+    field: &crate::radiosity::ElementRadiance<N>,
+    sending: &Sending<N>,
+) -> Vec<PairLink<N>> {
+    let face = sending.face();
+    let blocks = &ctx.clusters.cuts[face].far;
+    let root = ctx.forest.root(face.surface());
+    match sending {
+        Sending::Radiosity(_) => {
+            let dl = field.unshot[face.side()][root.index()];
+            far_links(&ctx.far(), face.of(root), blocks, |_| dl)
+        }
+        Sending::Far { field, .. } => far_links(&ctx.far(), face.of(root), blocks, |b| {
+            field.blocks[b].unshot
+        }),
+        Sending::Stored { .. } => Vec::new(),
+    }
 }
 
 /// Phase 4: three-point links into the stored hierarchies of every glossy
@@ -414,6 +476,20 @@ impl<const N: usize> Solver<N> {
                 glossy_flux[nl.group as usize] += nl.gathered * shot_scale * (PI * t);
             }
         }
+        // The glossy share each group reflects into its face's far field
+        // (per far block, before the group's renormalisation).
+        let far_adds: Vec<Option<Vec<Spectrum<N>>>> = pair_links
+            .iter()
+            .zip(incidences)
+            .map(|(l, inc)| self.far_reflection(l, inc.as_ref(), shot_scale))
+            .collect();
+        for (g, adds) in far_adds.iter().enumerate() {
+            if let (Some(adds), Some(field)) = (adds, &self.far[pair_links[g].face]) {
+                for (b, dl) in field.blocks.iter().zip(adds) {
+                    glossy_flux[g] += *dl * (PI * b.t);
+                }
+            }
+        }
         let mut group_scale = vec![Spectrum::<N>::splat(1.0); pair_links.len()];
         let mut total_arrived = Spectrum::<N>::zero();
         let mut absorbed = Spectrum::<N>::zero();
@@ -445,6 +521,18 @@ impl<const N: usize> Solver<N> {
             self.used[l.i.index()] = true;
             self.used[l.j.index()] = true;
         }
+        for (g, adds) in far_adds.into_iter().enumerate() {
+            let Some(adds) = adds else { continue };
+            let Some(field) = self.far[pair_links[g].face].as_mut() else {
+                continue;
+            };
+            for (b, dl) in field.blocks.iter_mut().zip(adds) {
+                let dl = dl * group_scale[g];
+                b.radiance += dl;
+                b.unshot += dl;
+                field.unshot_flux += dl * (PI * b.t);
+            }
+        }
         let escaped = phi - total_arrived;
         for b in 0..N {
             self.ledger.escaped[b] += escaped[b];
@@ -453,6 +541,43 @@ impl<const N: usize> Solver<N> {
         let rel = escaped.min_value() / phi.max_value().max(1e-300);
         self.ledger.min_shot_escaped = self.ledger.min_shot_escaped.min(rel);
         group_scale
+    }
+
+    /// The radiance increments ΔL_AC = π fr(i→j→C) T_ij δL_i / A_A that
+    /// pair link `l` into element j of glossy face A adds to A's far field,
+    /// one per far block (`cluster_transport`); `None` when A has no far
+    /// field or the light arrives from behind.
+    fn far_reflection(
+        &self,
+        l: &PairLink<N>,
+        incidence: Option<&Incidence<N>>,
+        shot_scale: Spectrum<N>,
+    ) -> Option<Vec<Spectrum<N>>> {
+        let field = self.far[l.face].as_ref()?;
+        let to_light = incidence?.direction()?;
+        let root = self.forest.root(l.face.surface());
+        let area = self.exposed_area[l.face.side()][root.index()];
+        if area <= 0.0 {
+            return None;
+        }
+        let bsdf = self.scene.material(self.faces[l.face].shape);
+        let frame = trilux_brdf::Frame::from_normal(self.forest.element(l.j).normal);
+        let wi = frame.to_local(to_light);
+        let dl = l.unshot * shot_scale * (PI * l.t / area);
+        Some(
+            field
+                .blocks
+                .iter()
+                .map(|b| {
+                    let wo = frame.to_local(b.direction);
+                    if wo.z * wi.z <= 0.0 {
+                        Spectrum::zero()
+                    } else {
+                        dl * bsdf.eval_glossy(wi, wo)
+                    }
+                })
+                .collect(),
+        )
     }
 
     /// The Lambertian share of a pair link: ρ_d (T_ij / A_j) δL into j's

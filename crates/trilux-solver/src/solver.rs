@@ -29,6 +29,8 @@ use trilux_geometry::{
     Side, Sided, Visibility,
 };
 
+use crate::cluster::ClusterTree;
+use crate::cluster_transport::{Clusters, Cut, FarContext, FarField, FarFields, cut_of};
 use crate::error::SolverError;
 use crate::faces::{TransportFace, build_faces, eligible_pairs};
 use crate::interaction::Hierarchy;
@@ -63,6 +65,8 @@ pub(crate) enum Source {
     Radiosity(FaceId),
     /// A stored interaction hierarchy.
     Stored(u32),
+    /// A glossy face's far field (`cluster_transport`).
+    Far(FaceId),
 }
 
 /// A prepared solve: the scene, its element trees, faces, root
@@ -80,7 +84,13 @@ pub struct Solver<const N: usize> {
     /// the face's stored receivers cover (`glossy`).
     pub(crate) coverage: Mutex<HashMap<(FaceId, ElementId), f64>>,
     pub(crate) faces: PerFace<TransportFace<N>>,
+    /// Near partners of every face: refined from their roots by the
+    /// paper's algorithm (every partner when clustering is off).
     pub(crate) partners: PerFace<Vec<FaceId>>,
+    /// The cluster hierarchy and every face's cut (`cluster_transport`).
+    pub(crate) clusters: Clusters,
+    /// The far fields of glossy faces (`None` while one sends).
+    pub(crate) far: FarFields<N>,
     /// Shading-normal moments of chart elements of smooth-shaded meshes
     /// (`ElementForest::shading_moments`).
     pub(crate) shading: Vec<Option<(DVec3, DVec3)>>,
@@ -191,13 +201,15 @@ fn clamp_reflectances<const N: usize>(faces: &mut PerFace<TransportFace<N>>) -> 
 }
 
 /// The buried parts of every face that sends light (the floor under a
-/// box): visibility treats them as blocked, and radiance is spread over
-/// the exposed area only (`trilux_geometry::burial`).
+/// box) and the parts that a crossing cuts off from the light:
+/// visibility treats them as blocked, and radiance is spread over the
+/// exposed area only (`trilux_geometry::burial`, `crossing`). Returns the
+/// map, and the map of burial alone.
 fn probe_burial<const N: usize>(
     forest: &ElementForest,
     faces: &PerFace<TransportFace<N>>,
     depth_of: &[u32],
-) -> Option<BurialMap> {
+) -> (Option<BurialMap>, Option<BurialMap>) {
     let requests: Vec<BurialRequest> = faces
         .iter()
         .filter(|(_, f)| !f.is_absorber())
@@ -206,8 +218,122 @@ fn probe_burial<const N: usize>(
             resolution: 2u32.pow(depth_of[face.surface().index()] + 1).min(256),
         })
         .collect();
-    let map = BurialMap::probe(forest.geometry(), &requests);
-    (!map.is_empty()).then_some(map)
+    let light = trilux_geometry::LightFaces {
+        emitters: faces
+            .iter()
+            .filter(|(_, f)| !f.emission.is_black())
+            .map(|(face, _)| face)
+            .collect(),
+        senders: PerFace::from(faces.values().map(|f| !f.is_absorber()).collect::<Vec<_>>()),
+    };
+    let plain = BurialMap::probe(forest.geometry(), &requests);
+    let crossed = trilux_geometry::crossing::crossed_faces(forest.geometry());
+    let map = if crossed.contains(&true) {
+        BurialMap::probe_with_light(forest.geometry(), &requests, Some(&light))
+    } else {
+        plain.clone()
+    };
+    let nonempty = |m: BurialMap| (!m.is_empty()).then_some(m);
+    (nonempty(map), nonempty(plain))
+}
+
+/// The face elements that a crossing cuts off in part (less exposed with
+/// the crossing probe than with burial alone, but not wholly cut off).
+fn partly_cut(
+    exposed: &Sided<Vec<f64>>,
+    forest: &ElementForest,
+    plain: Option<&BurialMap>,
+) -> Sided<Vec<bool>> {
+    let without = exposed_areas(forest, plain);
+    Sided::from_fn(|side| {
+        exposed[side]
+            .iter()
+            .zip(&without[side])
+            .map(|(&a, &b)| a > 0.0 && a < 0.999 * b)
+            .collect()
+    })
+}
+
+/// The cluster hierarchy, every face's cut and its near partners (the
+/// eligible pairs among the cut's near candidates). Clustering needs
+/// two-point transport (the uniform mode stays the paper's).
+fn clusters_and_partners<const N: usize>(
+    forest: &ElementForest,
+    faces: &PerFace<TransportFace<N>>,
+    settings: &SolverSettings,
+) -> (Clusters, PerFace<Vec<FaceId>>) {
+    let clustering =
+        settings.clustering && settings.transport == crate::settings::Transport::TwoPoint;
+    let tree = ClusterTree::build(forest.geometry());
+    let ids: Vec<FaceId> = faces.iter().map(|(f, _)| f).collect();
+    let mut cuts: Vec<Cut> = ids
+        .par_iter()
+        .map(|&f| {
+            if faces[f].is_absorber() {
+                return Cut::default();
+            }
+            let s = forest.geometry().surface(f.surface());
+            let root = forest.element(forest.root(f.surface()));
+            let planar = s
+                .is_planar()
+                .then(|| (root.centre, root.normal * f.side().sign()));
+            cut_of(
+                forest,
+                &tree,
+                f,
+                planar,
+                clustering,
+                !faces[f].emission.is_black(),
+            )
+        })
+        .collect();
+    let candidates = PerFace::from(
+        cuts.iter_mut()
+            .map(|c| std::mem::take(&mut c.near))
+            .collect::<Vec<_>>(),
+    );
+    let partners = eligible_pairs(forest, faces, &candidates);
+    let cuts = PerFace::from(cuts);
+    let enclosed = PerFace::from(
+        ids.par_iter()
+            .map(|&f| clustering && crate::cluster_transport::is_enclosed(forest, f))
+            .collect::<Vec<_>>(),
+    );
+    (
+        Clusters {
+            tree,
+            cuts,
+            enclosed,
+            partly_cut: Sided::from_fn(|_| Vec::new()),
+        },
+        partners,
+    )
+}
+
+/// The far field of every glossy face that has far blocks.
+fn far_fields<const N: usize>(
+    forest: &ElementForest,
+    faces: &PerFace<TransportFace<N>>,
+    clusters: &Clusters,
+    exposed_area: &Sided<Vec<f64>>,
+    burial: Option<&BurialMap>,
+) -> FarFields<N> {
+    let ctx = FarContext {
+        forest,
+        tree: &clusters.tree,
+        exposed_area,
+        burial,
+        enclosed: &clusters.enclosed,
+    };
+    let ids: Vec<FaceId> = faces.iter().map(|(f, _)| f).collect();
+    let fields: Vec<Option<FarField<N>>> = ids
+        .par_iter()
+        .map(|&f| {
+            let cut = &clusters.cuts[f];
+            (faces[f].stored && !cut.far.is_empty()).then(|| FarField::new(&ctx, f, cut))
+        })
+        .collect();
+    PerFace::from(fields)
 }
 
 /// Root interactions: every eligible pair whose sender needs stored
@@ -219,7 +345,7 @@ fn root_interactions<const N: usize>(
     vis: &Visibility<'_>,
     faces: &PerFace<TransportFace<N>>,
     partners: &PerFace<Vec<FaceId>>,
-    visibility_samples: u32,
+    samples: impl Fn([FaceElement; 2]) -> u32 + Sync,
 ) -> Vec<Hierarchy<N>> {
     let forest = vis.forest();
     let mut roots = Vec::new();
@@ -236,7 +362,8 @@ fn root_interactions<const N: usize>(
     roots
         .par_iter()
         .map(|&(a, b)| {
-            let t = compute_throughput(vis, root_of(b), root_of(a), visibility_samples, false);
+            let pair = [root_of(b), root_of(a)];
+            let t = compute_throughput(vis, pair[0], pair[1], samples(pair), false);
             Hierarchy::new(a, b, root_of(a).element, root_of(b).element, t)
         })
         .collect()
@@ -273,7 +400,7 @@ impl<const N: usize> Solver<N> {
             settings.transport,
         );
         let warnings = clamp_reflectances(&mut faces);
-        let burial = probe_burial(&forest, &faces, &depth_of);
+        let (burial, plain) = probe_burial(&forest, &faces, &depth_of);
         let exposed_area = exposed_areas(&forest, burial.as_ref());
         let textures = ElementTextures::new(&forest, &scene, &exposed_area);
         if textures.is_some() && settings.transport != crate::settings::Transport::TwoPoint {
@@ -281,9 +408,18 @@ impl<const N: usize> Solver<N> {
                 "textured materials need two-point transport (the uniform transport is for ablation only)".into(),
             ));
         }
-        let partners = eligible_pairs(&forest, &faces);
+        let (mut clusters, partners) = clusters_and_partners(&forest, &faces, &settings);
+        clusters.partly_cut = partly_cut(&exposed_area, &forest, plain.as_ref());
+        let far = far_fields(&forest, &faces, &clusters, &exposed_area, burial.as_ref());
         let vis = Visibility::new(&forest, burial.as_ref());
-        let hierarchies = root_interactions(&vis, &faces, &partners, settings.visibility_samples);
+        let samples = |pair| {
+            crate::refine::visibility_samples_for(
+                &clusters.partly_cut,
+                pair,
+                settings.visibility_samples,
+            )
+        };
+        let hierarchies = root_interactions(&vis, &faces, &partners, samples);
         let (field, face_flux, emitted) = emission(&forest, &faces, &exposed_area);
         let stats = initial_stats::<N>(&forest, &depth_of, hierarchies.len(), warnings);
         let count = forest.element_count() as u32;
@@ -313,6 +449,8 @@ impl<const N: usize> Solver<N> {
             albedo,
             faces,
             partners,
+            clusters,
+            far,
             shading,
             field,
             face_flux,
@@ -343,6 +481,12 @@ impl<const N: usize> Solver<N> {
             .flatten()
             .map(|h| h.unshot_flux)
             .sum::<Spectrum<N>>();
+        r += self
+            .far
+            .values()
+            .flatten()
+            .map(|f| f.unshot_flux)
+            .sum::<Spectrum<N>>();
         r
     }
 
@@ -371,7 +515,46 @@ impl<const N: usize> Solver<N> {
                 consider(Source::Stored(h as u32), hier.unshot_flux.sum());
             }
         }
+        for (face, f) in self.far.iter() {
+            if let Some(f) = f {
+                consider(Source::Far(face), f.unshot_flux.sum());
+            }
+        }
         best.map(|(s, _)| s)
+    }
+
+    /// Summed bytes of the solver's arenas now (stats'
+    /// `peak_memory_bytes`): the element trees, per-element radiance,
+    /// exposed areas and sample points, the stored interaction nodes, the
+    /// throughput cache, the cluster hierarchy, plus `links` live links.
+    pub(crate) fn arena_bytes(&self, links: usize) -> u64 {
+        use std::mem::size_of;
+        let elements = self.forest.element_count();
+        let per_element = size_of::<trilux_geometry::Element>()
+            + 9 * size_of::<Spectrum<N>>() // three fields × two sides, + spares
+            + 2 * size_of::<f64>()
+            + size_of::<[DVec3; 5]>()
+            + size_of::<[DVec3; 4]>()
+            + size_of::<Option<(DVec3, DVec3)>>()
+            + size_of::<bool>()
+            + size_of::<u32>();
+        let nodes: usize = self
+            .hierarchies
+            .iter()
+            .flatten()
+            .map(|h| h.nodes.capacity())
+            .sum();
+        let hierarchies = self.hierarchies.len() * size_of::<Option<Hierarchy<N>>>();
+        let partners: usize = self.partners.values().map(|p| p.capacity() * 4).sum();
+        let link =
+            size_of::<crate::refine::PairLink<N>>().max(size_of::<crate::refine::NodeLink<N>>());
+        (elements * per_element
+            + nodes * size_of::<crate::interaction::Node<N>>()
+            + hierarchies
+            + partners
+            + self.cache.bytes()
+            + self.clusters.bytes()
+            + links * link) as u64
     }
 
     /// Stored interaction nodes, over every hierarchy.
@@ -396,6 +579,8 @@ impl<const N: usize> Solver<N> {
             };
             let live = self.shoot(source);
             self.stats.shots += 1;
+            let bytes = self.arena_bytes(live);
+            self.stats.peak_memory_bytes = self.stats.peak_memory_bytes.max(bytes);
             progress(&Progress {
                 shots: self.stats.shots,
                 convergence_ratio: self.convergence_ratio(),
@@ -437,9 +622,14 @@ impl<const N: usize> Solver<N> {
             }
         }
         let links = self.gather_links();
+        let gather_bytes = links.bytes() as u64;
+        let bytes = self.arena_bytes(0) + gather_bytes;
+        self.stats.peak_memory_bytes = self.stats.peak_memory_bytes.max(bytes);
         let residual = self.residual();
         let stats = &mut self.stats;
         stats.gather_links = links.len();
+        stats.far_blocks = self.clusters.cuts.values().map(|c| c.far.len()).sum();
+        stats.far_fields = self.far.values().flatten().count();
         stats.elements = self.used.iter().filter(|&&u| u).count();
         stats.interactions = self
             .hierarchies

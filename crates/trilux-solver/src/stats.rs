@@ -52,6 +52,22 @@ pub struct SolveStats {
     /// a fraction of what arrived there (band minimum). Negative would mean
     /// an element reflected more than it received.
     pub min_element_absorbed: f64,
+    /// Far blocks over every face's cut through the cluster hierarchy
+    /// (`cluster_transport`; 0 with clustering off or in a scene too
+    /// small to have distant clusters).
+    #[serde(default)]
+    pub far_blocks: usize,
+    /// Glossy faces with a far field.
+    #[serde(default)]
+    pub far_fields: usize,
+    /// Peak bytes of the solver's arenas over the solve: element trees and
+    /// their radiance, interaction nodes, the links of the largest shot,
+    /// the throughput cache, the cluster hierarchy and the gather links
+    /// (summed sizes, `Solver::arena_bytes`; not the process's whole
+    /// allocation, which `cargo xtask scale` measures with a counting
+    /// allocator).
+    #[serde(default)]
+    pub peak_memory_bytes: u64,
     /// Warnings (e.g. a Lambertian reflectance above 1 clamped).
     pub warnings: Vec<String>,
 }

@@ -106,6 +106,17 @@ impl ThroughputCache {
         shard.get(&key).copied()
     }
 
+    /// Bytes the cache holds now (entries × (key + value), with the hash
+    /// table's load factor of about 8/7).
+    pub fn bytes(&self) -> usize {
+        let entries: usize = self
+            .shards
+            .iter()
+            .filter_map(|s| s.read().ok().map(|s| s.capacity()))
+            .sum();
+        entries * (std::mem::size_of::<u64>() + std::mem::size_of::<Throughput>() + 1)
+    }
+
     /// Stores a throughput; clears the shard when it is full (a simple bound
     /// that keeps memory O(capacity) whatever the scene).
     pub fn insert(&self, a: FaceElement, b: FaceElement, t: Throughput) {

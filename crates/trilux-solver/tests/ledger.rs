@@ -11,7 +11,7 @@ use proptest::prelude::*;
 use trilux_brdf::{BsdfParams, Distribution, RoughConductorParams};
 use trilux_color::ColorParam;
 use trilux_geometry::{Shape, ShapeKind};
-use trilux_solver::{Quality, SceneDescription, Solver, SolverSettings, Transport};
+use trilux_solver::{Quality, SceneDescription, Solution, Solver, SolverSettings, Transport};
 
 fn material() -> impl Strategy<Value = BsdfParams> {
     let diffuse = (0.0..0.95f64).prop_map(|r| BsdfParams::Diffuse {
@@ -125,6 +125,113 @@ fn scene(
     (shapes, bsdfs, emission)
 }
 
+/// The ledger's checks on a solution.
+fn check_ledger(solution: &Solution<3>) -> Result<(), TestCaseError> {
+    let stats = solution.stats();
+    for b in 0..3 {
+        let e = stats.emitted_flux[b];
+        let sum = stats.absorbed_flux[b] + stats.escaped_flux[b] + stats.residual_flux[b];
+        prop_assert!(
+            (e - sum).abs() <= 1e-6 * e,
+            "band {}: emitted {} vs {}",
+            b,
+            e,
+            sum
+        );
+        prop_assert!(stats.escaped_flux[b] >= -1e-9 * e);
+        prop_assert!(stats.absorbed_flux[b] >= -1e-9 * e);
+    }
+    prop_assert!(
+        stats.min_shot_escaped >= -1e-9,
+        "a shot created energy: {}",
+        stats.min_shot_escaped
+    );
+    prop_assert!(
+        stats.min_element_absorbed >= -1e-9,
+        "an element created energy: {}",
+        stats.min_element_absorbed
+    );
+    let min = solution.min_radiance();
+    prop_assert!(min.is_finite() && min >= 0.0, "radiance minimum {}", min);
+    Ok(())
+}
+
+/// A long room (a flipped cube 6 × 1 × 6) with a light under its ceiling
+/// and `boxes` small cubes (position on the floor in [−1, 1]², size, height
+/// above the floor, material), so that clustering finds far clusters.
+fn clustered_scene(
+    boxes: &[((f64, f64), f64, f64, BsdfParams)],
+    room: BsdfParams,
+) -> (Vec<Shape>, Vec<BsdfParams>, Vec<Option<ColorParam>>) {
+    let mut shapes = vec![
+        Shape {
+            kind: ShapeKind::Rectangle,
+            world_from_object: DMat4::from_translation(DVec3::new(0.0, 0.0, 0.95))
+                * DMat4::from_rotation_x(PI)
+                * DMat4::from_scale(DVec3::splat(0.2)),
+            flip_normals: false,
+        },
+        Shape {
+            kind: ShapeKind::Cube,
+            world_from_object: DMat4::from_scale(DVec3::new(6.0, 6.0, 1.0)),
+            flip_normals: true,
+        },
+    ];
+    let mut bsdfs = vec![
+        BsdfParams::Diffuse {
+            reflectance: ColorParam::Float(0.3),
+        },
+        room,
+    ];
+    let mut emission = vec![Some(ColorParam::Float(10.0)), None];
+    for ((x, y), size, lift, material) in boxes {
+        shapes.push(Shape {
+            kind: ShapeKind::Cube,
+            world_from_object: DMat4::from_translation(DVec3::new(
+                5.5 * x,
+                5.5 * y,
+                -1.0 + size + lift,
+            )) * DMat4::from_scale(DVec3::splat(*size)),
+            flip_normals: false,
+        });
+        bsdfs.push(material.clone());
+        emission.push(None);
+    }
+    (shapes, bsdfs, emission)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 12, ..ProptestConfig::default() })]
+    /// The ledger with clustering on, on scenes large enough to have far
+    /// clusters (checked: the solve must have made far blocks), diffuse and
+    /// glossy boxes mixed, some resting on the floor, some in the air.
+    #[test]
+    fn ledger_balances_on_clustered_scenes(
+        boxes in proptest::collection::vec(
+            ((-1.0..1.0f64, -1.0..1.0f64), 0.05..0.2f64, prop_oneof![Just(0.0), 0.0..0.5f64], material()),
+            8..24,
+        ),
+        room in material(),
+    ) {
+        let (shapes, bsdfs, emission) = clustered_scene(&boxes, room);
+        let input = SceneDescription { shapes: &shapes, bsdfs: &bsdfs, emission: &emission };
+        let mut settings = SolverSettings::preset(Quality::Draft);
+        settings.max_depth = 3;
+        settings.max_shots = 60;
+        settings.visibility_samples = 4;
+        prop_assert!(settings.clustering);
+        let mut last_cr = 0.0f64;
+        let mut monotone = true;
+        let solution = Solver::<3>::from_description(&input, settings).expect("builds").solve(|p| {
+            monotone &= p.convergence_ratio >= last_cr - 1e-12;
+            last_cr = p.convergence_ratio;
+        });
+        prop_assert!(monotone, "the residual grew between shots");
+        prop_assert!(solution.stats().far_blocks > 0, "no far clusters: the scene does not test clustering");
+        check_ledger(&solution)?;
+    }
+}
+
 proptest! {
     #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
     #[test]
@@ -150,17 +257,6 @@ proptest! {
             last_cr = p.convergence_ratio;
         });
         prop_assert!(monotone, "the residual grew between shots");
-        let stats = solution.stats();
-        for b in 0..3 {
-            let e = stats.emitted_flux[b];
-            let sum = stats.absorbed_flux[b] + stats.escaped_flux[b] + stats.residual_flux[b];
-            prop_assert!((e - sum).abs() <= 1e-6 * e, "band {}: emitted {} vs {}", b, e, sum);
-            prop_assert!(stats.escaped_flux[b] >= -1e-9 * e);
-            prop_assert!(stats.absorbed_flux[b] >= -1e-9 * e);
-        }
-        prop_assert!(stats.min_shot_escaped >= -1e-9, "a shot created energy: {}", stats.min_shot_escaped);
-        prop_assert!(stats.min_element_absorbed >= -1e-9, "an element created energy: {}", stats.min_element_absorbed);
-        let min = solution.min_radiance();
-        prop_assert!(min.is_finite() && min >= 0.0, "radiance minimum {}", min);
+        check_ledger(&solution)?;
     }
 }

@@ -15,6 +15,8 @@
 //!          element, plus the end), link count u32, and per link: sender
 //!          element u32, sender face u32, source tag u8 (0 face, 1 node),
 //!          source face or hierarchy u32, node u32, visibility f32
+//!          far fields (version 5): count u32; per field: sender face u32,
+//!          block count u32, and per block: cluster u32, radiance N × f32
 //! ```
 //!
 //! The solve hash covers the scene description, the band count and the
@@ -43,7 +45,7 @@ use crate::stats::SolveStats;
 
 const MAGIC: &[u8; 8] = b"TRILUXS\0";
 /// Version of the solution file format.
-pub const FORMAT_VERSION: u32 = 4;
+pub const FORMAT_VERSION: u32 = 5;
 /// Bytes of the header before the payload.
 const HEADER_LEN: usize = 8 + 4 + 8 + 4 + 8 + 8;
 /// The largest statistics block a reader accepts (64 MiB).
@@ -228,6 +230,15 @@ impl<const N: usize> Solution<N> {
             }
         }
         write_links(&mut w, &self.links);
+        w.u32(self.far.len() as u32);
+        for f in &self.far {
+            w.u32(f.face.0);
+            w.u32(f.blocks.len() as u32);
+            for (c, l) in &f.blocks {
+                w.u32(*c);
+                w.spectrum(l);
+            }
+        }
         Ok(w.0)
     }
 
@@ -303,6 +314,8 @@ impl<const N: usize> Solution<N> {
         let faces = 2 * surfaces as u32;
         let hierarchies = read_hierarchies::<N>(&mut r, faces, elements as u32)?;
         let links = read_links(&mut r, faces, elements as u32, &hierarchies)?;
+        let clusters = (2 * surfaces).saturating_sub(1) as u32;
+        let far = read_far::<N>(&mut r, faces, clusters)?;
         if r.pos != payload.len() {
             return Err("trailing bytes after the solution".into());
         }
@@ -314,6 +327,7 @@ impl<const N: usize> Solution<N> {
             exposed_area,
             radiance,
             hierarchies,
+            far,
             links,
             stats,
         }))
@@ -439,6 +453,7 @@ fn read_node<const N: usize>(r: &mut In<'_>, elements: u32) -> Result<Node<N>, B
         split,
         t,
         v: 1.0,
+        spread: 0.0,
         radiance,
         unshot: Spectrum::zero(),
         gathered: Spectrum::zero(),
@@ -471,6 +486,40 @@ fn write_links(w: &mut Out, links: &GatherLinks) {
 
 /// Bytes of one gather link in the file.
 const LINK_BYTES: usize = 4 + 4 + 1 + 4 + 4 + 4;
+
+/// The far fields (module docs): faces and clusters in range, radiance
+/// finite and non-negative, each face once.
+fn read_far<const N: usize>(
+    r: &mut In<'_>,
+    faces: u32,
+    clusters: u32,
+) -> Result<Vec<super::FarRecord<N>>, Bad> {
+    let count = r.u32()?;
+    let count = r.count(u64::from(count), 8, "far field")?;
+    let mut out: Vec<super::FarRecord<N>> = Vec::with_capacity(count);
+    for _ in 0..count {
+        let face = r.u32()?;
+        if face >= faces || out.last().is_some_and(|l| l.face.0 >= face) {
+            return Err("corrupt far field (face out of range or order)".into());
+        }
+        let n = r.u32()?;
+        let n = r.count(u64::from(n), 4 + 4 * N, "far block")?;
+        let blocks = (0..n)
+            .map(|_| {
+                let c = r.u32()?;
+                if c >= clusters {
+                    return Err("corrupt far block (cluster out of range)".to_string());
+                }
+                Ok((c, r.radiance::<N>()?))
+            })
+            .collect::<Result<Vec<_>, Bad>>()?;
+        out.push(super::FarRecord {
+            face: FaceId(face),
+            blocks,
+        });
+    }
+    Ok(out)
+}
 
 fn read_links<const N: usize>(
     r: &mut In<'_>,

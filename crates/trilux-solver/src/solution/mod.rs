@@ -9,6 +9,7 @@ use std::sync::Arc;
 use trilux_color::Spectrum;
 use trilux_geometry::{ElementForest, FaceId, Side, Sided, SurfaceCoord, SurfaceId};
 
+use crate::cluster::{ClusterId, ClusterTree};
 use crate::gather_links::{GatherLink, GatherLinks, link_radiance};
 use crate::interaction::Hierarchy;
 use crate::prepared::PreparedScene;
@@ -31,6 +32,16 @@ pub struct Solution<const N: usize> {
     radiance: Sided<Vec<Spectrum<N>>>,
     hierarchies: Vec<Hierarchy<N>>,
     by_faces: HashMap<(FaceId, FaceId), u32>,
+    /// The far fields of glossy faces: radiance towards each far block
+    /// (`cluster_transport`), in face order.
+    far: Vec<FarRecord<N>>,
+    /// The far radiance by (sending face, far cluster).
+    far_index: HashMap<(FaceId, ClusterId), Spectrum<N>>,
+    /// Faces that have a far field.
+    far_faces: Vec<bool>,
+    /// The cluster hierarchy the far fields refer to (rebuilt from the
+    /// geometry: it is deterministic).
+    tree: ClusterTree,
     /// The final gather's links into every receiving element.
     links: GatherLinks,
     /// The radiance every gather link's sender sends, in link order.
@@ -58,6 +69,15 @@ impl SurfaceSite {
     }
 }
 
+/// The far field of one glossy face as the solution keeps it.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct FarRecord<const N: usize> {
+    /// The sending face.
+    pub face: FaceId,
+    /// (far cluster, radiance towards it).
+    pub blocks: Vec<(ClusterId, Spectrum<N>)>,
+}
+
 /// What a solution is made of, before its derived indexes.
 pub(crate) struct Parts<const N: usize> {
     pub scene: Arc<PreparedScene<N>>,
@@ -67,6 +87,7 @@ pub(crate) struct Parts<const N: usize> {
     pub exposed_area: Sided<Vec<f64>>,
     pub radiance: Sided<Vec<Spectrum<N>>>,
     pub hierarchies: Vec<Hierarchy<N>>,
+    pub far: Vec<FarRecord<N>>,
     pub links: GatherLinks,
     pub stats: SolveStats,
 }
@@ -83,6 +104,15 @@ fn index_by_faces<const N: usize>(hierarchies: &[Hierarchy<N>]) -> HashMap<(Face
 impl<const N: usize> Solution<N> {
     pub(crate) fn from_solver(solver: Solver<N>, links: GatherLinks) -> Self {
         let hierarchies: Vec<Hierarchy<N>> = solver.hierarchies.into_iter().flatten().collect();
+        let far = solver
+            .far
+            .values()
+            .flatten()
+            .map(|f| FarRecord {
+                face: f.face,
+                blocks: f.blocks.iter().map(|b| (b.cluster, b.radiance)).collect(),
+            })
+            .collect();
         let mut stats = solver.stats;
         // The ledger's per-element and per-shot minima are diagnostics worth
         // keeping beside the stats.
@@ -100,6 +130,7 @@ impl<const N: usize> Solution<N> {
             exposed_area: solver.exposed_area,
             radiance: solver.field.radiance,
             hierarchies,
+            far,
             links,
             stats,
         })
@@ -126,7 +157,22 @@ impl<const N: usize> Solution<N> {
                 )
             })
             .collect();
+        let far_index = p
+            .far
+            .iter()
+            .flat_map(|r| r.blocks.iter().map(|&(c, l)| ((r.face, c), l)))
+            .collect();
+        let mut far_faces = vec![false; 2 * p.forest.geometry().surfaces().len()];
+        for r in &p.far {
+            if let Some(f) = far_faces.get_mut(r.face.index()) {
+                *f = true;
+            }
+        }
         Solution {
+            tree: ClusterTree::build(p.forest.geometry()),
+            far: p.far,
+            far_index,
+            far_faces,
             by_faces: index_by_faces(&p.hierarchies),
             scene: p.scene,
             forest: p.forest,
@@ -191,22 +237,31 @@ impl<const N: usize> Solution<N> {
     /// elements contain both points (paper Fig. 11c).
     pub fn radiance(&self, from: &SurfaceSite, to: &SurfaceSite) -> Spectrum<N> {
         let leaf = self.forest.locate(from.face.surface(), from.coord);
-        let mut l = self.radiance[from.face.side()][leaf.index()];
-        if let Some(&h) = self.by_faces.get(&(from.face, to.face)) {
-            l += self.hierarchies[h as usize].radiance_at(&self.forest, from.coord, to.coord);
-        }
-        l
+        self.radiance[from.face.side()][leaf.index()] + self.stored_radiance(from, to)
     }
 
     /// The stored (glossy, direction-dependent) part alone of
-    /// [`Solution::radiance`]: zero where no hierarchy joins the two faces.
+    /// [`Solution::radiance`]: the hierarchy joining the two faces, or,
+    /// for a receiver in one of the sender's far blocks, the sender's far
+    /// radiance towards that block (`cluster_transport`); zero where
+    /// neither exists.
     pub fn stored_radiance(&self, from: &SurfaceSite, to: &SurfaceSite) -> Spectrum<N> {
-        match self.by_faces.get(&(from.face, to.face)) {
-            Some(&h) => {
-                self.hierarchies[h as usize].radiance_at(&self.forest, from.coord, to.coord)
-            }
-            None => Spectrum::zero(),
+        if let Some(&h) = self.by_faces.get(&(from.face, to.face)) {
+            return self.hierarchies[h as usize].radiance_at(&self.forest, from.coord, to.coord);
         }
+        self.far_radiance(from.face, to.face)
+    }
+
+    /// The far radiance face `from` sends towards the far block holding
+    /// `to`'s surface, if any.
+    fn far_radiance(&self, from: FaceId, to: FaceId) -> Spectrum<N> {
+        if !self.far_faces.get(from.index()).copied().unwrap_or(false) {
+            return Spectrum::zero();
+        }
+        self.tree
+            .ancestors(to.surface())
+            .find_map(|c| self.far_index.get(&(from, c)).copied())
+            .unwrap_or_else(Spectrum::zero)
     }
 
     /// The final radiance L + Le that element `e` of a face sends (its
@@ -293,6 +348,9 @@ impl<const N: usize> Solution<N> {
         for h in &self.hierarchies {
             h.nodes.iter().for_each(|n| visit(&n.radiance));
         }
+        for r in &self.far {
+            r.blocks.iter().for_each(|(_, l)| visit(l));
+        }
         min
     }
 
@@ -308,5 +366,23 @@ impl<const N: usize> Solution<N> {
     /// `from`'s face towards `to`'s face.
     pub fn has_stored(&self, from: &SurfaceSite, to: &SurfaceSite) -> bool {
         self.by_faces.contains_key(&(from.face, to.face))
+            || (self
+                .far_faces
+                .get(from.face.index())
+                .copied()
+                .unwrap_or(false)
+                && self
+                    .tree
+                    .ancestors(to.face.surface())
+                    .any(|c| self.far_index.contains_key(&(from.face, c))))
+    }
+
+    /// Number of glossy far fields and of their far blocks
+    /// (`cluster_transport`).
+    pub fn far_field_counts(&self) -> (usize, usize) {
+        (
+            self.far.len(),
+            self.far.iter().map(|r| r.blocks.len()).sum(),
+        )
     }
 }
