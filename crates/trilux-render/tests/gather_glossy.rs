@@ -27,6 +27,23 @@ struct GlossyFloor {
 }
 
 impl GlossyFloor {
+    /// A rough conductor (specular reflectance 0.9) under a light of
+    /// radiance 4, half-size 0.3, at height 1.
+    fn new(distribution: Distribution, alpha: f64) -> Self {
+        let params = BsdfParams::RoughConductor(RoughConductorParams {
+            distribution,
+            alpha,
+            eta_k: None,
+            specular_reflectance: ColorParam::Float(0.9),
+        });
+        GlossyFloor {
+            bsdf: Bsdf::new(&params).unwrap(),
+            s: 0.3,
+            h: 1.0,
+            le: 4.0,
+        }
+    }
+
     fn brute_force(&self, p: DVec3, wo: DVec3) -> f64 {
         let n = 600;
         let da = (2.0 * self.s / n as f64).powi(2);
@@ -143,18 +160,7 @@ fn preview_glossy_direct_light_matches_brute_force() {
         (Distribution::Ggx, 0.5, DVec3::new(1.2, 0.4, 0.0)),
         (Distribution::Ggx, 0.8, DVec3::new(-0.4, 0.9, 0.0)),
     ] {
-        let params = BsdfParams::RoughConductor(RoughConductorParams {
-            distribution: dist,
-            alpha,
-            eta_k: None,
-            specular_reflectance: ColorParam::Float(0.9),
-        });
-        let scene = GlossyFloor {
-            bsdf: Bsdf::new(&params).unwrap(),
-            s: 0.3,
-            h: 1.0,
-            le: 4.0,
-        };
+        let scene = GlossyFloor::new(dist, alpha);
         let eye = DVec3::new(target.x * 2.0 + 0.4, target.y * 2.0 - 0.3, 0.9);
         let cam = Camera::new(
             look_at(eye, target, DVec3::Z).unwrap(),
@@ -191,18 +197,7 @@ fn glossy_direct_light_matches_brute_force() {
         (Distribution::Beckmann, 0.3, DVec3::new(0.6, -0.1, 0.0)),
         (Distribution::Ggx, 0.5, DVec3::new(1.2, 0.4, 0.0)),
     ] {
-        let params = BsdfParams::RoughConductor(RoughConductorParams {
-            distribution: dist,
-            alpha,
-            eta_k: None,
-            specular_reflectance: ColorParam::Float(0.9),
-        });
-        let scene = GlossyFloor {
-            bsdf: Bsdf::new(&params).unwrap(),
-            s: 0.3,
-            h: 1.0,
-            le: 4.0,
-        };
+        let scene = GlossyFloor::new(dist, alpha);
         // The eye sits roughly in the mirror direction of the light.
         let eye = DVec3::new(target.x * 2.0 + 0.4, target.y * 2.0 - 0.3, 0.9);
         let cam = Camera::new(
