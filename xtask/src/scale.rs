@@ -140,26 +140,17 @@ fn run_file(path: &std::path::Path, settings: &SolverSettings) -> Result<Row> {
 /// (a closed room: light lost to estimation error).
 fn compare(case: Case, dir: &std::path::Path) -> Result<()> {
     use trilux_geometry::{FaceId, Side};
-    use trilux_solver::{SceneDescription, Solver};
+    use trilux_solver::Solver;
     let path = write_case(case, dir)?;
     let scene = trilux_scene::load(&path).map_err(|e| anyhow::anyhow!("{e}"))?;
-    let (shapes, bsdfs, emission) = (
-        scene.geometry_shapes(),
-        scene.bsdf_params(),
-        scene.emitter_radiance(),
-    );
-    let desc = SceneDescription {
-        shapes: &shapes,
-        bsdfs: &bsdfs,
-        emission: &emission,
-    };
+    let prepared = trilux_render::prepare::<3>(&scene)?;
     let mut solutions = Vec::new();
     for clustering in [true, false] {
         let mut settings = SolverSettings::preset(Quality::Default);
         settings.clustering = clustering;
         let start = Instant::now();
-        let solver =
-            Solver::<3>::from_description(&desc, settings).map_err(|e| anyhow::anyhow!("{e}"))?;
+        let solver = Solver::<3>::new(std::sync::Arc::clone(&prepared), settings)
+            .map_err(|e| anyhow::anyhow!("{e}"))?;
         let solution = solver.solve(|_| {});
         let s = solution.stats();
         let escaped: f64 = s.escaped_flux.iter().sum::<f64>() / s.emitted_flux.iter().sum::<f64>();
