@@ -219,6 +219,18 @@ impl<'a, const N: usize, S: RadianceSolution<N>> SolvedScene<'a, N, S> {
         }
     }
 
+    /// The sites of a transfer from `from` to `towards`: each point on the
+    /// side of its surface that faces the other.
+    fn sites(
+        from: &SurfacePoint<HitLocator>,
+        towards: &SurfacePoint<HitLocator>,
+    ) -> (SurfaceSite, SurfaceSite) {
+        let d = towards.point - from.point;
+        let from_side = Side::from_back(from.normal.dot(d) < 0.0);
+        let to_side = Side::from_back(towards.normal.dot(-d) < 0.0);
+        (Self::site(from, from_side), Self::site(towards, to_side))
+    }
+
     /// The link sum at `at`, seen from `side`, in the leaf `leaf`.
     fn link_sum_at(
         &self,
@@ -345,12 +357,8 @@ impl<const N: usize, S: RadianceSolution<N>> GatherScene<N> for SolvedScene<'_, 
         from: &SurfacePoint<HitLocator>,
         towards: &SurfacePoint<HitLocator>,
     ) -> [f64; N] {
-        let d = towards.point - from.point;
-        let from_side = Side::from_back(from.normal.dot(d) < 0.0);
-        let to_side = Side::from_back(towards.normal.dot(-d) < 0.0);
-        self.solution
-            .reflected(&Self::site(from, from_side), &Self::site(towards, to_side))
-            .0
+        let (from, towards) = Self::sites(from, towards);
+        self.solution.reflected(&from, &towards).0
     }
 
     fn element_size(&self, at: &SurfacePoint<HitLocator>) -> f64 {
@@ -437,12 +445,8 @@ impl<const N: usize, S: RadianceSolution<N>> GatherScene<N> for SolvedScene<'_, 
         from: &SurfacePoint<HitLocator>,
         towards: &SurfacePoint<HitLocator>,
     ) -> [f64; N] {
-        let d = towards.point - from.point;
-        let from_side = Side::from_back(from.normal.dot(d) < 0.0);
-        let to_side = Side::from_back(towards.normal.dot(-d) < 0.0);
-        self.solution
-            .reflected_glossy(&Self::site(from, from_side), &Self::site(towards, to_side))
-            .0
+        let (from, towards) = Self::sites(from, towards);
+        self.solution.reflected_glossy(&from, &towards).0
     }
 
     fn sample_cosine(&self, at: &SurfacePoint<HitLocator>, wo: DVec3, u: DVec2) -> Option<DVec3> {

@@ -67,16 +67,22 @@ impl SolveOptions {
     }
 }
 
-/// A number in [0, 1].
-fn parse_unit(text: &str) -> Result<f64, String> {
+/// A finite number for which `ok` holds, `range` naming the values
+/// accepted in the message.
+fn parse_real(text: &str, ok: impl Fn(f64) -> bool, range: &str) -> Result<f64, String> {
     let v: f64 = text
         .parse()
         .map_err(|_| format!("{} is not a number", quoted(text)))?;
-    if v.is_finite() && (0.0..=1.0).contains(&v) {
+    if v.is_finite() && ok(v) {
         Ok(v)
     } else {
-        Err(format!("{v} is not in [0, 1]"))
+        Err(format!("{v} is not {range}"))
     }
+}
+
+/// A number in [0, 1].
+fn parse_unit(text: &str) -> Result<f64, String> {
+    parse_real(text, |v| (0.0..=1.0).contains(&v), "in [0, 1]")
 }
 
 /// `text` quoted for a message, its middle elided when long (a value of
@@ -116,39 +122,18 @@ pub fn parse_spp(text: &str) -> Result<u32, String> {
 
 /// A relative error target in (0, 1).
 pub fn parse_target_error(text: &str) -> Result<f64, String> {
-    let v: f64 = text
-        .parse()
-        .map_err(|_| format!("{} is not a number", quoted(text)))?;
-    if v.is_finite() && v > 0.0 && v < 1.0 {
-        Ok(v)
-    } else {
-        Err(format!("{v} is not in (0, 1)"))
-    }
+    parse_real(text, |v| v > 0.0 && v < 1.0, "in (0, 1)")
 }
 
 /// An exposure in stops, within ±64 (2^64 already turns any radiance
 /// trilux accepts into white or black).
 pub fn parse_exposure(text: &str) -> Result<f64, String> {
-    let v: f64 = text
-        .parse()
-        .map_err(|_| format!("{} is not a number", quoted(text)))?;
-    if v.is_finite() && v.abs() <= 64.0 {
-        Ok(v)
-    } else {
-        Err(format!("{v} is not within ±64 stops"))
-    }
+    parse_real(text, |v| v.abs() <= 64.0, "within ±64 stops")
 }
 
 /// A field of view in (0, 180) degrees.
 pub fn parse_fov(text: &str) -> Result<f64, String> {
-    let v: f64 = text
-        .parse()
-        .map_err(|_| format!("{} is not a number", quoted(text)))?;
-    if v.is_finite() && v > 0.0 && v < 180.0 {
-        Ok(v)
-    } else {
-        Err(format!("{v} is not in (0, 180) degrees"))
-    }
+    parse_real(text, |v| v > 0.0 && v < 180.0, "in (0, 180) degrees")
 }
 
 /// Eye, target and optional up of `--lookat`.
