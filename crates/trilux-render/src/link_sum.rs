@@ -340,6 +340,7 @@ pub fn link_sum<const N: usize, S: RadianceSolution<N>>(
     let Some(links) = field.leaf(solution, r.leaf, stats) else {
         return Spectrum::zero();
     };
+    let far = far_field(solution, r, links);
     let k = match cache.entries.iter().position(|e| e.leaf == Some(r.leaf)) {
         Some(k) => k,
         None => {
@@ -348,13 +349,15 @@ pub fn link_sum<const N: usize, S: RadianceSolution<N>>(
             let mut near = std::mem::take(&mut cache.near);
             let cut = !matches!(visibility, LinkVisibility::Secondary);
             let entry = &mut cache.entries[k];
-            fill(solution, &field.ff, r, links, entry, &mut near, cut, stats);
+            let far_total = far.full.sum() + far.partial.sum();
+            fill(
+                solution, &field.ff, r, links, far_total, entry, &mut near, cut, stats,
+            );
             cache.near = near;
             k
         }
     };
     cache.last = Some(k);
-    let far = far_field(solution, r, links);
     let entry = &cache.entries[k];
     let near: Spectrum<N> = entry.partial.iter().map(|t| t.c * t.link.v).sum();
     let cached = far.full + entry.full + near + far.partial;
@@ -414,6 +417,7 @@ fn fill<const N: usize, S: RadianceSolution<N>>(
     ff: &PointFormFactors,
     r: &Receiver,
     links: &LeafLinks<N>,
+    far_total: f64,
     entry: &mut LeafSum<N>,
     near: &mut Vec<Term<N>>,
     cut: bool,
@@ -450,7 +454,7 @@ fn fill<const N: usize, S: RadianceSolution<N>>(
         }
         return;
     }
-    let total = far_estimate(solution, r, links)
+    let total = far_total
         + entry.full.sum()
         + entry
             .partial
@@ -477,16 +481,6 @@ fn fill<const N: usize, S: RadianceSolution<N>>(
             }
         });
     }
-}
-
-/// The far field's total at `r` (for the near field's tolerance).
-fn far_estimate<const N: usize, S: RadianceSolution<N>>(
-    solution: &S,
-    r: &Receiver,
-    links: &LeafLinks<N>,
-) -> f64 {
-    let far = far_field(solution, r, links);
-    far.full.sum() + far.partial.sum()
 }
 
 /// Step 3: refines a term near the receiver into its children while its
