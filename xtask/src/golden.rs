@@ -154,6 +154,7 @@ pub fn run_trilux(spec: &TriluxSpec<'_>) -> Result<TriluxRun> {
         source: spec.source,
         save: spec.save,
         solution_file: false,
+        bake: None,
         render,
     };
     let outcome = Observer::quiet(|o| trilux_render::pipeline::run(&scene, &plan, o))?;

@@ -13,6 +13,7 @@ mod rays;
 mod scale;
 mod scale_scenes;
 mod sweep;
+mod viewer;
 
 /// Counts the process's allocations (the peak memory `scale` reports).
 #[global_allocator]
@@ -54,6 +55,12 @@ fn ci() -> Result<()> {
     // Every bundled scene against its stored Mitsuba 3 reference (issue 5's
     // golden test: relative RMSE ≤ 0.05, mean within 1 %).
     golden::main(&["--spp".to_string(), "64".to_string()])?;
+    // Every bundled scene baked, validated (Khronos glTF validator) and
+    // photographed in docs/viewer beside its preview (issue 12).
+    // (.ci/run installs Chromium and the viewer's npm packages.)
+    run("node", &["docs/viewer/scripts/vendor.mjs", "--check"])?;
+    run("node", &["--test", "docs/viewer/test/viewer.test.mjs"])?;
+    viewer::main(&[])?;
     Ok(())
 }
 
@@ -66,8 +73,9 @@ fn main() -> Result<()> {
         Some("sweep") => sweep::main(&args[1..]),
         Some("rays") => rays::main(&args[1..]),
         Some("scale") => scale::main(&args[1..]),
+        Some("viewer") => viewer::main(&args[1..]),
         _ => {
-            eprintln!("usage: cargo xtask ci | color | golden | sweep | rays | scale");
+            eprintln!("usage: cargo xtask ci | color | golden | sweep | rays | scale | viewer");
             std::process::exit(2);
         }
     }

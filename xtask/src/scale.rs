@@ -92,6 +92,7 @@ fn run_file(path: &std::path::Path, settings: &SolverSettings) -> Result<Row> {
         source: SolutionSource::Solve,
         save: None,
         solution_file: false,
+        bake: None,
         render: None,
     };
     // Progress every 2 000 shots, so that a long case shows where it is.

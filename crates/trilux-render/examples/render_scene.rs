@@ -62,6 +62,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         source: SolutionSource::Solve,
         save: None,
         solution_file: false,
+        bake: None,
         render: Some(RenderPlan {
             view: ViewOverrides {
                 width: size,

@@ -41,6 +41,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         source: SolutionSource::Solve,
         save: Some(&file),
         solution_file: false,
+        bake: None,
         render: Some(render),
     };
     let solved = Observer::quiet(|o| trilux_render::pipeline::run(&scene, &plan, o))?;

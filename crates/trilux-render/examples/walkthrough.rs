@@ -35,6 +35,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         source: SolutionSource::Solve,
         save: Some(&file),
         solution_file: false,
+        bake: None,
         render: None,
     };
     let t = Instant::now();

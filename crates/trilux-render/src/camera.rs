@@ -160,6 +160,16 @@ impl Camera {
         self.height
     }
 
+    /// Camera space (+x left, +y up, +z forward) to world.
+    pub fn world_from_camera(&self) -> DMat4 {
+        self.world_from_camera
+    }
+
+    /// The vertical field of view, radians.
+    pub fn yfov(&self) -> f64 {
+        2.0 * self.tan_half_y.atan()
+    }
+
     /// The camera's position in world space.
     pub fn origin(&self) -> DVec3 {
         self.origin

@@ -25,6 +25,9 @@ pub enum RenderError {
     /// Solving, or saving or loading a solution, failed.
     #[error(transparent)]
     Solver(#[from] trilux_solver::SolverError),
+    /// The solution could not be baked.
+    #[error(transparent)]
+    Bake(#[from] trilux_bake::BakeError),
     /// An output could not be written; the file is as it was.
     #[error(transparent)]
     Output(#[from] trilux_files::WriteError),

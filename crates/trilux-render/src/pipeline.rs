@@ -58,6 +58,8 @@ pub struct Plan<'p> {
     pub solution_file: bool,
     /// Render a view.
     pub render: Option<RenderPlan>,
+    /// Bake the solution's light into a glTF binary (`trilux_bake`).
+    pub bake: Option<trilux_bake::BakeOptions>,
 }
 
 /// What a plan did.
@@ -71,6 +73,8 @@ pub struct Outcome {
     pub solution_file: Option<Vec<u8>>,
     /// The render's statistics, when the plan renders.
     pub render: Option<RenderStats>,
+    /// The baked file, when the plan bakes.
+    pub baked: Option<trilux_bake::Baked>,
     /// Wall-clock seconds spent preparing the scene (geometry, BVH,
     /// materials).
     pub prepare_seconds: f64,
@@ -235,6 +239,10 @@ impl WithBands for Run<'_, '_> {
             true => Some(solution.to_bytes()?),
             false => None,
         };
+        let baked = match &self.plan.bake {
+            Some(options) => Some(bake(self.scene, &solution, options)?),
+            None => None,
+        };
         let start = Instant::now();
         let rendered = match &self.view {
             Some((camera, settings)) => {
@@ -249,9 +257,35 @@ impl WithBands for Run<'_, '_> {
             solve: std::mem::take(solution.stats_mut()),
             solution_file,
             render,
+            baked,
             prepare_seconds,
             solve_seconds,
             render_seconds,
         })
     }
+}
+
+/// The solution's light as a glTF binary, with the scene's materials,
+/// shape names and camera (when it has one).
+fn bake<const N: usize>(
+    scene: &Scene,
+    solution: &Solution<N>,
+    options: &trilux_bake::BakeOptions,
+) -> Result<trilux_bake::Baked, RenderError> {
+    let camera = scene_camera(scene, &ViewOverrides::default())
+        .ok()
+        .map(|c| trilux_bake::BakeCamera {
+            world_from_camera: c.world_from_camera(),
+            yfov: c.yfov(),
+            aspect: f64::from(c.width()) / f64::from(c.height()),
+        });
+    let materials = scene.bsdf_params();
+    let names: Vec<Option<String>> = scene.shapes.iter().map(|s| s.id.clone()).collect();
+    let input = trilux_bake::BakeInput {
+        solution,
+        materials: &materials,
+        names: &names,
+        camera,
+    };
+    Ok(trilux_bake::bake(&input, options)?)
 }

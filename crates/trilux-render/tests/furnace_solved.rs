@@ -87,6 +87,7 @@ fn furnace(estimator: Estimator, spp: u32, target_error: Option<f64>) -> ([f64; 
         source: SolutionSource::Solve,
         save: None,
         solution_file: false,
+        bake: None,
         render: Some(RenderPlan { view, settings }),
     };
     let outcome = Observer::quiet(|o| trilux_render::pipeline::run(&scene, &plan, o)).unwrap();

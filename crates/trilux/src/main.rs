@@ -11,6 +11,7 @@
 //! true)]` on the argument (`allow_negative_numbers` only covers plain
 //! numbers, not comma lists).
 
+mod bake;
 mod info;
 mod options;
 mod output;
@@ -46,6 +47,9 @@ enum Command {
     /// Render a view of a scene by final gathering (solving first, or from
     /// a saved solution).
     Render(Box<render::RenderArgs>),
+    /// Bake the solution's view-independent light into a glTF binary
+    /// (.glb) for walkthroughs in any glTF viewer.
+    Bake(bake::BakeArgs),
 }
 
 /// The bundled default scene (the Cornell box): `scenes/cornell-box.xml`
@@ -110,6 +114,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         Some(Command::Info(args)) => info::run(&args),
         Some(Command::Solve(args)) => solve::run(&args),
         Some(Command::Render(args)) => render::run(&args),
+        Some(Command::Bake(args)) => bake::run(&args),
         None => render_default(),
     }
 }

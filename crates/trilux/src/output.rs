@@ -130,3 +130,25 @@ pub fn stats_json(
     }
     Ok(serde_json::to_vec_pretty(&value)?)
 }
+
+/// The statistics JSON of a bake: the solver's figures plus the file's
+/// (`bake`: bytes, vertices, triangles, seconds, max_flux_error).
+pub fn bake_stats_json(
+    stats: &trilux_solver::SolveStats,
+    bake: &trilux_bake::BakeStats,
+) -> Result<Vec<u8>> {
+    let mut value = serde_json::to_value(stats)?;
+    if let Some(map) = value.as_object_mut() {
+        map.insert(
+            "bake".into(),
+            serde_json::json!({
+                "bytes": bake.bytes,
+                "vertices": bake.vertices,
+                "triangles": bake.triangles,
+                "seconds": bake.seconds,
+                "max_flux_error": bake.max_flux_error,
+            }),
+        );
+    }
+    Ok(serde_json::to_vec_pretty(&value)?)
+}

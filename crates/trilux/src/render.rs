@@ -187,6 +187,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         },
         save: None,
         solution_file: false,
+        bake: None,
         render: Some(args.render_plan(camera)),
     };
     trilux_render::pipeline::check(pending.scene(), &plan)?;

@@ -42,6 +42,7 @@ pub fn run(args: &SolveArgs) -> Result<()> {
         source: SolutionSource::Solve,
         save: None,
         solution_file: true,
+        bake: None,
         render: None,
     };
     trilux_render::pipeline::check(pending.scene(), &plan)?;

@@ -1,10 +1,11 @@
 #!/usr/bin/env node
 // Renders a .glb (or .gltf) with the viewer in headless Chromium and writes
-// a W × H PNG of the page (ui=0: no overlays).
+// a W × H PNG of the page (ui=0: no overlays; --ui keeps them, for pictures
+// of the page itself).
 //
 //   node test/screenshot.mjs --glb FILE --width W --height H --out OUT.png
 //                            [--exposure STOPS] [--chromium PATH] [--timeout S]
-//                            [--info INFO.json]
+//                            [--info INFO.json] [--ui]
 //
 // A static HTTP server on 127.0.0.1 (a free port) serves docs/viewer at / and
 // the model's directory at /model/; Debian's Chromium (/usr/bin/chromium, or
@@ -68,6 +69,7 @@ function parseArgs(argv) {
 		else if (a === '--chromium') o.chromium = val();
 		else if (a === '--timeout') o.timeout = val();
 		else if (a === '--info') o.info = val();
+		else if (a === '--ui') o.ui = true;
 		else usage(`unknown argument ${a}`);
 	}
 	if (!o.glb) usage('--glb is required');
@@ -165,7 +167,7 @@ async function main() {
 
 	const server = await startServer(viewerRoot, dirname(model));
 	const port = server.address().port;
-	const q = new URLSearchParams({ file: `/model/${basename(model)}`, ui: '0' });
+	const q = new URLSearchParams({ file: `/model/${basename(model)}`, ui: o.ui ? '1' : '0' });
 	if (o.exposure !== null) q.set('exposure', String(Number(o.exposure)));
 	const url = `http://127.0.0.1:${port}/index.html?${q}`;
 

@@ -277,6 +277,12 @@ impl<const N: usize> Solution<N> {
         self.radiance[face.side()][e.index()] + le
     }
 
+    /// The part of element `e`'s area that is exposed on `face`'s side
+    /// (buried parts, under another shape, send and receive nothing).
+    pub fn exposed_area(&self, face: FaceId, e: trilux_geometry::ElementId) -> f64 {
+        self.exposed_area[face.side()][e.index()]
+    }
+
     /// The Lambertian (two-point) reflected radiance alone at a point.
     pub fn lambertian_radiance(&self, from: &SurfaceSite) -> Spectrum<N> {
         let leaf = self.forest.locate(from.face.surface(), from.coord);

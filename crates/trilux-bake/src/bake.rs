@@ -1,0 +1,324 @@
+//! A whole bake: tessellate, reconstruct both sides of every shape, write
+//! the file.
+//!
+//! The file holds one node and mesh per scene shape (world-space
+//! positions, identity transform) with one primitive per input surface and
+//! side (`extras.trilux.surface`, `side`): all share the shape's positions,
+//! the back's triangles are wound the other way and its normals flipped,
+//! and each side has its own colours (a side the material does not reflect
+//! on is black, as in the renderer).
+//!
+//! Colours are linear Rec. 709 (sRGB primaries) radiance in the scene's
+//! units. glTF requires `COLOR_0` to lie in [0, 1] (the Khronos validator
+//! refuses anything above), so `COLOR_0` holds radiance × 2^exposure
+//! clamped to [0, 1], and the application attribute `_RADIANCE` the
+//! radiance itself; `asset.extras.trilux.exposure` says the exposure.
+//! Materials are `KHR_materials_unlit` with a white base colour, so any
+//! viewer shows `COLOR_0`; trilux's viewer (docs/viewer) shows `_RADIANCE`
+//! × 2^exposure. The scene's camera, when it has one, is the file's first
+//! camera.
+
+use std::time::Instant;
+
+use glam::DVec3;
+use serde_json::{Value, json};
+use trilux_brdf::BsdfParams;
+use trilux_geometry::{ElementForest, ElementId, FaceId, Side, SurfaceId};
+use trilux_solver::Solution;
+
+use crate::camera::BakeCamera;
+use crate::error::BakeError;
+use crate::glb::Document;
+use crate::reconstruct::{baked_flux, vertex_values};
+use crate::tessellate::{ShapeMesh, tessellate};
+
+/// What a bake reads.
+#[derive(Clone, Copy)]
+pub struct BakeInput<'a, const N: usize> {
+    /// The solved scene.
+    pub solution: &'a Solution<N>,
+    /// Every shape's material as the scene gives it (kept in the
+    /// materials' `extras`).
+    pub materials: &'a [BsdfParams],
+    /// Every shape's name (its `id`), if any.
+    pub names: &'a [Option<String>],
+    /// The scene's camera.
+    pub camera: Option<BakeCamera>,
+}
+
+/// How to bake.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BakeOptions {
+    /// `COLOR_0` is radiance × 2^exposure, clamped to [0, 1] (for viewers
+    /// that show vertex colours as display values).
+    pub exposure: f64,
+}
+
+impl Default for BakeOptions {
+    fn default() -> Self {
+        BakeOptions { exposure: 0.0 }
+    }
+}
+
+/// What a bake made.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BakeStats {
+    /// Vertex positions written (each shared by both sides).
+    pub vertices: usize,
+    /// Triangles written, both sides.
+    pub triangles: usize,
+    /// Size of the file.
+    pub bytes: usize,
+    /// Wall-clock seconds of the bake.
+    pub seconds: f64,
+    /// Largest relative gap, over input surfaces and sides carrying more
+    /// than 10⁻⁶ of the scene's largest flux, between the flux the file
+    /// shows and the solution's (module `reconstruct`).
+    pub max_flux_error: f64,
+}
+
+/// A baked file and its statistics.
+#[derive(Clone, Debug)]
+pub struct Baked {
+    /// The `.glb` file's bytes.
+    pub glb: Vec<u8>,
+    /// What it holds.
+    pub stats: BakeStats,
+}
+
+/// Bakes `input`'s solution (module docs).
+pub fn bake<const N: usize>(
+    input: &BakeInput<'_, N>,
+    options: &BakeOptions,
+) -> Result<Baked, BakeError> {
+    let start = Instant::now();
+    let meshes = tessellate(input.solution.forest());
+    let mut doc = Document::default();
+    let mut flux = FluxCheck::default();
+    let (mut vertices, mut triangles) = (0, 0);
+    for mesh in meshes.iter().filter(|m| !m.triangles.is_empty()) {
+        let sides = Side::BOTH.map(|side| {
+            let values = vertex_values(mesh, |leaf| leaf_value(input.solution, side, leaf));
+            flux.add(input.solution, mesh, side, &values);
+            values
+        });
+        write_shape(&mut doc, input, mesh, &sides, options.exposure.exp2())?;
+        vertices += mesh.positions.len();
+        triangles += 2 * mesh.triangles.len();
+    }
+    if let Some(camera) = input.camera {
+        write_camera(&mut doc, input.solution, &camera);
+    }
+    let glb = doc.to_glb(asset(options), &["KHR_materials_unlit"])?;
+    let stats = BakeStats {
+        vertices,
+        triangles,
+        bytes: glb.len(),
+        seconds: start.elapsed().as_secs_f64(),
+        max_flux_error: flux.max_error(),
+    };
+    Ok(Baked { glb, stats })
+}
+
+/// A leaf's exitant radiance (reflected and emitted) on `side`, averaged
+/// over its area with buried parts black, in linear sRGB.
+pub fn leaf_value<const N: usize>(solution: &Solution<N>, side: Side, leaf: ElementId) -> [f64; 3] {
+    let element = solution.forest().element(leaf);
+    let face = FaceId::new(element.surface, side);
+    let exposed = if element.area > 0.0 {
+        (solution.exposed_area(face, leaf) / element.area).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let rgb = solution.face_radiance(face, leaf).to_linear_srgb();
+    rgb.map(|x| (x * exposed).max(0.0))
+}
+
+/// One shape's node, mesh, materials and accessors.
+fn write_shape<const N: usize>(
+    doc: &mut Document,
+    input: &BakeInput<'_, N>,
+    mesh: &ShapeMesh,
+    sides: &[Vec<[f64; 3]>; 2],
+    scale: f64,
+) -> Result<(), BakeError> {
+    let f32s =
+        |v: &[DVec3]| -> Vec<[f32; 3]> { v.iter().map(|p| p.as_vec3().to_array()).collect() };
+    for values in sides {
+        if values.iter().flatten().any(|x| !x.is_finite()) {
+            return Err(BakeError::NotFinite { shape: mesh.shape });
+        }
+    }
+    let position = doc.vec3(&f32s(&mesh.positions), true);
+    let flipped: Vec<DVec3> = mesh.normals.iter().map(|n| -*n).collect();
+    let normals = [
+        doc.vec3(&f32s(&mesh.normals), false),
+        doc.vec3(&f32s(&flipped), false),
+    ];
+    let mut primitives = Vec::new();
+    for (k, side) in Side::BOTH.into_iter().enumerate() {
+        let radiance: Vec<[f32; 3]> = sides[k].iter().map(|c| c.map(|x| x as f32)).collect();
+        let display: Vec<[f32; 3]> = sides[k]
+            .iter()
+            .map(|c| c.map(|x| (x * scale).clamp(0.0, 1.0) as f32))
+            .collect();
+        let (radiance, display) = (doc.vec3(&radiance, false), doc.vec3(&display, false));
+        let material = doc.materials.len();
+        doc.materials.push(material_of(input, mesh.shape, side));
+        for (surface, triangles) in by_surface(input.solution.forest(), mesh) {
+            let triangles: Vec<[u32; 3]> = match side {
+                Side::Front => triangles,
+                Side::Back => triangles.into_iter().map(|[a, b, c]| [a, c, b]).collect(),
+            };
+            primitives.push(json!({
+                "attributes": {
+                    "POSITION": position,
+                    "NORMAL": normals[k],
+                    "COLOR_0": display,
+                    "_RADIANCE": radiance,
+                },
+                "indices": doc.indices(&triangles),
+                "material": material,
+                "mode": 4,
+                "extras": { "trilux": { "surface": surface.0, "side": side_name(side) } },
+            }));
+        }
+    }
+    let name = shape_name(input.names, mesh.shape);
+    doc.nodes
+        .push(json!({ "name": name, "mesh": doc.meshes.len() }));
+    doc.meshes.push(json!({
+        "name": name,
+        "primitives": primitives,
+        "extras": { "trilux": { "shape": mesh.shape } },
+    }));
+    Ok(())
+}
+
+/// The mesh's triangles by input surface, in surface order.
+fn by_surface(forest: &ElementForest, mesh: &ShapeMesh) -> Vec<(SurfaceId, Vec<[u32; 3]>)> {
+    let mut groups: Vec<(SurfaceId, Vec<[u32; 3]>)> = Vec::new();
+    for (tri, &owner) in mesh.triangles.iter().zip(&mesh.owners) {
+        let surface = forest.element(owner).surface;
+        match groups.iter_mut().find(|(s, _)| *s == surface) {
+            Some((_, list)) => list.push(*tri),
+            None => groups.push((surface, vec![*tri])),
+        }
+    }
+    groups.sort_by_key(|(s, _)| s.0);
+    groups
+}
+
+fn shape_name(names: &[Option<String>], shape: u32) -> String {
+    match names.get(shape as usize) {
+        Some(Some(id)) => id.clone(),
+        _ => format!("shape {shape}"),
+    }
+}
+
+fn side_name(side: Side) -> &'static str {
+    match side {
+        Side::Front => "front",
+        Side::Back => "back",
+    }
+}
+
+/// An unlit material showing `COLOR_0`, the scene's own in `extras`.
+fn material_of<const N: usize>(input: &BakeInput<'_, N>, shape: u32, side: Side) -> Value {
+    let bsdf = input
+        .materials
+        .get(shape as usize)
+        .and_then(|b| serde_json::to_value(b).ok())
+        .unwrap_or(Value::Null);
+    let glossy = input
+        .solution
+        .scene()
+        .material(shape as usize)
+        .has_glossy(side);
+    json!({
+        "name": format!("{} ({})", shape_name(input.names, shape), side_name(side)),
+        "pbrMetallicRoughness": {
+            "baseColorFactor": [1.0, 1.0, 1.0, 1.0],
+            "metallicFactor": 0.0,
+            "roughnessFactor": 1.0,
+        },
+        "extensions": { "KHR_materials_unlit": {} },
+        "extras": { "trilux": {
+            "shape": shape,
+            "side": side_name(side),
+            "bsdf": bsdf,
+            "glossy_left_out": glossy,
+        } },
+    })
+}
+
+/// The scene camera's node and camera.
+fn write_camera<const N: usize>(doc: &mut Document, solution: &Solution<N>, camera: &BakeCamera) {
+    let Some((origin, rotation)) = camera.pose() else {
+        return;
+    };
+    let bounds = solution.forest().geometry().bounds();
+    let extent = (bounds.max - bounds.min).length();
+    let distance = (0.5 * (bounds.min + bounds.max) - origin).length();
+    doc.cameras.push(camera.gltf_camera(extent, distance));
+    doc.nodes.push(json!({
+        "name": "camera",
+        "camera": 0,
+        "translation": origin.to_array(),
+        "rotation": rotation.to_array(),
+    }));
+}
+
+fn asset(options: &BakeOptions) -> Value {
+    json!({
+        "version": "2.0",
+        "generator": concat!("trilux ", env!("CARGO_PKG_VERSION")),
+        "extras": { "trilux": {
+            "exposure": options.exposure,
+            "colour": "_RADIANCE is linear Rec. 709 radiance (W sr^-1 m^-2 per channel); COLOR_0 is it times 2^exposure, clamped to [0, 1]",
+            "baked": "the view-independent (Lambertian) light of the solution, emission included",
+            "left_out": "the glossy (view-dependent) reflection of materials marked glossy_left_out",
+        } },
+    })
+}
+
+/// The baked flux of every input surface and side against the solution's.
+#[derive(Default)]
+struct FluxCheck {
+    /// (baked, solution) flux sums over bands, without the factor π.
+    pairs: Vec<(f64, f64)>,
+}
+
+impl FluxCheck {
+    fn add<const N: usize>(
+        &mut self,
+        solution: &Solution<N>,
+        mesh: &ShapeMesh,
+        side: Side,
+        values: &[[f64; 3]],
+    ) {
+        let forest = solution.forest();
+        for surface in forest.geometry().surfaces_of_shape(mesh.shape) {
+            let baked = baked_flux(mesh, values, |leaf| forest.element(leaf).surface == surface);
+            let face = FaceId::new(surface, side);
+            let exact: f64 = forest
+                .leaves(forest.root(surface))
+                .into_iter()
+                .map(|leaf| {
+                    let l = solution.face_radiance(face, leaf).to_linear_srgb();
+                    l.iter().map(|x| x.max(0.0)).sum::<f64>() * solution.exposed_area(face, leaf)
+                })
+                .sum();
+            self.pairs.push((baked.iter().sum(), exact));
+        }
+    }
+
+    fn max_error(&self) -> f64 {
+        let largest = self.pairs.iter().map(|p| p.1).fold(0.0, f64::max);
+        self.pairs
+            .iter()
+            .filter(|(_, exact)| *exact > 1e-6 * largest)
+            .map(|(baked, exact)| (baked - exact).abs() / exact)
+            .fold(0.0, f64::max)
+    }
+}

@@ -1,0 +1,23 @@
+//! What can go wrong in a bake.
+
+use thiserror::Error;
+
+/// A bake that cannot be written.
+#[derive(Debug, Error)]
+pub enum BakeError {
+    /// The scene's light has no finite value somewhere.
+    #[error("shape {shape}: its baked radiance is not finite")]
+    NotFinite {
+        /// The shape's index in the scene.
+        shape: u32,
+    },
+    /// The file would pass glTF's 32-bit length fields.
+    #[error("the baked file would hold {bytes} bytes, more than glTF's 4 GiB limit")]
+    TooLarge {
+        /// The size it would have.
+        bytes: u64,
+    },
+    /// The JSON part could not be written.
+    #[error("the glTF JSON could not be written: {0}")]
+    Json(#[from] serde_json::Error),
+}

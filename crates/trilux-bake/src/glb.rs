@@ -1,0 +1,136 @@
+//! The glTF 2.0 binary container (glTF 2.0 specification, §4.4 "GLB File
+//! Format"): a 12-byte header, a JSON chunk padded with spaces and a BIN
+//! chunk padded with zeros, each to 4 bytes. One buffer holds every
+//! accessor's data; every accessor has its own buffer view (tightly packed,
+//! 4-byte aligned: every component here is 4 bytes).
+
+use serde_json::{Value, json};
+
+use crate::error::BakeError;
+
+/// `ARRAY_BUFFER`, the target of vertex attributes.
+const ARRAY_BUFFER: u32 = 34962;
+/// `ELEMENT_ARRAY_BUFFER`, the target of indices.
+const ELEMENT_ARRAY_BUFFER: u32 = 34963;
+/// `FLOAT`.
+const FLOAT: u32 = 5126;
+/// `UNSIGNED_INT`.
+const UNSIGNED_INT: u32 = 5125;
+
+/// The parts of a glTF document being written.
+#[derive(Debug, Default)]
+pub struct Document {
+    /// The BIN chunk's contents.
+    pub bin: Vec<u8>,
+    /// `bufferViews`.
+    pub views: Vec<Value>,
+    /// `accessors`.
+    pub accessors: Vec<Value>,
+    /// `meshes`.
+    pub meshes: Vec<Value>,
+    /// `materials`.
+    pub materials: Vec<Value>,
+    /// `nodes`.
+    pub nodes: Vec<Value>,
+    /// `cameras`.
+    pub cameras: Vec<Value>,
+}
+
+impl Document {
+    fn view(&mut self, bytes: &[u8], target: u32) -> usize {
+        let offset = self.bin.len();
+        self.bin.extend_from_slice(bytes);
+        self.views.push(json!({
+            "buffer": 0,
+            "byteOffset": offset,
+            "byteLength": bytes.len(),
+            "target": target,
+        }));
+        self.views.len() - 1
+    }
+
+    /// A `VEC3` float vertex attribute; with `bounds`, its `min` and `max`
+    /// (required for `POSITION`). Returns the accessor's index.
+    pub fn vec3(&mut self, data: &[[f32; 3]], bounds: bool) -> usize {
+        let bytes: Vec<u8> = data
+            .iter()
+            .flatten()
+            .flat_map(|x| x.to_le_bytes())
+            .collect();
+        let view = self.view(&bytes, ARRAY_BUFFER);
+        let mut accessor = json!({
+            "bufferView": view,
+            "componentType": FLOAT,
+            "count": data.len(),
+            "type": "VEC3",
+        });
+        if bounds {
+            let mut lo = [f32::INFINITY; 3];
+            let mut hi = [f32::NEG_INFINITY; 3];
+            for p in data {
+                for k in 0..3 {
+                    lo[k] = lo[k].min(p[k]);
+                    hi[k] = hi[k].max(p[k]);
+                }
+            }
+            accessor["min"] = json!(lo);
+            accessor["max"] = json!(hi);
+        }
+        self.accessors.push(accessor);
+        self.accessors.len() - 1
+    }
+
+    /// Triangle indices. Returns the accessor's index.
+    pub fn indices(&mut self, data: &[[u32; 3]]) -> usize {
+        let bytes: Vec<u8> = data
+            .iter()
+            .flatten()
+            .flat_map(|x| x.to_le_bytes())
+            .collect();
+        let view = self.view(&bytes, ELEMENT_ARRAY_BUFFER);
+        self.accessors.push(json!({
+            "bufferView": view,
+            "componentType": UNSIGNED_INT,
+            "count": 3 * data.len(),
+            "type": "SCALAR",
+        }));
+        self.accessors.len() - 1
+    }
+
+    /// The whole file: `asset` and `extensionsUsed` as given, one scene of
+    /// every node.
+    pub fn to_glb(self, asset: Value, extensions: &[&str]) -> Result<Vec<u8>, BakeError> {
+        let nodes: Vec<usize> = (0..self.nodes.len()).collect();
+        let mut root = json!({
+            "asset": asset,
+            "extensionsUsed": extensions,
+            "scene": 0,
+            "scenes": [{ "nodes": nodes }],
+            "nodes": self.nodes,
+            "meshes": self.meshes,
+            "materials": self.materials,
+            "accessors": self.accessors,
+            "bufferViews": self.views,
+            "buffers": [{ "byteLength": self.bin.len() }],
+        });
+        if !self.cameras.is_empty() {
+            root["cameras"] = json!(self.cameras);
+        }
+        let mut text = serde_json::to_vec(&root)?;
+        text.resize(text.len().next_multiple_of(4), b' ');
+        let mut bin = self.bin;
+        bin.resize(bin.len().next_multiple_of(4), 0);
+        let total = 12 + 8 + text.len() as u64 + 8 + bin.len() as u64;
+        let length = u32::try_from(total).map_err(|_| BakeError::TooLarge { bytes: total })?;
+        let mut out = Vec::with_capacity(total as usize);
+        out.extend_from_slice(b"glTF");
+        out.extend_from_slice(&2u32.to_le_bytes());
+        out.extend_from_slice(&length.to_le_bytes());
+        for (kind, chunk) in [(b"JSON", &text), (b"BIN\0", &bin)] {
+            out.extend_from_slice(&(chunk.len() as u32).to_le_bytes());
+            out.extend_from_slice(kind);
+            out.extend_from_slice(chunk);
+        }
+        Ok(out)
+    }
+}

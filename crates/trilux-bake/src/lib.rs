@@ -1,0 +1,35 @@
+//! # trilux-bake — the solution's light as a glTF 2.0 binary
+//!
+//! Layer: above `trilux-solver` (it reads a [`trilux_solver::Solution`])
+//! and below `trilux-render`, whose pipeline calls it. Depends on
+//! `trilux-color`, `trilux-geometry`, `trilux-brdf` and `trilux-solver`.
+//!
+//! A view-independent solution is what a walkthrough needs: solve once,
+//! look around freely. [`bake`] writes the solution's view-independent
+//! (Lambertian) light as a `.glb` that any glTF viewer shows: every input
+//! surface tessellated at its leaf elements, the outgoing radiance as
+//! linear vertex colours (`COLOR_0`), materials unlit
+//! (`KHR_materials_unlit`). docs/bake.md is the user's account.
+//!
+//! Contents, in the order a bake runs:
+//! - [`tessellate`]: every shape's leaves as welded triangles, each owned
+//!   by one leaf; T-junctions split so that neighbours share vertices.
+//! - [`reconstruct`]: vertex colours from the leaves' radiance by
+//!   flux-conserving averaging (the rule and its error bound are there).
+//! - [`camera`]: the scene's camera as a glTF camera node.
+//! - [`glb`]: the glTF JSON and the binary container.
+//! - [`bake()`](bake()): the whole, with its [`BakeStats`].
+//! - [`error`]: [`BakeError`].
+#![forbid(unsafe_code)]
+
+pub mod bake;
+pub mod camera;
+pub mod error;
+pub mod glb;
+pub mod reconstruct;
+pub mod tessellate;
+
+pub use bake::{BakeInput, BakeOptions, BakeStats, Baked, bake};
+pub use camera::BakeCamera;
+pub use error::BakeError;
+pub use tessellate::ShapeMesh;

@@ -1,0 +1,107 @@
+//! `trilux bake SCENE -o OUT.glb`: the solution's view-independent light as
+//! a glTF 2.0 binary, for walkthroughs in any glTF viewer
+//! (docs/bake.md; the file's layout is `trilux_bake`'s).
+
+use std::path::PathBuf;
+
+use anyhow::{Context, Result, bail};
+use clap::Args;
+use trilux_bake::BakeOptions;
+use trilux_render::{Observer, Plan, SolutionSource};
+
+use crate::options::{SolveOptions, parse_exposure, parse_threads};
+use crate::output::{Outputs, bake_stats_json};
+use crate::progress::Bars;
+
+/// Arguments of `trilux bake`.
+#[derive(Debug, Args)]
+pub struct BakeArgs {
+    /// The scene file (Mitsuba 3 XML subset, or glTF 2.0: .gltf, .glb).
+    pub scene: PathBuf,
+    /// Where to write the baked scene (a .glb file).
+    #[arg(short = 'o', long = "output")]
+    pub output: PathBuf,
+    /// Bake a saved solution instead of solving (`trilux solve`; it must
+    /// have been made with the same --quality, --convergence and --mode).
+    #[arg(long)]
+    pub solution: Option<PathBuf>,
+    /// COLOR_0's exposure in stops: radiance × 2^stops, clamped to [0, 1]
+    /// (the _RADIANCE attribute keeps the radiance).
+    #[arg(long, default_value_t = 0.0, value_parser = parse_exposure, allow_hyphen_values = true)]
+    pub exposure: f64,
+    /// Write solve and bake statistics (file size, vertices, triangles) as
+    /// JSON.
+    #[arg(long)]
+    pub stats: Option<PathBuf>,
+    /// Worker threads (default: all cores).
+    #[arg(long, value_parser = parse_threads)]
+    pub threads: Option<u32>,
+    #[command(flatten)]
+    pub options: SolveOptions,
+}
+
+/// Runs `trilux bake`.
+pub fn run(args: &BakeArgs) -> Result<()> {
+    crate::set_threads(args.threads);
+    let glb = args
+        .output
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("glb"));
+    if !glb {
+        bail!(
+            "{}: a bake is a glTF binary; name the output .glb",
+            args.output.display()
+        );
+    }
+    let mut outputs = vec![(args.output.as_path(), "baked scene")];
+    outputs.extend(args.stats.as_deref().map(|p| (p, "statistics")));
+    let mut inputs = vec![args.scene.as_path()];
+    inputs.extend(args.solution.as_deref());
+    let outputs = Outputs::plan(&outputs, &inputs, None)?;
+    let pending = trilux_scene::open(&args.scene)?;
+    let plan = Plan {
+        mode: args.options.mode(pending.scene()),
+        solver: args.options.settings(),
+        source: match &args.solution {
+            Some(path) => SolutionSource::Load(path),
+            None => SolutionSource::Solve,
+        },
+        save: None,
+        solution_file: false,
+        bake: Some(BakeOptions {
+            exposure: args.exposure,
+        }),
+        render: None,
+    };
+    trilux_render::pipeline::check(pending.scene(), &plan)?;
+    let scene = pending.finish()?;
+    let bars = Bars::new(false);
+    let mut on_shot = |p: &trilux_solver::Progress| bars.solve(p);
+    let outcome = trilux_render::pipeline::run(
+        &scene,
+        &plan,
+        Observer {
+            solve: &mut on_shot,
+            render: &|_, _| {},
+        },
+    );
+    bars.finish();
+    let mut outcome = outcome?;
+    let baked = outcome.baked.take().context("the bake produced no file")?;
+    let mut files = vec![baked.glb];
+    if args.stats.is_some() {
+        files.push(bake_stats_json(&outcome.solve, &baked.stats)?);
+    }
+    outputs.write(&files)?;
+    crate::warn(&outcome);
+    let s = &baked.stats;
+    println!(
+        "wrote {} ({} bytes: {} vertices, {} triangles; baked in {:.2} s)",
+        args.output.display(),
+        s.bytes,
+        s.vertices,
+        s.triangles,
+        s.seconds
+    );
+    Ok(())
+}

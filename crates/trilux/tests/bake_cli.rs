@@ -1,0 +1,382 @@
+//! `trilux bake`: the baked file read back with the `gltf` crate and held
+//! against the solution it was baked from (saved by `trilux solve` and
+//! loaded here).
+//!
+//! - At the centre of every leaf element the radiance interpolated from
+//!   the file's vertices is the leaf's (to f32 rounding) where the
+//!   reconstruction puts a vertex there (parametric leaves, one-piece
+//!   chart leaves); elsewhere it lies between the least and the greatest
+//!   leaf value around the triangle that holds the centre (the bound
+//!   `trilux_bake::reconstruct` states).
+//! - The flux each input surface and side shows equals the solution's
+//!   within 1 %.
+//! - `COLOR_0` is `_RADIANCE` × 2^exposure clamped to [0, 1].
+
+mod common;
+
+use std::path::{Path, PathBuf};
+
+use common::{folder, trilux};
+use glam::{DVec3, Vec3};
+use serde_json::Value;
+use trilux_color::WithBands;
+use trilux_geometry::{ElementDomain, ElementId, FaceId, Side, SurfaceId};
+use trilux_solver::{Quality, Solution, SolverSettings};
+
+fn repo(path: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../..")
+        .join(path)
+}
+
+/// Solves `scene` at draft quality and bakes the saved solution.
+fn solve_and_bake(scene: &Path, dir: &Path, extra: &[&str]) -> (PathBuf, PathBuf) {
+    let sol = dir.join("scene.sol");
+    let glb = dir.join("scene.glb");
+    let s = scene.to_str().unwrap();
+    let out = trilux(&[
+        "solve",
+        s,
+        "--quality",
+        "draft",
+        "-o",
+        sol.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let mut args = vec!["bake", s, "--quality", "draft", "--solution"];
+    args.extend([sol.to_str().unwrap(), "-o", glb.to_str().unwrap()]);
+    args.extend(extra);
+    let out = trilux(&args);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    (sol, glb)
+}
+
+/// One primitive of the file: an input surface's side.
+struct Primitive {
+    surface: SurfaceId,
+    side: Side,
+    positions: Vec<Vec3>,
+    radiance: Vec<[f32; 3]>,
+    colour: Vec<[f32; 3]>,
+    triangles: Vec<[u32; 3]>,
+}
+
+/// The little-endian 4-byte components of accessor `index` (tightly
+/// packed, as the glTF specification lays out an accessor without a
+/// byteStride).
+fn components(json: &Value, bin: &[u8], index: &Value) -> Vec<[u8; 4]> {
+    let accessor = &json["accessors"][index.as_u64().unwrap() as usize];
+    let view = &json["bufferViews"][accessor["bufferView"].as_u64().unwrap() as usize];
+    let start =
+        view["byteOffset"].as_u64().unwrap_or(0) + accessor["byteOffset"].as_u64().unwrap_or(0);
+    let width = match accessor["type"].as_str().unwrap() {
+        "SCALAR" => 1,
+        "VEC3" => 3,
+        t => panic!("accessor type {t}"),
+    };
+    let count = accessor["count"].as_u64().unwrap() * width;
+    let bytes = &bin[start as usize..(start + 4 * count) as usize];
+    bytes.chunks(4).map(|c| [c[0], c[1], c[2], c[3]]).collect()
+}
+
+fn vec3s(json: &Value, bin: &[u8], index: &Value) -> Vec<[f32; 3]> {
+    let f: Vec<f32> = components(json, bin, index)
+        .into_iter()
+        .map(f32::from_le_bytes)
+        .collect();
+    f.chunks(3).map(|c| [c[0], c[1], c[2]]).collect()
+}
+
+fn read_primitives(glb: &Path) -> (Vec<Primitive>, Value) {
+    let bytes = std::fs::read(glb).unwrap();
+    // The gltf crate's own validation must accept the file.
+    let gltf = gltf::Gltf::from_slice(&bytes).expect("the gltf crate reads the bake");
+    let bin = gltf.blob.clone().expect("a BIN chunk");
+    let json: Value = serde_json::from_slice(&gltf::Glb::from_slice(&bytes).unwrap().json).unwrap();
+    let mut out = Vec::new();
+    for mesh in json["meshes"].as_array().unwrap() {
+        for prim in mesh["primitives"].as_array().unwrap() {
+            let extras = &prim["extras"]["trilux"];
+            let attr = &prim["attributes"];
+            let indices: Vec<u32> = components(&json, &bin, &prim["indices"])
+                .into_iter()
+                .map(u32::from_le_bytes)
+                .collect();
+            out.push(Primitive {
+                surface: SurfaceId(extras["surface"].as_u64().unwrap() as u32),
+                side: match extras["side"].as_str().unwrap() {
+                    "front" => Side::Front,
+                    _ => Side::Back,
+                },
+                positions: vec3s(&json, &bin, &attr["POSITION"])
+                    .into_iter()
+                    .map(Vec3::from)
+                    .collect(),
+                radiance: vec3s(&json, &bin, &attr["_RADIANCE"]),
+                colour: vec3s(&json, &bin, &attr["COLOR_0"]),
+                triangles: indices.chunks(3).map(|t| [t[0], t[1], t[2]]).collect(),
+            });
+        }
+    }
+    (out, json)
+}
+
+/// The leaf's exitant radiance averaged over its area (buried parts
+/// black), linear sRGB: what the solution says the leaf sends.
+fn leaf_value<const N: usize>(s: &Solution<N>, face: FaceId, leaf: ElementId) -> DVec3 {
+    let e = s.forest().element(leaf);
+    let exposed = (s.exposed_area(face, leaf) / e.area).clamp(0.0, 1.0);
+    DVec3::from(s.face_radiance(face, leaf).to_linear_srgb()).max(DVec3::ZERO) * exposed
+}
+
+/// Barycentrics of `p` in triangle (a, b, c) and its distance to the plane.
+fn barycentric(p: DVec3, [a, b, c]: [DVec3; 3]) -> ([f64; 3], f64) {
+    let (e1, e2) = (b - a, c - a);
+    let n = e1.cross(e2);
+    let d = p - a;
+    let area2 = n.length_squared();
+    let l1 = d.cross(e2).dot(n) / area2;
+    let l2 = e1.cross(d).dot(n) / area2;
+    ([1.0 - l1 - l2, l1, l2], (d.dot(n) / area2.sqrt()).abs())
+}
+
+struct Check<'s, const N: usize> {
+    solution: &'s Solution<N>,
+}
+
+impl<const N: usize> Check<'_, N> {
+    fn corners(&self, prim: &Primitive, t: usize) -> [DVec3; 3] {
+        prim.triangles[t].map(|i| prim.positions[i as usize].as_dvec3())
+    }
+
+    /// The triangle holding `p` and its barycentrics.
+    fn locate(&self, prim: &Primitive, p: DVec3) -> (usize, [f64; 3]) {
+        let mut best = (usize::MAX, [0.0; 3], f64::INFINITY);
+        for t in 0..prim.triangles.len() {
+            let (l, dist) = barycentric(p, self.corners(prim, t));
+            let outside = l.iter().map(|x| (-x).max(0.0)).sum::<f64>();
+            let score = dist + outside * 1e3;
+            if score < best.2 {
+                best = (t, l, score);
+            }
+        }
+        assert!(best.0 != usize::MAX, "no triangle");
+        (best.0, best.1)
+    }
+
+    fn interpolate(&self, prim: &Primitive, t: usize, l: [f64; 3]) -> DVec3 {
+        let v = prim.triangles[t].map(|i| DVec3::from(prim.radiance[i as usize].map(f64::from)));
+        v[0] * l[0] + v[1] * l[1] + v[2] * l[2]
+    }
+
+    /// The leaf values of the leaves of `surface` whose (padded) bounds
+    /// hold a vertex of triangle `t`: a superset of the leaves that touch
+    /// its vertices.
+    fn around(&self, prim: &Primitive, t: usize) -> (DVec3, DVec3) {
+        let forest = self.solution.forest();
+        let face = FaceId::new(prim.surface, prim.side);
+        let pad = 1e-5 * forest.geometry().extent();
+        let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+        for leaf in forest.leaves(forest.root(prim.surface)) {
+            let b = forest.element(leaf).bounds;
+            let near = self
+                .corners(prim, t)
+                .iter()
+                .any(|p| p.cmpge(b.min - pad).all() && p.cmple(b.max + pad).all());
+            if near {
+                let v = leaf_value(self.solution, face, leaf);
+                lo = lo.min(v);
+                hi = hi.max(v);
+            }
+        }
+        (lo, hi)
+    }
+
+    /// The centre and flux checks for one primitive; returns the flux's
+    /// relative error (0 for a surface side that carries nothing).
+    fn primitive(&self, prim: &Primitive, largest: f64) -> f64 {
+        let forest = self.solution.forest();
+        let face = FaceId::new(prim.surface, prim.side);
+        let tol = 2e-6 * largest + 1e-30;
+        let mut exact_flux = 0.0;
+        for leaf in forest.leaves(forest.root(prim.surface)) {
+            let e = forest.element(leaf);
+            let want = leaf_value(self.solution, face, leaf);
+            exact_flux += want.element_sum() * e.area;
+            let (t, l) = self.locate(prim, e.centre);
+            let got = self.interpolate(prim, t, l);
+            let exact = match e.domain {
+                ElementDomain::Rect { .. } => true,
+                ElementDomain::Cluster { count, .. } => count == 1,
+            };
+            if exact {
+                let err = (got - want).abs().max_element();
+                assert!(
+                    err <= 1e-5 * want.max_element() + tol,
+                    "surface {:?} {:?} leaf {leaf:?}: {got} at the centre, the leaf sends {want}",
+                    prim.surface,
+                    prim.side
+                );
+            } else {
+                let (lo, hi) = self.around(prim, t);
+                assert!(
+                    got.cmpge(lo - tol - 1e-5 * lo.abs()).all()
+                        && got.cmple(hi + tol + 1e-5 * hi.abs()).all(),
+                    "surface {:?} leaf {leaf:?}: {got} outside [{lo}, {hi}]",
+                    prim.surface
+                );
+            }
+        }
+        let mut baked = 0.0;
+        for t in 0..prim.triangles.len() {
+            let [a, b, c] = self.corners(prim, t);
+            let area = 0.5 * (b - a).cross(c - a).length();
+            let mean: f64 = prim.triangles[t]
+                .iter()
+                .map(|&i| {
+                    prim.radiance[i as usize]
+                        .iter()
+                        .map(|&x| f64::from(x))
+                        .sum::<f64>()
+                })
+                .sum::<f64>()
+                / 3.0;
+            baked += area * mean;
+        }
+        if exact_flux <= 1e-6 * largest {
+            return 0.0;
+        }
+        (baked - exact_flux).abs() / exact_flux
+    }
+}
+
+/// Every check on one scene, in its own band count.
+struct Verify<'a> {
+    scene: &'a trilux_scene::Scene,
+    sol: &'a Path,
+    prims: &'a [Primitive],
+}
+
+impl WithBands for Verify<'_> {
+    type Output = f64;
+
+    fn run<const N: usize>(self) -> f64 {
+        let prepared = trilux_render::prepare::<N>(self.scene).unwrap();
+        let settings = SolverSettings::preset(Quality::Draft);
+        let solution = Solution::<N>::load(self.sol, prepared, &settings).unwrap();
+        let largest = self
+            .prims
+            .iter()
+            .flat_map(|p| p.radiance.iter().flatten())
+            .fold(0.0f64, |m, &x| m.max(f64::from(x)));
+        let check = Check {
+            solution: &solution,
+        };
+        let mut worst = 0.0f64;
+        for prim in self.prims {
+            worst = worst.max(check.primitive(prim, largest));
+        }
+        let surfaces = solution.forest().geometry().surfaces().len();
+        let with_triangles = self.prims.len();
+        assert!(
+            with_triangles <= 2 * surfaces && with_triangles > 0,
+            "{with_triangles} primitives for {surfaces} surfaces"
+        );
+        worst
+    }
+}
+
+fn check_scene(scene_path: &Path, name: &str) {
+    let dir = folder(&format!("bake-{name}"));
+    let (sol, glb) = solve_and_bake(scene_path, &dir, &["--exposure", "-1"]);
+    let (prims, json) = read_primitives(&glb);
+    assert_eq!(json["extensionsUsed"][0], "KHR_materials_unlit");
+    assert_eq!(json["asset"]["extras"]["trilux"]["exposure"], -1.0);
+    for p in &prims {
+        for (c, r) in p.colour.iter().zip(&p.radiance) {
+            for k in 0..3 {
+                let want = (r[k] * 0.5).clamp(0.0, 1.0);
+                assert!(
+                    (c[k] - want).abs() <= 1e-6,
+                    "COLOR_0 {c:?} for radiance {r:?}"
+                );
+            }
+        }
+    }
+    let scene = trilux_scene::open(scene_path).unwrap().finish().unwrap();
+    let worst = scene.mode().with_bands(Verify {
+        scene: &scene,
+        sol: &sol,
+        prims: &prims,
+    });
+    assert!(
+        worst <= 0.01,
+        "{name}: a surface's baked flux is {worst:.4} off the solution's"
+    );
+}
+
+/// Cubes on a floor (buried faces), spectral bands.
+#[test]
+fn cornell_box_bakes_to_its_solution() {
+    check_scene(&repo("scenes/cornell-box.xml"), "cornell");
+}
+
+/// Curved pieces: a cylinder (the glossy tube; its glossy part is left out
+/// of the bake, its diffuse part is what is checked).
+#[test]
+fn glossy_tube_bakes_to_its_solution() {
+    check_scene(&repo("scenes/glossy-tube.xml"), "tube");
+}
+
+/// Meshes as charts, with a textured floor (glTF).
+#[test]
+fn gltf_meshes_bake_to_their_solution() {
+    check_scene(&repo("scenes/textured-room.gltf"), "textured-room");
+}
+
+/// A sphere, a disk and a rectangle light: the curved and polar pieces
+/// with their poles and centre, tessellated finer than their leaves.
+#[test]
+fn spheres_and_disks_bake_to_their_solution() {
+    let dir = folder("bake-scene-sphere-disk");
+    let scene = dir.join("sphere-disk.xml");
+    std::fs::write(
+        &scene,
+        r#"<scene version="3.0.0">
+  <shape type="sphere"><point name="center" x="0" y="0.5" z="0"/><float name="radius" value="0.5"/>
+    <bsdf type="diffuse"><rgb name="reflectance" value="0.7, 0.6, 0.5"/></bsdf></shape>
+  <shape type="disk"><transform name="to_world"><rotate x="1" angle="-90"/><scale value="2"/></transform>
+    <bsdf type="diffuse"><rgb name="reflectance" value="0.5"/></bsdf></shape>
+  <shape type="rectangle"><transform name="to_world"><scale value="0.5"/><rotate x="1" angle="90"/><translate y="2"/></transform>
+    <emitter type="area"><rgb name="radiance" value="10"/></emitter></shape>
+</scene>"#,
+    )
+    .unwrap();
+    check_scene(&scene, "sphere-disk");
+}
+
+/// The output must be a .glb, said before any work.
+#[test]
+fn a_bake_that_is_not_a_glb_is_refused() {
+    let dir = folder("bake-not-glb");
+    let out = dir.join("scene.gltf");
+    let o = trilux(&[
+        "bake",
+        repo("scenes/cornell-box.xml").to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("scene.gltf") && err.contains(".glb"), "{err}");
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(!out.exists());
+}

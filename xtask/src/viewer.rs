@@ -1,0 +1,253 @@
+//! `cargo xtask viewer`: every bundled scene solved (default quality),
+//! baked (`trilux bake`'s code) and previewed (`trilux render --preview`'s);
+//! every bake checked by the Khronos glTF validator, and photographed in
+//! docs/viewer by headless Chromium from the scene's own camera, beside
+//! the preview of the same view.
+//!
+//! Gates: the validator reports no error and no warning; every bake takes
+//! under [`MAX_BAKE_SECONDS`]; for scenes without glossy materials (whose
+//! view-dependent part a bake leaves out) the screenshot's mean, after
+//! tone mapping (PNG values at exposure [`EXPOSURE`]), is within
+//! [`MAX_MEAN_GAP`] of the preview's. Writes `target/viewer/NAME.glb`,
+//! `NAME-preview.png`, `NAME-viewer.png` and `report.md`.
+//!
+//! Needs `npm ci` in docs/viewer and Debian's Chromium
+//! (`docs/viewer/scripts/ci.sh` installs both).
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use anyhow::{Context, Result, bail};
+use trilux_brdf::BsdfParams;
+use trilux_render::{
+    Estimator, Observer, Plan, RenderPlan, RenderSettings, SolutionSource, ViewOverrides,
+};
+use trilux_solver::{Quality, SolverSettings};
+
+use crate::golden::root;
+
+/// Exposure of both PNGs, in stops (the furnace's radiance of 2.0 shows
+/// as grey, not clipped white).
+const EXPOSURE: f64 = -1.5;
+/// Largest relative gap between the screenshot's mean and the preview's.
+const MAX_MEAN_GAP: f64 = 0.03;
+/// Longest bake after the solve.
+const MAX_BAKE_SECONDS: f64 = 2.0;
+
+/// One scene's figures.
+struct Row {
+    name: String,
+    glossy: bool,
+    solve_seconds: f64,
+    bake_seconds: f64,
+    bytes: usize,
+    triangles: usize,
+    means: Option<(f64, f64)>,
+}
+
+/// The bundled scenes: scenes/*.xml, *.gltf, *.glb, by name.
+fn scenes() -> Result<Vec<PathBuf>> {
+    let mut out: Vec<PathBuf> = std::fs::read_dir(root().join("scenes"))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| {
+            p.extension()
+                .is_some_and(|e| e == "xml" || e == "gltf" || e == "glb")
+        })
+        .collect();
+    out.sort();
+    Ok(out)
+}
+
+fn glossy(b: &BsdfParams) -> bool {
+    match b {
+        BsdfParams::Diffuse { .. } => false,
+        BsdfParams::RoughConductor(_) => true,
+        BsdfParams::Blend { first, second, .. } => glossy(first) || glossy(second),
+        BsdfParams::TwoSided { front, back } => {
+            glossy(front) || back.as_deref().is_some_and(glossy)
+        }
+    }
+}
+
+fn name_of(path: &Path) -> String {
+    path.file_stem()
+        .map_or_else(String::new, |s| s.to_string_lossy().into_owned())
+}
+
+/// Solves, bakes and previews one scene into `dir`.
+fn bake_scene(path: &Path, dir: &Path) -> Result<Row> {
+    let name = name_of(path);
+    let scene = trilux_scene::load(path).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let render = scene.camera.as_ref().map(|camera| {
+        let mut settings = RenderSettings::for_scene(camera);
+        settings.estimator = Estimator::Preview;
+        settings.spp = 1;
+        RenderPlan {
+            view: ViewOverrides::default(),
+            settings,
+        }
+    });
+    let plan = Plan {
+        mode: scene.mode(),
+        solver: SolverSettings::preset(Quality::Default),
+        source: SolutionSource::Solve,
+        save: None,
+        solution_file: false,
+        bake: Some(trilux_bake::BakeOptions::default()),
+        render,
+    };
+    let outcome = Observer::quiet(|o| trilux_render::pipeline::run(&scene, &plan, o))?;
+    let baked = outcome.baked.context("the plan bakes")?;
+    std::fs::write(dir.join(format!("{name}.glb")), &baked.glb)?;
+    if let Some(image) = &outcome.image {
+        std::fs::write(
+            dir.join(format!("{name}-preview.png")),
+            image.png_bytes(EXPOSURE)?,
+        )?;
+    }
+    Ok(Row {
+        name,
+        glossy: scene.shapes.iter().any(|s| glossy(&s.bsdf)),
+        solve_seconds: outcome.prepare_seconds + outcome.solve_seconds,
+        bake_seconds: baked.stats.seconds,
+        bytes: baked.stats.bytes,
+        triangles: baked.stats.triangles,
+        means: None,
+    })
+}
+
+/// The mean of a PNG's RGB values in [0, 1].
+fn png_mean(path: &Path) -> Result<f64> {
+    let file = std::fs::File::open(path).with_context(|| format!("{}", path.display()))?;
+    let mut decoder = png::Decoder::new(std::io::BufReader::new(file));
+    decoder.set_transformations(png::Transformations::EXPAND | png::Transformations::STRIP_16);
+    let mut reader = decoder.read_info()?;
+    let mut buf = vec![0; reader.output_buffer_size().context("PNG size")?];
+    let info = reader.next_frame(&mut buf)?;
+    let channels = info.color_type.samples();
+    if channels < 3 {
+        bail!("{}: not an RGB PNG", path.display());
+    }
+    let pixels = &buf[..info.buffer_size()];
+    let sum: u64 = pixels
+        .chunks(channels)
+        .flat_map(|p| &p[..3])
+        .map(|&v| u64::from(v))
+        .sum();
+    let count = (pixels.len() / channels * 3) as f64;
+    Ok(sum as f64 / (255.0 * count))
+}
+
+fn node(script: &str, args: &[String]) -> Result<()> {
+    let script = root().join("docs/viewer").join(script);
+    eprintln!("xtask: node {} {}", script.display(), args.join(" "));
+    let status = Command::new("node")
+        .arg(&script)
+        .args(args)
+        .status()
+        .context(
+            "could not start node (docs/viewer/scripts/ci.sh installs what the viewer needs)",
+        )?;
+    if !status.success() {
+        bail!("node {} failed ({status})", script.display());
+    }
+    Ok(())
+}
+
+/// The viewer's screenshot of `row`'s bake beside its preview.
+fn photograph(row: &mut Row, dir: &Path) -> Result<()> {
+    let preview = dir.join(format!("{}-preview.png", row.name));
+    if !preview.exists() {
+        return Ok(());
+    }
+    let (w, h) = png_size(&preview)?;
+    let shot = dir.join(format!("{}-viewer.png", row.name));
+    let glb = dir.join(format!("{}.glb", row.name));
+    let args = [
+        "--glb".into(),
+        glb.display().to_string(),
+        "--width".into(),
+        w.to_string(),
+        "--height".into(),
+        h.to_string(),
+        "--out".into(),
+        shot.display().to_string(),
+        "--exposure".into(),
+        EXPOSURE.to_string(),
+    ];
+    node("test/screenshot.mjs", &args)?;
+    row.means = Some((png_mean(&preview)?, png_mean(&shot)?));
+    Ok(())
+}
+
+fn png_size(path: &Path) -> Result<(u32, u32)> {
+    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(path)?));
+    let info = decoder.read_info()?;
+    Ok((info.info().width, info.info().height))
+}
+
+/// Runs the whole check (module docs).
+pub fn main(args: &[String]) -> Result<()> {
+    if let Some(a) = args.first() {
+        bail!("unknown argument {a}");
+    }
+    let dir = root().join("target/viewer");
+    std::fs::create_dir_all(&dir)?;
+    let mut rows = Vec::new();
+    for path in scenes()? {
+        eprintln!("xtask viewer: {}", path.display());
+        rows.push(bake_scene(&path, &dir)?);
+    }
+    let glbs: Vec<String> = rows
+        .iter()
+        .map(|r| dir.join(format!("{}.glb", r.name)).display().to_string())
+        .collect();
+    node("test/validate.mjs", &glbs)?;
+    for row in &mut rows {
+        photograph(row, &dir)?;
+    }
+    let report = report(&rows);
+    print!("{report}");
+    std::fs::write(dir.join("report.md"), &report)?;
+    let failed: Vec<&str> = rows
+        .iter()
+        .filter(|r| !passes(r))
+        .map(|r| r.name.as_str())
+        .collect();
+    if !failed.is_empty() {
+        bail!("the bakes of {} miss the viewer gates", failed.join(", "));
+    }
+    Ok(())
+}
+
+fn gap(r: &Row) -> Option<f64> {
+    r.means.map(|(p, v)| v / p - 1.0)
+}
+
+fn passes(r: &Row) -> bool {
+    let mean_ok = r.glossy || gap(r).is_none_or(|g| g.abs() <= MAX_MEAN_GAP);
+    mean_ok && r.bake_seconds < MAX_BAKE_SECONDS
+}
+
+fn report(rows: &[Row]) -> String {
+    let mut s = String::from(
+        "| scene | glossy | solve s | bake s | file MB | triangles | preview mean | viewer mean | gap |\n\
+         |---|---|---|---|---|---|---|---|---|\n",
+    );
+    for r in rows {
+        let (p, v) = r.means.map_or(("–".into(), "–".into()), |(p, v)| {
+            (format!("{p:.4}"), format!("{v:.4}"))
+        });
+        let g = gap(r).map_or("–".into(), |g| format!("{:+.2} %", 100.0 * g));
+        s += &format!(
+            "| {} | {} | {:.2} | {:.3} | {:.2} | {} | {p} | {v} | {g} |\n",
+            r.name,
+            if r.glossy { "yes" } else { "no" },
+            r.solve_seconds,
+            r.bake_seconds,
+            r.bytes as f64 / 1e6,
+            r.triangles,
+        );
+    }
+    s
+}
