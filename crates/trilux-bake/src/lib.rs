@@ -19,7 +19,7 @@
 //! - [`camera`]: the scene's camera as a glTF camera node.
 //! - [`glb`]: the glTF JSON and the binary container.
 //! - [`bake()`](bake()): the whole, with its [`BakeStats`].
-//! - [`error`]: [`BakeError`].
+//! - [`mod@error`]: the error type, [`BakeError`].
 #![forbid(unsafe_code)]
 
 pub mod bake;

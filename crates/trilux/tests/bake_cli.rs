@@ -11,6 +11,7 @@
 //! - The flux each input surface and side shows equals the solution's
 //!   within 1 %.
 //! - `COLOR_0` is `_RADIANCE` × 2^exposure clamped to [0, 1].
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test may panic
 
 mod common;
 
