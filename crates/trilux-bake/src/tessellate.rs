@@ -8,7 +8,8 @@
 //!   within [`AREA_TOLERANCE`] or the leaf has [`MAX_CELLS`] cells. A planar
 //!   quad stays one cell; curved pieces and disks get as many as their
 //!   curvature needs, so the baked flux is the solution's within that
-//!   tolerance.
+//!   tolerance. A leaf cut at all is cut in both directions, so that its
+//!   centre is a cell corner.
 //! - A cell is a fan of triangles from its centre over its boundary: its
 //!   corners, and every point where another cell's corner lies on one of
 //!   its edges (found by halving the edge while its midpoint is such a
@@ -178,7 +179,13 @@ fn cell_counts(
             mv *= 2;
         }
     }
-    (mu, mv)
+    // The leaf's centre must be a vertex touching only this leaf's cells
+    // (`reconstruct`): a 1 × m or m × 1 grid has it mid-edge.
+    if (mu == 1) != (mv == 1) {
+        (mu.max(2), mv.max(2))
+    } else {
+        (mu, mv)
+    }
 }
 
 /// Area of the centre fans of an m_u × m_v grid of cells over [min, max].

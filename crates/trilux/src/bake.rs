@@ -7,11 +7,10 @@ use std::path::PathBuf;
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use trilux_bake::BakeOptions;
-use trilux_render::{Observer, Plan, SolutionSource};
+use trilux_render::{Plan, SolutionSource};
 
 use crate::options::{SolveOptions, parse_exposure, parse_threads};
 use crate::output::{Outputs, bake_stats_json};
-use crate::progress::Bars;
 
 /// Arguments of `trilux bake`.
 #[derive(Debug, Args)]
@@ -73,20 +72,7 @@ pub fn run(args: &BakeArgs) -> Result<()> {
         }),
         render: None,
     };
-    trilux_render::pipeline::check(pending.scene(), &plan)?;
-    let scene = pending.finish()?;
-    let bars = Bars::new(false);
-    let mut on_shot = |p: &trilux_solver::Progress| bars.solve(p);
-    let outcome = trilux_render::pipeline::run(
-        &scene,
-        &plan,
-        Observer {
-            solve: &mut on_shot,
-            render: &|_, _| {},
-        },
-    );
-    bars.finish();
-    let mut outcome = outcome?;
+    let mut outcome = crate::progress::run_plan(pending, &plan)?;
     let baked = outcome.baked.take().context("the bake produced no file")?;
     let mut files = vec![baked.glb];
     if args.stats.is_some() {

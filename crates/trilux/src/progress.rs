@@ -66,3 +66,28 @@ impl Bars {
         }
     }
 }
+
+/// Checks `plan` against the scene read so far, reads the rest of it
+/// (meshes, textures) and carries the plan out, with bars for its solve
+/// and, when it renders, its render (`pipeline::check`, then
+/// `pipeline::run`): what `solve`, `render` and `bake` share.
+pub fn run_plan(
+    pending: trilux_scene::Pending,
+    plan: &trilux_render::Plan<'_>,
+) -> anyhow::Result<trilux_render::Outcome> {
+    trilux_render::pipeline::check(pending.scene(), plan)?;
+    let scene = pending.finish()?;
+    let bars = Bars::new(plan.render.is_some());
+    let mut on_shot = |p: &Progress| bars.solve(p);
+    let on_tile = |done: usize, total: usize| bars.render(done, total);
+    let outcome = trilux_render::pipeline::run(
+        &scene,
+        plan,
+        trilux_render::Observer {
+            solve: &mut on_shot,
+            render: &on_tile,
+        },
+    );
+    bars.finish();
+    Ok(outcome?)
+}

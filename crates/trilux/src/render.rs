@@ -6,8 +6,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
 use trilux_render::{
-    Estimator, ExtraBounce, Observer, Plan, RenderPlan, RenderSettings, SolutionSource,
-    ViewOverrides,
+    Estimator, ExtraBounce, Plan, RenderPlan, RenderSettings, SolutionSource, ViewOverrides,
 };
 
 use crate::options::{
@@ -15,7 +14,6 @@ use crate::options::{
     parse_target_error, parse_threads,
 };
 use crate::output::{Outputs, stats_json};
-use crate::progress::Bars;
 
 /// Where the gather continues one bounce before reading the solution.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -190,21 +188,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         bake: None,
         render: Some(args.render_plan(camera)),
     };
-    trilux_render::pipeline::check(pending.scene(), &plan)?;
-    let scene = pending.finish()?;
-    let bars = Bars::new(true);
-    let mut on_shot = |p: &trilux_solver::Progress| bars.solve(p);
-    let on_tile = |done: usize, total: usize| bars.render(done, total);
-    let outcome = trilux_render::pipeline::run(
-        &scene,
-        &plan,
-        Observer {
-            solve: &mut on_shot,
-            render: &on_tile,
-        },
-    );
-    bars.finish();
-    let outcome = outcome?;
+    let outcome = crate::progress::run_plan(pending, &plan)?;
     let image = outcome
         .image
         .as_ref()

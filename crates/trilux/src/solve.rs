@@ -5,11 +5,10 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 use clap::Args;
-use trilux_render::{Observer, Plan, SolutionSource};
+use trilux_render::{Plan, SolutionSource};
 
 use crate::options::{SolveOptions, parse_threads};
 use crate::output::{Outputs, stats_json};
-use crate::progress::Bars;
 
 /// Arguments of `trilux solve`.
 #[derive(Debug, Args)]
@@ -45,20 +44,7 @@ pub fn run(args: &SolveArgs) -> Result<()> {
         bake: None,
         render: None,
     };
-    trilux_render::pipeline::check(pending.scene(), &plan)?;
-    let scene = pending.finish()?;
-    let bars = Bars::new(false);
-    let mut on_shot = |p: &trilux_solver::Progress| bars.solve(p);
-    let outcome = trilux_render::pipeline::run(
-        &scene,
-        &plan,
-        Observer {
-            solve: &mut on_shot,
-            render: &|_, _| {},
-        },
-    );
-    bars.finish();
-    let mut outcome = outcome?;
+    let mut outcome = crate::progress::run_plan(pending, &plan)?;
     let solution = outcome
         .solution_file
         .take()
