@@ -1,4 +1,5 @@
-//! `cargo xtask viewer`: every bundled scene solved (default quality),
+//! `cargo xtask viewer`: every bundled scene, and tests/bake's, solved
+//! (default quality),
 //! baked (`trilux bake`'s code) and previewed (`trilux render --preview`'s);
 //! every bake checked by the Khronos glTF validator, and photographed in
 //! docs/viewer by headless Chromium from the scene's own camera, beside
@@ -34,28 +35,40 @@ const MAX_MEAN_GAP: f64 = 0.03;
 /// Longest bake after the solve.
 const MAX_BAKE_SECONDS: f64 = 2.0;
 
-/// One scene's figures.
+/// One bake's figures.
 struct Row {
+    /// The scene (its preview is `SCENE-preview.png`).
+    scene: String,
+    /// The bake's file stem (`NAME.glb`, `NAME-viewer.png`).
     name: String,
+    /// False for the `--no-albedo-maps` variant of a textured scene (shown
+    /// for comparison, not gated).
+    default: bool,
     glossy: bool,
     solve_seconds: f64,
     bake_seconds: f64,
     bytes: usize,
     triangles: usize,
-    means: Option<(f64, f64)>,
+    /// Preview mean, viewer mean, RMSE of the PNG values.
+    means: Option<(f64, f64, f64)>,
 }
 
-/// The bundled scenes: scenes/*.xml, *.gltf, *.glb, by name.
+/// The bundled scenes (scenes/*.xml, *.gltf, *.glb), then the bake's own
+/// test scenes (tests/bake: a diffuse textured room), each by name.
 fn scenes() -> Result<Vec<PathBuf>> {
-    let mut out: Vec<PathBuf> = std::fs::read_dir(root().join("scenes"))?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| {
-            p.extension()
-                .is_some_and(|e| e == "xml" || e == "gltf" || e == "glb")
-        })
-        .collect();
-    out.sort();
-    Ok(out)
+    let mut all = Vec::new();
+    for dir in ["scenes", "tests/bake"] {
+        let mut out: Vec<PathBuf> = std::fs::read_dir(root().join(dir))?
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| {
+                p.extension()
+                    .is_some_and(|e| e == "xml" || e == "gltf" || e == "glb")
+            })
+            .collect();
+        out.sort();
+        all.extend(out);
+    }
+    Ok(all)
 }
 
 fn glossy(b: &BsdfParams) -> bool {
@@ -74,8 +87,9 @@ fn name_of(path: &Path) -> String {
         .map_or_else(String::new, |s| s.to_string_lossy().into_owned())
 }
 
-/// Solves, bakes and previews one scene into `dir`.
-fn bake_scene(path: &Path, dir: &Path) -> Result<Row> {
+/// Solves, bakes and previews one scene into `dir`; a textured scene is
+/// baked a second time without albedo maps, from the saved solution.
+fn bake_scene(path: &Path, dir: &Path) -> Result<Vec<Row>> {
     let name = name_of(path);
     let scene = trilux_scene::load(path).map_err(|e| anyhow::anyhow!("{e}"))?;
     let render = scene.camera.as_ref().map(|camera| {
@@ -87,37 +101,60 @@ fn bake_scene(path: &Path, dir: &Path) -> Result<Row> {
             settings,
         }
     });
-    let plan = Plan {
+    let solution = dir.join(format!("{name}.sol"));
+    let mut plan = Plan {
         mode: scene.mode(),
         solver: SolverSettings::preset(Quality::Default),
         source: SolutionSource::Solve,
-        save: None,
+        save: Some(&solution),
         solution_file: false,
         bake: Some(trilux_bake::BakeOptions::default()),
         render,
     };
     let outcome = Observer::quiet(|o| trilux_render::pipeline::run(&scene, &plan, o))?;
-    let baked = outcome.baked.context("the plan bakes")?;
-    std::fs::write(dir.join(format!("{name}.glb")), &baked.glb)?;
     if let Some(image) = &outcome.image {
         std::fs::write(
             dir.join(format!("{name}-preview.png")),
             image.png_bytes(EXPOSURE)?,
         )?;
     }
-    Ok(Row {
-        name,
-        glossy: scene.shapes.iter().any(|s| glossy(&s.bsdf)),
-        solve_seconds: outcome.prepare_seconds + outcome.solve_seconds,
-        bake_seconds: baked.stats.seconds,
-        bytes: baked.stats.bytes,
-        triangles: baked.stats.triangles,
-        means: None,
-    })
+    let solve_seconds = outcome.prepare_seconds + outcome.solve_seconds;
+    let row = |stem: String, default: bool, baked: trilux_bake::Baked| -> Result<Row> {
+        std::fs::write(dir.join(format!("{stem}.glb")), &baked.glb)?;
+        Ok(Row {
+            scene: name.clone(),
+            name: stem,
+            default,
+            glossy: scene.shapes.iter().any(|s| glossy(&s.bsdf)),
+            solve_seconds,
+            bake_seconds: baked.stats.seconds,
+            bytes: baked.stats.bytes,
+            triangles: baked.stats.triangles,
+            means: None,
+        })
+    };
+    let mut rows = vec![row(
+        name.clone(),
+        true,
+        outcome.baked.context("the plan bakes")?,
+    )?];
+    if scene.shapes.iter().any(|s| !s.textures.is_empty()) {
+        plan.source = SolutionSource::Load(&solution);
+        plan.save = None;
+        plan.render = None;
+        plan.bake = Some(trilux_bake::BakeOptions {
+            albedo_maps: false,
+            ..Default::default()
+        });
+        let outcome = Observer::quiet(|o| trilux_render::pipeline::run(&scene, &plan, o))?;
+        let baked = outcome.baked.context("the plan bakes")?;
+        rows.push(row(format!("{name}-vertex"), false, baked)?);
+    }
+    Ok(rows)
 }
 
-/// The mean of a PNG's RGB values in [0, 1].
-fn png_mean(path: &Path) -> Result<f64> {
+/// A PNG's RGB values in [0, 1].
+fn png_values(path: &Path) -> Result<Vec<f64>> {
     let file = std::fs::File::open(path).with_context(|| format!("{}", path.display()))?;
     let mut decoder = png::Decoder::new(std::io::BufReader::new(file));
     decoder.set_transformations(png::Transformations::EXPAND | png::Transformations::STRIP_16);
@@ -129,13 +166,27 @@ fn png_mean(path: &Path) -> Result<f64> {
         bail!("{}: not an RGB PNG", path.display());
     }
     let pixels = &buf[..info.buffer_size()];
-    let sum: u64 = pixels
+    Ok(pixels
         .chunks(channels)
         .flat_map(|p| &p[..3])
-        .map(|&v| u64::from(v))
-        .sum();
-    let count = (pixels.len() / channels * 3) as f64;
-    Ok(sum as f64 / (255.0 * count))
+        .map(|&v| f64::from(v) / 255.0)
+        .collect())
+}
+
+/// (preview mean, viewer mean, RMSE between them) of two PNGs of one size.
+fn png_compare(preview: &Path, viewer: &Path) -> Result<(f64, f64, f64)> {
+    let (p, v) = (png_values(preview)?, png_values(viewer)?);
+    if p.len() != v.len() || p.is_empty() {
+        bail!(
+            "{} and {} differ in size",
+            preview.display(),
+            viewer.display()
+        );
+    }
+    let n = p.len() as f64;
+    let mean = |x: &[f64]| x.iter().sum::<f64>() / n;
+    let sq: f64 = p.iter().zip(&v).map(|(a, b)| (a - b) * (a - b)).sum();
+    Ok((mean(&p), mean(&v), (sq / n).sqrt()))
 }
 
 fn node(script: &str, args: &[String]) -> Result<()> {
@@ -156,7 +207,7 @@ fn node(script: &str, args: &[String]) -> Result<()> {
 
 /// The viewer's screenshot of `row`'s bake beside its preview.
 fn photograph(row: &mut Row, dir: &Path) -> Result<()> {
-    let preview = dir.join(format!("{}-preview.png", row.name));
+    let preview = dir.join(format!("{}-preview.png", row.scene));
     if !preview.exists() {
         return Ok(());
     }
@@ -176,7 +227,7 @@ fn photograph(row: &mut Row, dir: &Path) -> Result<()> {
         EXPOSURE.to_string(),
     ];
     node("test/screenshot.mjs", &args)?;
-    row.means = Some((png_mean(&preview)?, png_mean(&shot)?));
+    row.means = Some(png_compare(&preview, &shot)?);
     Ok(())
 }
 
@@ -196,7 +247,7 @@ pub fn main(args: &[String]) -> Result<()> {
     let mut rows = Vec::new();
     for path in scenes()? {
         eprintln!("xtask viewer: {}", path.display());
-        rows.push(bake_scene(&path, &dir)?);
+        rows.extend(bake_scene(&path, &dir)?);
     }
     let glbs: Vec<String> = rows
         .iter()
@@ -221,27 +272,32 @@ pub fn main(args: &[String]) -> Result<()> {
 }
 
 fn gap(r: &Row) -> Option<f64> {
-    r.means.map(|(p, v)| v / p - 1.0)
+    r.means.map(|(p, v, _)| v / p - 1.0)
 }
 
 fn passes(r: &Row) -> bool {
-    let mean_ok = r.glossy || gap(r).is_none_or(|g| g.abs() <= MAX_MEAN_GAP);
+    let mean_ok = r.glossy || !r.default || gap(r).is_none_or(|g| g.abs() <= MAX_MEAN_GAP);
     mean_ok && r.bake_seconds < MAX_BAKE_SECONDS
 }
 
 fn report(rows: &[Row]) -> String {
     let mut s = String::from(
-        "| scene | glossy | solve s | bake s | file MB | triangles | preview mean | viewer mean | gap |\n\
-         |---|---|---|---|---|---|---|---|---|\n",
+        "| bake | glossy | solve s | bake s | file MB | triangles | preview mean | viewer mean | gap | RMSE |\n\
+         |---|---|---|---|---|---|---|---|---|---|\n",
     );
     for r in rows {
-        let (p, v) = r.means.map_or(("–".into(), "–".into()), |(p, v)| {
-            (format!("{p:.4}"), format!("{v:.4}"))
-        });
+        let (p, v, e) = r
+            .means
+            .map_or(("–".into(), "–".into(), "–".into()), |(p, v, e)| {
+                (format!("{p:.4}"), format!("{v:.4}"), format!("{e:.4}"))
+            });
         let g = gap(r).map_or("–".into(), |g| format!("{:+.2} %", 100.0 * g));
+        let label = match r.default {
+            true => r.scene.clone(),
+            false => format!("{} (`--no-albedo-maps`)", r.scene),
+        };
         s += &format!(
-            "| {} | {} | {:.2} | {:.3} | {:.2} | {} | {p} | {v} | {g} |\n",
-            r.name,
+            "| {label} | {} | {:.2} | {:.3} | {:.2} | {} | {p} | {v} | {g} | {e} |\n",
             if r.glossy { "yes" } else { "no" },
             r.solve_seconds,
             r.bake_seconds,

@@ -24,8 +24,9 @@ use glam::DVec3;
 use serde_json::{Value, json};
 use trilux_brdf::BsdfParams;
 use trilux_geometry::{ElementForest, ElementId, FaceId, Side, SurfaceId};
-use trilux_solver::Solution;
+use trilux_solver::{ElementTextures, Solution};
 
+use crate::albedo::{AlbedoMap, albedo_map};
 use crate::camera::BakeCamera;
 use crate::error::BakeError;
 use crate::glb::Document;
@@ -52,11 +53,18 @@ pub struct BakeOptions {
     /// `COLOR_0` is radiance × 2^exposure, clamped to [0, 1] (for viewers
     /// that show vertex colours as display values).
     pub exposure: f64,
+    /// Textured sides as an albedo map times the light (module `albedo`);
+    /// without, their radiance goes into the vertex colours like any other
+    /// (smaller files, texture detail finer than the leaves lost).
+    pub albedo_maps: bool,
 }
 
 impl Default for BakeOptions {
     fn default() -> Self {
-        BakeOptions { exposure: 0.0 }
+        BakeOptions {
+            exposure: 0.0,
+            albedo_maps: true,
+        }
     }
 }
 
@@ -92,15 +100,22 @@ pub fn bake<const N: usize>(
     options: &BakeOptions,
 ) -> Result<Baked, BakeError> {
     let start = Instant::now();
-    let meshes = tessellate(input.solution.forest());
+    let scene = input.solution.scene();
+    let meshes = tessellate(input.solution.forest(), |shape| {
+        options.albedo_maps && scene.textured(shape as usize).is_some()
+    });
+    let textures = input
+        .solution
+        .element_textures()
+        .filter(|_| options.albedo_maps);
     let mut doc = Document::default();
     let mut flux = FluxCheck::default();
     let (mut vertices, mut triangles) = (0, 0);
     for mesh in meshes.iter().filter(|m| !m.triangles.is_empty()) {
         let sides = Side::BOTH.map(|side| {
-            let values = vertex_values(mesh, |leaf| leaf_value(input.solution, side, leaf));
-            flux.add(input.solution, mesh, side, &values);
-            values
+            let light = SideLight::new(input.solution, textures.as_ref(), mesh, side);
+            flux.add(input.solution, mesh, side, &light);
+            light
         });
         write_shape(&mut doc, input, mesh, &sides, options.exposure.exp2())?;
         vertices += mesh.positions.len();
@@ -134,18 +149,78 @@ pub fn leaf_value<const N: usize>(solution: &Solution<N>, side: Side, leaf: Elem
     rgb.map(|x| (x * exposed).max(0.0))
 }
 
+/// What one side of a shape shows: its vertex values and, for a textured
+/// side, its albedo map and every leaf's mean albedo (module `albedo`).
+struct SideLight<'t, const N: usize> {
+    side: Side,
+    values: Vec<[f64; 3]>,
+    map: Option<AlbedoMap>,
+    textures: Option<&'t ElementTextures<N>>,
+}
+
+impl<'t, const N: usize> SideLight<'t, N> {
+    fn new(
+        solution: &Solution<N>,
+        textures: Option<&'t ElementTextures<N>>,
+        mesh: &ShapeMesh,
+        side: Side,
+    ) -> Self {
+        let map = solution
+            .scene()
+            .textured(mesh.shape as usize)
+            .filter(|_| textures.is_some())
+            .and_then(|t| albedo_map(t, side));
+        let textured = map.is_some();
+        let mut light = SideLight {
+            side,
+            values: Vec::new(),
+            map,
+            textures: textures.filter(|_| textured),
+        };
+        let values = vertex_values(
+            mesh,
+            |leaf| light.value(solution, leaf),
+            |leaf| light.weight(solution, leaf),
+        );
+        light.values = values;
+        light
+    }
+
+    /// The leaf's mean albedo on a textured side.
+    fn albedo(&self, solution: &Solution<N>, leaf: ElementId) -> Option<[f64; 3]> {
+        let face = FaceId::new(solution.forest().element(leaf).surface, self.side);
+        let rho = self.textures?.rho(face, leaf)?;
+        Some(rho.to_linear_srgb().map(|x| x.max(0.0)))
+    }
+
+    /// The leaf's value: its radiance, or on a textured side the light
+    /// E/π (radiance over mean albedo).
+    fn value(&self, solution: &Solution<N>, leaf: ElementId) -> [f64; 3] {
+        let l = leaf_value(solution, self.side, leaf);
+        match self.albedo(solution, leaf) {
+            Some(rho) => std::array::from_fn(|c| if rho[c] > 0.0 { l[c] / rho[c] } else { 0.0 }),
+            None => l,
+        }
+    }
+
+    /// The leaf's weight in the reconstruction (`reconstruct`).
+    fn weight(&self, solution: &Solution<N>, leaf: ElementId) -> [f64; 3] {
+        self.albedo(solution, leaf).unwrap_or([1.0; 3])
+    }
+}
+
 /// One shape's node, mesh, materials and accessors.
 fn write_shape<const N: usize>(
     doc: &mut Document,
     input: &BakeInput<'_, N>,
     mesh: &ShapeMesh,
-    sides: &[Vec<[f64; 3]>; 2],
+    sides: &[SideLight<'_, N>; 2],
     scale: f64,
 ) -> Result<(), BakeError> {
     let f32s =
         |v: &[DVec3]| -> Vec<[f32; 3]> { v.iter().map(|p| p.as_vec3().to_array()).collect() };
-    for values in sides {
-        if values.iter().flatten().any(|x| !x.is_finite()) {
+    for light in sides {
+        if light.values.iter().flatten().any(|x| !x.is_finite()) {
             return Err(BakeError::NotFinite { shape: mesh.shape });
         }
     }
@@ -155,28 +230,49 @@ fn write_shape<const N: usize>(
         doc.vec3(&f32s(&mesh.normals), false),
         doc.vec3(&f32s(&flipped), false),
     ];
+    let texcoord = sides.iter().any(|l| l.map.is_some()).then(|| {
+        let uv: Vec<[f32; 2]> = mesh
+            .texcoords
+            .iter()
+            .map(|t| t.unwrap_or_default().as_vec2().to_array())
+            .collect();
+        doc.vec2(&uv)
+    });
     let mut primitives = Vec::new();
     for (k, side) in Side::BOTH.into_iter().enumerate() {
-        let radiance: Vec<[f32; 3]> = sides[k].iter().map(|c| c.map(|x| x as f32)).collect();
-        let display: Vec<[f32; 3]> = sides[k]
+        let values = &sides[k].values;
+        let radiance: Vec<[f32; 3]> = values.iter().map(|c| c.map(|x| x as f32)).collect();
+        let display: Vec<[f32; 3]> = values
             .iter()
             .map(|c| c.map(|x| (x * scale).clamp(0.0, 1.0) as f32))
             .collect();
         let (radiance, display) = (doc.vec3(&radiance, false), doc.vec3(&display, false));
         let material = doc.materials.len();
-        doc.materials.push(material_of(input, mesh.shape, side));
+        let mut m = material_of(input, mesh.shape, side);
+        if let Some(map) = &sides[k].map {
+            let png = map.png().map_err(|e| BakeError::Image(e.to_string()))?;
+            let texture = doc.png_texture(&png, map.sampler());
+            m["pbrMetallicRoughness"]["baseColorTexture"] =
+                json!({ "index": texture, "texCoord": 0 });
+            m["extras"]["trilux"]["albedo_map"] = json!(true);
+        }
+        doc.materials.push(m);
         for (surface, triangles) in by_surface(input.solution.forest(), mesh) {
             let triangles: Vec<[u32; 3]> = match side {
                 Side::Front => triangles,
                 Side::Back => triangles.into_iter().map(|[a, b, c]| [a, c, b]).collect(),
             };
+            let mut attributes = json!({
+                "POSITION": position,
+                "NORMAL": normals[k],
+                "COLOR_0": display,
+                "_RADIANCE": radiance,
+            });
+            if let (Some(uv), Some(_)) = (texcoord, &sides[k].map) {
+                attributes["TEXCOORD_0"] = json!(uv);
+            }
             primitives.push(json!({
-                "attributes": {
-                    "POSITION": position,
-                    "NORMAL": normals[k],
-                    "COLOR_0": display,
-                    "_RADIANCE": radiance,
-                },
+                "attributes": attributes,
                 "indices": doc.indices(&triangles),
                 "material": material,
                 "mode": 4,
@@ -295,11 +391,16 @@ impl FluxCheck {
         solution: &Solution<N>,
         mesh: &ShapeMesh,
         side: Side,
-        values: &[[f64; 3]],
+        light: &SideLight<'_, N>,
     ) {
         let forest = solution.forest();
         for surface in forest.geometry().surfaces_of_shape(mesh.shape) {
-            let baked = baked_flux(mesh, values, |leaf| forest.element(leaf).surface == surface);
+            let baked = baked_flux(
+                mesh,
+                &light.values,
+                |leaf| light.weight(solution, leaf),
+                |leaf| forest.element(leaf).surface == surface,
+            );
             let face = FaceId::new(surface, side);
             let exact: f64 = forest
                 .leaves(forest.root(surface))

@@ -17,6 +17,9 @@ pub enum BakeError {
         /// The size it would have.
         bytes: u64,
     },
+    /// An albedo map could not be encoded.
+    #[error("an albedo map could not be encoded as PNG: {0}")]
+    Image(String),
     /// The JSON part could not be written.
     #[error("the glTF JSON could not be written: {0}")]
     Json(#[from] serde_json::Error),

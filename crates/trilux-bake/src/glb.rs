@@ -1,8 +1,8 @@
 //! The glTF 2.0 binary container (glTF 2.0 specification, §4.4 "GLB File
 //! Format"): a 12-byte header, a JSON chunk padded with spaces and a BIN
 //! chunk padded with zeros, each to 4 bytes. One buffer holds every
-//! accessor's data; every accessor has its own buffer view (tightly packed,
-//! 4-byte aligned: every component here is 4 bytes).
+//! accessor's data and every image; each has its own buffer view (tightly
+//! packed, 4-byte aligned).
 
 use serde_json::{Value, json};
 
@@ -34,19 +34,58 @@ pub struct Document {
     pub nodes: Vec<Value>,
     /// `cameras`.
     pub cameras: Vec<Value>,
+    /// `images`.
+    pub images: Vec<Value>,
+    /// `textures`.
+    pub textures: Vec<Value>,
+    /// `samplers`.
+    pub samplers: Vec<Value>,
 }
 
 impl Document {
-    fn view(&mut self, bytes: &[u8], target: u32) -> usize {
+    /// A buffer view of `bytes` (4-byte aligned) for `target`, if any.
+    fn view(&mut self, bytes: &[u8], target: Option<u32>) -> usize {
+        self.bin.resize(self.bin.len().next_multiple_of(4), 0);
         let offset = self.bin.len();
         self.bin.extend_from_slice(bytes);
-        self.views.push(json!({
-            "buffer": 0,
-            "byteOffset": offset,
-            "byteLength": bytes.len(),
-            "target": target,
-        }));
+        let mut view = json!({ "buffer": 0, "byteOffset": offset, "byteLength": bytes.len() });
+        if let Some(t) = target {
+            view["target"] = json!(t);
+        }
+        self.views.push(view);
         self.views.len() - 1
+    }
+
+    /// A `VEC2` float vertex attribute (texture coordinates). Returns the
+    /// accessor's index.
+    pub fn vec2(&mut self, data: &[[f32; 2]]) -> usize {
+        let bytes: Vec<u8> = data
+            .iter()
+            .flatten()
+            .flat_map(|x| x.to_le_bytes())
+            .collect();
+        let view = self.view(&bytes, Some(ARRAY_BUFFER));
+        self.accessors.push(json!({
+            "bufferView": view,
+            "componentType": FLOAT,
+            "count": data.len(),
+            "type": "VEC2",
+        }));
+        self.accessors.len() - 1
+    }
+
+    /// A PNG image in the buffer with its sampler, as a texture. Returns
+    /// the texture's index.
+    pub fn png_texture(&mut self, png: &[u8], sampler: Value) -> usize {
+        let view = self.view(png, None);
+        self.images
+            .push(json!({ "bufferView": view, "mimeType": "image/png" }));
+        self.samplers.push(sampler);
+        self.textures.push(json!({
+            "source": self.images.len() - 1,
+            "sampler": self.samplers.len() - 1,
+        }));
+        self.textures.len() - 1
     }
 
     /// A `VEC3` float vertex attribute; with `bounds`, its `min` and `max`
@@ -57,7 +96,7 @@ impl Document {
             .flatten()
             .flat_map(|x| x.to_le_bytes())
             .collect();
-        let view = self.view(&bytes, ARRAY_BUFFER);
+        let view = self.view(&bytes, Some(ARRAY_BUFFER));
         let mut accessor = json!({
             "bufferView": view,
             "componentType": FLOAT,
@@ -87,7 +126,7 @@ impl Document {
             .flatten()
             .flat_map(|x| x.to_le_bytes())
             .collect();
-        let view = self.view(&bytes, ELEMENT_ARRAY_BUFFER);
+        let view = self.view(&bytes, Some(ELEMENT_ARRAY_BUFFER));
         self.accessors.push(json!({
             "bufferView": view,
             "componentType": UNSIGNED_INT,
@@ -113,8 +152,15 @@ impl Document {
             "bufferViews": self.views,
             "buffers": [{ "byteLength": self.bin.len() }],
         });
-        if !self.cameras.is_empty() {
-            root["cameras"] = json!(self.cameras);
+        for (key, list) in [
+            ("cameras", self.cameras),
+            ("images", self.images),
+            ("textures", self.textures),
+            ("samplers", self.samplers),
+        ] {
+            if !list.is_empty() {
+                root[key] = json!(list);
+            }
         }
         let mut text = serde_json::to_vec(&root)?;
         text.resize(text.len().next_multiple_of(4), b' ');

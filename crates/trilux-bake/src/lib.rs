@@ -16,12 +16,14 @@
 //!   by one leaf; T-junctions split so that neighbours share vertices.
 //! - [`reconstruct`]: vertex colours from the leaves' radiance by
 //!   flux-conserving averaging (the rule and its error bound are there).
+//! - [`albedo`]: textured materials as an albedo map times the light.
 //! - [`camera`]: the scene's camera as a glTF camera node.
 //! - [`glb`]: the glTF JSON and the binary container.
 //! - [`bake()`](bake()): the whole, with its [`BakeStats`].
 //! - [`mod@error`]: the error type, [`BakeError`].
 #![forbid(unsafe_code)]
 
+pub mod albedo;
 pub mod bake;
 pub mod camera;
 pub mod error;

@@ -28,41 +28,57 @@ use trilux_geometry::ElementId;
 
 use crate::tessellate::ShapeMesh;
 
-/// Vertex values of `mesh` from each leaf's value (module docs); a vertex
-/// no triangle uses gets zero.
+/// Vertex values of `mesh` from each leaf's value (module docs), each
+/// triangle weighted by its area times `weight` of its leaf (per channel):
+/// 1 for plain surfaces; for a textured side, whose file shows the light
+/// E/π times an albedo map, the leaf's mean albedo ρ̄, so that
+/// Σ_T A_T ρ̄_T (v_a + v_b + v_c)/3 is again the leaves' flux. A vertex no
+/// triangle uses gets zero.
 pub fn vertex_values(
     mesh: &ShapeMesh,
-    leaf_value: impl Fn(ElementId) -> [f64; 3],
+    value: impl Fn(ElementId) -> [f64; 3],
+    weight: impl Fn(ElementId) -> [f64; 3],
 ) -> Vec<[f64; 3]> {
-    let mut sum = vec![[0.0; 3]; mesh.positions.len()];
-    let mut weight = vec![0.0; mesh.positions.len()];
-    let mut last: Option<(ElementId, [f64; 3])> = None;
+    let n = mesh.positions.len();
+    let (mut sum, mut total) = (vec![[0.0; 3]; n], vec![[0.0; 3]; n]);
+    let (mut plain, mut area) = (vec![[0.0; 3]; n], vec![0.0; n]);
+    let mut last: Option<(ElementId, [f64; 3], [f64; 3])> = None;
     for (t, (tri, &owner)) in mesh.triangles.iter().zip(&mesh.owners).enumerate() {
-        let f = match last {
-            Some((e, f)) if e == owner => f,
-            _ => leaf_value(owner),
+        let (f, w) = match last {
+            Some((e, f, w)) if e == owner => (f, w),
+            _ => (value(owner), weight(owner)),
         };
-        last = Some((owner, f));
+        last = Some((owner, f, w));
         let a = mesh.triangle_area(t);
         for &v in tri {
             let v = v as usize;
-            weight[v] += a;
-            for (s, x) in sum[v].iter_mut().zip(f) {
-                *s += a * x;
+            area[v] += a;
+            for c in 0..3 {
+                sum[v][c] += a * w[c] * f[c];
+                total[v][c] += a * w[c];
+                plain[v][c] += a * f[c];
             }
         }
     }
-    sum.iter()
-        .zip(&weight)
-        .map(|(s, &w)| if w > 0.0 { s.map(|x| x / w) } else { [0.0; 3] })
+    (0..n)
+        .map(|v| {
+            std::array::from_fn(|c| match (total[v][c] > 0.0, area[v] > 0.0) {
+                (true, _) => sum[v][c] / total[v][c],
+                // Every weight zero (a black albedo): the plain mean.
+                (false, true) => plain[v][c] / area[v],
+                (false, false) => 0.0,
+            })
+        })
         .collect()
 }
 
-/// The flux Σ_T A_T mean(v_T) (without the factor π) of the triangles of
-/// `mesh` for which `keep` holds, with vertex values `values`.
+/// The flux Σ_T A_T w_T mean(v_T) (without the factor π) of the triangles
+/// of `mesh` whose leaf `keep` accepts, with vertex values `values` and
+/// the weights of [`vertex_values`].
 pub fn baked_flux(
     mesh: &ShapeMesh,
     values: &[[f64; 3]],
+    weight: impl Fn(ElementId) -> [f64; 3],
     keep: impl Fn(ElementId) -> bool,
 ) -> [f64; 3] {
     let mut flux = [0.0; 3];
@@ -70,10 +86,10 @@ pub fn baked_flux(
         if !keep(owner) {
             continue;
         }
-        let a = mesh.triangle_area(t) / 3.0;
+        let (a, w) = (mesh.triangle_area(t) / 3.0, weight(owner));
         for &v in tri {
-            for (f, x) in flux.iter_mut().zip(values[v as usize]) {
-                *f += a * x;
+            for c in 0..3 {
+                flux[c] += a * w[c] * values[v as usize][c];
             }
         }
     }

@@ -20,7 +20,8 @@
 //!   sub-triangles of them. A piece with another piece's corner on an edge,
 //!   and the piece of a one-piece leaf, becomes a fan from its centroid.
 //! - Vertices are welded per input surface by position (rounded to f32)
-//!   when their normals are within [`CREASE_DEG`]. Each surface keeps its
+//!   when their normals are within [`CREASE_DEG`] and their texture
+//!   coordinates agree (a mesh's texture seams keep their two vertices). Each surface keeps its
 //!   own vertices, so that each keeps its own flux (`reconstruct`); where
 //!   surfaces meet, their vertices take one position, the first computed,
 //!   so the seam has no crack.
@@ -53,6 +54,9 @@ pub struct ShapeMesh {
     pub positions: Vec<DVec3>,
     /// Front unit normals of the vertices.
     pub normals: Vec<DVec3>,
+    /// Texture coordinates of the vertices (`Geometry::texcoord`), where
+    /// the surface has them.
+    pub texcoords: Vec<Option<DVec2>>,
     /// Triangles, counter-clockwise seen from the front.
     pub triangles: Vec<[u32; 3]>,
     /// The leaf element each triangle covers part of.
@@ -68,8 +72,9 @@ impl ShapeMesh {
 }
 
 /// The display meshes of every shape of `forest`'s geometry (empty meshes
-/// for shapes without surfaces), in shape order.
-pub fn tessellate(forest: &ElementForest) -> Vec<ShapeMesh> {
+/// for shapes without surfaces), in shape order; the shapes for which
+/// `textured` holds keep texture coordinates.
+pub fn tessellate(forest: &ElementForest, textured: impl Fn(u32) -> bool) -> Vec<ShapeMesh> {
     let geometry = forest.geometry();
     let shapes = geometry
         .surfaces()
@@ -78,7 +83,7 @@ pub fn tessellate(forest: &ElementForest) -> Vec<ShapeMesh> {
         .max()
         .unwrap_or(0);
     (0..shapes)
-        .map(|shape| tessellate_shape(forest, shape))
+        .map(|shape| tessellate_shape(forest, shape, textured(shape)))
         .collect()
 }
 
@@ -102,7 +107,7 @@ impl Cell {
     }
 }
 
-fn tessellate_shape(forest: &ElementForest, shape: u32) -> ShapeMesh {
+fn tessellate_shape(forest: &ElementForest, shape: u32, textured: bool) -> ShapeMesh {
     let geometry = forest.geometry();
     let mut cells = Vec::new();
     for surface in geometry.surfaces_of_shape(shape) {
@@ -110,7 +115,7 @@ fn tessellate_shape(forest: &ElementForest, shape: u32) -> ShapeMesh {
             leaf_cells(forest, surface, leaf, &mut cells);
         }
     }
-    let mut b = Builder::new(geometry, shape);
+    let mut b = Builder::new(geometry, shape, textured);
     for cell in &cells {
         for &c in &cell.corners {
             if let Some(p) = b.point(cell, c) {
@@ -240,11 +245,12 @@ struct Builder<'g> {
     canonical: HashMap<[u32; 3], DVec3>,
     crease_cos: f64,
     min_area: f64,
+    textured: bool,
     mesh: ShapeMesh,
 }
 
 impl<'g> Builder<'g> {
-    fn new(geometry: &'g Geometry, shape: u32) -> Self {
+    fn new(geometry: &'g Geometry, shape: u32, textured: bool) -> Self {
         let extent = geometry.extent().max(f64::MIN_POSITIVE);
         Builder {
             geometry,
@@ -253,6 +259,7 @@ impl<'g> Builder<'g> {
             canonical: HashMap::new(),
             crease_cos: CREASE_DEG.to_radians().cos(),
             min_area: 1e-14 * extent * extent,
+            textured,
             mesh: ShapeMesh {
                 shape,
                 ..ShapeMesh::default()
@@ -264,21 +271,33 @@ impl<'g> Builder<'g> {
         self.geometry.surface_point(cell.surface, cell.coord(p))
     }
 
-    /// The welded vertex of `surface` at `p`.
-    fn vertex(&mut self, surface: SurfaceId, p: SurfacePoint) -> u32 {
+    /// The point `p` of `cell` with its texture coordinates.
+    fn located(&self, cell: &Cell, p: DVec2) -> Option<(SurfacePoint, Option<DVec2>)> {
+        let coord = cell.coord(p);
+        let point = self.geometry.surface_point(cell.surface, coord)?;
+        let uv = match self.textured {
+            true => self.geometry.texcoord(cell.surface, coord),
+            false => None,
+        };
+        Some((point, uv))
+    }
+
+    /// The welded vertex of `surface` at `p` with texture coordinates `uv`.
+    fn vertex(&mut self, surface: SurfaceId, (p, uv): (SurfacePoint, Option<DVec2>)) -> u32 {
         let k = key(p.point);
         let point = *self.canonical.entry(k).or_insert(p.point);
         let bucket = self.welded.entry((k, surface)).or_default();
-        let normals = &self.mesh.normals;
-        if let Some(&v) = bucket
-            .iter()
-            .find(|&&v| normals[v as usize].dot(p.normal) >= self.crease_cos)
-        {
+        let (normals, texcoords) = (&self.mesh.normals, &self.mesh.texcoords);
+        let same = |v: u32| {
+            normals[v as usize].dot(p.normal) >= self.crease_cos && texcoords[v as usize] == uv
+        };
+        if let Some(&v) = bucket.iter().find(|&&v| same(v)) {
             return v;
         }
         let v = self.mesh.positions.len() as u32;
         self.mesh.positions.push(point);
         self.mesh.normals.push(p.normal);
+        self.mesh.texcoords.push(uv);
         bucket.push(v);
         v
     }
@@ -313,21 +332,22 @@ impl<'g> Builder<'g> {
                 &mut ring,
             );
         }
-        let ring: Vec<SurfacePoint> = ring.iter().filter_map(|&c| self.point(cell, c)).collect();
+        let ring: Vec<_> = ring.iter().filter_map(|&c| self.located(cell, c)).collect();
         if ring.len() == 3 && !cell.always_fan {
-            let front = ring[0].normal + ring[1].normal + ring[2].normal;
+            let front = ring[0].0.normal + ring[1].0.normal + ring[2].0.normal;
             let v = [ring[0], ring[1], ring[2]].map(|p| self.vertex(cell.surface, p));
             self.triangle(v, front, cell.leaf);
             return;
         }
         let centre = cell.corners.iter().sum::<DVec2>() / n as f64;
-        let Some(c) = self.point(cell, centre) else {
+        let Some(c) = self.located(cell, centre) else {
             return;
         };
+        let front = c.0.normal;
         let cv = self.vertex(cell.surface, c);
         let vs: Vec<u32> = ring.iter().map(|&p| self.vertex(cell.surface, p)).collect();
         for k in 0..vs.len() {
-            self.triangle([cv, vs[k], vs[(k + 1) % vs.len()]], c.normal, cell.leaf);
+            self.triangle([cv, vs[k], vs[(k + 1) % vs.len()]], front, cell.leaf);
         }
     }
 

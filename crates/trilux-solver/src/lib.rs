@@ -67,3 +67,4 @@ pub use settings::{Quality, SolverSettings, Transport};
 pub use solution::{FORMAT_VERSION, Solution, SurfaceSite, solve_hash};
 pub use solver::{Progress, Solver};
 pub use stats::SolveStats;
+pub use textures::ElementTextures;

@@ -31,7 +31,7 @@ const GRID: usize = 8;
 
 /// ρ_d and g of every element of a textured face (module docs).
 #[derive(Clone, Debug)]
-pub(crate) struct ElementTextures<const N: usize> {
+pub struct ElementTextures<const N: usize> {
     /// By element index: `None` for elements of uniform materials.
     parts: Vec<Option<Sided<PointParts<N>>>>,
 }

@@ -28,6 +28,11 @@ pub struct BakeArgs {
     /// (the _RADIANCE attribute keeps the radiance).
     #[arg(long, default_value_t = 0.0, value_parser = parse_exposure, allow_hyphen_values = true)]
     pub exposure: f64,
+    /// Bake textured materials into the vertex colours too, instead of an
+    /// albedo map times the light (smaller files; texture detail finer than
+    /// the elements is lost).
+    #[arg(long)]
+    pub no_albedo_maps: bool,
     /// Write solve and bake statistics (file size, vertices, triangles) as
     /// JSON.
     #[arg(long)]
@@ -69,6 +74,7 @@ pub fn run(args: &BakeArgs) -> Result<()> {
         solution_file: false,
         bake: Some(BakeOptions {
             exposure: args.exposure,
+            albedo_maps: !args.no_albedo_maps,
         }),
         render: None,
     };

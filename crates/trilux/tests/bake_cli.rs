@@ -9,7 +9,11 @@
 //!   leaf value around the triangle that holds the centre (the bound
 //!   `trilux_bake::reconstruct` states).
 //! - The flux each input surface and side shows equals the solution's
-//!   within 1 %.
+//!   within 1 %: Σ over triangles of the interpolated radiance, or on a
+//!   textured side the albedo map (decoded from the file) times the
+//!   interpolated light, integrated by a 16-point rule per triangle.
+//! - On a textured side the vertex values are the light E/π, the leaf's
+//!   radiance over its mean albedo (the solver's averages).
 //! - `COLOR_0` is `_RADIANCE` × 2^exposure clamped to [0, 1].
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test may panic
 
@@ -68,6 +72,71 @@ struct Primitive {
     radiance: Vec<[f32; 3]>,
     colour: Vec<[f32; 3]>,
     triangles: Vec<[u32; 3]>,
+    /// The albedo map and the texture coordinates, on a textured side.
+    albedo: Option<(AlbedoImage, Vec<[f32; 2]>)>,
+}
+
+/// An albedo map decoded to linear RGB (repeat wrap, bilinear).
+struct AlbedoImage {
+    width: usize,
+    height: usize,
+    texels: Vec<DVec3>,
+}
+
+impl AlbedoImage {
+    fn decode(png_bytes: &[u8]) -> Self {
+        let decoder = png::Decoder::new(std::io::Cursor::new(png_bytes));
+        let mut reader = decoder.read_info().unwrap();
+        let mut buf = vec![0; reader.output_buffer_size().unwrap()];
+        let info = reader.next_frame(&mut buf).unwrap();
+        assert_eq!(info.color_type, png::ColorType::Rgb);
+        let texels = buf[..info.buffer_size()]
+            .chunks(3)
+            .map(|p| {
+                DVec3::from(
+                    [p[0], p[1], p[2]]
+                        .map(|c| trilux_color::srgb::decode_srgb(f64::from(c) / 255.0)),
+                )
+            })
+            .collect();
+        AlbedoImage {
+            width: info.width as usize,
+            height: info.height as usize,
+            texels,
+        }
+    }
+
+    fn texel(&self, x: i64, y: i64) -> DVec3 {
+        let (w, h) = (self.width as i64, self.height as i64);
+        self.texels[(y.rem_euclid(h) * w + x.rem_euclid(w)) as usize]
+    }
+
+    /// glTF's bilinear lookup: texel centres at (i + ½)/w.
+    fn at(&self, uv: [f64; 2]) -> DVec3 {
+        let p = [
+            uv[0] * self.width as f64 - 0.5,
+            uv[1] * self.height as f64 - 0.5,
+        ];
+        let (fx, fy) = (p[0].floor(), p[1].floor());
+        let (tx, ty) = (p[0] - fx, p[1] - fy);
+        let (x, y) = (fx as i64, fy as i64);
+        let top = self.texel(x, y) * (1.0 - tx) + self.texel(x + 1, y) * tx;
+        let bottom = self.texel(x, y + 1) * (1.0 - tx) + self.texel(x + 1, y + 1) * tx;
+        top * (1.0 - ty) + bottom * ty
+    }
+}
+
+/// The albedo map of a primitive's material, if it has one.
+fn albedo_image(json: &Value, bin: &[u8], prim: &Value) -> Option<AlbedoImage> {
+    let material = &json["materials"][prim["material"].as_u64()? as usize];
+    let texture = material["pbrMetallicRoughness"]["baseColorTexture"]["index"].as_u64()?;
+    let source = json["textures"][texture as usize]["source"].as_u64()?;
+    let image = &json["images"][source as usize];
+    assert_eq!(image["mimeType"], "image/png");
+    let view = &json["bufferViews"][image["bufferView"].as_u64()? as usize];
+    let start = view["byteOffset"].as_u64().unwrap_or(0) as usize;
+    let len = view["byteLength"].as_u64()? as usize;
+    Some(AlbedoImage::decode(&bin[start..start + len]))
 }
 
 /// The little-endian 4-byte components of accessor `index` (tightly
@@ -80,6 +149,7 @@ fn components(json: &Value, bin: &[u8], index: &Value) -> Vec<[u8; 4]> {
         view["byteOffset"].as_u64().unwrap_or(0) + accessor["byteOffset"].as_u64().unwrap_or(0);
     let width = match accessor["type"].as_str().unwrap() {
         "SCALAR" => 1,
+        "VEC2" => 2,
         "VEC3" => 3,
         t => panic!("accessor type {t}"),
     };
@@ -124,6 +194,13 @@ fn read_primitives(glb: &Path) -> (Vec<Primitive>, Value) {
                 radiance: vec3s(&json, &bin, &attr["_RADIANCE"]),
                 colour: vec3s(&json, &bin, &attr["COLOR_0"]),
                 triangles: indices.chunks(3).map(|t| [t[0], t[1], t[2]]).collect(),
+                albedo: albedo_image(&json, &bin, prim).map(|image| {
+                    let uv: Vec<f32> = components(&json, &bin, &attr["TEXCOORD_0"])
+                        .into_iter()
+                        .map(f32::from_le_bytes)
+                        .collect();
+                    (image, uv.chunks(2).map(|c| [c[0], c[1]]).collect())
+                }),
             });
         }
     }
@@ -151,9 +228,23 @@ fn barycentric(p: DVec3, [a, b, c]: [DVec3; 3]) -> ([f64; 3], f64) {
 
 struct Check<'s, const N: usize> {
     solution: &'s Solution<N>,
+    textures: Option<trilux_solver::ElementTextures<N>>,
 }
 
 impl<const N: usize> Check<'_, N> {
+    /// The value the file should hold for `leaf`: its radiance, or on a
+    /// textured side the light E/π (radiance over the leaf's mean albedo).
+    fn expected(&self, prim: &Primitive, face: FaceId, leaf: ElementId) -> DVec3 {
+        let radiance = leaf_value(self.solution, face, leaf);
+        match (&prim.albedo, &self.textures) {
+            (Some(_), Some(t)) => {
+                let rho = DVec3::from(t.rho(face, leaf).unwrap().to_linear_srgb()).max(DVec3::ZERO);
+                DVec3::select(rho.cmpgt(DVec3::ZERO), radiance / rho, DVec3::ZERO)
+            }
+            _ => radiance,
+        }
+    }
+
     fn corners(&self, prim: &Primitive, t: usize) -> [DVec3; 3] {
         prim.triangles[t].map(|i| prim.positions[i as usize].as_dvec3())
     }
@@ -193,12 +284,44 @@ impl<const N: usize> Check<'_, N> {
                 .iter()
                 .any(|p| p.cmpge(b.min - pad).all() && p.cmple(b.max + pad).all());
             if near {
-                let v = leaf_value(self.solution, face, leaf);
+                let v = self.expected(prim, face, leaf);
                 lo = lo.min(v);
                 hi = hi.max(v);
             }
         }
         (lo, hi)
+    }
+
+    /// ∫ over triangle `t` of what the file shows (radiance, or albedo
+    /// map × light), by the centroids of a 4 × 4 split (16 sub-triangles).
+    fn triangle_flux(&self, prim: &Primitive, t: usize) -> f64 {
+        let [a, b, c] = self.corners(prim, t);
+        let area = 0.5 * (b - a).cross(c - a).length();
+        let v = prim.triangles[t].map(|i| DVec3::from(prim.radiance[i as usize].map(f64::from)));
+        let Some((image, uv)) = &prim.albedo else {
+            return area * (v[0] + v[1] + v[2]).element_sum() / 3.0;
+        };
+        let w = prim.triangles[t].map(|i| uv[i as usize].map(f64::from));
+        const K: usize = 4;
+        let mut sum = 0.0;
+        for i in 0..K {
+            for j in 0..K - i {
+                // Upward sub-triangle (i, j) and, where it exists, the
+                // downward one beside it: their centroids in barycentrics.
+                let mut points = vec![[i as f64 + 1.0 / 3.0, j as f64 + 1.0 / 3.0]];
+                if i + j + 1 < K {
+                    points.push([i as f64 + 2.0 / 3.0, j as f64 + 2.0 / 3.0]);
+                }
+                for [p, q] in points {
+                    let (l1, l2) = (p / K as f64, q / K as f64);
+                    let l = [1.0 - l1 - l2, l1, l2];
+                    let light = v[0] * l[0] + v[1] * l[1] + v[2] * l[2];
+                    let st = [0, 1].map(|k| w[0][k] * l[0] + w[1][k] * l[1] + w[2][k] * l[2]);
+                    sum += (image.at(st) * light).element_sum();
+                }
+            }
+        }
+        area * sum / (K * K) as f64
     }
 
     /// The centre and flux checks for one primitive; returns the flux's
@@ -210,8 +333,9 @@ impl<const N: usize> Check<'_, N> {
         let mut exact_flux = 0.0;
         for leaf in forest.leaves(forest.root(prim.surface)) {
             let e = forest.element(leaf);
-            let want = leaf_value(self.solution, face, leaf);
-            exact_flux += want.element_sum() * e.area;
+            let radiance = leaf_value(self.solution, face, leaf);
+            exact_flux += radiance.element_sum() * e.area;
+            let want = self.expected(prim, face, leaf);
             let (t, l) = self.locate(prim, e.centre);
             let got = self.interpolate(prim, t, l);
             let exact = match e.domain {
@@ -236,22 +360,9 @@ impl<const N: usize> Check<'_, N> {
                 );
             }
         }
-        let mut baked = 0.0;
-        for t in 0..prim.triangles.len() {
-            let [a, b, c] = self.corners(prim, t);
-            let area = 0.5 * (b - a).cross(c - a).length();
-            let mean: f64 = prim.triangles[t]
-                .iter()
-                .map(|&i| {
-                    prim.radiance[i as usize]
-                        .iter()
-                        .map(|&x| f64::from(x))
-                        .sum::<f64>()
-                })
-                .sum::<f64>()
-                / 3.0;
-            baked += area * mean;
-        }
+        let baked: f64 = (0..prim.triangles.len())
+            .map(|t| self.triangle_flux(prim, t))
+            .sum();
         if exact_flux <= 1e-6 * largest {
             return 0.0;
         }
@@ -280,6 +391,7 @@ impl WithBands for Verify<'_> {
             .fold(0.0f64, |m, &x| m.max(f64::from(x)));
         let check = Check {
             solution: &solution,
+            textures: solution.element_textures(),
         };
         let mut worst = 0.0f64;
         for prim in self.prims {
@@ -295,7 +407,9 @@ impl WithBands for Verify<'_> {
     }
 }
 
-fn check_scene(scene_path: &Path, name: &str) {
+/// Bakes `scene_path` and runs every check; returns how many primitives
+/// carry an albedo map.
+fn check_scene(scene_path: &Path, name: &str) -> usize {
     let dir = folder(&format!("bake-{name}"));
     let (sol, glb) = solve_and_bake(scene_path, &dir, &["--exposure", "-1"]);
     let (prims, json) = read_primitives(&glb);
@@ -318,29 +432,33 @@ fn check_scene(scene_path: &Path, name: &str) {
         sol: &sol,
         prims: &prims,
     });
+    println!("{name}: largest flux gap {worst:.2e}");
     assert!(
         worst <= 0.01,
         "{name}: a surface's baked flux is {worst:.4} off the solution's"
     );
+    prims.iter().filter(|p| p.albedo.is_some()).count()
 }
 
 /// Cubes on a floor (buried faces), spectral bands.
 #[test]
 fn cornell_box_bakes_to_its_solution() {
-    check_scene(&repo("scenes/cornell-box.xml"), "cornell");
+    assert_eq!(check_scene(&repo("scenes/cornell-box.xml"), "cornell"), 0);
 }
 
 /// Curved pieces: a cylinder (the glossy tube; its glossy part is left out
 /// of the bake, its diffuse part is what is checked).
 #[test]
 fn glossy_tube_bakes_to_its_solution() {
-    check_scene(&repo("scenes/glossy-tube.xml"), "tube");
+    assert_eq!(check_scene(&repo("scenes/glossy-tube.xml"), "tube"), 0);
 }
 
-/// Meshes as charts, with a textured floor (glTF).
+/// Meshes as charts, with a textured floor and back wall (glTF): those
+/// sides carry albedo maps.
 #[test]
 fn gltf_meshes_bake_to_their_solution() {
-    check_scene(&repo("scenes/textured-room.gltf"), "textured-room");
+    let maps = check_scene(&repo("scenes/textured-room.gltf"), "textured-room");
+    assert!(maps >= 2, "{maps} primitives with albedo maps");
 }
 
 /// A sphere, a disk and a rectangle light: the curved and polar pieces
@@ -361,7 +479,7 @@ fn spheres_and_disks_bake_to_their_solution() {
 </scene>"#,
     )
     .unwrap();
-    check_scene(&scene, "sphere-disk");
+    assert_eq!(check_scene(&scene, "sphere-disk"), 0);
 }
 
 /// The output must be a .glb, said before any work.

@@ -283,6 +283,13 @@ impl<const N: usize> Solution<N> {
         self.exposed_area[face.side()][e.index()]
     }
 
+    /// Every element's texture averages (its Lambertian reflectance ρ_d
+    /// and glossy ratio), as the solve took them; `None` when no material
+    /// is textured.
+    pub fn element_textures(&self) -> Option<crate::ElementTextures<N>> {
+        crate::ElementTextures::new(&self.forest, &self.scene, &self.exposed_area)
+    }
+
     /// The Lambertian (two-point) reflected radiance alone at a point.
     pub fn lambertian_radiance(&self, from: &SurfaceSite) -> Spectrum<N> {
         let leaf = self.forest.locate(from.face.surface(), from.coord);
