@@ -1,6 +1,7 @@
-//! `trilux bake SCENE -o OUT.glb`: the solution's view-independent light as
-//! a glTF 2.0 binary, for walkthroughs in any glTF viewer
-//! (docs/bake.md; the file's layout is `trilux_bake`'s).
+//! `trilux bake SCENE -o OUT.glb [--open]`: the solution's view-independent
+//! light as a glTF 2.0 binary, for walkthroughs in any glTF viewer
+//! (docs/bake.md; the file's layout is `trilux_bake`'s), and with `--open`
+//! in trilux's own viewer on localhost (`serve`).
 
 use std::path::PathBuf;
 
@@ -37,6 +38,13 @@ pub struct BakeArgs {
     /// JSON.
     #[arg(long)]
     pub stats: Option<PathBuf>,
+    /// Then serve the viewer (docs/viewer, built into trilux) with the
+    /// bake on 127.0.0.1 and print its address; runs until stopped.
+    #[arg(long)]
+    pub open: bool,
+    /// The port for --open (default: any free one).
+    #[arg(long, requires = "open")]
+    pub port: Option<u16>,
     /// Worker threads (default: all cores).
     #[arg(long, value_parser = parse_threads)]
     pub threads: Option<u32>,
@@ -80,7 +88,7 @@ pub fn run(args: &BakeArgs) -> Result<()> {
     };
     let mut outcome = crate::progress::run_plan(pending, &plan)?;
     let baked = outcome.baked.take().context("the bake produced no file")?;
-    let mut files = vec![baked.glb];
+    let mut files = vec![baked.glb.clone()];
     if args.stats.is_some() {
         files.push(bake_stats_json(&outcome.solve, &baked.stats)?);
     }
@@ -95,5 +103,8 @@ pub fn run(args: &BakeArgs) -> Result<()> {
         s.triangles,
         s.seconds
     );
+    if args.open {
+        crate::serve::serve(&baked.glb, args.port.unwrap_or(0))?;
+    }
     Ok(())
 }

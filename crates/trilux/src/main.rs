@@ -18,6 +18,7 @@ mod output;
 mod power;
 mod progress;
 mod render;
+mod serve;
 mod solve;
 
 use std::path::PathBuf;

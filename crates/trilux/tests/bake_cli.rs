@@ -499,3 +499,58 @@ fn a_bake_that_is_not_a_glb_is_refused() {
     assert_eq!(err.lines().count(), 1, "{err}");
     assert!(!out.exists());
 }
+
+/// `GET path` from the server at `port`: (status line, body).
+fn http_get(port: u16, path: &str) -> (String, Vec<u8>) {
+    use std::io::{Read, Write};
+    let mut s = std::net::TcpStream::connect(("127.0.0.1", port)).unwrap();
+    write!(s, "GET {path} HTTP/1.1\r\nHost: localhost\r\n\r\n").unwrap();
+    let mut all = Vec::new();
+    s.read_to_end(&mut all).unwrap();
+    let split = all.windows(4).position(|w| w == b"\r\n\r\n").unwrap();
+    let head = String::from_utf8_lossy(&all[..split]).into_owned();
+    (
+        head.lines().next().unwrap().to_string(),
+        all[split + 4..].to_vec(),
+    )
+}
+
+/// `--open` serves the viewer with the bake on 127.0.0.1: the page, its
+/// three.js, the file just written (byte for byte); 404 for anything else.
+#[test]
+fn open_serves_the_viewer_and_the_bake() {
+    use std::io::BufRead;
+    let dir = folder("bake-open");
+    let glb = dir.join("furnace.glb");
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_trilux"))
+        .args(["bake", repo("scenes/furnace.xml").to_str().unwrap()])
+        .args(["--quality", "draft", "--open", "-o", glb.to_str().unwrap()])
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut lines = std::io::BufReader::new(child.stdout.take().unwrap()).lines();
+    let url = lines
+        .by_ref()
+        .map(|l| l.unwrap())
+        .find(|l| l.starts_with("viewer: "))
+        .expect("the address is printed");
+    let port: u16 = url
+        .split("127.0.0.1:")
+        .nth(1)
+        .and_then(|r| r.split('/').next())
+        .unwrap()
+        .parse()
+        .unwrap();
+    let (status, page) = http_get(port, "/index.html?file=/model.glb");
+    assert!(status.contains("200"), "{status}");
+    assert!(String::from_utf8_lossy(&page).contains("importmap"));
+    let (status, three) = http_get(port, "/vendor/three/build/three.module.js");
+    assert!(status.contains("200") && three.len() > 1000, "{status}");
+    let (status, model) = http_get(port, "/model.glb");
+    assert!(status.contains("200"), "{status}");
+    assert_eq!(model, std::fs::read(&glb).unwrap());
+    let (status, _) = http_get(port, "/../Cargo.toml");
+    assert!(status.contains("404"), "{status}");
+    child.kill().unwrap();
+    child.wait().unwrap();
+}
