@@ -56,22 +56,58 @@ impl Document {
         self.views.len() - 1
     }
 
+    /// An accessor over 4-byte little-endian `components`, `width` per
+    /// element (`type_`: "SCALAR", "VEC2", "VEC3"), of `component_type`,
+    /// in a view for `target`. Returns the accessor's index.
+    fn accessor(
+        &mut self,
+        components: impl Iterator<Item = [u8; 4]>,
+        (type_, width): (&str, usize),
+        component_type: u32,
+        target: u32,
+    ) -> usize {
+        let bytes: Vec<u8> = components.flatten().collect();
+        let view = self.view(&bytes, Some(target));
+        self.accessors.push(json!({
+            "bufferView": view,
+            "componentType": component_type,
+            "count": bytes.len() / (4 * width),
+            "type": type_,
+        }));
+        self.accessors.len() - 1
+    }
+
     /// A `VEC2` float vertex attribute (texture coordinates). Returns the
     /// accessor's index.
     pub fn vec2(&mut self, data: &[[f32; 2]]) -> usize {
-        let bytes: Vec<u8> = data
-            .iter()
-            .flatten()
-            .flat_map(|x| x.to_le_bytes())
-            .collect();
-        let view = self.view(&bytes, Some(ARRAY_BUFFER));
-        self.accessors.push(json!({
-            "bufferView": view,
-            "componentType": FLOAT,
-            "count": data.len(),
-            "type": "VEC2",
-        }));
-        self.accessors.len() - 1
+        let c = data.iter().flatten().map(|x| x.to_le_bytes());
+        self.accessor(c, ("VEC2", 2), FLOAT, ARRAY_BUFFER)
+    }
+
+    /// A `VEC3` float vertex attribute; with `bounds`, its `min` and `max`
+    /// (required for `POSITION`). Returns the accessor's index.
+    pub fn vec3(&mut self, data: &[[f32; 3]], bounds: bool) -> usize {
+        let c = data.iter().flatten().map(|x| x.to_le_bytes());
+        let index = self.accessor(c, ("VEC3", 3), FLOAT, ARRAY_BUFFER);
+        if bounds {
+            let mut lo = [f32::INFINITY; 3];
+            let mut hi = [f32::NEG_INFINITY; 3];
+            for p in data {
+                for k in 0..3 {
+                    lo[k] = lo[k].min(p[k]);
+                    hi[k] = hi[k].max(p[k]);
+                }
+            }
+            self.accessors[index]["min"] = json!(lo);
+            self.accessors[index]["max"] = json!(hi);
+        }
+        index
+    }
+
+    /// Triangle indices. Returns the accessor's index.
+    pub fn indices(&mut self, data: &[[u32; 3]]) -> usize {
+        let c = data.iter().flatten().map(|x| x.to_le_bytes());
+        self.accessor(c, ("SCALAR", 1), UNSIGNED_INT, ELEMENT_ARRAY_BUFFER)
     }
 
     /// A PNG image in the buffer with its sampler, as a texture. Returns
@@ -86,54 +122,6 @@ impl Document {
             "sampler": self.samplers.len() - 1,
         }));
         self.textures.len() - 1
-    }
-
-    /// A `VEC3` float vertex attribute; with `bounds`, its `min` and `max`
-    /// (required for `POSITION`). Returns the accessor's index.
-    pub fn vec3(&mut self, data: &[[f32; 3]], bounds: bool) -> usize {
-        let bytes: Vec<u8> = data
-            .iter()
-            .flatten()
-            .flat_map(|x| x.to_le_bytes())
-            .collect();
-        let view = self.view(&bytes, Some(ARRAY_BUFFER));
-        let mut accessor = json!({
-            "bufferView": view,
-            "componentType": FLOAT,
-            "count": data.len(),
-            "type": "VEC3",
-        });
-        if bounds {
-            let mut lo = [f32::INFINITY; 3];
-            let mut hi = [f32::NEG_INFINITY; 3];
-            for p in data {
-                for k in 0..3 {
-                    lo[k] = lo[k].min(p[k]);
-                    hi[k] = hi[k].max(p[k]);
-                }
-            }
-            accessor["min"] = json!(lo);
-            accessor["max"] = json!(hi);
-        }
-        self.accessors.push(accessor);
-        self.accessors.len() - 1
-    }
-
-    /// Triangle indices. Returns the accessor's index.
-    pub fn indices(&mut self, data: &[[u32; 3]]) -> usize {
-        let bytes: Vec<u8> = data
-            .iter()
-            .flatten()
-            .flat_map(|x| x.to_le_bytes())
-            .collect();
-        let view = self.view(&bytes, Some(ELEMENT_ARRAY_BUFFER));
-        self.accessors.push(json!({
-            "bufferView": view,
-            "componentType": UNSIGNED_INT,
-            "count": 3 * data.len(),
-            "type": "SCALAR",
-        }));
-        self.accessors.len() - 1
     }
 
     /// The whole file: `asset` and `extensionsUsed` as given, one scene of

@@ -8,7 +8,7 @@ use std::path::PathBuf;
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use trilux_bake::BakeOptions;
-use trilux_render::{Plan, SolutionSource};
+use trilux_render::Plan;
 
 use crate::options::{SolveOptions, parse_exposure, parse_threads};
 use crate::output::{Outputs, bake_stats_json};
@@ -74,10 +74,7 @@ pub fn run(args: &BakeArgs) -> Result<()> {
     let plan = Plan {
         mode: args.options.mode(pending.scene()),
         solver: args.options.settings(),
-        source: match &args.solution {
-            Some(path) => SolutionSource::Load(path),
-            None => SolutionSource::Solve,
-        },
+        source: crate::options::source(args.solution.as_deref()),
         save: None,
         solution_file: false,
         bake: Some(BakeOptions {

@@ -159,3 +159,12 @@ pub fn parse_lookat(text: &str) -> Result<LookAt, String> {
         n => Err(format!("takes 6 or 9 numbers (eye, target[, up]), got {n}")),
     }
 }
+
+/// Where a command's solution comes from: the saved one given by
+/// `--solution`, else a solve.
+pub fn source(solution: Option<&std::path::Path>) -> trilux_render::SolutionSource<'_> {
+    match solution {
+        Some(path) => trilux_render::SolutionSource::Load(path),
+        None => trilux_render::SolutionSource::Solve,
+    }
+}

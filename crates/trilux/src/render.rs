@@ -5,9 +5,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
-use trilux_render::{
-    Estimator, ExtraBounce, Plan, RenderPlan, RenderSettings, SolutionSource, ViewOverrides,
-};
+use trilux_render::{Estimator, ExtraBounce, Plan, RenderPlan, RenderSettings, ViewOverrides};
 
 use crate::options::{
     LookAt, SolveOptions, parse_exposure, parse_film_edge, parse_fov, parse_lookat, parse_spp,
@@ -179,10 +177,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let plan = Plan {
         mode: args.options.mode(pending.scene()),
         solver: args.options.settings(),
-        source: match &args.solution {
-            Some(path) => SolutionSource::Load(path),
-            None => SolutionSource::Solve,
-        },
+        source: crate::options::source(args.solution.as_deref()),
         save: None,
         solution_file: false,
         bake: None,

@@ -55,11 +55,9 @@ pub fn serve(glb: &[u8], port: u16) -> Result<()> {
     let port = listener.local_addr()?.port();
     println!("viewer: http://127.0.0.1:{port}/index.html?file=/model.glb (Ctrl-C stops it)");
     std::io::stdout().flush()?;
-    for stream in listener.incoming() {
-        // One failed connection (a closed tab) does not stop the server.
-        if let Ok(stream) = stream {
-            let _ = answer(stream, glb);
-        }
+    // A failed connection (a closed tab) does not stop the server.
+    for stream in listener.incoming().flatten() {
+        let _ = answer(stream, glb);
     }
     Ok(())
 }
