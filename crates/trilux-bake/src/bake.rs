@@ -217,68 +217,15 @@ fn write_shape<const N: usize>(
     sides: &[SideLight<'_, N>; 2],
     scale: f64,
 ) -> Result<(), BakeError> {
-    let f32s =
-        |v: &[DVec3]| -> Vec<[f32; 3]> { v.iter().map(|p| p.as_vec3().to_array()).collect() };
     for light in sides {
         if light.values.iter().flatten().any(|x| !x.is_finite()) {
             return Err(BakeError::NotFinite { shape: mesh.shape });
         }
     }
-    let position = doc.vec3(&f32s(&mesh.positions), true);
-    let flipped: Vec<DVec3> = mesh.normals.iter().map(|n| -*n).collect();
-    let normals = [
-        doc.vec3(&f32s(&mesh.normals), false),
-        doc.vec3(&f32s(&flipped), false),
-    ];
-    let texcoord = sides.iter().any(|l| l.map.is_some()).then(|| {
-        let uv: Vec<[f32; 2]> = mesh
-            .texcoords
-            .iter()
-            .map(|t| t.unwrap_or_default().as_vec2().to_array())
-            .collect();
-        doc.vec2(&uv)
-    });
+    let shared = SharedAttributes::write(doc, mesh, sides.iter().any(|l| l.map.is_some()));
     let mut primitives = Vec::new();
-    for (k, side) in Side::BOTH.into_iter().enumerate() {
-        let values = &sides[k].values;
-        let radiance: Vec<[f32; 3]> = values.iter().map(|c| c.map(|x| x as f32)).collect();
-        let display: Vec<[f32; 3]> = values
-            .iter()
-            .map(|c| c.map(|x| (x * scale).clamp(0.0, 1.0) as f32))
-            .collect();
-        let (radiance, display) = (doc.vec3(&radiance, false), doc.vec3(&display, false));
-        let material = doc.materials.len();
-        let mut m = material_of(input, mesh.shape, side);
-        if let Some(map) = &sides[k].map {
-            let png = map.png().map_err(|e| BakeError::Image(e.to_string()))?;
-            let texture = doc.png_texture(&png, map.sampler());
-            m["pbrMetallicRoughness"]["baseColorTexture"] =
-                json!({ "index": texture, "texCoord": 0 });
-            m["extras"]["trilux"]["albedo_map"] = json!(true);
-        }
-        doc.materials.push(m);
-        for (surface, triangles) in by_surface(input.solution.forest(), mesh) {
-            let triangles: Vec<[u32; 3]> = match side {
-                Side::Front => triangles,
-                Side::Back => triangles.into_iter().map(|[a, b, c]| [a, c, b]).collect(),
-            };
-            let mut attributes = json!({
-                "POSITION": position,
-                "NORMAL": normals[k],
-                "COLOR_0": display,
-                "_RADIANCE": radiance,
-            });
-            if let (Some(uv), Some(_)) = (texcoord, &sides[k].map) {
-                attributes["TEXCOORD_0"] = json!(uv);
-            }
-            primitives.push(json!({
-                "attributes": attributes,
-                "indices": doc.indices(&triangles),
-                "material": material,
-                "mode": 4,
-                "extras": { "trilux": { "surface": surface.0, "side": side_name(side) } },
-            }));
-        }
+    for light in sides {
+        primitives.extend(side_primitives(doc, input, mesh, light, &shared, scale)?);
     }
     let name = shape_name(input.names, mesh.shape);
     doc.nodes
@@ -289,6 +236,92 @@ fn write_shape<const N: usize>(
         "extras": { "trilux": { "shape": mesh.shape } },
     }));
     Ok(())
+}
+
+/// The accessors both sides of a shape share: positions, the normals of
+/// each side, texture coordinates when a side has an albedo map.
+struct SharedAttributes {
+    position: usize,
+    normals: [usize; 2],
+    texcoord: Option<usize>,
+}
+
+impl SharedAttributes {
+    fn write(doc: &mut Document, mesh: &ShapeMesh, texcoords: bool) -> Self {
+        let f32s =
+            |v: &[DVec3]| -> Vec<[f32; 3]> { v.iter().map(|p| p.as_vec3().to_array()).collect() };
+        let flipped: Vec<DVec3> = mesh.normals.iter().map(|n| -*n).collect();
+        let position = doc.vec3(&f32s(&mesh.positions), true);
+        let normals = [
+            doc.vec3(&f32s(&mesh.normals), false),
+            doc.vec3(&f32s(&flipped), false),
+        ];
+        let texcoord = texcoords.then(|| {
+            let uv: Vec<[f32; 2]> = mesh
+                .texcoords
+                .iter()
+                .map(|t| t.unwrap_or_default().as_vec2().to_array())
+                .collect();
+            doc.vec2(&uv)
+        });
+        SharedAttributes {
+            position,
+            normals,
+            texcoord,
+        }
+    }
+}
+
+/// One side's colours, material and a primitive per input surface.
+fn side_primitives<const N: usize>(
+    doc: &mut Document,
+    input: &BakeInput<'_, N>,
+    mesh: &ShapeMesh,
+    light: &SideLight<'_, N>,
+    shared: &SharedAttributes,
+    scale: f64,
+) -> Result<Vec<Value>, BakeError> {
+    let side = light.side;
+    let radiance: Vec<[f32; 3]> = light.values.iter().map(|c| c.map(|x| x as f32)).collect();
+    let display: Vec<[f32; 3]> = light
+        .values
+        .iter()
+        .map(|c| c.map(|x| (x * scale).clamp(0.0, 1.0) as f32))
+        .collect();
+    let (radiance, display) = (doc.vec3(&radiance, false), doc.vec3(&display, false));
+    let material = doc.materials.len();
+    let mut m = material_of(input, mesh.shape, side);
+    if let Some(map) = &light.map {
+        let png = map.png().map_err(|e| BakeError::Image(e.to_string()))?;
+        let texture = doc.png_texture(&png, map.sampler());
+        m["pbrMetallicRoughness"]["baseColorTexture"] = json!({ "index": texture, "texCoord": 0 });
+        m["extras"]["trilux"]["albedo_map"] = json!(true);
+    }
+    doc.materials.push(m);
+    let mut attributes = json!({
+        "POSITION": shared.position,
+        "NORMAL": shared.normals[usize::from(side == Side::Back)],
+        "COLOR_0": display,
+        "_RADIANCE": radiance,
+    });
+    if let (Some(uv), Some(_)) = (shared.texcoord, &light.map) {
+        attributes["TEXCOORD_0"] = json!(uv);
+    }
+    let mut primitives = Vec::new();
+    for (surface, triangles) in by_surface(input.solution.forest(), mesh) {
+        let triangles: Vec<[u32; 3]> = match side {
+            Side::Front => triangles,
+            Side::Back => triangles.into_iter().map(|[a, b, c]| [a, c, b]).collect(),
+        };
+        primitives.push(json!({
+            "attributes": attributes,
+            "indices": doc.indices(&triangles),
+            "material": material,
+            "mode": 4,
+            "extras": { "trilux": { "surface": surface.0, "side": side_name(side) } },
+        }));
+    }
+    Ok(primitives)
 }
 
 /// The mesh's triangles by input surface, in surface order.
