@@ -345,6 +345,6 @@ pub fn sample_glossy_lobe<const N: usize>(
         }
     }));
     for s in &mut out[start..] {
-        s.share = s.share * norm;
+        s.share *= norm;
     }
 }

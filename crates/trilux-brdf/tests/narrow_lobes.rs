@@ -11,7 +11,8 @@ use std::f64::consts::PI;
 use glam::DVec3;
 use proptest::prelude::*;
 use trilux_brdf::{
-    Bsdf, BsdfParams, Distribution, Frame, Side, is_narrow, lobe_width, sample_glossy_lobe,
+    AlbedoTable, Bsdf, BsdfParams, Distribution, Frame, Side, is_narrow, lobe_width,
+    sample_glossy_lobe,
 };
 
 fn material() -> impl Strategy<Value = BsdfParams> {
@@ -43,16 +44,22 @@ fn direction(z: f64, phi: f64) -> DVec3 {
 }
 
 /// The glossy albedo the solver uses: the table less the Lambertian part.
-fn glossy_albedo(b: &Bsdf<3>, wi: DVec3) -> trilux_color::Spectrum<3> {
+fn glossy_albedo(b: &Bsdf<3>, table: &AlbedoTable<3>, wi: DVec3) -> trilux_color::Spectrum<3> {
     let side = if wi.z > 0.0 { Side::Front } else { Side::Back };
-    (b.albedo_table().albedo(wi) - b.diffuse_albedo(side)).max(trilux_color::Spectrum::zero())
+    (table.albedo(wi) - b.diffuse_albedo(side)).max(trilux_color::Spectrum::zero())
 }
 
 /// The flux that a cone of directions `from` (axis, angular radius) sends
 /// through the reflector into the cone `to`, per unit radiance:
 /// (1/π) ∫_{Ω_from} cos θ_i ∫_{Ω_to} fr cos θ_o, the incident directions
 /// on a stratified grid over the cone, each lobe sampled.
-fn cone_transfer(b: &Bsdf<3>, from: (DVec3, f64), to: (DVec3, f64), n: u32) -> f64 {
+fn cone_transfer(
+    b: &Bsdf<3>,
+    table: &AlbedoTable<3>,
+    from: (DVec3, f64),
+    to: (DVec3, f64),
+    n: u32,
+) -> f64 {
     let (axis, radius) = from;
     let frame = Frame::from_normal(axis);
     let cos_r = radius.cos();
@@ -69,7 +76,7 @@ fn cone_transfer(b: &Bsdf<3>, from: (DVec3, f64), to: (DVec3, f64), n: u32) -> f
             }
             let dw = 2.0 * PI * (1.0 - cos_r) / f64::from(n * n);
             samples.clear();
-            sample_glossy_lobe(b, wi, glossy_albedo(b, wi), 16, 1.0, &mut samples);
+            sample_glossy_lobe(b, wi, glossy_albedo(b, table, wi), 8, 1.0, &mut samples);
             let into: f64 = samples
                 .iter()
                 .filter(|s| s.wo.dot(to.0) >= to.1.cos())
@@ -82,7 +89,7 @@ fn cone_transfer(b: &Bsdf<3>, from: (DVec3, f64), to: (DVec3, f64), n: u32) -> f
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(500))]
+    #![proptest_config(ProptestConfig::with_cases(200))]
 
     /// Over receivers that tile the sphere of directions (a latitude ×
     /// longitude grid of any size), the shares are finite, non-negative and
@@ -96,7 +103,7 @@ proptest! {
         if back {
             wi.z = -wi.z;
         }
-        let albedo = glossy_albedo(&b, wi);
+        let albedo = glossy_albedo(&b, &b.albedo_table(), wi);
         let mut samples = Vec::new();
         sample_glossy_lobe(&b, wi, albedo, grid, 1.0, &mut samples);
         let mut cells = vec![[0.0f64; 3]; rows * cols];
@@ -105,8 +112,8 @@ proptest! {
             prop_assert!(s.wo.z * wi.z > 0.0, "a sample left on the other side");
             let row = (((s.wo.z + 1.0) * 0.5 * rows as f64) as usize).min(rows - 1);
             let col = (((s.wo.y.atan2(s.wo.x) + PI) / (2.0 * PI) * cols as f64) as usize).min(cols - 1);
-            for q in 0..3 {
-                cells[row * cols + col][q] += s.share[q];
+            for (q, c) in cells[row * cols + col].iter_mut().enumerate() {
+                *c += s.share[q];
             }
         }
         for q in 0..3 {
@@ -141,16 +148,18 @@ proptest! {
         let f = Frame::from_normal(mirror);
         let dk = f.to_world(direction((off * radius).cos(), turn)).normalize();
         prop_assume!(dk.z > radius.sin() + 0.05);
-        let a = cone_transfer(&b, (di, radius), (dk, radius), 48);
-        let c = cone_transfer(&b, (dk, radius), (di, radius), 48);
+        let table = b.albedo_table();
+        let a = cone_transfer(&b, &table, (di, radius), (dk, radius), 48);
+        let c = cone_transfer(&b, &table, (dk, radius), (di, radius), 48);
         prop_assert!(a > 0.0 && c > 0.0);
         prop_assert!((a - c).abs() <= 0.05 * a.max(c), "I→K {a}, K→I {c}");
     }
 }
 
 /// The narrow/wide rule: a lobe is sampled exactly when it is narrower than
-/// the receiver's angular radius; a mirror-like lobe is narrow against any
-/// element, the widest is narrow against none.
+/// an eighth of the receiver's angular radius; a mirror-like lobe is
+/// narrow against any element but the tiniest, a lobe of α ≥ 0.1 against
+/// none.
 #[test]
 fn the_rule_compares_width_and_angular_radius() {
     let w = |a: f64| {
@@ -160,7 +169,7 @@ fn the_rule_compares_width_and_angular_radius() {
         )
         .unwrap()
     };
-    assert!(is_narrow(w(1e-4), 1e-3));
+    assert!(is_narrow(w(1e-4), 1e-2));
     assert!(!is_narrow(w(1.0), std::f64::consts::FRAC_PI_2));
     assert!(!is_narrow(w(0.1), std::f64::consts::FRAC_PI_2));
     assert!(is_narrow(w(0.01), 0.2) && !is_narrow(w(0.015), 0.2));
