@@ -253,3 +253,98 @@ pub fn brdf_variation<const N: usize>(
     v.evaluations = evals;
     v
 }
+
+/// The angular width, in radians, of the glossy lobe of one side of a
+/// material: 2·atan(α) for a microfacet part of roughness α (the reflected
+/// directions spread about twice as far as the microfacet normals),
+/// `None` for a side without a glossy part. The width decides how a
+/// three-point link's area reflectance is estimated ([`is_narrow`]).
+pub fn lobe_width<const N: usize>(bsdf: &Bsdf<N>, side: Side) -> Option<f64> {
+    if !bsdf.has_glossy(side) {
+        return None;
+    }
+    bsdf.min_alpha(side).map(|a| 2.0 * a.max(0.0).atan())
+}
+
+/// The rule that chooses the estimate of a glossy area reflectance
+/// (docs/solver.md, "Narrow lobes"): a lobe of angular width `width` is
+/// *narrow* against a receiver of angular radius `angular_radius` (both in
+/// radians, as seen from J's centre) when it is narrower than an eighth of
+/// that radius. The midpoint rule evaluates fr at K's quadrant centres,
+/// about one angular radius apart, and refinement by the BRDF variation
+/// halves that spacing at each split of K: a lobe narrower than the
+/// spacing two splits further down is one the BRDF criterion would chase
+/// through several levels (to the leaves, for a mirror), and is estimated
+/// by sampling it ([`sample_glossy_lobe`]) instead. (With a quarter or a
+/// half of the radius, lobes of α = 0.12–0.25 were sampled over the largest
+/// receivers, where the sampled links then stayed coarser than the BRDF
+/// criterion had made them: five golden images got slightly worse, by up
+/// to 0.0023 of relative RMSE.)
+pub fn is_narrow(width: f64, angular_radius: f64) -> bool {
+    width < 0.125 * angular_radius
+}
+
+/// One direction of a sampled glossy lobe and the share of the reflected
+/// light it carries.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LobeSample<const N: usize> {
+    /// The outgoing direction (the BSDF's local frame).
+    pub wo: DVec3,
+    /// The glossy albedo's share that leaves along `wo`: non-negative, and
+    /// the shares of one call sum to at most `glossy_albedo` per band.
+    pub share: Spectrum<N>,
+}
+
+/// Samples the glossy lobe of `bsdf` for light arriving from `wi` (local
+/// frame, either side) on a `grid` × `grid` stratified grid, appending one
+/// [`LobeSample`] per sample that leaves on wi's side, scaled by `scale`.
+///
+/// The samples say *where* the light goes (importance sampling of the
+/// BSDF, each weighted by fr_glossy cos / pdf); `glossy_albedo` (the
+/// material's directional albedo less its Lambertian part, e.g. from an
+/// `AlbedoTable`) says *how much*: the weights are normalised to sum to it.
+/// Counting the shares that land in a receiver K therefore estimates
+/// ∫_{Ω_K} fr_glossy cos dω (the flux ratio of K, docs/solver.md,
+/// "Area reflectance") without bias from the lobe's width, and the shares
+/// over receivers that do not overlap never sum to more than the albedo.
+pub fn sample_glossy_lobe<const N: usize>(
+    bsdf: &Bsdf<N>,
+    wi: DVec3,
+    glossy_albedo: Spectrum<N>,
+    grid: u32,
+    scale: f64,
+    out: &mut Vec<LobeSample<N>>,
+) {
+    let start = out.len();
+    let mut total = Spectrum::<N>::zero();
+    let g = f64::from(grid.max(1));
+    for a in 0..grid.max(1) {
+        for b in 0..grid.max(1) {
+            let u = glam::DVec2::new((f64::from(a) + 0.5) / g, (f64::from(b) + 0.5) / g);
+            let Some(s) = bsdf.sample(wi, u) else {
+                continue;
+            };
+            if s.wi.z * wi.z <= 0.0 {
+                continue;
+            }
+            let w = bsdf.eval_glossy(wi, s.wi) * (s.wi.z.abs() / s.pdf);
+            if !w.is_finite() || w.is_black() {
+                continue;
+            }
+            let w = w.max(Spectrum::zero());
+            total += w;
+            out.push(LobeSample { wo: s.wi, share: w });
+        }
+    }
+    let albedo = glossy_albedo.max(Spectrum::zero());
+    let norm = Spectrum::<N>::new(std::array::from_fn(|c| {
+        if total[c] > 0.0 {
+            albedo[c] * scale / total[c]
+        } else {
+            0.0
+        }
+    }));
+    for s in &mut out[start..] {
+        s.share *= norm;
+    }
+}

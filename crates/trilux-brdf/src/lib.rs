@@ -47,7 +47,10 @@ pub mod texture;
 pub mod textured;
 
 pub use albedo::AlbedoTable;
-pub use area::{AreaReflectance, BrdfVariation, ElementPoints, area_reflectance, brdf_variation};
+pub use area::{
+    AreaReflectance, BrdfVariation, ElementPoints, LobeSample, area_reflectance, brdf_variation,
+    is_narrow, lobe_width, sample_glossy_lobe,
+};
 pub use bsdf::{Bsdf, BsdfSample};
 pub use error::BrdfError;
 pub use frame::Frame;

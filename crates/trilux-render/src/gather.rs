@@ -80,6 +80,23 @@ pub struct BsdfSample<const N: usize> {
     pub pdf: f64,
 }
 
+/// A gather hit whose BSDF lobe subtends less than this solid angle (sr)
+/// is near-specular: the path continues through it instead of reading the
+/// solution there ([`FinalGather::gather`]; a roughconductor lobe of
+/// roughness α subtends about 4πα², so this is α below about 0.056;
+/// docs/rendering.md, "Near-specular surfaces").
+pub const NEAR_SPECULAR_SR: f64 = 0.04;
+
+/// The most gather levels a path continues through near-specular hits
+/// (a closed mirror box reflects a path until it meets the light; after
+/// this many levels the solution is read).
+pub const MAX_SPECULAR_LEVELS: u32 = 48;
+
+/// First sample dimension of gather levels beyond the third (the first
+/// three use [`dims::GATHER`] onwards; the dimensions after them belong
+/// to the link gather).
+const DEEP_LEVELS: u32 = 256;
+
 /// When to continue a gather path one bounce before reading the solution.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub enum ExtraBounce {
@@ -361,7 +378,11 @@ impl<'a, S> FinalGather<'a, S> {
         S: GatherScene<N>,
     {
         let scene = self.scene;
-        let base = dims::GATHER + level * dims::PER_LEVEL;
+        let base = if level < 3 {
+            dims::GATHER + level * dims::PER_LEVEL
+        } else {
+            DEEP_LEVELS + level * dims::PER_LEVEL
+        };
         let mut l = bands::zero::<N>();
 
         // 1. Light sampling with a shadow ray.
@@ -413,8 +434,11 @@ impl<'a, S> FinalGather<'a, S> {
             l = bands::add(l, bands::scale(bands::mul(bs.weight, le), w));
         }
         // Reflected radiance at the gather hit: the solution, or one more
-        // bounce where its steps would show.
-        let lr = if level == 0 && self.wants_extra_bounce(x, wo, &xd) {
+        // bounce where its steps would show, or through a near-specular
+        // hit (whose lobe the solution cannot resolve).
+        let specular =
+            level < MAX_SPECULAR_LEVELS && scene.lobe_solid_angle(&xd, back) < NEAR_SPECULAR_SR;
+        let lr = if specular || (level == 0 && self.wants_extra_bounce(x, wo, &xd)) {
             stats.extra_bounces += 1;
             self.gather(&xd, back, level + 1, sampler, stats)
         } else {

@@ -40,26 +40,35 @@ const LOBE_SAMPLES: u32 = 64;
 /// coverage of the target).
 const CLOSED_COVERAGE: f64 = 0.9;
 
-/// The per-band scale of a group's glossy flux `glossy`: towards `target`
-/// (within [`MAX_RENORMALISATION`]), and never beyond `room`, what arrived
-/// less the Lambertian share.
+/// The per-band scales of a group's glossy flux: of `glossy`, the flux of
+/// its midpoint-rule links, towards `target` less what the sampled links
+/// carry (within [`MAX_RENORMALISATION`]); of `sampled`, the flux of its
+/// sampled links (docs/solver.md, "Narrow lobes"), 1, as sampling already
+/// conserves energy. Both are lowered alike if together they would exceed
+/// `room`, what arrived less the Lambertian share.
 pub(crate) fn group_scale<const N: usize>(
     target: Option<Spectrum<N>>,
     glossy: Spectrum<N>,
+    sampled: Spectrum<N>,
     room: Spectrum<N>,
-) -> Spectrum<N> {
-    Spectrum::<N>::new(std::array::from_fn(|b| {
-        let mut f = 1.0;
+) -> (Spectrum<N>, Spectrum<N>) {
+    let mut mid = Spectrum::<N>::splat(1.0);
+    let mut smp = Spectrum::<N>::splat(1.0);
+    for b in 0..N {
         if let Some(t) = target
             && glossy[b] > 0.0
         {
-            f = (t[b] / glossy[b]).clamp(1.0 / MAX_RENORMALISATION, MAX_RENORMALISATION);
+            let want = (t[b] - sampled[b]).max(0.0);
+            mid[b] = (want / glossy[b]).clamp(1.0 / MAX_RENORMALISATION, MAX_RENORMALISATION);
         }
-        if glossy[b] * f > room[b] && glossy[b] > 0.0 {
-            f = room[b] / glossy[b];
+        let total = glossy[b] * mid[b] + sampled[b];
+        if total > room[b] && total > 0.0 {
+            let f = room[b].max(0.0) / total;
+            mid[b] *= f;
+            smp[b] *= f;
         }
-        f
-    }))
+    }
+    (mid, smp)
 }
 
 impl<const N: usize> Solver<N> {

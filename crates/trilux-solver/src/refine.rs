@@ -24,13 +24,18 @@
 //! across the parallel tasks of one shot.
 
 use std::f64::consts::PI;
+use std::sync::{Arc, OnceLock};
 
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 use trilux_brdf::area::Element as Driver;
-use trilux_brdf::{Bsdf, ElementPoints, brdf_variation};
+use trilux_brdf::{
+    AlbedoTable, Bsdf, ElementPoints, LobeSample, brdf_variation, is_narrow, lobe_width,
+    sample_glossy_lobe,
+};
 use trilux_color::Spectrum;
 use trilux_geometry::{
-    ElementForest, ElementId, FaceElement, FaceId, PerFace, Side, Sided, Visibility,
+    ElementForest, ElementId, FaceElement, FaceId, PerFace, Ray, Side, Sided, SurfaceCoord,
+    Visibility,
 };
 
 use crate::faces::TransportFace;
@@ -175,12 +180,42 @@ pub(crate) struct NodeLink<const N: usize> {
     pub group: u32,
     /// ΔL^G = δL_ij · R(i→j→k) (paper §4.2, step 2).
     pub gathered: Spectrum<N>,
+    /// R was estimated by sampling the lobe (docs/solver.md, "Narrow
+    /// lobes"): the link's flux already conserves energy and is not
+    /// renormalised.
+    pub sampled: bool,
 }
+
+/// Where one sampled direction of j's glossy lobe (for light from i) met
+/// the scene, and the share of the light arriving at j it carries.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct LobeHit<const N: usize> {
+    /// The face hit (the side the ray arrived on).
+    pub face: FaceId,
+    /// The point hit, in its surface's coordinates.
+    pub coord: SurfaceCoord,
+    /// Its share of the flux arriving at j (sums to at most j's glossy
+    /// albedo over all hits).
+    pub share: Spectrum<N>,
+}
+
+/// Stratified points over j (and over i, paired with them) from which the
+/// lobe of a pair (i, j) is sampled, as a side of a square grid.
+const LOBE_POINT_GRID: u32 = 4;
+/// Directions sampled per point of j, as a side of a square grid.
+const LOBE_DIRECTION_GRID: u32 = 2;
+/// The fewest sampled hits in a receiver for its footprint (where in K the
+/// lobe lands) to be trusted enough to split K for it.
+const FOOTPRINT_MIN_HITS: usize = 8;
+/// The largest share of a sampled link's flux allowed to land in one
+/// quadrant of K beyond that quadrant's share of K's area before K is
+/// split (docs/solver.md, "Narrow lobes").
+const FOOTPRINT_TOLERANCE: f64 = 0.25;
 
 /// What a three-point link (i j) → (j k) takes from its pair (i, j), the
 /// same for every receiver node k: computed once per pair link and handed
 /// down the K-side recursion.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub(crate) struct Incidence<const N: usize> {
     /// T_ij.
     tij: Throughput,
@@ -191,6 +226,10 @@ pub(crate) struct Incidence<const N: usize> {
     incoming: Option<Incoming>,
     /// i has points on both sides of j's tangent plane.
     straddle_i: bool,
+    /// The sampled lobe of the pair (docs/solver.md, "Narrow lobes"),
+    /// traced when a link first needs it and shared by every hierarchy the
+    /// pair link feeds.
+    lobe: Arc<OnceLock<Vec<LobeHit<N>>>>,
 }
 
 impl<const N: usize> Incidence<N> {
@@ -275,6 +314,8 @@ pub(crate) struct RefineContext<'a, const N: usize> {
     pub textures: Option<&'a ElementTextures<N>>,
     /// The cluster hierarchy and every face's cut (`cluster_transport`).
     pub clusters: &'a crate::cluster_transport::Clusters,
+    /// Directional albedo per material (the sampled lobes' scale).
+    pub albedo: &'a [AlbedoTable<N>],
 }
 
 impl<'a, const N: usize> RefineContext<'a, N> {
@@ -689,6 +730,138 @@ impl<const N: usize> RefineContext<'_, N> {
                 .incident(&frame, i.element, j.element, j.side.sign())
                 .map(|wi| Incoming { frame, wi }),
             straddle_i: self.straddles(i.element, j.element),
+            lobe: Arc::new(OnceLock::new()),
+        })
+    }
+
+    /// The sampled glossy lobe of the pair (i, j) (docs/solver.md, "Narrow
+    /// lobes"): from stratified points y over j, each lit from a point of i
+    /// (paired stratum by stratum, so that both areas are averaged),
+    /// [`LOBE_DIRECTION_GRID`]² directions of fr_glossy cos at y, each
+    /// traced to the first surface it meets. The shares are normalised per
+    /// point to the glossy albedo there, so they sum to at most the glossy
+    /// albedo (what leaves through the open part of the hemisphere, or
+    /// towards a face without stored interactions, is left out).
+    fn lobe_hits(&self, sj: FaceId, i: ElementId, j: ElementId) -> Vec<LobeHit<N>> {
+        let geom = self.forest.geometry();
+        let shape = self.faces[sj].shape;
+        let bsdf = &self.materials[shape];
+        let side = sj.side();
+        let sign = side.sign();
+        let eps = 1e-7 * geom.bounds().diagonal().length();
+        let n = LOBE_POINT_GRID;
+        let points = f64::from(n * n);
+        let mut out = Vec::new();
+        let mut samples: Vec<LobeSample<N>> = Vec::new();
+        for a in 0..n {
+            for b in 0..n {
+                let u = DVec2::new(
+                    (f64::from(a) + 0.5) / f64::from(n),
+                    (f64::from(b) + 0.5) / f64::from(n),
+                );
+                // i's stratum: the grid transposed and shifted, so that
+                // the pairs are not aligned.
+                let v = DVec2::new(
+                    (f64::from((b + 1) % n) + 0.5) / f64::from(n),
+                    (f64::from((a + 2) % n) + 0.5) / f64::from(n),
+                );
+                let y = self.forest.sample_element(j, u);
+                let x = self.forest.sample_element(i, v);
+                let frame = trilux_brdf::Frame::from_normal(y.normal);
+                let wi = frame.to_local((x.point - y.point).normalize_or_zero());
+                if wi.z * sign <= 0.0 {
+                    continue;
+                }
+                let glossy_albedo = (self.albedo[shape].albedo(wi) - bsdf.diffuse_albedo(side))
+                    .max(Spectrum::zero());
+                samples.clear();
+                sample_glossy_lobe(
+                    bsdf,
+                    wi,
+                    glossy_albedo,
+                    LOBE_DIRECTION_GRID,
+                    1.0 / points,
+                    &mut samples,
+                );
+                let origin = y.point + y.normal * (sign * eps);
+                for smp in &samples {
+                    let ray = Ray {
+                        origin,
+                        dir: frame.to_world(smp.wo),
+                    };
+                    let Some(hit) = geom.intersect(&ray, f64::INFINITY) else {
+                        continue;
+                    };
+                    out.push(LobeHit {
+                        face: FaceId::new(hit.surface, Side::from_back(!hit.front_facing(&ray))),
+                        coord: hit.coord,
+                        share: smp.share,
+                    });
+                }
+            }
+        }
+        out
+    }
+
+    /// The sampled lobe's share that lands in element k of face `to`, with
+    /// the hits there; `None` when the lobe is not sampled for this link
+    /// (it is not narrow against K; docs/solver.md, "Narrow lobes").
+    fn sampled_share(
+        &self,
+        known: &Incidence<N>,
+        (sj, i, j): (FaceId, ElementId, ElementId),
+        to: FaceId,
+        k: ElementId,
+    ) -> Option<(Spectrum<N>, Vec<LobeHit<N>>)> {
+        if self.settings.transport != Transport::TwoPoint {
+            return None;
+        }
+        let bsdf = &self.materials[self.faces[sj].shape];
+        let width = lobe_width(bsdf, sj.side())?;
+        let (ej, ek) = (self.forest.element(j), self.forest.element(k));
+        let dist = (ek.centre - ej.centre).length();
+        let radius = 0.5 * ek.bounds.diagonal().length();
+        let angular_radius = if dist > radius {
+            (radius / dist).asin()
+        } else {
+            std::f64::consts::FRAC_PI_2
+        };
+        if !is_narrow(width, angular_radius) {
+            return None;
+        }
+        let hits = known.lobe.get_or_init(|| self.lobe_hits(sj, i, j));
+        let inside: Vec<LobeHit<N>> = hits
+            .iter()
+            .filter(|h| h.face == to && self.forest.element_contains(k, h.coord))
+            .copied()
+            .collect();
+        let share = inside.iter().fold(Spectrum::zero(), |acc, h| acc + h.share);
+        Some((share, inside))
+    }
+
+    /// True when the sampled lobe lands unevenly over K's quadrants: some
+    /// quadrant receives a share of the hits' flux more than
+    /// [`FOOTPRINT_TOLERANCE`] beyond its share of K's area, so piecewise
+    /// constant radiance over K would put the light in the wrong place.
+    fn footprint_uneven(&self, k: ElementId, inside: &[LobeHit<N>]) -> bool {
+        if inside.len() < FOOTPRINT_MIN_HITS {
+            return false;
+        }
+        let Some(children) = self.forest.element(k).children() else {
+            return false;
+        };
+        let total: f64 = inside.iter().map(|h| h.share.sum()).sum();
+        let area = self.forest.element(k).area;
+        if !(total > 0.0 && area > 0.0) {
+            return false;
+        }
+        children.iter().any(|&c| {
+            let got: f64 = inside
+                .iter()
+                .filter(|h| self.forest.element_contains(c, h.coord))
+                .map(|h| h.share.sum())
+                .sum();
+            got / total - self.forest.element(c).area / area > FOOTPRINT_TOLERANCE
         })
     }
 
@@ -708,6 +881,7 @@ impl<const N: usize> RefineContext<'_, N> {
         let Some(known) = known.or_else(|| self.incidence(task.sender, si.of(i), sj.of(j))) else {
             return;
         };
+        let known = &known;
         let node = &task.h.nodes[n as usize];
         debug_assert_eq!(node.from, j);
         let (k, tjk, vjk, spread_jk) = (node.to, node.t, node.v, node.spread);
@@ -730,6 +904,40 @@ impl<const N: usize> RefineContext<'_, N> {
             self.split_across_plane(task, i, j, n, known, straddle_k);
             return;
         };
+        // A lobe narrow against K: its sampled share that lands in K
+        // (docs/solver.md, "Narrow lobes").
+        if let Some((share, inside)) = self.sampled_share(known, (sj, i, j), task.h.to, k) {
+            let g = self
+                .textures
+                .map_or(Spectrum::splat(1.0), |t| t.glossy(sj, j));
+            // The flux on towards k is π T_ij δL · share, so ΔL^G = δL ·
+            // share · T_ij / T_jk.
+            let gathered = known.unshot * share * g * (known.tij.t / tjk);
+            let link = NodeLink {
+                hierarchy: task.h_index,
+                node: n,
+                group: task.group,
+                gathered,
+                sampled: true,
+            };
+            if PI * tjk * gathered.sum() < self.flux_threshold {
+                task.push(link);
+                return;
+            }
+            let errors = TripleErrors {
+                // Where in K the lobe lands, not fr's variation, decides.
+                brdf: if self.footprint_uneven(k, &inside) {
+                    2.0
+                } else {
+                    0.0
+                },
+                ff: spread_jk / self.settings.ff_eps,
+                partial: (vjk > 0.0 && vjk < 1.0) || straddle_k,
+                driver: Driver::K,
+            };
+            self.link_or_split(task, (i, j, n), known, link, errors);
+            return;
+        }
         // A textured j: its glossy part is g(j) times the nominal one.
         let (fr, texture_variation) = match self.textures {
             Some(t) => (fr * t.glossy(sj, j), t.glossy_variation(self.forest, sj, j)),
@@ -741,8 +949,9 @@ impl<const N: usize> RefineContext<'_, N> {
             node: n,
             group: task.group,
             gathered,
+            sampled: false,
         };
-        if self.below_photometric(bsdf, &known, j, &task.h.nodes[n as usize], aj, gathered) {
+        if self.below_photometric(bsdf, known, j, &task.h.nodes[n as usize], aj, gathered) {
             task.push(link);
             return;
         }
@@ -779,7 +988,7 @@ impl<const N: usize> RefineContext<'_, N> {
         i: ElementId,
         j: ElementId,
         n: u32,
-        known: Incidence<N>,
+        known: &Incidence<N>,
     ) {
         let k = task.h.nodes[n as usize].to;
         let (ej, ek) = (self.forest.element(j), self.forest.element(k));
@@ -805,7 +1014,7 @@ impl<const N: usize> RefineContext<'_, N> {
         i: ElementId,
         j: ElementId,
         n: u32,
-        known: Incidence<N>,
+        known: &Incidence<N>,
         straddle_k: bool,
     ) {
         let k = task.h.nodes[n as usize].to;
@@ -860,7 +1069,7 @@ impl<const N: usize> RefineContext<'_, N> {
         &self,
         task: &mut TripleTask<'_, N>,
         (i, j, n): (ElementId, ElementId, u32),
-        known: Incidence<N>,
+        known: &Incidence<N>,
         link: NodeLink<N>,
         e: TripleErrors,
     ) {
@@ -910,7 +1119,7 @@ impl<const N: usize> RefineContext<'_, N> {
         i: ElementId,
         j: ElementId,
         n: u32,
-        known: Incidence<N>,
+        known: &Incidence<N>,
     ) -> bool {
         let node_split = task.h.nodes[n as usize].split;
         let which = match (which, node_split) {
@@ -934,7 +1143,7 @@ impl<const N: usize> RefineContext<'_, N> {
                     return false;
                 };
                 for c in nodes {
-                    self.refine_triple(task, i, j, c, Some(known));
+                    self.refine_triple(task, i, j, c, Some(known.clone()));
                 }
                 true
             }

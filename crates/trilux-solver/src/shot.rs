@@ -47,6 +47,7 @@ macro_rules! refine_context {
             exposed_area: &$s.exposed_area,
             textures: $s.textures.as_ref(),
             clusters: &$s.clusters,
+            albedo: &$s.albedo,
         }
     };
 }
@@ -299,14 +300,15 @@ impl<const N: usize> Solver<N> {
         &mut self,
         node_links: &[NodeLink<N>],
         shot_scale: Spectrum<N>,
-        group_scale: &[Spectrum<N>],
+        group_scale: &[(Spectrum<N>, Spectrum<N>)],
     ) {
         for nl in node_links {
             let Some(hier) = self.hierarchies[nl.hierarchy as usize].as_mut() else {
                 continue;
             };
             let node = &mut hier.nodes[nl.node as usize];
-            let dl = nl.gathered * shot_scale * group_scale[nl.group as usize];
+            let (midpoint, sampled) = group_scale[nl.group as usize];
+            let dl = nl.gathered * shot_scale * if nl.sampled { sampled } else { midpoint };
             node.gathered += dl;
             let t = node.t;
             hier.unshot_flux += dl * (PI * t);
@@ -441,12 +443,12 @@ fn stage_two<const N: usize>(
             };
             for &g in &groups_of_face[&from] {
                 let l = &pair_links[g as usize];
-                let Some(incidence) = incidences[g as usize] else {
+                let Some(incidence) = &incidences[g as usize] else {
                     continue;
                 };
                 task.group = g;
                 for n in ctx.nodes_for(task.h, l.j, &mut task.lost) {
-                    ctx.refine_triple(&mut task, l.i, l.j, n, Some(incidence));
+                    ctx.refine_triple(&mut task, l.i, l.j, n, Some(incidence.clone()));
                 }
             }
             (task.out, h as u32, task.lost)
@@ -468,12 +470,21 @@ impl<const N: usize> Solver<N> {
         node_links: &[NodeLink<N>],
         shot_scale: Spectrum<N>,
         phi: Spectrum<N>,
-    ) -> Vec<Spectrum<N>> {
+    ) -> Vec<(Spectrum<N>, Spectrum<N>)> {
+        // Per group, the glossy flux of midpoint-rule links (renormalised)
+        // and of sampled links (already conserving: docs/solver.md,
+        // "Narrow lobes").
         let mut glossy_flux = vec![Spectrum::<N>::zero(); pair_links.len()];
+        let mut sampled_flux = vec![Spectrum::<N>::zero(); pair_links.len()];
         for nl in node_links {
             if let Some(h) = &self.hierarchies[nl.hierarchy as usize] {
                 let t = h.nodes[nl.node as usize].t;
-                glossy_flux[nl.group as usize] += nl.gathered * shot_scale * (PI * t);
+                let flux = nl.gathered * shot_scale * (PI * t);
+                if nl.sampled {
+                    sampled_flux[nl.group as usize] += flux;
+                } else {
+                    glossy_flux[nl.group as usize] += flux;
+                }
             }
         }
         // The glossy share each group reflects into its face's far field
@@ -490,7 +501,8 @@ impl<const N: usize> Solver<N> {
                 }
             }
         }
-        let mut group_scale = vec![Spectrum::<N>::splat(1.0); pair_links.len()];
+        let mut group_scale =
+            vec![(Spectrum::<N>::splat(1.0), Spectrum::splat(1.0)); pair_links.len()];
         let mut total_arrived = Spectrum::<N>::zero();
         let mut absorbed = Spectrum::<N>::zero();
         for (g, l) in pair_links.iter().enumerate() {
@@ -507,11 +519,11 @@ impl<const N: usize> Solver<N> {
             };
             // What an element reflects may not exceed what arrived there.
             let room = (arrived - diffuse).max(Spectrum::zero());
-            let glossy = glossy_flux[g];
+            let (glossy, sampled) = (glossy_flux[g], sampled_flux[g]);
             let target = self.glossy_target(l, incidences[g].as_ref(), arrived, glossy);
-            let scale = crate::glossy::group_scale(target, glossy, room);
+            let scale = crate::glossy::group_scale(target, glossy, sampled, room);
             group_scale[g] = scale;
-            let absorbed_g = arrived - diffuse - glossy * scale;
+            let absorbed_g = arrived - diffuse - glossy * scale.0 - sampled * scale.1;
             self.ledger.min_element_absorbed = self
                 .ledger
                 .min_element_absorbed
@@ -527,7 +539,7 @@ impl<const N: usize> Solver<N> {
                 continue;
             };
             for (b, dl) in field.blocks.iter_mut().zip(adds) {
-                let dl = dl * group_scale[g];
+                let dl = dl * group_scale[g].0;
                 b.radiance += dl;
                 b.unshot += dl;
                 field.unshot_flux += dl * (PI * b.t);

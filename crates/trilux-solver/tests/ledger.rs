@@ -17,18 +17,21 @@ fn material() -> impl Strategy<Value = BsdfParams> {
     let diffuse = (0.0..0.95f64).prop_map(|r| BsdfParams::Diffuse {
         reflectance: ColorParam::Float(r),
     });
-    let conductor = (0.01..1.0f64, any::<bool>(), 0.3..1.0f64).prop_map(|(alpha, ggx, spec)| {
-        BsdfParams::RoughConductor(RoughConductorParams {
-            distribution: if ggx {
-                Distribution::Ggx
-            } else {
-                Distribution::Beckmann
-            },
-            alpha,
-            eta_k: None,
-            specular_reflectance: ColorParam::Float(spec),
-        })
-    });
+    // α log-uniform from 1e-4 (near mirrors, sampled lobes) to 1.
+    let conductor =
+        (-4.0..0.0f64, any::<bool>(), 0.3..1.0f64).prop_map(|(log_alpha, ggx, spec)| {
+            let alpha = 10f64.powf(log_alpha);
+            BsdfParams::RoughConductor(RoughConductorParams {
+                distribution: if ggx {
+                    Distribution::Ggx
+                } else {
+                    Distribution::Beckmann
+                },
+                alpha,
+                eta_k: None,
+                specular_reflectance: ColorParam::Float(spec),
+            })
+        });
     prop_oneof![
         diffuse.clone(),
         conductor.clone(),

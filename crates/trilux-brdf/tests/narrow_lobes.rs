@@ -1,0 +1,177 @@
+//! The sampled area reflectance of narrow lobes (docs/solver.md, "Narrow
+//! lobes"): `sample_glossy_lobe` shares are non-negative, sum to the glossy
+//! albedo and so never to more over receivers that do not overlap, and the
+//! flux they carry between two receivers is reciprocal.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
+
+mod common;
+
+use std::f64::consts::PI;
+
+use glam::DVec3;
+use proptest::prelude::*;
+use trilux_brdf::{
+    AlbedoTable, Bsdf, BsdfParams, Distribution, Frame, Side, is_narrow, lobe_width,
+    sample_glossy_lobe,
+};
+
+fn material() -> impl Strategy<Value = BsdfParams> {
+    // α drawn log-uniformly down to 1e-4 (near mirrors), half of them
+    // blended with a diffuse part.
+    (-4.0..0.0f64, 0.0..=1.0f64, any::<bool>(), any::<bool>()).prop_map(|(la, w, ggx, blend)| {
+        let d = if ggx {
+            Distribution::Ggx
+        } else {
+            Distribution::Beckmann
+        };
+        let g = common::gold(d, 10f64.powf(la));
+        if blend {
+            BsdfParams::Blend {
+                weight: w,
+                first: Box::new(common::diffuse(0.5)),
+                second: Box::new(g),
+            }
+        } else {
+            g
+        }
+    })
+}
+
+/// A direction from its polar angle's cosine and its azimuth.
+fn direction(z: f64, phi: f64) -> DVec3 {
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    DVec3::new(r * phi.cos(), r * phi.sin(), z)
+}
+
+/// The glossy albedo the solver uses: the table less the Lambertian part.
+fn glossy_albedo(b: &Bsdf<3>, table: &AlbedoTable<3>, wi: DVec3) -> trilux_color::Spectrum<3> {
+    let side = if wi.z > 0.0 { Side::Front } else { Side::Back };
+    (table.albedo(wi) - b.diffuse_albedo(side)).max(trilux_color::Spectrum::zero())
+}
+
+/// The flux that a cone of directions `from` (axis, angular radius) sends
+/// through the reflector into the cone `to`, per unit radiance:
+/// (1/π) ∫_{Ω_from} cos θ_i ∫_{Ω_to} fr cos θ_o, the incident directions
+/// on a stratified grid over the cone, each lobe sampled.
+fn cone_transfer(
+    b: &Bsdf<3>,
+    table: &AlbedoTable<3>,
+    from: (DVec3, f64),
+    to: (DVec3, f64),
+    n: u32,
+) -> f64 {
+    let (axis, radius) = from;
+    let frame = Frame::from_normal(axis);
+    let cos_r = radius.cos();
+    let mut sum = 0.0;
+    let mut samples = Vec::new();
+    for a in 0..n {
+        for c in 0..n {
+            // Uniform in solid angle over the cone.
+            let z = 1.0 - (f64::from(a) + 0.5) / f64::from(n) * (1.0 - cos_r);
+            let phi = (f64::from(c) + 0.5) / f64::from(n) * 2.0 * PI;
+            let wi = frame.to_world(direction(z, phi));
+            if wi.z <= 0.0 {
+                continue;
+            }
+            let dw = 2.0 * PI * (1.0 - cos_r) / f64::from(n * n);
+            samples.clear();
+            sample_glossy_lobe(b, wi, glossy_albedo(b, table, wi), 8, 1.0, &mut samples);
+            let into: f64 = samples
+                .iter()
+                .filter(|s| s.wo.dot(to.0) >= to.1.cos())
+                .map(|s| s.share[1])
+                .sum();
+            sum += wi.z * dw / PI * into;
+        }
+    }
+    sum
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(200))]
+
+    /// Over receivers that tile the sphere of directions (a latitude ×
+    /// longitude grid of any size), the shares are finite, non-negative and
+    /// sum to exactly the glossy albedo: never more.
+    #[test]
+    fn shares_conserve_energy(p in material(), z in 0.02..1.0f64, phi in 0.0..6.3f64,
+                              back in any::<bool>(), grid in 1u32..9,
+                              rows in 1usize..12, cols in 1usize..12) {
+        let b = Bsdf::<3>::new(&p).unwrap();
+        let mut wi = direction(z, phi);
+        if back {
+            wi.z = -wi.z;
+        }
+        let albedo = glossy_albedo(&b, &b.albedo_table(), wi);
+        let mut samples = Vec::new();
+        sample_glossy_lobe(&b, wi, albedo, grid, 1.0, &mut samples);
+        let mut cells = vec![[0.0f64; 3]; rows * cols];
+        for s in &samples {
+            prop_assert!(s.share.is_finite() && s.share.is_non_negative());
+            prop_assert!(s.wo.z * wi.z > 0.0, "a sample left on the other side");
+            let row = (((s.wo.z + 1.0) * 0.5 * rows as f64) as usize).min(rows - 1);
+            let col = (((s.wo.y.atan2(s.wo.x) + PI) / (2.0 * PI) * cols as f64) as usize).min(cols - 1);
+            for (q, c) in cells[row * cols + col].iter_mut().enumerate() {
+                *c += s.share[q];
+            }
+        }
+        for q in 0..3 {
+            let total: f64 = cells.iter().map(|c| c[q]).sum();
+            prop_assert!(cells.iter().all(|c| c[q] >= 0.0));
+            prop_assert!(total <= albedo[q] * (1.0 + 1e-12) + 1e-15,
+                "Σ shares {} > glossy albedo {}", total, albedo[q]);
+            if !samples.is_empty() && albedo[q] > 0.0 {
+                prop_assert!((total - albedo[q]).abs() <= 1e-9 * albedo[q]);
+            }
+        }
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(12))]
+
+    /// Reciprocity of the sampled transfer for narrow lobes: the flux from
+    /// a cone I into a cone K near I's mirror direction equals the flux
+    /// from K into I (both are ∫∫ fr cos cos, symmetric by fr's
+    /// reciprocity), to the sampling's accuracy.
+    #[test]
+    fn sampled_transfer_is_reciprocal(la in -4.0..-1.5f64, ggx in any::<bool>(),
+                                      z in 0.3..0.95f64, phi in 0.0..6.3f64,
+                                      radius in 0.08..0.2f64, off in 0.0..0.5f64,
+                                      turn in 0.0..6.3f64) {
+        let d = if ggx { Distribution::Ggx } else { Distribution::Beckmann };
+        let b = Bsdf::<3>::new(&common::gold(d, 10f64.powf(la))).unwrap();
+        let di = direction(z, phi);
+        let mirror = DVec3::new(-di.x, -di.y, di.z);
+        // K's axis: the mirror direction moved by up to half the radius.
+        let f = Frame::from_normal(mirror);
+        let dk = f.to_world(direction((off * radius).cos(), turn)).normalize();
+        prop_assume!(dk.z > radius.sin() + 0.05);
+        let table = b.albedo_table();
+        let a = cone_transfer(&b, &table, (di, radius), (dk, radius), 48);
+        let c = cone_transfer(&b, &table, (dk, radius), (di, radius), 48);
+        prop_assert!(a > 0.0 && c > 0.0);
+        prop_assert!((a - c).abs() <= 0.05 * a.max(c), "I→K {a}, K→I {c}");
+    }
+}
+
+/// The narrow/wide rule: a lobe is sampled exactly when it is narrower than
+/// an eighth of the receiver's angular radius; a mirror-like lobe is
+/// narrow against any element but the tiniest, a lobe of α ≥ 0.1 against
+/// none.
+#[test]
+fn the_rule_compares_width_and_angular_radius() {
+    let w = |a: f64| {
+        lobe_width(
+            &Bsdf::<3>::new(&common::conductor(Distribution::Ggx, a)).unwrap(),
+            Side::Front,
+        )
+        .unwrap()
+    };
+    assert!(is_narrow(w(1e-4), 1e-2));
+    assert!(!is_narrow(w(1.0), std::f64::consts::FRAC_PI_2));
+    assert!(!is_narrow(w(0.1), std::f64::consts::FRAC_PI_2));
+    assert!(is_narrow(w(0.01), 0.2) && !is_narrow(w(0.015), 0.2));
+    assert!(lobe_width(&Bsdf::<3>::new(&common::diffuse(0.5)).unwrap(), Side::Front).is_none());
+}
