@@ -18,6 +18,7 @@
 //! × 2^exposure. The scene's camera, when it has one, is the file's first
 //! camera.
 
+use std::collections::BTreeMap;
 use std::time::Instant;
 
 use glam::DVec3;
@@ -223,9 +224,17 @@ fn write_shape<const N: usize>(
         }
     }
     let shared = SharedAttributes::write(doc, mesh, sides.iter().any(|l| l.map.is_some()));
+    let surfaces = by_surface(input.solution.forest(), mesh);
     let mut primitives = Vec::new();
     for light in sides {
-        primitives.extend(side_primitives(doc, input, mesh, light, &shared, scale)?);
+        primitives.extend(side_primitives(
+            doc,
+            input,
+            mesh.shape,
+            light,
+            (&shared, &surfaces),
+            scale,
+        )?);
     }
     let name = shape_name(input.names, mesh.shape);
     doc.nodes
@@ -276,9 +285,9 @@ impl SharedAttributes {
 fn side_primitives<const N: usize>(
     doc: &mut Document,
     input: &BakeInput<'_, N>,
-    mesh: &ShapeMesh,
+    shape: u32,
     light: &SideLight<'_, N>,
-    shared: &SharedAttributes,
+    (shared, surfaces): (&SharedAttributes, &[SurfaceTriangles]),
     scale: f64,
 ) -> Result<Vec<Value>, BakeError> {
     let side = light.side;
@@ -290,7 +299,7 @@ fn side_primitives<const N: usize>(
         .collect();
     let (radiance, display) = (doc.vec3(&radiance, false), doc.vec3(&display, false));
     let material = doc.materials.len();
-    let mut m = material_of(input, mesh.shape, side);
+    let mut m = material_of(input, shape, side);
     if let Some(map) = &light.map {
         let png = map.png().map_err(|e| BakeError::Image(e.to_string()))?;
         let texture = doc.png_texture(&png, map.sampler());
@@ -308,10 +317,10 @@ fn side_primitives<const N: usize>(
         attributes["TEXCOORD_0"] = json!(uv);
     }
     let mut primitives = Vec::new();
-    for (surface, triangles) in by_surface(input.solution.forest(), mesh) {
+    for (surface, triangles) in surfaces {
         let triangles: Vec<[u32; 3]> = match side {
-            Side::Front => triangles,
-            Side::Back => triangles.into_iter().map(|[a, b, c]| [a, c, b]).collect(),
+            Side::Front => triangles.clone(),
+            Side::Back => triangles.iter().map(|&[a, b, c]| [a, c, b]).collect(),
         };
         primitives.push(json!({
             "attributes": attributes,
@@ -324,18 +333,19 @@ fn side_primitives<const N: usize>(
     Ok(primitives)
 }
 
-/// The mesh's triangles by input surface, in surface order.
-fn by_surface(forest: &ElementForest, mesh: &ShapeMesh) -> Vec<(SurfaceId, Vec<[u32; 3]>)> {
-    let mut groups: Vec<(SurfaceId, Vec<[u32; 3]>)> = Vec::new();
+/// An input surface and its triangles in a shape's mesh.
+type SurfaceTriangles = (SurfaceId, Vec<[u32; 3]>);
+
+/// The mesh's triangles by input surface, in surface order (one pass).
+fn by_surface(forest: &ElementForest, mesh: &ShapeMesh) -> Vec<SurfaceTriangles> {
+    let mut groups: BTreeMap<u32, Vec<[u32; 3]>> = BTreeMap::new();
     for (tri, &owner) in mesh.triangles.iter().zip(&mesh.owners) {
-        let surface = forest.element(owner).surface;
-        match groups.iter_mut().find(|(s, _)| *s == surface) {
-            Some((_, list)) => list.push(*tri),
-            None => groups.push((surface, vec![*tri])),
-        }
+        groups
+            .entry(forest.element(owner).surface.0)
+            .or_default()
+            .push(*tri);
     }
-    groups.sort_by_key(|(s, _)| s.0);
-    groups
+    groups.into_iter().map(|(s, t)| (SurfaceId(s), t)).collect()
 }
 
 fn shape_name(names: &[Option<String>], shape: u32) -> String {
@@ -427,23 +437,22 @@ impl FluxCheck {
         light: &SideLight<'_, N>,
     ) {
         let forest = solution.forest();
+        let baked = baked_flux(
+            mesh,
+            &light.values,
+            |leaf| light.weight(solution, leaf),
+            |leaf| forest.element(leaf).surface.0,
+        );
         for surface in forest.geometry().surfaces_of_shape(mesh.shape) {
-            let baked = baked_flux(
-                mesh,
-                &light.values,
-                |leaf| light.weight(solution, leaf),
-                |leaf| forest.element(leaf).surface == surface,
-            );
-            let face = FaceId::new(surface, side);
             let exact: f64 = forest
                 .leaves(forest.root(surface))
                 .into_iter()
                 .map(|leaf| {
-                    let l = solution.face_radiance(face, leaf).to_linear_srgb();
-                    l.iter().map(|x| x.max(0.0)).sum::<f64>() * solution.exposed_area(face, leaf)
+                    leaf_value(solution, side, leaf).iter().sum::<f64>() * forest.element(leaf).area
                 })
                 .sum();
-            self.pairs.push((baked.iter().sum(), exact));
+            let baked = baked.get(&surface.0).map_or(0.0, |f| f.iter().sum());
+            self.pairs.push((baked, exact));
         }
     }
 

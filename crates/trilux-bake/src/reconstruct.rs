@@ -24,6 +24,8 @@
 //! leaf: there the colour is the leaf's value exactly (a parametric leaf's
 //! centre, a one-piece chart leaf's centroid).
 
+use std::collections::BTreeMap;
+
 use trilux_geometry::ElementId;
 
 use crate::tessellate::ShapeMesh;
@@ -73,23 +75,22 @@ pub fn vertex_values(
 }
 
 /// The flux Σ_T A_T w_T mean(v_T) (without the factor π) of the triangles
-/// of `mesh` whose leaf `keep` accepts, with vertex values `values` and
-/// the weights of [`vertex_values`].
-pub fn baked_flux(
+/// of `mesh`, with vertex values `values` and the weights of
+/// [`vertex_values`], summed by `key` of each triangle's leaf (its input
+/// surface, say), in one pass.
+pub fn baked_flux<K: Ord>(
     mesh: &ShapeMesh,
     values: &[[f64; 3]],
     weight: impl Fn(ElementId) -> [f64; 3],
-    keep: impl Fn(ElementId) -> bool,
-) -> [f64; 3] {
-    let mut flux = [0.0; 3];
+    key: impl Fn(ElementId) -> K,
+) -> BTreeMap<K, [f64; 3]> {
+    let mut flux = BTreeMap::new();
     for (t, (tri, &owner)) in mesh.triangles.iter().zip(&mesh.owners).enumerate() {
-        if !keep(owner) {
-            continue;
-        }
         let (a, w) = (mesh.triangle_area(t) / 3.0, weight(owner));
+        let sum: &mut [f64; 3] = flux.entry(key(owner)).or_insert([0.0; 3]);
         for &v in tri {
             for c in 0..3 {
-                flux[c] += a * w[c] * values[v as usize][c];
+                sum[c] += a * w[c] * values[v as usize][c];
             }
         }
     }
