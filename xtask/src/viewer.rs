@@ -71,15 +71,13 @@ fn scenes() -> Result<Vec<PathBuf>> {
     Ok(all)
 }
 
+/// The material has a glossy part on some side (trilux-brdf's own rule).
 fn glossy(b: &BsdfParams) -> bool {
-    match b {
-        BsdfParams::Diffuse { .. } => false,
-        BsdfParams::RoughConductor(_) => true,
-        BsdfParams::Blend { first, second, .. } => glossy(first) || glossy(second),
-        BsdfParams::TwoSided { front, back } => {
-            glossy(front) || back.as_deref().is_some_and(glossy)
-        }
-    }
+    trilux_brdf::Bsdf::<3>::new(b).is_ok_and(|b| {
+        [trilux_brdf::Side::Front, trilux_brdf::Side::Back]
+            .into_iter()
+            .any(|s| b.has_glossy(s))
+    })
 }
 
 fn name_of(path: &Path) -> String {
