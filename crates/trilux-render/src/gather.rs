@@ -92,11 +92,6 @@ pub const NEAR_SPECULAR_SR: f64 = 0.04;
 /// this many levels the solution is read).
 pub const MAX_SPECULAR_LEVELS: u32 = 48;
 
-/// First sample dimension of gather levels beyond the third (the first
-/// three use [`dims::GATHER`] onwards; the dimensions after them belong
-/// to the link gather).
-const DEEP_LEVELS: u32 = 256;
-
 /// When to continue a gather path one bounce before reading the solution.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub enum ExtraBounce {
@@ -378,11 +373,11 @@ impl<'a, S> FinalGather<'a, S> {
         S: GatherScene<N>,
     {
         let scene = self.scene;
-        let base = if level < 3 {
-            dims::GATHER + level * dims::PER_LEVEL
+        let base = if level < dims::GATHER_LEVELS {
+            dims::GATHER
         } else {
-            DEEP_LEVELS + level * dims::PER_LEVEL
-        };
+            dims::DEEP_GATHER
+        } + level * dims::PER_LEVEL;
         let mut l = bands::zero::<N>();
 
         // 1. Light sampling with a shadow ray.

@@ -22,7 +22,14 @@ pub mod dims {
     pub const PER_LEVEL: u32 = 5;
     /// The cosine-sampled direction of the link gather's glossy-sender term
     /// (2 dimensions per level, three levels, after three gather levels).
-    pub const GLOSSY_SENDERS: u32 = GATHER + 3 * PER_LEVEL;
+    pub const GLOSSY_SENDERS: u32 = GATHER + GATHER_LEVELS * PER_LEVEL;
+    /// Gather levels laid out from [`GATHER`], before the link gather's
+    /// dimensions.
+    pub const GATHER_LEVELS: u32 = 3;
+    /// Dimensions of gather level L ≥ [`GATHER_LEVELS`] (paths continued
+    /// through near-specular hits) start at DEEP_GATHER + L · PER_LEVEL,
+    /// past every dimension the link gather uses.
+    pub const DEEP_GATHER: u32 = 256;
     /// First dimension of the shadow rays of partly visible gather links.
     pub const LINKS: u32 = GLOSSY_SENDERS + 6;
 }
