@@ -24,7 +24,7 @@
 //! across the parallel tasks of one shot.
 
 use std::f64::consts::PI;
-use std::sync::{Arc, OnceLock};
+use std::sync::OnceLock;
 
 use glam::{DVec2, DVec3};
 use trilux_brdf::area::Element as Driver;
@@ -228,8 +228,8 @@ pub(crate) struct Incidence<const N: usize> {
     straddle_i: bool,
     /// The sampled lobe of the pair (docs/solver.md, "Narrow lobes"),
     /// traced when a link first needs it and shared by every hierarchy the
-    /// pair link feeds.
-    lobe: Arc<OnceLock<Vec<LobeHit<N>>>>,
+    /// pair link feeds (they borrow one incidence).
+    lobe: OnceLock<Vec<LobeHit<N>>>,
 }
 
 impl<const N: usize> Incidence<N> {
@@ -730,7 +730,7 @@ impl<const N: usize> RefineContext<'_, N> {
                 .incident(&frame, i.element, j.element, j.side.sign())
                 .map(|wi| Incoming { frame, wi }),
             straddle_i: self.straddles(i.element, j.element),
-            lobe: Arc::new(OnceLock::new()),
+            lobe: OnceLock::new(),
         })
     }
 
@@ -873,15 +873,24 @@ impl<const N: usize> RefineContext<'_, N> {
         i: ElementId,
         j: ElementId,
         n: u32,
-        known: Option<Incidence<N>>,
+        known: Option<&Incidence<N>>,
     ) {
         let (si, sj) = (task.si, task.h.from);
         // T_ij, δL_ij and the incidence at j are the same for every receiver
         // node of one (i, j): the K-side recursion hands them down.
-        let Some(known) = known.or_else(|| self.incidence(task.sender, si.of(i), sj.of(j))) else {
-            return;
+        // A (sub)element of i makes its own incidence; a node below the
+        // pair's receives the pair's.
+        let owned;
+        let known = match known {
+            Some(k) => k,
+            None => {
+                let Some(k) = self.incidence(task.sender, si.of(i), sj.of(j)) else {
+                    return;
+                };
+                owned = k;
+                &owned
+            }
         };
-        let known = &known;
         let node = &task.h.nodes[n as usize];
         debug_assert_eq!(node.from, j);
         let (k, tjk, vjk, spread_jk) = (node.to, node.t, node.v, node.spread);
@@ -1143,7 +1152,7 @@ impl<const N: usize> RefineContext<'_, N> {
                     return false;
                 };
                 for c in nodes {
-                    self.refine_triple(task, i, j, c, Some(known.clone()));
+                    self.refine_triple(task, i, j, c, Some(known));
                 }
                 true
             }

@@ -448,7 +448,7 @@ fn stage_two<const N: usize>(
                 };
                 task.group = g;
                 for n in ctx.nodes_for(task.h, l.j, &mut task.lost) {
-                    ctx.refine_triple(&mut task, l.i, l.j, n, Some(incidence.clone()));
+                    ctx.refine_triple(&mut task, l.i, l.j, n, Some(incidence));
                 }
             }
             (task.out, h as u32, task.lost)
