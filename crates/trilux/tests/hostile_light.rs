@@ -8,7 +8,6 @@
 
 use std::path::Path;
 use std::process::Output;
-use std::time::{Duration, Instant};
 
 mod common;
 use common::hostile::{assert_refused, furnace, s, write};
@@ -81,7 +80,7 @@ fn a_closed_scene_reflecting_everything_is_refused_before_the_solve() {
     let scene = write(&dir, "trapped.xml", furnace("1", "1", 1.0));
     let exr = dir.join("trapped.exr");
     let sol = dir.join("trapped.sol");
-    let start = Instant::now();
+    // One line and no progress: refused by the check before the solve.
     for out in [
         trilux(&["solve", s(&scene), "-o", s(&sol), "--quality", "draft"]),
         render(&scene, &exr, &[]),
@@ -93,11 +92,6 @@ fn a_closed_scene_reflecting_everything_is_refused_before_the_solve() {
             "the scene has no finite solution",
         );
     }
-    assert!(
-        start.elapsed() < Duration::from_secs(4),
-        "{:?}",
-        start.elapsed()
-    );
     assert!(!exr.exists() && !sol.exists());
     // Open it (one face black on its inside: it absorbs) and it solves.
     let open = furnace("1", "1", 1.0).replace(

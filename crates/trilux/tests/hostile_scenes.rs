@@ -2,19 +2,22 @@
 //! "errors a person can act on"): deep nesting, exponential `$name` and
 //! `<ref>` expansion, files that never end or are too large, other
 //! encodings, malformed versions and megabyte values all give one line
-//! `error: FILE:LINE:COL: ...` (status 1), from every command, quickly.
+//! `error: FILE:LINE:COL: ...` (status 1), from every command, without
+//! hanging. (That refusing `<ref>` expansion costs work proportional to
+//! the file, not to its expansion, is tested where the work is done, in
+//! the scene crate's `resolve`.)
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test may panic
 
 use std::path::Path;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 mod common;
-use common::hostile::{mkfifo, s, write};
+use common::hostile::{assert_refused, mkfifo, s, trilux_or_hang, write};
 use common::{folder, trilux};
 
 /// Runs `info`, `solve` and `render` on `scene` and checks each error: one
 /// line starting with `error: {prefix}` and containing `what`, status 1,
-/// no panic, at most 1000 characters, within two seconds.
+/// no panic, at most 1000 characters, and no hang (a minute's guard).
 fn assert_refused_by_every_command(scene: &Path, prefix: &str, what: &str) {
     let dir = scene.parent().unwrap();
     let sol = dir.join("never.sol");
@@ -25,26 +28,14 @@ fn assert_refused_by_every_command(scene: &Path, prefix: &str, what: &str) {
         vec!["render", s(scene), "-o", s(&exr)],
     ];
     for args in commands {
-        let start = Instant::now();
-        let out = trilux(&args);
-        let took = start.elapsed();
+        let out = trilux_or_hang(&args, Duration::from_secs(60));
+        assert_refused(&out, prefix, what);
         let stderr = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(out.status.code(), Some(1), "{args:?}: {stderr}");
-        assert_eq!(stderr.lines().count(), 1, "{args:?}: one line: {stderr}");
-        assert!(
-            stderr.starts_with(&format!("error: {prefix}")),
-            "{args:?}: {stderr}"
-        );
-        assert!(
-            stderr.contains(what),
-            "{args:?}: {stderr:?} should say {what:?}"
-        );
         assert!(
             stderr.chars().count() <= 1010,
             "{args:?}: {} chars",
             stderr.len()
         );
-        assert!(took < Duration::from_secs(2), "{args:?} took {took:?}");
         assert!(out.stdout.is_empty() || args[0] == "info");
     }
     assert!(!sol.exists() && !exr.exists(), "no output left behind");
@@ -358,7 +349,6 @@ fn deep_reference_chains_are_not_called_cycles() {
 /// Runs the binary and checks a refusal (status `code`, one line for
 /// status 1) that does not come from reading the mesh.
 fn assert_refused_before_meshes(args: &[&str], code: i32, what: &str) {
-    let start = Instant::now();
     let out = trilux(args);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(code), "{args:?}: {stderr}");
@@ -374,7 +364,6 @@ fn assert_refused_before_meshes(args: &[&str], code: i32, what: &str) {
         "{args:?}: the mesh was read first: {stderr}"
     );
     assert!(!stderr.contains("panicked"), "{stderr}");
-    assert!(start.elapsed() < Duration::from_secs(2));
 }
 
 #[test]

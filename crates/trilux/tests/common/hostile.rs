@@ -1,7 +1,8 @@
 //! Helpers of the hostile-input tests (`hostile_*.rs`).
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
 
 /// A path as the `&str` the command line takes.
 pub fn s(p: &Path) -> &str {
@@ -23,6 +24,32 @@ pub fn mkfifo(path: &Path) {
         .status()
         .expect("mkfifo runs");
     assert!(status.success());
+}
+
+/// Runs the `trilux` binary with `args`, killing it if it has not ended
+/// after `limit`: a guard against a hang (an input read forever, an
+/// expansion without bound), not a speed figure, so `limit` is generous.
+pub fn trilux_or_hang(args: &[&str], limit: Duration) -> Output {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_trilux"))
+        .args(args)
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the trilux binary runs");
+    let start = Instant::now();
+    while child
+        .try_wait()
+        .expect("the child can be waited on")
+        .is_none()
+    {
+        if start.elapsed() > limit {
+            let _ = child.kill();
+            panic!("{args:?} had not ended after {limit:?}: a hang");
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    child.wait_with_output().expect("the child's output")
 }
 
 /// One line `error: {prefix}...` containing `what`, status 1, no panic.
