@@ -218,6 +218,7 @@ pub fn main(args: &[String]) -> Result<()> {
     let mut gather = None;
     let mut quality_name = "default".to_string();
     let mut only = Vec::new();
+    let mut solutions: Option<PathBuf> = None;
     let mut it = args.iter();
     while let Some(a) = it.next() {
         match a.as_str() {
@@ -225,17 +226,28 @@ pub fn main(args: &[String]) -> Result<()> {
             "--quality" => quality_name = it.next().context("--quality needs a value")?.clone(),
             "--only" => only.push(it.next().context("--only needs a scene name")?.clone()),
             "--gather" => gather = Some(estimator(it.next().context("--gather needs a name")?)?),
+            "--save-solutions" => {
+                solutions = Some(PathBuf::from(
+                    it.next().context("--save-solutions needs a folder")?,
+                ))
+            }
             other => bail!("unknown argument {other}"),
         }
     }
+    if let Some(dir) = &solutions {
+        std::fs::create_dir_all(dir)?;
+    }
     let mut failed = Vec::new();
     for r in references(&only)? {
+        let save = solutions
+            .as_ref()
+            .map(|d| d.join(format!("{}.sol", r.name)));
         let spec = TriluxSpec {
             name: &r.name,
             size: (r.image.width(), r.image.height()),
             quality: quality(&quality_name)?,
             source: SolutionSource::Solve,
-            save: None,
+            save: save.as_deref(),
             render: Some(&|s: &mut RenderSettings| {
                 if let Some(spp) = spp {
                     s.spp = spp;

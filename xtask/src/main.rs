@@ -54,13 +54,20 @@ fn ci() -> Result<()> {
     color::color()?;
     // Every bundled scene against its stored Mitsuba 3 reference (issue 5's
     // golden test: relative RMSE ≤ 0.05, mean within 1 %).
-    golden::main(&["--spp".to_string(), "64".to_string()])?;
+    // Its solutions are saved for the viewer step, which bakes them.
+    let solutions = "target/ci-solutions".to_string();
+    golden::main(&[
+        "--spp".to_string(),
+        "64".to_string(),
+        "--save-solutions".to_string(),
+        solutions.clone(),
+    ])?;
     // Every bundled scene baked, validated (Khronos glTF validator) and
     // photographed in docs/viewer beside its preview (issue 12).
     // (.ci/run installs Chromium and the viewer's npm packages.)
     run("node", &["docs/viewer/scripts/vendor.mjs", "--check"])?;
     run("node", &["--test", "docs/viewer/test/viewer.test.mjs"])?;
-    viewer::main(&[])?;
+    viewer::main(&["--solutions".to_string(), solutions])?;
     Ok(())
 }
 

@@ -12,6 +12,9 @@
 //! [`MAX_MEAN_GAP`] of the preview's. Writes `target/viewer/NAME.glb`,
 //! `NAME-preview.png`, `NAME-viewer.png` and `report.md`.
 //!
+//! `--solutions DIR` loads `DIR/NAME.sol` where it exists instead of
+//! solving (CI passes the solutions the golden step saved).
+//!
 //! Needs `npm ci` in docs/viewer and Debian's Chromium
 //! (`docs/viewer/scripts/ci.sh` installs both).
 
@@ -45,6 +48,8 @@ struct Row {
     /// for comparison, not gated).
     default: bool,
     glossy: bool,
+    /// Seconds of preparing the scene and solving it, or loading its
+    /// solution.
     solve_seconds: f64,
     bake_seconds: f64,
     bytes: usize,
@@ -87,7 +92,7 @@ fn name_of(path: &Path) -> String {
 
 /// Solves, bakes and previews one scene into `dir`; a textured scene is
 /// baked a second time without albedo maps, from the saved solution.
-fn bake_scene(path: &Path, dir: &Path) -> Result<Vec<Row>> {
+fn bake_scene(path: &Path, dir: &Path, solutions: Option<&Path>) -> Result<Vec<Row>> {
     let name = name_of(path);
     let scene = trilux_scene::load(path).map_err(|e| anyhow::anyhow!("{e}"))?;
     let render = scene.camera.as_ref().map(|camera| {
@@ -99,12 +104,19 @@ fn bake_scene(path: &Path, dir: &Path) -> Result<Vec<Row>> {
             settings,
         }
     });
-    let solution = dir.join(format!("{name}.sol"));
+    let saved = solutions
+        .map(|d| d.join(format!("{name}.sol")))
+        .filter(|p| p.exists());
+    let solved_before = saved.is_some();
+    let solution = saved.unwrap_or_else(|| dir.join(format!("{name}.sol")));
     let mut plan = Plan {
         mode: scene.mode(),
         solver: SolverSettings::preset(Quality::Default),
-        source: SolutionSource::Solve,
-        save: Some(&solution),
+        source: match solved_before {
+            true => SolutionSource::Load(&solution),
+            false => SolutionSource::Solve,
+        },
+        save: (!solved_before).then_some(solution.as_path()),
         solution_file: false,
         bake: Some(trilux_bake::BakeOptions::default()),
         render,
@@ -237,15 +249,17 @@ fn png_size(path: &Path) -> Result<(u32, u32)> {
 
 /// Runs the whole check (module docs).
 pub fn main(args: &[String]) -> Result<()> {
-    if let Some(a) = args.first() {
-        bail!("unknown argument {a}");
-    }
+    let solutions = match args {
+        [] => None,
+        [flag, dir] if flag == "--solutions" => Some(PathBuf::from(dir)),
+        _ => bail!("usage: cargo xtask viewer [--solutions DIR]"),
+    };
     let dir = root().join("target/viewer");
     std::fs::create_dir_all(&dir)?;
     let mut rows = Vec::new();
     for path in scenes()? {
         eprintln!("xtask viewer: {}", path.display());
-        rows.extend(bake_scene(&path, &dir)?);
+        rows.extend(bake_scene(&path, &dir, solutions.as_deref())?);
     }
     let glbs: Vec<String> = rows
         .iter()
@@ -280,7 +294,7 @@ fn passes(r: &Row) -> bool {
 
 fn report(rows: &[Row]) -> String {
     let mut s = String::from(
-        "| bake | glossy | solve s | bake s | file MB | triangles | preview mean | viewer mean | gap | RMSE |\n\
+        "| bake | glossy | solve or load s | bake s | file MB | triangles | preview mean | viewer mean | gap | RMSE |\n\
          |---|---|---|---|---|---|---|---|---|---|\n",
     );
     for r in rows {
