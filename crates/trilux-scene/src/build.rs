@@ -174,7 +174,7 @@ fn scene_shape(e: &Element, folder: &Path) -> Result<ShapeRequests> {
         return Err(SceneError::at(
             &e.loc,
             format!(
-                "{} has a textured material, but only rectangle and obj shapes have texture coordinates here",
+                "{} has a textured material, but only rectangle, obj and ply shapes have texture coordinates here",
                 e.describe()
             ),
         ));

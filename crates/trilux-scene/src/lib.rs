@@ -20,7 +20,8 @@
 //! 3. `build`: typed parameters (`props`, `value`, [`transform`]) → the
 //!    model: shapes ([`shape`]), materials (`material`), area lights and the
 //!    camera ([`camera`]).
-//! 4. [`meshes`]: the OBJ files the shapes name ([`obj`]) and the
+//! 4. [`meshes`]: the OBJ and PLY files the shapes name ([`obj`],
+//!    [`ply`]) and the
 //!    textures' images, read last, so that a command can check the camera
 //!    and its options against the [`Pending`] scene first ([`open`]).
 //!
@@ -47,6 +48,7 @@ pub mod limits;
 mod material;
 pub mod meshes;
 pub mod obj;
+pub mod ply;
 mod props;
 mod resolve;
 pub mod scene;

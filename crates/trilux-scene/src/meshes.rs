@@ -1,4 +1,4 @@
-//! Stage 5 of loading: the files a scene names — OBJ meshes, glTF
+//! Stage 5 of loading: the files a scene names — OBJ and PLY meshes, glTF
 //! buffers, texture images — read only once the whole scene file is
 //! checked.
 //!
@@ -9,7 +9,6 @@
 
 use crate::error::{Result, SceneError};
 use crate::gltf::GltfMeshes;
-use crate::obj::load_obj;
 use crate::scene::Scene;
 use crate::shape::{MeshRequest, check_area};
 use crate::textures::{TextureCache, TextureRequest};
@@ -18,7 +17,7 @@ use trilux_geometry::ShapeKind;
 /// What a scene still has to read, by shape index.
 #[derive(Debug, Default)]
 pub(crate) struct Requests {
-    /// OBJ meshes.
+    /// OBJ and PLY meshes.
     pub meshes: Vec<(usize, MeshRequest)>,
     /// Textures of materials.
     pub textures: Vec<(usize, TextureRequest)>,
@@ -48,11 +47,17 @@ impl Pending {
     /// scene that names the file.
     pub fn finish(mut self) -> Result<Scene> {
         for (index, request) in self.requests.meshes {
-            let mesh = load_obj(&request.path, request.face_normals)
-                .map_err(|e| SceneError::at(&request.filename, e.to_string()))?;
+            let mesh = request
+                .format
+                .load(&request.path, request.face_normals)
+                .map_err(|e| SceneError::at(&request.filename, e))?;
             let shape = &mut self.scene.shapes[index].shape;
             shape.kind = ShapeKind::Mesh(mesh);
-            check_area(shape, &request.shape, "<shape type=\"obj\">")?;
+            let what = match request.format {
+                crate::shape::MeshFormat::Obj => "<shape type=\"obj\">",
+                crate::shape::MeshFormat::Ply => "<shape type=\"ply\">",
+            };
+            check_area(shape, &request.shape, what)?;
         }
         let mut cache = TextureCache::default();
         let mut textures = self.requests.textures;
@@ -67,7 +72,7 @@ impl Pending {
             {
                 return Err(SceneError::at(
                     &request.location,
-                    "this texture's shape has no texture coordinates (OBJ vt, glTF TEXCOORD_0)",
+                    "this texture's shape has no texture coordinates (OBJ vt, PLY u v, glTF TEXCOORD_0)",
                 ));
             }
             shape.textures.push(slot);

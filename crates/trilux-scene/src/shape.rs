@@ -80,10 +80,35 @@ fn same_length_orthogonal(a: DVec3, b: DVec3) -> bool {
     (la - lb).abs() <= 1e-6 * la.max(lb) && a.dot(b).abs() <= 1e-6 * la * lb
 }
 
-/// An OBJ file a `<shape type="obj">` names, to be read after the whole
-/// scene file is checked.
+/// The mesh file formats a `<shape>` can name.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum MeshFormat {
+    /// Wavefront OBJ (`crate::obj`).
+    Obj,
+    /// Stanford PLY (`crate::ply`).
+    Ply,
+}
+
+impl MeshFormat {
+    /// Reads `path` in this format; the error is one line naming the file.
+    pub fn load(
+        self,
+        path: &std::path::Path,
+        face_normals: bool,
+    ) -> std::result::Result<trilux_geometry::TriangleMesh, String> {
+        match self {
+            MeshFormat::Obj => crate::obj::load_obj(path, face_normals).map_err(|e| e.to_string()),
+            MeshFormat::Ply => crate::ply::load_ply(path, face_normals).map_err(|e| e.to_string()),
+        }
+    }
+}
+
+/// A mesh file a `<shape type="obj">` or `<shape type="ply">` names, to be
+/// read after the whole scene file is checked.
 #[derive(Clone, Debug)]
 pub(crate) struct MeshRequest {
+    /// The file's format.
+    pub format: MeshFormat,
     /// The file (relative names resolved against the scene's folder).
     pub path: std::path::PathBuf,
     /// `face_normals` of the shape.
@@ -139,7 +164,8 @@ pub(crate) fn build_shape(
         Ok(v)
     };
     let mut request = None;
-    let kind = match e.plugin_type()? {
+    let plugin = e.plugin_type()?;
+    let kind = match plugin {
         "rectangle" => ShapeKind::Rectangle,
         "cube" => ShapeKind::Cube,
         "disk" => ShapeKind::Disk,
@@ -178,15 +204,19 @@ pub(crate) fn build_shape(
             }
             ShapeKind::Cylinder { p0, p1, radius }
         }
-        "obj" => {
+        "obj" | "ply" => {
             let name = props.string("filename")?.ok_or_else(|| {
                 SceneError::at(
                     &e.loc,
-                    "<shape type=\"obj\"> needs <string name=\"filename\">",
+                    format!("<shape type=\"{plugin}\"> needs <string name=\"filename\">"),
                 )
             })?;
             let face_normals = props.boolean("face_normals")?.unwrap_or(false);
             request = Some(MeshRequest {
+                format: match plugin {
+                    "obj" => MeshFormat::Obj,
+                    _ => MeshFormat::Ply,
+                },
                 path: folder.join(&name),
                 face_normals,
                 filename: props.loc("filename"),
@@ -201,7 +231,7 @@ pub(crate) fn build_shape(
             return Err(SceneError::at(
                 &e.required("type")?.loc,
                 format!(
-                    "unknown shape plugin \"{other}\" (supported: rectangle, cube, disk, sphere, cylinder, obj)"
+                    "unknown shape plugin \"{other}\" (supported: rectangle, cube, disk, sphere, cylinder, obj, ply)"
                 ),
             ));
         }

@@ -1,11 +1,11 @@
-//! Mutated OBJ meshes and scene files (issue 14): 12 000 corruptions of
-//! real OBJ files — bytes, tokens such as `1e30`, `nan`, `-7`, `99999999`
+//! Mutated OBJ and PLY meshes and scene files (issue 14): 12 000
+//! corruptions of real OBJ files, 6 000 of ASCII and binary PLY files — bytes, tokens such as `1e30`, `nan`, `-7`, `99999999`
 //! and whole lines of them — each parsed and, when it parses, built into
 //! geometry and a BVH; and 10 000 of the bundled Cornell box, loaded. None
 //! panics; every refusal is one line; no case makes the loader hold more
 //! than its stated bound (a counting allocator measures every case and
 //! refuses any single request above 256 MiB outright):
-//! - OBJ: 256 KiB + 256 bytes per byte of the file, through
+//! - OBJ and PLY: 256 KiB + 256 bytes per byte of the file, through
 //!   `Geometry::build` (the worst case measured: 34 bytes per byte);
 //! - scene: 1 MiB + 64 bytes per byte of the file (measured: 12).
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test may panic
@@ -19,11 +19,13 @@ use capped_alloc::{Capped, Rng, peak, reset_peak};
 use glam::DMat4;
 use trilux_geometry::{Geometry, Shape, ShapeKind};
 use trilux_scene::obj::parse_obj;
+use trilux_scene::ply::parse_ply;
 
 #[global_allocator]
 static ALLOCATOR: Capped = Capped;
 
 const OBJ_CASES: usize = 12_000;
+const PLY_CASES: usize = 6_000;
 const XML_CASES: usize = 10_000;
 
 /// Valid seeds: a cube of quads with texture coordinates and normals,
@@ -109,11 +111,41 @@ fn mutate_text(rng: &mut Rng, b: &mut Vec<u8>, tokens: &[&str]) {
     }
 }
 
-/// Parses and builds one OBJ; the peak bytes it took and whether it
-/// became geometry.
-fn obj_case(bytes: &[u8], face_normals: bool) -> (usize, bool) {
+/// PLY seeds: ASCII (positions only) and binary (normals, texture
+/// coordinates, a colour), little- and big-endian.
+const PLY_SEEDS: [&[u8]; 3] = [
+    include_bytes!("data/pyramid.ply"),
+    include_bytes!("data/tent-le.ply"),
+    include_bytes!("data/tent-be.ply"),
+];
+
+/// Pieces a mutation inserts into a PLY file: header words, counts.
+const PLY_TOKENS: [&str; 16] = [
+    " ",
+    "\n",
+    "element vertex 3\n",
+    "element face 99999999\n",
+    "property float x\n",
+    "property list uchar int vertex_indices\n",
+    "property list int double vertex_indices\n",
+    "format binary_big_endian 1.0\n",
+    "end_header\n",
+    "255",
+    "-1",
+    "4294967295",
+    "nan",
+    "1e30",
+    "\u{ff}\u{ff}\u{ff}\u{7f}",
+    "\0\0\0\0",
+];
+
+/// Parses and builds one mesh (`parse` reads it); the peak bytes it took
+/// and whether it became geometry.
+fn mesh_case<E: std::fmt::Display>(
+    parse: impl Fn() -> Result<trilux_geometry::TriangleMesh, E>,
+) -> (usize, bool) {
     let base = reset_peak();
-    let built = match parse_obj(bytes, Path::new("fuzz.obj"), face_normals) {
+    let built = match parse() {
         Ok(mesh) => {
             let shape = Shape {
                 kind: ShapeKind::Mesh(mesh),
@@ -144,11 +176,33 @@ fn fuzz_obj(rng: &mut Rng) -> usize {
         for _ in 0..1 + rng.below(3) {
             mutate_text(rng, &mut bytes, &TOKENS);
         }
-        let (used, ok) = obj_case(&bytes, rng.below(2) == 0);
+        let face_normals = rng.below(2) == 0;
+        let (used, ok) = mesh_case(|| parse_obj(&bytes, Path::new("fuzz.obj"), face_normals));
         let bound = (256 << 10) + 256 * bytes.len();
         assert!(
             used <= bound,
             "OBJ case {case}: {used} bytes, bound {bound}: {:?}",
+            String::from_utf8_lossy(&bytes)
+        );
+        built += usize::from(ok);
+    }
+    built
+}
+
+/// The PLY loop; how many cases became geometry.
+fn fuzz_ply(rng: &mut Rng) -> usize {
+    let mut built = 0;
+    for case in 0..PLY_CASES {
+        let mut bytes = PLY_SEEDS[case % PLY_SEEDS.len()].to_vec();
+        for _ in 0..1 + rng.below(3) {
+            mutate_text(rng, &mut bytes, &PLY_TOKENS);
+        }
+        let face_normals = rng.below(2) == 0;
+        let (used, ok) = mesh_case(|| parse_ply(&bytes, Path::new("fuzz.ply"), face_normals));
+        let bound = (256 << 10) + 256 * bytes.len();
+        assert!(
+            used <= bound,
+            "PLY case {case}: {used} bytes, bound {bound}: {:?}",
             String::from_utf8_lossy(&bytes)
         );
         built += usize::from(ok);
@@ -216,10 +270,21 @@ fn mutated_meshes_and_scenes_never_panic_nor_exceed_their_memory_bounds() {
         let mesh = parse_obj(seed.as_bytes(), Path::new("seed.obj"), false);
         assert!(mesh.is_ok(), "{seed}: {:?}", mesh.err());
     }
+    for seed in PLY_SEEDS {
+        let mesh = parse_ply(seed, Path::new("seed.ply"), false);
+        assert!(mesh.is_ok(), "{:?}", mesh.err());
+    }
     let built = fuzz_obj(&mut rng);
+    let built_ply = fuzz_ply(&mut rng);
     let loaded = fuzz_xml(&mut rng);
-    eprintln!("{OBJ_CASES} OBJ cases ({built} built), {XML_CASES} scene cases ({loaded} loaded)");
+    eprintln!(
+        "{OBJ_CASES} OBJ cases ({built} built), {PLY_CASES} PLY cases ({built_ply} built), {XML_CASES} scene cases ({loaded} loaded)"
+    );
     // Both kinds of outcome are exercised.
     assert!(built > OBJ_CASES / 10 && built < OBJ_CASES, "{built}");
+    assert!(
+        built_ply > PLY_CASES / 10 && built_ply < PLY_CASES,
+        "{built_ply}"
+    );
     assert!(loaded > XML_CASES / 10 && loaded < XML_CASES, "{loaded}");
 }

@@ -96,8 +96,10 @@ fn areas_match_mitsuba() {
     }
 }
 
+/// Vertex normals (recomputed without the file's, or the file's) and
+/// texture coordinates of OBJ and PLY meshes.
 #[test]
-fn recomputed_vertex_normals_match_mitsuba() {
+fn mesh_normals_and_texture_coordinates_match_mitsuba() {
     let exp = expected();
     for case in exp["meshes"].as_array().expect("meshes") {
         let xml = case["xml"].as_str().expect("xml");
@@ -108,9 +110,16 @@ fn recomputed_vertex_normals_match_mitsuba() {
         let normals = mesh.normals.as_ref().expect("recomputed normals");
         let positions = case["positions"].as_array().expect("positions");
         assert_eq!(positions.len(), mesh.positions.len(), "vertex count");
-        for (p, n) in positions
+        let texcoords = case["texcoords"].as_array().expect("texcoords");
+        assert_eq!(
+            mesh.texcoords.is_some(),
+            !texcoords.is_empty(),
+            "{xml}: texture coordinates"
+        );
+        for (j, (p, n)) in positions
             .iter()
             .zip(case["normals"].as_array().expect("normals"))
+            .enumerate()
         {
             let p = glam::DVec3::new(
                 p[0].as_f64().unwrap_or(f64::NAN),
@@ -129,6 +138,17 @@ fn recomputed_vertex_normals_match_mitsuba() {
                     "vertex {p}: normal {} vs Mitsuba {n}",
                     normals[i]
                 );
+            }
+            if let Some(uv) = &mesh.texcoords {
+                let w = &texcoords[j];
+                for k in 0..2 {
+                    let w = w[k].as_f64().expect("number");
+                    assert!(
+                        (uv[i][k] - w).abs() < 1e-6,
+                        "{xml}: vertex {p}: uv {}",
+                        uv[i]
+                    );
+                }
             }
         }
     }

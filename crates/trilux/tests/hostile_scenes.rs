@@ -283,8 +283,26 @@ fn every_scene_error_from_every_command_is_located() {
         "nan.obj",
         "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn nan 0 1\nf 1//1 2//1 3//1\n",
     );
+    let ply_head = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
+    write(
+        &dir,
+        "flat.ply",
+        format!("{ply_head}0 0 0\n1 0 0\n2 0 0\n3 0 1 2\n"),
+    );
+    write(
+        &dir,
+        "index.ply",
+        format!("{ply_head}0 0 0\n1 0 0\n0 1 0\n3 0 1 9\n"),
+    );
+    write(
+        &dir,
+        "short.ply",
+        format!("{ply_head}0 0 0\n1 0 0\n0 1 0\n3 0 1\n"),
+    );
     let obj =
         |f: &str| format!("<shape type=\"obj\"><string name=\"filename\" value=\"{f}\"/></shape>");
+    let ply =
+        |f: &str| format!("<shape type=\"ply\"><string name=\"filename\" value=\"{f}\"/></shape>");
     let closed = "<shape type=\"cube\"><boolean name=\"flip_normals\" value=\"true\"/><bsdf type=\"diffuse\"><float name=\"reflectance\" value=\"1\"/></bsdf><emitter type=\"area\"/></shape>";
     let cases: Vec<(String, bool)> = vec![
         (obj("flat.obj"), true),
@@ -292,6 +310,10 @@ fn every_scene_error_from_every_command_is_located() {
         (obj("index.obj"), true),
         (obj("nan.obj"), true),
         (obj("missing.obj"), true),
+        (ply("flat.ply"), true),
+        (ply("index.ply"), true),
+        (ply("short.ply"), true),
+        (ply("missing.ply"), true),
         ("<shape type=\"rectangle\"><bsdf type=\"diffuse\"><spectrum name=\"reflectance\" value=\"400:0.5, 500:1e400\"/></bsdf></shape>".into(), true),
         ("<shape type=\"rectangle\"><emitter type=\"area\"><rgb name=\"radiance\" value=\"1e300, 0, 0\"/></emitter></shape>".into(), true),
         ("<shape type=\"sphere\"><float name=\"radius\" value=\"1e-300\"/></shape>".into(), true),

@@ -9,7 +9,8 @@ scalar_rgb, single precision) built from the same text:
 - "transforms": the `to_world` of a rectangle with that <transform>;
 - "sensors": the sensor's to_world matrix and its horizontal fov (x_fov);
 - "areas": the surface area of a shape;
-- "meshes": positions and vertex normals of an OBJ mesh without `vn`;
+- "meshes": positions, vertex normals and texture coordinates of OBJ and
+  PLY meshes (the PLY files are made by make_ply.py);
 - "rays": for each shape of "areas" (and flip_normals variants), rays aimed
   near the shape's bounding-box centre from fixed pseudo-random origins, with
   Mitsuba's hit distance and geometric normal (or a miss): the scene's object
@@ -20,6 +21,8 @@ import json
 import mitsuba as mi
 
 mi.set_variant("scalar_rgb")
+# Mitsuba logs to stdout; only errors (the PLY colour warning is expected).
+mi.set_log_level(mi.LogLevel.Error)
 
 HEAD = '<scene version="3.0.0">'
 
@@ -87,11 +90,20 @@ AREAS = [
     '<shape type="obj"><string name="filename" value="quad.obj"/></shape>',
     '<shape type="obj"><string name="filename" value="pyramid.obj"/>'
     '<transform name="to_world"><scale x="2"/><rotate x="1" angle="10"/></transform></shape>',
+    '<shape type="ply"><string name="filename" value="pyramid.ply"/></shape>',
+    '<shape type="ply"><string name="filename" value="tent-le.ply"/>'
+    '<transform name="to_world"><rotate y="1" angle="25"/><translate z="0.5"/></transform></shape>',
+    '<shape type="ply"><string name="filename" value="tent-be.ply"/></shape>',
 ]
 
-# Vertex normals Mitsuba computes for an OBJ without `vn` (by position).
+# Vertex normals Mitsuba computes for an OBJ or PLY without normals, or
+# reads from a PLY with them, and the PLY's texture coordinates (matched by
+# position).
 MESHES = [
     '<shape type="obj"><string name="filename" value="pyramid.obj"/></shape>',
+    '<shape type="ply"><string name="filename" value="pyramid.ply"/></shape>',
+    '<shape type="ply"><string name="filename" value="tent-le.ply"/></shape>',
+    '<shape type="ply"><string name="filename" value="tent-be.ply"/></shape>',
 ]
 
 
@@ -120,10 +132,12 @@ for m in MESHES:
     params = mi.traverse(load(m).shapes()[0])
     p = list(params["vertex_positions"])
     n = list(params["vertex_normals"])
+    uv = list(params["vertex_texcoords"]) if "vertex_texcoords" in params else []
     out["meshes"].append({
         "xml": m,
         "positions": [p[i:i + 3] for i in range(0, len(p), 3)],
         "normals": [n[i:i + 3] for i in range(0, len(n), 3)],
+        "texcoords": [uv[i:i + 2] for i in range(0, len(uv), 2)],
     })
 
 def lcg(seed):
