@@ -163,7 +163,16 @@ mod tests {
 
     #[test]
     fn a_constant_develops_to_itself_with_any_filter() {
-        for f in [ReconstructionFilter::default(), ReconstructionFilter::Box] {
+        for f in [
+            ReconstructionFilter::default(),
+            ReconstructionFilter::Box,
+            ReconstructionFilter::Tent { radius: 1.3 },
+            ReconstructionFilter::Mitchell {
+                b: 1.0 / 3.0,
+                c: 1.0 / 3.0,
+            },
+            ReconstructionFilter::Lanczos { lobes: 3 },
+        ] {
             let mut film = Film::new(0, 0, 7, 5, f).unwrap();
             let mut k = 0u32;
             for j in 0..5 {

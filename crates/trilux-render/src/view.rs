@@ -35,9 +35,13 @@ fn axis(a: trilux_scene::camera::FovAxis) -> FovAxis {
 
 /// The film filter a scene asks for.
 pub fn filter_of(c: &trilux_scene::Camera) -> ReconstructionFilter {
+    use trilux_scene::camera::ReconstructionFilter as F;
     match c.rfilter {
-        trilux_scene::camera::ReconstructionFilter::Gaussian => ReconstructionFilter::default(),
-        trilux_scene::camera::ReconstructionFilter::Box => ReconstructionFilter::Box,
+        F::Gaussian { stddev } => ReconstructionFilter::Gaussian { stddev },
+        F::Box => ReconstructionFilter::Box,
+        F::Tent { radius } => ReconstructionFilter::Tent { radius },
+        F::Mitchell { b, c } => ReconstructionFilter::Mitchell { b, c },
+        F::Lanczos { lobes } => ReconstructionFilter::Lanczos { lobes },
     }
 }
 

@@ -323,7 +323,7 @@ fn sensor(e: &Element) -> Result<Camera> {
     };
     let mut width = 768;
     let mut height = 576;
-    let mut rfilter = ReconstructionFilter::Gaussian;
+    let mut rfilter = ReconstructionFilter::default();
     let mut sample_count = 4;
     let mut seen_film = false;
     let mut seen_sampler = false;
@@ -397,7 +397,7 @@ fn film(e: &Element) -> Result<(u32, u32, ReconstructionFilter)> {
         SceneError::at(&props.loc(at), m)
     })?;
     props.ignore(&["pixel_format", "component_format"]);
-    let mut rfilter = ReconstructionFilter::Gaussian;
+    let mut rfilter = ReconstructionFilter::default();
     for (i, o) in props.objects.iter().enumerate() {
         if o.tag != "rfilter" || i > 0 {
             return Err(SceneError::at(
@@ -408,20 +408,76 @@ fn film(e: &Element) -> Result<(u32, u32, ReconstructionFilter)> {
         o.check_attrs(&["type", "id", "name"])?;
         let fp = Props::new(o)?;
         fp.no_objects()?;
-        rfilter = match o.plugin_type()? {
-            "gaussian" => ReconstructionFilter::Gaussian,
-            "box" => ReconstructionFilter::Box,
-            other => {
-                return Err(SceneError::at(
-                    &o.required("type")?.loc,
-                    format!("unknown rfilter plugin \"{other}\" (gaussian or box)"),
-                ));
-            }
-        };
+        rfilter = rfilter_of(o, &fp)?;
         fp.finish()?;
     }
     props.finish()?;
     Ok((width, height, rfilter))
+}
+
+/// Widest reconstruction filter, in pixels: every sample is added to
+/// (2 r + 1)² pixels, so a radius of thousands would make each sample cost
+/// millions of additions (docs/limits.md).
+const MAX_FILTER_RADIUS: f64 = 16.0;
+
+/// An `<rfilter>` with its parameters (Mitsuba's names and defaults).
+fn rfilter_of(o: &Element, fp: &Props<'_>) -> Result<ReconstructionFilter> {
+    let positive = |name: &str, default: f64, radius_per_unit: f64| -> Result<f64> {
+        let v = fp.float(name)?.unwrap_or(default);
+        if !(v > 0.0 && v * radius_per_unit <= MAX_FILTER_RADIUS) {
+            return Err(SceneError::at(
+                &fp.loc(name),
+                format!(
+                    "{name} must be positive and make a filter radius of at most {MAX_FILTER_RADIUS} px, found {v}"
+                ),
+            ));
+        }
+        Ok(v)
+    };
+    let finite = |name: &str, default: f64| -> Result<f64> {
+        let v = fp.float(name)?.unwrap_or(default);
+        if !v.is_finite() {
+            return Err(SceneError::at(
+                &fp.loc(name),
+                format!("{name} must be a finite number"),
+            ));
+        }
+        Ok(v)
+    };
+    Ok(match o.plugin_type()? {
+        "gaussian" => ReconstructionFilter::Gaussian {
+            stddev: positive("stddev", 0.5, 4.0)?,
+        },
+        "box" => ReconstructionFilter::Box,
+        "tent" => ReconstructionFilter::Tent {
+            radius: positive("radius", 1.0, 1.0)?,
+        },
+        "mitchell" => ReconstructionFilter::Mitchell {
+            b: finite("B", 1.0 / 3.0)?,
+            c: finite("C", 1.0 / 3.0)?,
+        },
+        "catmullrom" => ReconstructionFilter::Mitchell { b: 0.0, c: 0.5 },
+        "lanczos" => {
+            let lobes = fp.integer("lobes")?.unwrap_or(3);
+            if !(1..=MAX_FILTER_RADIUS as i64).contains(&lobes) {
+                return Err(SceneError::at(
+                    &fp.loc("lobes"),
+                    format!("lobes must be between 1 and {MAX_FILTER_RADIUS}, found {lobes}"),
+                ));
+            }
+            ReconstructionFilter::Lanczos {
+                lobes: lobes as u32,
+            }
+        }
+        other => {
+            return Err(SceneError::at(
+                &o.required("type")?.loc,
+                format!(
+                    "unknown rfilter plugin \"{other}\" (gaussian, box, tent, mitchell, catmullrom or lanczos)"
+                ),
+            ));
+        }
+    })
 }
 
 fn sampler(e: &Element) -> Result<u32> {

@@ -53,14 +53,43 @@ impl FovAxis {
     }
 }
 
-/// The film's reconstruction filter (`<rfilter>`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+/// The film's reconstruction filter (`<rfilter>`), with Mitsuba's
+/// parameters (trilux-render's `filter` evaluates them).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum ReconstructionFilter {
-    /// Mitsuba's default: Gaussian, standard deviation 0.5 px, radius 2 px.
-    Gaussian,
-    /// One pixel box.
+    /// `gaussian`: standard deviation `stddev` px (0.5), radius 4·stddev.
+    Gaussian {
+        /// Standard deviation in pixels.
+        stddev: f64,
+    },
+    /// `box`: one pixel.
     Box,
+    /// `tent`: radius in pixels (1).
+    Tent {
+        /// Radius in pixels.
+        radius: f64,
+    },
+    /// `mitchell` (B = C = 1/3 by default) and `catmullrom` (B = 0,
+    /// C = 1/2): radius 2 px.
+    Mitchell {
+        /// B.
+        b: f64,
+        /// C.
+        c: f64,
+    },
+    /// `lanczos`: `lobes` (3) on each side, the radius in pixels.
+    Lanczos {
+        /// Lobes.
+        lobes: u32,
+    },
+}
+
+impl Default for ReconstructionFilter {
+    /// Mitsuba's default.
+    fn default() -> Self {
+        ReconstructionFilter::Gaussian { stddev: 0.5 }
+    }
 }
 
 /// A perspective camera with its film and sample count.

@@ -78,13 +78,15 @@ pub fn load(path: impl AsRef<Path>) -> Result<Scene, SceneError> {
 /// Reads and checks a scene file, all but its meshes and textures; for a
 /// glTF file, `camera` names the camera to use (a camera's or its node's
 /// name; the first one otherwise). An XML scene has one `<sensor>`: naming
-/// a camera for it is an error.
+/// a camera for it is an error. `params` are `$name` values, as for
+/// [`open_with_params`].
 pub fn open_with_camera(
     path: impl AsRef<Path>,
     camera: Option<&str>,
+    params: &[(String, String)],
 ) -> Result<Pending, SceneError> {
     let path = path.as_ref();
-    if gltf::is_gltf(path) {
+    if gltf::is_gltf(path) && params.is_empty() {
         return gltf::open(path, camera);
     }
     if let Some(name) = camera {
@@ -100,7 +102,7 @@ pub fn open_with_camera(
             ),
         ));
     }
-    open(path)
+    open_with_params(path, params)
 }
 
 /// Reads a glTF or GLB file from bytes in memory; `path` names it in errors

@@ -396,7 +396,7 @@ fn the_first_perspective_camera_or_one_by_name() {
     let path = dir.join("scene.gltf");
     std::fs::write(&path, serde_json::to_vec(&with_cameras()).unwrap()).unwrap();
     for name in ["side", "wide"] {
-        let scene = trilux_scene::open_with_camera(&path, Some(name))
+        let scene = trilux_scene::open_with_camera(&path, Some(name), &[])
             .unwrap()
             .finish()
             .unwrap();
@@ -414,7 +414,7 @@ fn the_first_perspective_camera_or_one_by_name() {
             assert!(close(c.origin, DVec3::new(0.0, 1.0, 5.0)));
         }
     }
-    let err = trilux_scene::open_with_camera(&path, Some("top"))
+    let err = trilux_scene::open_with_camera(&path, Some("top"), &[])
         .unwrap_err()
         .to_string();
     assert!(err.contains("no camera named \"top\""), "{err}");

@@ -211,7 +211,7 @@ fn sensor_defaults_follow_mitsuba() {
         .camera
         .expect("camera");
     assert_eq!((c.width, c.height), (768, 576));
-    assert_eq!(c.rfilter, ReconstructionFilter::Gaussian);
+    assert_eq!(c.rfilter, ReconstructionFilter::Gaussian { stddev: 0.5 });
     assert_eq!(c.sample_count, 4);
     assert_eq!(c.fov_axis, FovAxis::Diagonal);
     // 50 mm lens on 36 x 24 mm: 2 atan(43.2666 / 100) = 46.7930° (the
@@ -303,7 +303,7 @@ fn sensor_errors() {
             .contains("unknown parameter \"near_clip\"")
     );
     assert!(err(r#"<sensor type="perspective"><film type="hdrfilm"><integer name="width" value="0"/></film></sensor>"#).contains("width must be a positive integer"));
-    assert!(err(r#"<sensor type="perspective"><film type="hdrfilm"><rfilter type="tent"/></film></sensor>"#).contains("unknown rfilter plugin"));
+    assert!(err(r#"<sensor type="perspective"><film type="hdrfilm"><rfilter type="sinc"/></film></sensor>"#).contains("unknown rfilter plugin"));
     assert!(
         err(r#"<sensor type="perspective"><film type="specfilm"/></sensor>"#)
             .contains("unknown film plugin")
@@ -691,9 +691,80 @@ fn zero_and_degenerate_shapes_are_refused() {
     assert!(err(r#"<shape type="rectangle"><transform name="to_world"><matrix value="1 1 0 0  1 1 0 0  0 0 1 0  0 0 0 1"/></transform></shape>"#).contains("singular"));
 }
 
+/// Every `<rfilter>` Mitsuba 3 has, with its parameters and defaults
+/// (Mitsuba's documentation: tent radius 1, Mitchell B = C = 1/3,
+/// Catmull–Rom B = 0 and C = 1/2, Lanczos 3 lobes, Gaussian stddev 0.5).
+#[test]
+fn reconstruction_filters_and_their_parameters() {
+    let filter = |body: &str| {
+        load(&format!(
+            r#"<sensor type="perspective"><film type="hdrfilm">{body}</film></sensor>"#
+        ))
+        .camera
+        .expect("camera")
+        .rfilter
+    };
+    use ReconstructionFilter as F;
+    assert_eq!(filter(""), F::Gaussian { stddev: 0.5 });
+    assert_eq!(
+        filter(r#"<rfilter type="gaussian"><float name="stddev" value="0.3"/></rfilter>"#),
+        F::Gaussian { stddev: 0.3 }
+    );
+    assert_eq!(filter(r#"<rfilter type="tent"/>"#), F::Tent { radius: 1.0 });
+    assert_eq!(
+        filter(r#"<rfilter type="tent"><float name="radius" value="1.5"/></rfilter>"#),
+        F::Tent { radius: 1.5 }
+    );
+    assert_eq!(
+        filter(r#"<rfilter type="mitchell"/>"#),
+        F::Mitchell {
+            b: 1.0 / 3.0,
+            c: 1.0 / 3.0
+        }
+    );
+    assert_eq!(
+        filter(
+            r#"<rfilter type="mitchell"><float name="B" value="0.5"/><float name="C" value="0.25"/></rfilter>"#
+        ),
+        F::Mitchell { b: 0.5, c: 0.25 }
+    );
+    assert_eq!(
+        filter(r#"<rfilter type="catmullrom"/>"#),
+        F::Mitchell { b: 0.0, c: 0.5 }
+    );
+    assert_eq!(
+        filter(r#"<rfilter type="lanczos"/>"#),
+        F::Lanczos { lobes: 3 }
+    );
+    let sensor = |body: &str| {
+        format!(r#"<sensor type="perspective"><film type="hdrfilm">{body}</film></sensor>"#)
+    };
+    for (body, what) in [
+        (
+            r#"<rfilter type="tent"><float name="radius" value="-1"/></rfilter>"#,
+            "radius must be positive",
+        ),
+        (
+            r#"<rfilter type="gaussian"><float name="stddev" value="5"/></rfilter>"#,
+            "at most 16 px, found 5",
+        ),
+        (
+            r#"<rfilter type="lanczos"><integer name="lobes" value="40"/></rfilter>"#,
+            "lobes must be between 1 and 16",
+        ),
+        (
+            r#"<rfilter type="mitchell"><float name="b" value="0.5"/></rfilter>"#,
+            "unknown parameter \"b\"",
+        ),
+    ] {
+        let e = err(&sensor(body));
+        assert!(e.contains(what), "{body}: {e}");
+    }
+}
+
 #[test]
 fn unknown_things_are_refused() {
-    assert!(err(r#"<shape type="ply"/>"#).contains("unknown shape plugin \"ply\""));
+    assert!(err(r#"<shape type="serialized"/>"#).contains("unknown shape plugin \"serialized\""));
     assert!(
         err(r#"<shape type="rectangle"><float name="size" value="2"/></shape>"#)
             .contains("unknown parameter \"size\" for <shape type=\"rectangle\">")

@@ -18,6 +18,8 @@ use crate::output::{Outputs, bake_stats_json};
 pub struct BakeArgs {
     /// The scene file (Mitsuba 3 XML subset, or glTF 2.0: .gltf, .glb).
     pub scene: PathBuf,
+    #[command(flatten)]
+    pub params: crate::options::SceneParams,
     /// Where to write the baked scene (a .glb file).
     #[arg(short = 'o', long = "output")]
     pub output: PathBuf,
@@ -70,7 +72,7 @@ pub fn run(args: &BakeArgs) -> Result<()> {
     let mut inputs = vec![args.scene.as_path()];
     inputs.extend(args.solution.as_deref());
     let outputs = Outputs::plan(&outputs, &inputs, None)?;
-    let pending = trilux_scene::open(&args.scene)?;
+    let pending = trilux_scene::open_with_params(&args.scene, &args.params.define)?;
     let plan = Plan {
         mode: args.options.mode(pending.scene()),
         solver: args.options.settings(),

@@ -18,6 +18,8 @@ use crate::power::emitted_power;
 pub struct InfoArgs {
     /// The scene file (Mitsuba 3 XML subset, or glTF 2.0: .gltf, .glb).
     pub scene: PathBuf,
+    #[command(flatten)]
+    pub params: crate::options::SceneParams,
     /// The glTF camera to show (a camera's or its node's name; default: the
     /// first).
     #[arg(long)]
@@ -57,7 +59,9 @@ struct CameraJson {
 
 /// Runs `trilux info`.
 pub fn run(args: &InfoArgs) -> Result<()> {
-    let scene = trilux_scene::open_with_camera(&args.scene, args.camera.as_deref())?.finish()?;
+    let scene =
+        trilux_scene::open_with_camera(&args.scene, args.camera.as_deref(), &args.params.define)?
+            .finish()?;
     let mode = match args.mode {
         Some(ModeArg::Rgb) => Mode::Rgb,
         Some(ModeArg::Spectral) => Mode::Spectral,

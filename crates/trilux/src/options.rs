@@ -31,6 +31,30 @@ pub struct SolveOptions {
     pub mode: Option<ModeArg>,
 }
 
+/// `$name` values for an XML scene, as Mitsuba's `-D name=value`.
+#[derive(Debug, Args, Clone, Default)]
+pub struct SceneParams {
+    /// Set the XML scene's $NAME to VALUE, overriding its <default> (as
+    /// Mitsuba's -D); repeatable.
+    #[arg(short = 'D', long = "define", value_name = "NAME=VALUE", value_parser = parse_define)]
+    pub define: Vec<(String, String)>,
+}
+
+/// `NAME=VALUE`, NAME made of letters, digits and `_` (the characters a
+/// `$name` reference takes).
+fn parse_define(text: &str) -> Result<(String, String), String> {
+    let Some((name, value)) = text.split_once('=') else {
+        return Err(format!("{} is not NAME=VALUE", quoted(text)));
+    };
+    if name.is_empty() || !name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
+        return Err(format!(
+            "{} is not a parameter name (letters, digits and _)",
+            quoted(name)
+        ));
+    }
+    Ok((name.to_string(), value.to_string()))
+}
+
 /// The quality presets.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum QualityArg {

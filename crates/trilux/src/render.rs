@@ -41,6 +41,8 @@ pub enum GatherArg {
 pub struct RenderArgs {
     /// The scene file (Mitsuba 3 XML subset, or glTF 2.0: .gltf, .glb).
     pub scene: PathBuf,
+    #[command(flatten)]
+    pub params: crate::options::SceneParams,
     /// The glTF camera to render from (a camera's or its node's name;
     /// default: the first camera of the scene).
     #[arg(long)]
@@ -162,7 +164,8 @@ impl RenderArgs {
 pub fn run(args: &RenderArgs) -> Result<()> {
     crate::set_threads(args.threads);
     let outputs = args.plan_outputs()?;
-    let pending = trilux_scene::open_with_camera(&args.scene, args.camera.as_deref())?;
+    let pending =
+        trilux_scene::open_with_camera(&args.scene, args.camera.as_deref(), &args.params.define)?;
     let camera = pending.scene().camera.as_ref().with_context(|| {
         let what = if trilux_scene::gltf::is_gltf(&args.scene) {
             "perspective camera"

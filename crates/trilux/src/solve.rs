@@ -15,6 +15,8 @@ use crate::output::{Outputs, stats_json};
 pub struct SolveArgs {
     /// The scene file (Mitsuba 3 XML subset, or glTF 2.0: .gltf, .glb).
     pub scene: PathBuf,
+    #[command(flatten)]
+    pub params: crate::options::SceneParams,
     /// Where to write the solution.
     #[arg(short = 'o', long = "output")]
     pub output: PathBuf,
@@ -34,7 +36,7 @@ pub fn run(args: &SolveArgs) -> Result<()> {
     let mut outputs = vec![(args.output.as_path(), "solution")];
     outputs.extend(args.stats.as_deref().map(|p| (p, "statistics")));
     let outputs = Outputs::plan(&outputs, &[args.scene.as_path()], None)?;
-    let pending = trilux_scene::open(&args.scene)?;
+    let pending = trilux_scene::open_with_params(&args.scene, &args.params.define)?;
     let plan = Plan {
         mode: args.options.mode(pending.scene()),
         solver: args.options.settings(),

@@ -71,10 +71,10 @@ fn malformed_xml() {
 fn unknown_plugin() {
     assert_scene_error(
         "plugin",
-        &format!("{HEAD}  <shape type=\"ply\"/>\n</scene>\n"),
+        &format!("{HEAD}  <shape type=\"serialized\"/>\n</scene>\n"),
         2,
-        "ply",
-        "unknown shape plugin \"ply\"",
+        "serialized",
+        "unknown shape plugin \"serialized\"",
     );
     assert_scene_error(
         "bsdf-plugin",
@@ -272,6 +272,31 @@ fn info_json_has_exactly_the_design_keys() {
     assert_eq!(
         v["emitted_power"].as_array().map(Vec::len),
         Some(trilux_color::SPECTRAL_BANDS)
+    );
+}
+
+/// `-D NAME=VALUE` sets a `$name` as Mitsuba's `-D` does: the Cornell box
+/// writes its film as `$res` × `$res` with `<default name="res" value="256"/>`.
+#[test]
+fn defines_override_the_scenes_defaults() {
+    let box_ = scenes_dir().join("cornell-box.xml");
+    assert_eq!(info_json(&box_, &[])["camera"]["width"], 256);
+    let v = info_json(&box_, &["-D", "res=96", "--define", "spp=4"]);
+    assert_eq!(
+        (&v["camera"]["width"], &v["camera"]["height"]),
+        (&96.into(), &96.into())
+    );
+    for bad in ["res", "=96", "r-s=96"] {
+        let out = trilux(&["info", box_.to_str().expect("utf-8"), "-D", bad]);
+        assert_eq!(out.status.code(), Some(2), "-D {bad}");
+    }
+    let gltf = scenes_dir().join("product-shot.glb");
+    let out = trilux(&["info", gltf.to_str().expect("utf-8"), "-D", "res=96"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("$name parameters are for Mitsuba XML scenes"),
+        "{stderr}"
     );
 }
 

@@ -383,7 +383,7 @@ fn camera(file: &Arc<Path>, c: &CameraNode) -> Result<Camera> {
         fov_axis: FovAxis::Y,
         width,
         height,
-        rfilter: ReconstructionFilter::Gaussian,
+        rfilter: ReconstructionFilter::default(),
         sample_count: 4,
         location,
     })
