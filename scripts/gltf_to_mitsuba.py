@@ -145,9 +145,25 @@ class Converter:
         bmp = mi.Bitmap(tmp).convert(mi.Bitmap.PixelFormat.RGB, mi.Struct.Type.Float32, srgb_gamma=False)
         return np.array(bmp, np.float64)
 
+    def to_uv_xml(self, info):
+        """KHR_texture_transform as Mitsuba's to_uv: T R S, with the rotation
+        implementations agree on, (u, v) -> (c u + s v, -s u + c v)
+        (KhronosGroup/glTF issue 1563); docs/gltf.md."""
+        tt = info.get("extensions", {}).get("KHR_texture_transform")
+        if tt is None:
+            return ""
+        if tt.get("texCoord", 0) != 0:
+            raise SystemExit("KHR_texture_transform's texCoord other than 0 is refused")
+        ox, oy = tt.get("offset", [0.0, 0.0])
+        sx, sy = tt.get("scale", [1.0, 1.0])
+        r = tt.get("rotation", 0.0)
+        c, s = math.cos(r), math.sin(r)
+        m = [c * sx, s * sy, 0, ox, -s * sx, c * sy, 0, oy, 0, 0, 1, 0, 0, 0, 0, 1]
+        return '<transform name="to_uv"><matrix value="' + " ".join(f"{v:.9g}" for v in m) + '"/></transform>'
+
     def texture_xml(self, info, name, scale, offset):
-        if info.get("texCoord", 0) != 0 or "extensions" in info:
-            raise SystemExit("texCoord other than 0 and KHR_texture_transform are refused")
+        if info.get("texCoord", 0) != 0:
+            raise SystemExit("texCoord other than 0 is refused")
         tex = self.j["textures"][info["index"]]
         sampler = self.j.get("samplers", [{}])[tex["sampler"]] if "sampler" in tex else {}
         ws, wt = sampler.get("wrapS", 10497), sampler.get("wrapT", 10497)
@@ -163,7 +179,7 @@ class Converter:
         filt = "nearest" if sampler.get("magFilter") == 9728 else "bilinear"
         return (f'<texture type="bitmap" name="{name}"><string name="filename" value="{self.textures[key]}"/>'
                 f'<boolean name="raw" value="true"/><string name="filter_type" value="{filt}"/>'
-                f'<string name="wrap_mode" value="{WRAP[ws]}"/></texture>')
+                f'<string name="wrap_mode" value="{WRAP[ws]}"/>{self.to_uv_xml(info)}</texture>')
 
     def material(self, index):
         m = self.j["materials"][index] if index is not None else {}

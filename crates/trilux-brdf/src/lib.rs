@@ -55,6 +55,6 @@ pub use bsdf::{Bsdf, BsdfSample};
 pub use error::BrdfError;
 pub use frame::Frame;
 pub use params::{BsdfParams, Distribution, RoughConductorParams};
-pub use texture::{Filter, Texture, Wrap};
+pub use texture::{Filter, Texture, UvTransform, Wrap};
 pub use textured::{Branch, PointParts, Shading, SlotKind, SlotValues, TextureSlot, TexturedBsdf};
 pub use trilux_geometry::Side;

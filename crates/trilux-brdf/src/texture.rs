@@ -54,6 +54,33 @@ impl Wrap {
     }
 }
 
+/// An affine map of texture coordinates, Mitsuba's `to_uv`:
+/// (u, v) ↦ (m[0]·u + m[1]·v + m[2], m[3]·u + m[4]·v + m[5]), applied
+/// before the lookup (a scale of 4 tiles the image 4 times).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct UvTransform(pub [f64; 6]);
+
+impl UvTransform {
+    /// (u, v) unchanged.
+    pub const IDENTITY: UvTransform = UvTransform([1.0, 0.0, 0.0, 0.0, 1.0, 0.0]);
+
+    /// The coordinates `uv` maps to.
+    #[inline]
+    pub fn apply(&self, uv: DVec2) -> DVec2 {
+        let m = &self.0;
+        DVec2::new(
+            m[0] * uv.x + m[1] * uv.y + m[2],
+            m[3] * uv.x + m[4] * uv.y + m[5],
+        )
+    }
+}
+
+impl Default for UvTransform {
+    fn default() -> Self {
+        Self::IDENTITY
+    }
+}
+
 /// How a lookup between texel centres is filtered.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]

@@ -35,7 +35,7 @@ use trilux_geometry::{Side, Sided};
 use crate::bsdf::{Bsdf, BsdfSample};
 use crate::error::BrdfError;
 use crate::params::BsdfParams;
-use crate::texture::{Texture, luminance};
+use crate::texture::{Texture, UvTransform, luminance};
 
 /// One step from a BSDF to a BSDF nested in it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -76,6 +76,8 @@ pub struct TextureSlot {
     pub scale: [f64; 3],
     /// See `scale`.
     pub offset: [f64; 3],
+    /// The map from the surface's texture coordinates to the image's.
+    pub to_uv: UvTransform,
 }
 
 fn texture_summary<S: serde::Serializer>(t: &Arc<Texture>, s: S) -> Result<S::Ok, S::Error> {
@@ -373,7 +375,7 @@ impl<const N: usize> TexturedBsdf<N> {
     pub fn values_at(&self, uv: DVec2) -> SlotValues {
         let mut v = [[0.0; 3]; MAX_SLOTS];
         for (i, s) in self.slots.iter().enumerate() {
-            v[i] = self.slot_value(i, s.texture.eval(uv));
+            v[i] = self.slot_value(i, s.texture.eval(s.to_uv.apply(uv)));
         }
         SlotValues(v)
     }
@@ -562,6 +564,7 @@ mod tests {
             texture: checker(),
             scale: [scale; 3],
             offset: [0.0; 3],
+            to_uv: UvTransform::IDENTITY,
         }
     }
 

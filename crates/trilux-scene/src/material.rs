@@ -22,7 +22,9 @@
 
 use std::path::Path;
 
-use trilux_brdf::{Branch, BsdfParams, Distribution, Filter, RoughConductorParams, SlotKind, Wrap};
+use trilux_brdf::{
+    Branch, BsdfParams, Distribution, Filter, RoughConductorParams, SlotKind, UvTransform, Wrap,
+};
 use trilux_color::ColorParam;
 
 use crate::error::{Result, SceneError, SourceLocation};
@@ -221,14 +223,18 @@ fn texture(
     Ok(found)
 }
 
-/// A `<texture type="bitmap">` (Mitsuba's defaults: bilinear, repeat, sRGB).
+/// A `<texture>`: `bitmap` (Mitsuba's defaults: bilinear, repeat, sRGB) or
+/// `checkerboard`, either with a `to_uv` transform.
 fn bitmap(e: &Element, kind: SlotKind, tex: &TextureCollector<'_>) -> Result<TextureRequest> {
     e.check_attrs(&["type", "id", "name"])?;
     let t = e.plugin_type()?;
+    if t == "checkerboard" {
+        return checkerboard(e, kind, tex);
+    }
     if t != "bitmap" {
         return Err(SceneError::at(
             &e.required("type")?.loc,
-            format!("unknown texture plugin \"{t}\" (only \"bitmap\")"),
+            format!("unknown texture plugin \"{t}\" (bitmap or checkerboard)"),
         ));
     }
     let props = Props::new(e)?;
@@ -258,6 +264,7 @@ fn bitmap(e: &Element, kind: SlotKind, tex: &TextureCollector<'_>) -> Result<Tex
         _ => Wrap::Repeat,
     };
     let raw = props.boolean("raw")?.unwrap_or(false);
+    let to_uv = to_uv(&props)?;
     let location = props.loc("filename");
     props.finish()?;
     Ok(TextureRequest {
@@ -271,7 +278,64 @@ fn bitmap(e: &Element, kind: SlotKind, tex: &TextureCollector<'_>) -> Result<Tex
         },
         scale: [1.0; 3],
         offset: [0.0; 3],
+        to_uv,
         location,
+    })
+}
+
+/// A texture's `to_uv`: Mitsuba keeps the 2D affine part of the 4 × 4
+/// matrix (rows and columns x, y and the translation).
+fn to_uv(props: &Props<'_>) -> Result<UvTransform> {
+    let Some(t) = props.transform("to_uv")? else {
+        return Ok(UvTransform::IDENTITY);
+    };
+    let m = t.matrix;
+    let uv = UvTransform([
+        m.x_axis.x, m.y_axis.x, m.w_axis.x, m.x_axis.y, m.y_axis.y, m.w_axis.y,
+    ]);
+    if !uv.0.iter().all(|v| v.is_finite()) {
+        return Err(SceneError::at(&props.loc("to_uv"), "to_uv must be finite"));
+    }
+    Ok(uv)
+}
+
+/// Mitsuba's `checkerboard`: `color0` where ⌊2u⌋ + ⌊2v⌋ is even (the
+/// [0, ½)² quarter of every unit tile), `color1` elsewhere; defaults 0.4
+/// and 0.2. It is a 2 × 2 image looked up at its nearest texel, repeated:
+/// value = color1 + (color0 − color1) · t with t = 1 on the diagonal
+/// texels, so either colour comes out exactly.
+fn checkerboard(e: &Element, kind: SlotKind, tex: &TextureCollector<'_>) -> Result<TextureRequest> {
+    let props = Props::new(e)?;
+    props.no_objects()?;
+    let color = |name: &str, default: f64| -> Result<[f64; 3]> {
+        let c = reflectance(&props, name, default)?;
+        match c {
+            ColorParam::Float(v) => Ok([v; 3]),
+            ColorParam::Rgb(rgb) => Ok(rgb),
+            _ => Err(SceneError::at(
+                &props.loc(name),
+                format!(
+                    "{name} of a checkerboard must be a float or an rgb value (textures are RGB)"
+                ),
+            )),
+        }
+    };
+    let (c0, c1) = (color("color0", 0.4)?, color("color1", 0.2)?);
+    let to_uv = to_uv(&props)?;
+    props.finish()?;
+    Ok(TextureRequest {
+        path: tex.path.clone(),
+        kind,
+        source: ImageSource::Checkerboard,
+        sampling: Sampling {
+            wrap: [Wrap::Repeat; 2],
+            filter: Filter::Nearest,
+            raw: true,
+        },
+        scale: std::array::from_fn(|c| c0[c] - c1[c]),
+        offset: c1,
+        to_uv,
+        location: e.loc.clone(),
     })
 }
 

@@ -627,7 +627,7 @@ mod tests {
         )
         .into_bytes();
         let big = format == "binary_big_endian";
-        let mut put = |out: &mut Vec<u8>, bytes: &mut [u8]| {
+        let put = |out: &mut Vec<u8>, bytes: &mut [u8]| {
             if big {
                 bytes.reverse();
             }
@@ -760,9 +760,7 @@ mod tests {
         let cases: Vec<(Vec<u8>, &str)> = vec![
             (b"plx\n".to_vec(), "line 1: the file does not start"),
             (
-                good[..good.find("end_header").expect("a header")]
-                    .as_bytes()
-                    .to_vec(),
+                good.as_bytes()[..good.find("end_header").expect("a header")].to_vec(),
                 "no end_header line",
             ),
             (

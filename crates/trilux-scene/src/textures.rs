@@ -10,7 +10,7 @@ use std::collections::HashMap;
 use std::path::PathBuf;
 use std::sync::Arc;
 
-use trilux_brdf::{Branch, SlotKind, Texture, TextureSlot};
+use trilux_brdf::{Branch, SlotKind, Texture, TextureSlot, UvTransform};
 
 use crate::error::{Result, SceneError, SourceLocation};
 use crate::image::{MAX_IMAGE_BYTES, Sampling, decode};
@@ -23,6 +23,9 @@ pub(crate) enum ImageSource {
     File(PathBuf),
     /// Bytes already in memory (a glTF `data:` URI or buffer view).
     Bytes(Arc<[u8]>),
+    /// Mitsuba's `checkerboard`: 1 on the diagonal of 2 × 2 texels, 0 off
+    /// it (its colours are the request's offset and scale).
+    Checkerboard,
 }
 
 /// A texture of one material parameter, not read yet.
@@ -40,6 +43,9 @@ pub(crate) struct TextureRequest {
     pub scale: [f64; 3],
     /// See `scale`.
     pub offset: [f64; 3],
+    /// The map from the shape's texture coordinates to the image's
+    /// (Mitsuba's `to_uv`, glTF's `KHR_texture_transform`).
+    pub to_uv: UvTransform,
     /// Where the texture is named, for errors.
     pub location: SourceLocation,
 }
@@ -78,6 +84,7 @@ impl TextureCache {
             texture,
             scale: request.scale,
             offset: request.offset,
+            to_uv: request.to_uv,
         })
     }
 }
@@ -90,6 +97,14 @@ fn read(request: &TextureRequest) -> Result<Texture> {
                 .map_err(|e| at(format!("cannot read image {}: {e}", path.display())))?;
             decode(&bytes, request.sampling).map_err(|e| at(format!("{}: {e}", path.display())))
         }
+        ImageSource::Checkerboard => Texture::new(
+            2,
+            2,
+            vec![[1.0; 3], [0.0; 3], [0.0; 3], [1.0; 3]],
+            request.sampling.wrap,
+            request.sampling.filter,
+        )
+        .map_err(|e| at(e.to_string())),
         ImageSource::Bytes(bytes) => {
             if bytes.len() as u64 > MAX_IMAGE_BYTES {
                 return Err(at(format!(

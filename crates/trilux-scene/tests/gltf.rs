@@ -458,6 +458,63 @@ fn a_base_colour_texture_is_decoded_from_srgb() {
     );
 }
 
+/// `KHR_texture_transform` maps TEXCOORD_0 by T · R · S. The extension's
+/// examples: an offset (0.5, 0) moves the lookup half an image right; a
+/// scale of 2 tiles the image twice; a rotation of +90° turns (1, 0) into
+/// (0, −1), a clockwise turn in y-up terms, counter-clockwise in glTF's
+/// v-down coordinates (what implementations do, KhronosGroup/glTF #1563).
+#[test]
+fn texture_transforms_map_the_texture_coordinates() {
+    let dir = folder("texture-transform");
+    let ramp = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/textures/ramp.png");
+    std::fs::copy(ramp, dir.join("ramp.png")).unwrap();
+    let to_uv = |transform: serde_json::Value| {
+        let m = json!({"pbrMetallicRoughness": {"metallicFactor": 0.0,
+                       "baseColorTexture": {"index": 0, "extensions": {"KHR_texture_transform": transform}}},
+                       "extensions": {"KHR_materials_specular": {"specularFactor": 0.0}}});
+        let mut j = with_material(Some(m));
+        j["extensionsUsed"] = json!(["KHR_materials_specular", "KHR_texture_transform"]);
+        j["extensionsRequired"] = json!(["KHR_texture_transform"]);
+        j["images"] = json!([{"uri": "ramp.png"}]);
+        j["textures"] = json!([{"source": 0}]);
+        let scene = load_in(&dir, &j).unwrap();
+        scene.shapes[0].textures[0].to_uv
+    };
+    let p = glam::DVec2::new(1.0, 0.0);
+    let q = glam::DVec2::new(0.25, 0.5);
+    let close = |a: glam::DVec2, b: glam::DVec2| (a - b).length() < 1e-6;
+    assert!(close(
+        to_uv(json!({"offset": [0.5, 0.0]})).apply(q),
+        glam::DVec2::new(0.75, 0.5)
+    ));
+    assert!(close(
+        to_uv(json!({"scale": [2.0, 3.0]})).apply(q),
+        glam::DVec2::new(0.5, 1.5)
+    ));
+    let quarter = std::f64::consts::FRAC_PI_2;
+    assert!(close(
+        to_uv(json!({"rotation": quarter})).apply(p),
+        glam::DVec2::new(0.0, -1.0)
+    ));
+    // All three: scale, then rotate, then offset.
+    let all = to_uv(json!({"offset": [0.1, 0.2], "rotation": quarter, "scale": [2.0, 1.0]}));
+    assert!(close(all.apply(p), glam::DVec2::new(0.1, 0.2 - 2.0)));
+    let err = |transform: serde_json::Value| {
+        let m = json!({"pbrMetallicRoughness": {"baseColorTexture": {"index": 0,
+                       "extensions": {"KHR_texture_transform": transform}}}});
+        let mut j = with_material(Some(m));
+        j["images"] = json!([{"uri": "ramp.png"}]);
+        j["textures"] = json!([{"source": 0}]);
+        load_in(&dir, &j).unwrap_err().to_string()
+    };
+    let e = err(json!({"texCoord": 1}));
+    assert!(e.contains("texCoord 1 is not supported"), "{e}");
+    assert!(
+        e.contains("/materials/0/pbrMetallicRoughness/baseColorTexture"),
+        "{e}"
+    );
+}
+
 #[test]
 fn punctual_lights_are_refused_naming_the_light() {
     let mut j = with_material(None);

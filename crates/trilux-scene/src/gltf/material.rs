@@ -26,16 +26,19 @@
 //!
 //! Refused (one error naming the material): `metallicRoughnessTexture`,
 //! `emissiveTexture`, the textures of `KHR_materials_specular`,
-//! `KHR_texture_transform`, texture coordinates other than `TEXCOORD_0`,
+//! texture coordinates other than `TEXCOORD_0`,
 //! `alphaMode` other than `OPAQUE`, and `normalTexture` (a shading normal
 //! per texel, which trilux's element normals cannot follow).
-//! `occlusionTexture` is ignored: it approximates, for real-time engines,
+//! `KHR_texture_transform` on the base colour texture maps TEXCOORD_0 (as
+//! Mitsuba's `to_uv` does). `occlusionTexture` is ignored: it approximates, for real-time engines,
 //! the shadowing that a global illumination solve computes.
 
 use std::path::Path;
 use std::sync::Arc;
 
-use trilux_brdf::{Branch, BsdfParams, Distribution, Filter, RoughConductorParams, SlotKind, Wrap};
+use trilux_brdf::{
+    Branch, BsdfParams, Distribution, Filter, RoughConductorParams, SlotKind, UvTransform, Wrap,
+};
 use trilux_color::ColorParam;
 
 use crate::error::{Result, SceneError, SourceLocation};
@@ -60,6 +63,8 @@ pub(crate) struct TextureUse {
     pub scale: [f64; 3],
     /// See `scale`.
     pub offset: [f64; 3],
+    /// `KHR_texture_transform`.
+    pub to_uv: UvTransform,
     /// `/materials/i/pbrMetallicRoughness/baseColorTexture`.
     pub location: SourceLocation,
 }
@@ -139,7 +144,7 @@ pub(crate) fn map(file: &Arc<Path>, m: &gltf::Material<'_>) -> Result<Mapped> {
     };
     let mut textures = Vec::new();
     let mut add = |path: Vec<Branch>, kind, scale: [f64; 3], offset: [f64; 3]| {
-        if let Some((image, sampling, location)) = &base_texture
+        if let Some((image, sampling, to_uv, location)) = &base_texture
             && scale.iter().any(|&s| s > 0.0)
         {
             textures.push(TextureUse {
@@ -149,6 +154,7 @@ pub(crate) fn map(file: &Arc<Path>, m: &gltf::Material<'_>) -> Result<Mapped> {
                 sampling: *sampling,
                 scale,
                 offset,
+                to_uv: *to_uv,
                 location: location.clone(),
             });
         }
@@ -270,13 +276,14 @@ fn emission(m: &gltf::Material<'_>, at: &At<'_>) -> Result<Option<ColorParam>> {
     Ok(emits.then_some(ColorParam::Rgb(e)))
 }
 
-/// The image, sampling and place of a texture reference.
+/// The image, sampling, coordinate transform and place of a texture
+/// reference.
 fn texture_info(
     t: &gltf::texture::Info<'_>,
     at: &At<'_>,
     suffix: &str,
     location: SourceLocation,
-) -> Result<(usize, Sampling, SourceLocation)> {
+) -> Result<(usize, Sampling, UvTransform, SourceLocation)> {
     if t.tex_coord() != 0 {
         return Err(at(
             suffix,
@@ -286,9 +293,10 @@ fn texture_info(
             ),
         ));
     }
-    if t.texture_transform().is_some() {
-        return Err(at(suffix, "KHR_texture_transform is not supported".into()));
-    }
+    let to_uv = match t.texture_transform() {
+        Some(tt) => texture_transform(&tt, at, suffix)?,
+        None => UvTransform::IDENTITY,
+    };
     let texture = t.texture();
     let sampler = texture.sampler();
     let wrap = |w: gltf::texture::WrappingMode| match w {
@@ -311,6 +319,39 @@ fn texture_info(
             filter,
             raw: false,
         },
+        to_uv,
         location,
     ))
+}
+
+/// `KHR_texture_transform` as the map from TEXCOORD_0 to the image's
+/// coordinates: T · R · S (the extension's order), with R the rotation that
+/// implementations and the extension's sample model agree on, (u, v) ↦
+/// (c·u + s·v, −s·u + c·v), counter-clockwise in glTF's v-down coordinates
+/// (the extension's GLSL listing has the opposite sign; KhronosGroup/glTF
+/// issue 1563).
+fn texture_transform(
+    tt: &gltf::texture::TextureTransform<'_>,
+    at: &At<'_>,
+    suffix: &str,
+) -> Result<UvTransform> {
+    if let Some(tc) = tt.tex_coord()
+        && tc != 0
+    {
+        return Err(at(
+            suffix,
+            format!("KHR_texture_transform's texCoord {tc} is not supported (only TEXCOORD_0)"),
+        ));
+    }
+    let [ox, oy] = tt.offset().map(f64::from);
+    let [sx, sy] = tt.scale().map(f64::from);
+    let (s, c) = f64::from(tt.rotation()).sin_cos();
+    let m = UvTransform([c * sx, s * sy, ox, -s * sx, c * sy, oy]);
+    if !m.0.iter().all(|v| v.is_finite()) {
+        return Err(at(
+            suffix,
+            "KHR_texture_transform has a value that is not finite".into(),
+        ));
+    }
+    Ok(m)
 }

@@ -34,8 +34,11 @@ pub(crate) use nodes::GltfMeshes;
 /// Extensions a file may require (others in `extensionsRequired` are
 /// refused; others only used are ignored, as the glTF specification
 /// allows).
-pub const SUPPORTED_EXTENSIONS: [&str; 2] =
-    ["KHR_materials_specular", "KHR_materials_emissive_strength"];
+pub const SUPPORTED_EXTENSIONS: [&str; 3] = [
+    "KHR_materials_specular",
+    "KHR_materials_emissive_strength",
+    "KHR_texture_transform",
+];
 
 /// True when `path` names a glTF file (`.gltf` or `.glb`, any case).
 pub fn is_gltf(path: &Path) -> bool {

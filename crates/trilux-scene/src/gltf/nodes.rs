@@ -430,6 +430,7 @@ impl GltfMeshes {
                     sampling: t.sampling,
                     scale: t.scale,
                     offset: t.offset,
+                    to_uv: t.to_uv,
                     location: t.location.clone(),
                 },
             ));

@@ -11,6 +11,9 @@ scalar_rgb, single precision) built from the same text:
 - "areas": the surface area of a shape;
 - "meshes": positions, vertex normals and texture coordinates of OBJ and
   PLY meshes (the PLY files are made by make_ply.py);
+- "textures": the diffuse reflectance of a rectangle textured with a
+  `bitmap` (ramp.png, 4 x 2 texels) or `checkerboard`, with `to_uv`
+  transforms, at fixed texture coordinates;
 - "rays": for each shape of "areas" (and flip_normals variants), rays aimed
   near the shape's bounding-box centre from fixed pseudo-random origins, with
   Mitsuba's hit distance and geometric normal (or a miss): the scene's object
@@ -139,6 +142,38 @@ for m in MESHES:
         "normals": [n[i:i + 3] for i in range(0, len(n), 3)],
         "texcoords": [uv[i:i + 2] for i in range(0, len(uv), 2)],
     })
+
+TEXTURES = [
+    '<texture type="bitmap" name="reflectance"><string name="filename" value="ramp.png"/>'
+    '<boolean name="raw" value="true"/><string name="filter_type" value="nearest"/>'
+    '<transform name="to_uv"><scale x="2" y="1"/></transform></texture>',
+    '<texture type="bitmap" name="reflectance"><string name="filename" value="ramp.png"/>'
+    '<boolean name="raw" value="true"/><string name="filter_type" value="nearest"/>'
+    '<transform name="to_uv"><translate x="0.25" y="0.1"/></transform></texture>',
+    '<texture type="bitmap" name="reflectance"><string name="filename" value="ramp.png"/>'
+    '<boolean name="raw" value="true"/><string name="filter_type" value="nearest"/>'
+    '<transform name="to_uv"><rotate z="1" angle="90"/></transform></texture>',
+    '<texture type="bitmap" name="reflectance"><string name="filename" value="ramp.png"/>'
+    '<string name="wrap_mode" value="mirror"/>'
+    '<transform name="to_uv"><scale x="1.5" y="0.7"/><rotate z="1" angle="30"/><translate x="0.3"/></transform></texture>',
+    '<texture type="checkerboard" name="reflectance"/>',
+    '<texture type="checkerboard" name="reflectance"><rgb name="color0" value="0.9, 0.5, 0.1"/>'
+    '<float name="color1" value="0.05"/><transform name="to_uv"><scale value="4"/></transform></texture>',
+]
+TEXTURE_UVS = [(0.1, 0.1), (0.3, 0.15), (0.6, 0.2), (0.85, 0.35), (0.05, 0.8),
+               (0.45, 0.6), (0.7, 0.9), (0.93, 0.55)]
+out["textures"] = []
+for t in TEXTURES:
+    bsdf = load(f'<shape type="rectangle"><bsdf type="diffuse">{t}</bsdf></shape>').shapes()[0].bsdf()
+    values = []
+    for u, v in TEXTURE_UVS:
+        si = mi.SurfaceInteraction3f()
+        si.uv = mi.Point2f(u, v)
+        si.wi = mi.Vector3f(0, 0, 1)
+        r = bsdf.eval_diffuse_reflectance(si)
+        values.append({"uv": [u, v], "rgb": [float(r[0]), float(r[1]), float(r[2])]})
+    out["textures"].append({"xml": t, "values": values})
+
 
 def lcg(seed):
     """A tiny deterministic generator (so the rays do not depend on numpy)."""
