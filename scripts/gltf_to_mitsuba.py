@@ -296,8 +296,13 @@ class Converter:
         to_world[:3, 0], to_world[:3, 1], to_world[:3, 2] = -axes[:, 0], axes[:, 1], -axes[:, 2]
         to_world[:3, 3] = world[:3, 3]
         mat = " ".join(f"{v:.12g}" for v in to_world.reshape(-1))
+        clip = f'<float name="near_clip" value="{persp["znear"]:.12g}"/>'
+        if "zfar" in persp:
+            clip += f'<float name="far_clip" value="{persp["zfar"]:.12g}"/>'
+        else:
+            clip += '<float name="far_clip" value="1e30"/>'  # glTF: infinite
         sensor = (f'<sensor type="perspective"><float name="fov" value="{math.degrees(persp["yfov"]):.12g}"/>'
-                  f'<string name="fov_axis" value="y"/><transform name="to_world"><matrix value="{mat}"/></transform>'
+                  f'{clip}<string name="fov_axis" value="y"/><transform name="to_world"><matrix value="{mat}"/></transform>'
                   f'<film type="hdrfilm"><integer name="width" value="{width}"/><integer name="height" value="{height}"/>'
                   f'<rfilter type="gaussian"/></film></sensor>')
         xml = ('<?xml version="1.0" encoding="utf-8"?>\n<scene version="3.0.0">\n'

@@ -69,6 +69,11 @@ pub struct Camera {
     tan_half_y: f64,
     width: u32,
     height: u32,
+    /// Depth of the near clip plane: rays start on it.
+    near_clip: f64,
+    /// Depth of the far clip plane (checked against the scene, not
+    /// clipped: `check_far_clip`).
+    far_clip: f64,
 }
 
 /// Mitsuba's `Transform4f.look_at`: camera space (+x left, +y up, +z
@@ -147,7 +152,48 @@ impl Camera {
             tan_half_y: tan_half_x / aspect,
             width,
             height,
+            near_clip: 0.0,
+            far_clip: f64::INFINITY,
         })
+    }
+
+    /// The camera with clip planes at depths `near` and `far` (Mitsuba's
+    /// `near_clip`, `far_clip`): camera rays start on the near plane.
+    pub fn with_clip(mut self, near: f64, far: f64) -> Result<Self, RenderError> {
+        if !(near.is_finite() && near >= 0.0 && far > near) {
+            return Err(RenderError::Camera(format!(
+                "near_clip {near} must be non-negative and below far_clip {far}"
+            )));
+        }
+        (self.near_clip, self.far_clip) = (near, far);
+        Ok(self)
+    }
+
+    /// Refuses a far clip plane that would cut geometry inside `bounds`
+    /// (trilux does not clip there; with every corner of the bounds in
+    /// front of the plane, not clipping is what Mitsuba renders).
+    pub fn check_far_clip(&self, bounds: &trilux_geometry::Bounds) -> Result<(), RenderError> {
+        let forward = self
+            .world_from_camera
+            .transform_vector3(DVec3::Z)
+            .normalize();
+        let mut deepest = f64::NEG_INFINITY;
+        for i in 0..8 {
+            let pick = |bit: usize, lo: f64, hi: f64| if i & bit == 0 { lo } else { hi };
+            let corner = DVec3::new(
+                pick(1, bounds.min.x, bounds.max.x),
+                pick(2, bounds.min.y, bounds.max.y),
+                pick(4, bounds.min.z, bounds.max.z),
+            );
+            deepest = deepest.max((corner - self.origin).dot(forward));
+        }
+        if deepest > self.far_clip {
+            return Err(RenderError::Camera(format!(
+                "far_clip {} would cut the scene, which reaches {deepest:.6} along the view; trilux renders without a far plane: raise far_clip",
+                self.far_clip
+            )));
+        }
+        Ok(())
     }
 
     /// Film width in pixels.
@@ -191,10 +237,11 @@ impl Camera {
             (1.0 - 2.0 * s.y) * self.tan_half_y,
             1.0,
         );
-        let dir = self.world_from_camera.transform_vector3(d_cam).normalize();
+        // d_cam has depth 1: the ray meets the near plane at d·near.
+        let d = self.world_from_camera.transform_vector3(d_cam);
         Ray {
-            origin: self.origin,
-            dir,
+            origin: self.origin + d * self.near_clip,
+            dir: d.normalize(),
         }
     }
 }
@@ -211,6 +258,45 @@ mod tests {
         // Diagonal of a square: tan(h/2) = tan(d/2)/sqrt(2).
         let h = horizontal_fov(90.0, FovAxis::Diagonal, 1.0);
         assert!(((h.to_radians() / 2.0).tan() - 1.0 / 2f64.sqrt()).abs() < 1e-12);
+    }
+
+    /// Mitsuba's clip planes: every camera ray starts on the near plane
+    /// (depth `near` along the view axis, so near/cos θ from the eye); a
+    /// far plane in front of any corner of the scene's bounds is refused.
+    #[test]
+    fn rays_start_on_the_near_plane_and_a_cutting_far_plane_is_refused() {
+        let m = look_at(
+            DVec3::new(1.0, 2.0, 3.0),
+            DVec3::new(1.0, 2.0, 0.0),
+            DVec3::Y,
+        )
+        .unwrap();
+        let cam = Camera::new(m, 90.0, FovAxis::X, 8, 8)
+            .unwrap()
+            .with_clip(0.5, 10.0)
+            .unwrap();
+        let forward = DVec3::new(0.0, 0.0, -1.0);
+        for s in [
+            DVec2::new(0.5, 0.5),
+            DVec2::new(0.0, 0.0),
+            DVec2::new(0.9, 0.2),
+        ] {
+            let r = cam.ray_unit(s);
+            let depth = (r.origin - cam.origin()).dot(forward);
+            assert!((depth - 0.5).abs() < 1e-12, "{s}: depth {depth}");
+            let along = (r.origin - cam.origin()).normalize();
+            assert!((along - r.dir).length() < 1e-12, "on the ray through {s}");
+        }
+        // The corner (0, 0, −7.5) is 10.5 deep; −6.5 is 9.5 deep.
+        let scene = |z: f64| trilux_geometry::Bounds {
+            min: DVec3::new(0.0, 0.0, z),
+            max: DVec3::new(1.0, 1.0, 0.0),
+        };
+        assert!(cam.check_far_clip(&scene(-6.5)).is_ok());
+        let e = cam.check_far_clip(&scene(-7.5)).unwrap_err().to_string();
+        assert!(e.contains("far_clip 10 would cut the scene"), "{e}");
+        assert!(cam.clone().with_clip(1.0, 0.5).is_err());
+        assert!(cam.with_clip(f64::NAN, 1.0).is_err());
     }
 
     #[test]

@@ -219,6 +219,15 @@ impl WithBands for Run<'_, '_> {
     fn run<const N: usize>(self) -> Self::Output {
         let start = Instant::now();
         let prepared = prepare::<N>(self.scene)?;
+        if let Some((camera, _)) = &self.view {
+            let located = |e| match (e, &self.scene.camera) {
+                (RenderError::Camera(m), Some(c)) => SceneError::at(&c.location, m).into(),
+                (e, _) => e,
+            };
+            camera
+                .check_far_clip(&prepared.geometry().bounds())
+                .map_err(located)?;
+        }
         let prepare_seconds = start.elapsed().as_secs_f64();
         let start = Instant::now();
         let mut solution = match self.plan.source {

@@ -68,7 +68,8 @@ pub fn camera_of(c: &trilux_scene::Camera, o: &ViewOverrides) -> Result<Camera, 
         axis(c.fov_axis),
         o.width.unwrap_or(c.width),
         o.height.unwrap_or(c.height),
-    )
+    )?
+    .with_clip(c.near_clip, c.far_clip)
 }
 
 #[cfg(test)]
@@ -96,7 +97,8 @@ mod tests {
         assert_eq!((cam.width(), cam.height()), (30, 20));
         let centre = cam.ray_unit(DVec2::splat(0.5));
         assert!((centre.dir - DVec3::new(0.0, 0.0, -1.0)).length() < 1e-12);
-        assert!((centre.origin - DVec3::new(1.0, 2.0, 3.0)).length() < 1e-12);
+        // On the near plane, Mitsuba's default 0.01 in front of the eye.
+        assert!((centre.origin - DVec3::new(1.0, 2.0, 2.99)).length() < 1e-12);
         // fov 40 along y: the top edge of the film is 20° above the axis.
         let top = cam.ray_unit(DVec2::new(0.5, 0.0));
         assert!((top.dir.y.atan2(-top.dir.z).to_degrees() - 20.0).abs() < 1e-9);

@@ -321,6 +321,7 @@ fn sensor(e: &Element) -> Result<Camera> {
             world_from_camera.transform_vector3(DVec3::Y),
         ),
     };
+    let (near_clip, far_clip) = clip_planes(&props)?;
     let mut width = 768;
     let mut height = 576;
     let mut rfilter = ReconstructionFilter::default();
@@ -360,8 +361,32 @@ fn sensor(e: &Element) -> Result<Camera> {
         height,
         rfilter,
         sample_count,
+        near_clip,
+        far_clip,
         location: e.loc.clone(),
     })
+}
+
+/// `near_clip` and `far_clip` (Mitsuba's defaults 0.01 and 10⁴): positive,
+/// finite, near < far.
+fn clip_planes(props: &Props<'_>) -> Result<(f64, f64)> {
+    let near = props.float("near_clip")?.unwrap_or(0.01);
+    let far = props.float("far_clip")?.unwrap_or(1e4);
+    for (name, v) in [("near_clip", near), ("far_clip", far)] {
+        if !(v.is_finite() && v > 0.0) {
+            return Err(SceneError::at(
+                &props.loc(name),
+                format!("{name} must be a positive number, found {v}"),
+            ));
+        }
+    }
+    if near >= far {
+        return Err(SceneError::at(
+            &props.loc("far_clip"),
+            format!("far_clip {far} must be larger than near_clip {near}"),
+        ));
+    }
+    Ok((near, far))
 }
 
 fn positive_u32(props: &Props<'_>, name: &str, default: u32) -> Result<u32> {

@@ -833,6 +833,34 @@ fn blackbody_spectra_are_mitsubas() {
     }
 }
 
+/// `near_clip` and `far_clip`, with Mitsuba's defaults (0.01, 10⁴).
+#[test]
+fn clip_planes() {
+    let camera = |params: &str| {
+        load(&format!(
+            r#"<sensor type="perspective"><float name="fov" value="40"/>{params}</sensor>"#
+        ))
+        .camera
+        .expect("camera")
+    };
+    let c = camera("");
+    assert_eq!((c.near_clip, c.far_clip), (0.01, 1e4));
+    let c = camera(r#"<float name="near_clip" value="0.1"/><float name="far_clip" value="100"/>"#);
+    assert_eq!((c.near_clip, c.far_clip), (0.1, 100.0));
+    let e = err(r#"<sensor type="perspective"><float name="near_clip" value="0"/></sensor>"#);
+    assert!(
+        e.contains("near_clip must be a positive number, found 0"),
+        "{e}"
+    );
+    let e = err(
+        r#"<sensor type="perspective"><float name="near_clip" value="2"/><float name="far_clip" value="1"/></sensor>"#,
+    );
+    assert!(
+        e.contains("far_clip 1 must be larger than near_clip 2"),
+        "{e}"
+    );
+}
+
 #[test]
 fn unknown_things_are_refused() {
     assert!(err(r#"<shape type="serialized"/>"#).contains("unknown shape plugin \"serialized\""));

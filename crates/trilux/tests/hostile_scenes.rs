@@ -449,3 +449,31 @@ fn arguments_camera_film_and_outputs_are_checked_before_meshes_or_solving() {
     );
     assert!(!exr.exists());
 }
+
+/// A far clip plane that would cut the scene is refused at the `<sensor>`
+/// (trilux renders without one), before the solve; one beyond every
+/// corner of the scene renders.
+#[test]
+fn a_far_clip_plane_cutting_the_scene_is_refused_at_the_sensor() {
+    let dir = folder("scene-far-clip");
+    let scene = |far: &str| {
+        format!(
+            "{HEAD}\n<sensor type=\"perspective\"><float name=\"far_clip\" value=\"{far}\"/><transform name=\"to_world\"><lookat origin=\"0, 0, 5\" target=\"0, 0, 0\" up=\"0, 1, 0\"/></transform><film type=\"hdrfilm\"><integer name=\"width\" value=\"8\"/><integer name=\"height\" value=\"8\"/></film></sensor>\n<shape type=\"cube\"><emitter type=\"area\"/></shape>\n</scene>\n"
+        )
+    };
+    // The cube's far corners are 6 deep.
+    let cut = write(&dir, "cut.xml", scene("5.5"));
+    let exr = dir.join("cut.exr");
+    let out = trilux(&["render", s(&cut), "-o", s(&exr), "--quality", "draft"]);
+    assert_refused(
+        &out,
+        &format!("{}:2:1: ", s(&cut)),
+        "far_clip 5.5 would cut the scene",
+    );
+    assert!(!exr.exists());
+    let whole = write(&dir, "whole.xml", scene("6.5"));
+    let exr = dir.join("whole.exr");
+    let out = trilux(&["render", s(&whole), "-o", s(&exr), "--quality", "draft"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(exr.exists());
+}

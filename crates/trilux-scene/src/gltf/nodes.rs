@@ -137,6 +137,8 @@ struct CameraNode {
     node: usize,
     yfov: f64,
     aspect: Option<f64>,
+    znear: f64,
+    zfar: Option<f64>,
     world: DMat4,
 }
 
@@ -189,6 +191,8 @@ impl Walk<'_> {
                     node: i,
                     yfov: f64::from(p.yfov()),
                     aspect: p.aspect_ratio().map(f64::from),
+                    znear: f64::from(p.znear()),
+                    zfar: p.zfar().map(f64::from),
                     world,
                 }),
                 gltf::camera::Projection::Orthographic(_) => {
@@ -366,6 +370,13 @@ fn camera(file: &Arc<Path>, c: &CameraNode) -> Result<Camera> {
         (-axes[2]).extend(0.0),
         origin.extend(1.0),
     );
+    let far_clip = c.zfar.unwrap_or(f64::INFINITY);
+    let near_clip = c.znear;
+    if !(near_clip.is_finite() && near_clip > 0.0 && far_clip > near_clip) {
+        return Err(err(format!(
+            "znear {near_clip} must be positive and below zfar {far_clip}"
+        )));
+    }
     let width = 768u32;
     let height = match c.aspect {
         Some(a) if a.is_finite() && a > 0.0 => {
@@ -385,6 +396,8 @@ fn camera(file: &Arc<Path>, c: &CameraNode) -> Result<Camera> {
         height,
         rfilter: ReconstructionFilter::default(),
         sample_count: 4,
+        near_clip,
+        far_clip,
         location,
     })
 }
