@@ -421,7 +421,9 @@ fn film(e: &Element) -> Result<(u32, u32, ReconstructionFilter)> {
         };
         SceneError::at(&props.loc(at), m)
     })?;
-    props.ignore(&["pixel_format", "component_format"]);
+    // What the output file holds and how it is written: trilux's command
+    // line decides (EXR, PNG); radiance is the same.
+    props.ignore(&["pixel_format", "component_format", "file_format"]);
     let mut rfilter = ReconstructionFilter::default();
     for (i, o) in props.objects.iter().enumerate() {
         if o.tag != "rfilter" || i > 0 {
@@ -512,6 +514,9 @@ fn sampler(e: &Element) -> Result<u32> {
     let props = Props::new(e)?;
     props.no_objects()?;
     let n = positive_u32(&props, "sample_count", 4)?;
+    // Mitsuba's seed picks other random numbers (the noise, not the
+    // image it converges to); trilux's sequences are its own (`--seed`).
+    props.ignore(&["seed"]);
     props.finish()?;
     Ok(n)
 }

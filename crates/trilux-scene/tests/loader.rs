@@ -230,10 +230,10 @@ fn sensor_parameters() {
         r#"<sensor type="perspective">
              <float name="fov" value="30"/><string name="fov_axis" value="larger"/>
              <transform name="to_world"><lookat origin="1, 2, 3" target="1, 2, 0" up="0, 1, 0"/></transform>
-             <sampler type="stratified"><integer name="sample_count" value="16"/></sampler>
+             <sampler type="stratified"><integer name="sample_count" value="16"/><integer name="seed" value="7"/></sampler>
              <film type="hdrfilm"><integer name="width" value="320"/><integer name="height" value="240"/>
                <rfilter type="box"/><string name="pixel_format" value="rgba"/>
-               <string name="component_format" value="float16"/></film>
+               <string name="component_format" value="float16"/><string name="file_format" value="openexr"/></film>
            </sensor>"#,
     )
     .camera
