@@ -299,8 +299,8 @@ fn sensor_errors() {
             .contains("fov_axis needs a fov")
     );
     assert!(
-        err(r#"<sensor type="perspective"><float name="near_clip" value="0.1"/></sensor>"#)
-            .contains("unknown parameter \"near_clip\"")
+        err(r#"<sensor type="perspective"><float name="focus_distance" value="0.1"/></sensor>"#)
+            .contains("unknown parameter \"focus_distance\"")
     );
     assert!(err(r#"<sensor type="perspective"><film type="hdrfilm"><integer name="width" value="0"/></film></sensor>"#).contains("width must be a positive integer"));
     assert!(err(r#"<sensor type="perspective"><film type="hdrfilm"><rfilter type="sinc"/></film></sensor>"#).contains("unknown rfilter plugin"));
