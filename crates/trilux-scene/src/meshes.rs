@@ -49,7 +49,7 @@ impl Pending {
         for (index, request) in self.requests.meshes {
             let mesh = request
                 .format
-                .load(&request.path, request.face_normals)
+                .load(&request.path, request.face_normals, request.flip_tex_coords)
                 .map_err(|e| SceneError::at(&request.filename, e))?;
             let shape = &mut self.scene.shapes[index].shape;
             shape.kind = ShapeKind::Mesh(mesh);

@@ -67,17 +67,27 @@ pub enum ObjError {
     },
 }
 
-/// Reads an OBJ file into one triangle mesh (all its objects merged).
-pub fn load_obj(path: &Path, face_normals: bool) -> Result<TriangleMesh, ObjError> {
+/// Reads an OBJ file into one triangle mesh (all its objects merged);
+/// `flip_tex_coords` is Mitsuba's parameter (true by default: v ↦ 1 − v).
+pub fn load_obj(
+    path: &Path,
+    face_normals: bool,
+    flip_tex_coords: bool,
+) -> Result<TriangleMesh, ObjError> {
     let bytes = trilux_files::read_limited(path, MAX_OBJ_BYTES).map_err(|source| ObjError::Io {
         path: path.to_path_buf(),
         source,
     })?;
-    parse_obj(&bytes, path, face_normals)
+    parse_obj(&bytes, path, face_normals, flip_tex_coords)
 }
 
 /// [`load_obj`] on the bytes of an OBJ file; `path` names it in errors.
-pub fn parse_obj(bytes: &[u8], path: &Path, face_normals: bool) -> Result<TriangleMesh, ObjError> {
+pub fn parse_obj(
+    bytes: &[u8],
+    path: &Path,
+    face_normals: bool,
+    flip_tex_coords: bool,
+) -> Result<TriangleMesh, ObjError> {
     // Before tobj spends memory on them: every face line makes at least
     // one triangle, every vertex line one position.
     let (faces, positions) = count_lines(bytes);
@@ -144,13 +154,17 @@ pub fn parse_obj(bytes: &[u8], path: &Path, face_normals: bool) -> Result<Triang
             all_have_normals = false;
             normals.extend(std::iter::repeat_n(DVec3::ZERO, count));
         }
-        // Mitsuba's OBJ loader flips v (v = 0 is an image's bottom row in
-        // OBJ, its top row in trilux and Mitsuba).
+        // Mitsuba's OBJ loader flips v by default (v = 0 is an image's
+        // bottom row in OBJ, its top row in trilux and Mitsuba).
         if m.texcoords.len() / 2 == count {
+            let v = |t: f32| match flip_tex_coords {
+                true => 1.0 - f64::from(t),
+                false => f64::from(t),
+            };
             texcoords.extend(
                 m.texcoords
                     .chunks_exact(2)
-                    .map(|t| DVec2::new(f64::from(t[0]), 1.0 - f64::from(t[1]))),
+                    .map(|t| DVec2::new(f64::from(t[0]), v(t[1]))),
             );
         } else {
             all_have_texcoords = false;
@@ -312,7 +326,7 @@ mod tests {
         ];
         for (text, bad) in &cases {
             assert_eq!(bad_face_index(text.as_bytes()), *bad, "{text:?}");
-            let parsed = parse_obj(text.as_bytes(), Path::new("t.obj"), false);
+            let parsed = parse_obj(text.as_bytes(), Path::new("t.obj"), false, true);
             assert_eq!(parsed.is_err(), bad.is_some(), "{text:?}: {parsed:?}");
         }
     }

@@ -72,17 +72,27 @@ pub enum PlyError {
     },
 }
 
-/// Reads a PLY file into one triangle mesh.
-pub fn load_ply(path: &Path, face_normals: bool) -> Result<TriangleMesh, PlyError> {
+/// Reads a PLY file into one triangle mesh; `flip_tex_coords` (false by
+/// default in Mitsuba for PLY) maps v ↦ 1 − v.
+pub fn load_ply(
+    path: &Path,
+    face_normals: bool,
+    flip_tex_coords: bool,
+) -> Result<TriangleMesh, PlyError> {
     let bytes = trilux_files::read_limited(path, MAX_OBJ_BYTES).map_err(|source| PlyError::Io {
         path: path.to_path_buf(),
         source,
     })?;
-    parse_ply(&bytes, path, face_normals)
+    parse_ply(&bytes, path, face_normals, flip_tex_coords)
 }
 
 /// [`load_ply`] on the bytes of a PLY file; `path` names it in errors.
-pub fn parse_ply(bytes: &[u8], path: &Path, face_normals: bool) -> Result<TriangleMesh, PlyError> {
+pub fn parse_ply(
+    bytes: &[u8],
+    path: &Path,
+    face_normals: bool,
+    flip_tex_coords: bool,
+) -> Result<TriangleMesh, PlyError> {
     let fail = |place: String, reason: String| PlyError::Parse {
         path: path.to_path_buf(),
         place,
@@ -93,7 +103,11 @@ pub fn parse_ply(bytes: &[u8], path: &Path, face_normals: bool) -> Result<Triang
     header.check_size(bytes.len(), path)?;
     let mut data = Data::new(&bytes[header.data_start..], header.format, header.lines);
     let raw = read_elements(&header, &mut data).map_err(|reason| fail(data.place(), reason))?;
-    raw.into_mesh(path, face_normals)
+    let mut mesh = raw.into_mesh(path, face_normals)?;
+    if flip_tex_coords && let Some(t) = &mut mesh.texcoords {
+        t.iter_mut().for_each(|uv| uv.y = 1.0 - uv.y);
+    }
+    Ok(mesh)
 }
 
 /// A scalar type of the format.
@@ -674,7 +688,7 @@ mod tests {
     }
 
     fn parse(bytes: &[u8], face_normals: bool) -> Result<TriangleMesh, PlyError> {
-        parse_ply(bytes, Path::new("t.ply"), face_normals)
+        parse_ply(bytes, Path::new("t.ply"), face_normals, false)
     }
 
     #[test]

@@ -95,11 +95,22 @@ impl MeshFormat {
         self,
         path: &std::path::Path,
         face_normals: bool,
+        flip_tex_coords: bool,
     ) -> std::result::Result<trilux_geometry::TriangleMesh, String> {
         match self {
-            MeshFormat::Obj => crate::obj::load_obj(path, face_normals).map_err(|e| e.to_string()),
-            MeshFormat::Ply => crate::ply::load_ply(path, face_normals).map_err(|e| e.to_string()),
+            MeshFormat::Obj => {
+                crate::obj::load_obj(path, face_normals, flip_tex_coords).map_err(|e| e.to_string())
+            }
+            MeshFormat::Ply => {
+                crate::ply::load_ply(path, face_normals, flip_tex_coords).map_err(|e| e.to_string())
+            }
         }
+    }
+
+    /// Mitsuba's default `flip_tex_coords`: OBJ's v runs up, PLY's is
+    /// taken as written.
+    pub fn flips_by_default(self) -> bool {
+        self == MeshFormat::Obj
     }
 }
 
@@ -113,6 +124,8 @@ pub(crate) struct MeshRequest {
     pub path: std::path::PathBuf,
     /// `face_normals` of the shape.
     pub face_normals: bool,
+    /// `flip_tex_coords` of the shape (its format's default otherwise).
+    pub flip_tex_coords: bool,
     /// Where the file name is written.
     pub filename: SourceLocation,
     /// Where the `<shape>` is written.
@@ -212,13 +225,18 @@ pub(crate) fn build_shape(
                 )
             })?;
             let face_normals = props.boolean("face_normals")?.unwrap_or(false);
+            let format = match plugin {
+                "obj" => MeshFormat::Obj,
+                _ => MeshFormat::Ply,
+            };
+            let flip_tex_coords = props
+                .boolean("flip_tex_coords")?
+                .unwrap_or(format.flips_by_default());
             request = Some(MeshRequest {
-                format: match plugin {
-                    "obj" => MeshFormat::Obj,
-                    _ => MeshFormat::Ply,
-                },
+                format,
                 path: folder.join(&name),
                 face_normals,
+                flip_tex_coords,
                 filename: props.loc("filename"),
                 shape: e.loc.clone(),
             });

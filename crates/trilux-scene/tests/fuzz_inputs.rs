@@ -177,7 +177,7 @@ fn fuzz_obj(rng: &mut Rng) -> usize {
             mutate_text(rng, &mut bytes, &TOKENS);
         }
         let face_normals = rng.below(2) == 0;
-        let (used, ok) = mesh_case(|| parse_obj(&bytes, Path::new("fuzz.obj"), face_normals));
+        let (used, ok) = mesh_case(|| parse_obj(&bytes, Path::new("fuzz.obj"), face_normals, true));
         let bound = (256 << 10) + 256 * bytes.len();
         assert!(
             used <= bound,
@@ -198,7 +198,8 @@ fn fuzz_ply(rng: &mut Rng) -> usize {
             mutate_text(rng, &mut bytes, &PLY_TOKENS);
         }
         let face_normals = rng.below(2) == 0;
-        let (used, ok) = mesh_case(|| parse_ply(&bytes, Path::new("fuzz.ply"), face_normals));
+        let (used, ok) =
+            mesh_case(|| parse_ply(&bytes, Path::new("fuzz.ply"), face_normals, false));
         let bound = (256 << 10) + 256 * bytes.len();
         assert!(
             used <= bound,
@@ -267,11 +268,11 @@ fn mutated_meshes_and_scenes_never_panic_nor_exceed_their_memory_bounds() {
     let mut rng = Rng(14);
     // The seeds themselves build.
     for seed in SEEDS {
-        let mesh = parse_obj(seed.as_bytes(), Path::new("seed.obj"), false);
+        let mesh = parse_obj(seed.as_bytes(), Path::new("seed.obj"), false, true);
         assert!(mesh.is_ok(), "{seed}: {:?}", mesh.err());
     }
     for seed in PLY_SEEDS {
-        let mesh = parse_ply(seed, Path::new("seed.ply"), false);
+        let mesh = parse_ply(seed, Path::new("seed.ply"), false, false);
         assert!(mesh.is_ok(), "{:?}", mesh.err());
     }
     let built = fuzz_obj(&mut rng);

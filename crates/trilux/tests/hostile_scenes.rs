@@ -474,6 +474,10 @@ fn a_far_clip_plane_cutting_the_scene_is_refused_at_the_sensor() {
     let whole = write(&dir, "whole.xml", scene("6.5"));
     let exr = dir.join("whole.exr");
     let out = trilux(&["render", s(&whole), "-o", s(&exr), "--quality", "draft"]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     assert!(exr.exists());
 }

@@ -107,6 +107,9 @@ MESHES = [
     '<shape type="ply"><string name="filename" value="pyramid.ply"/></shape>',
     '<shape type="ply"><string name="filename" value="tent-le.ply"/></shape>',
     '<shape type="ply"><string name="filename" value="tent-be.ply"/></shape>',
+    '<shape type="obj"><string name="filename" value="uvquad.obj"/></shape>',
+    '<shape type="obj"><string name="filename" value="uvquad.obj"/><boolean name="flip_tex_coords" value="false"/></shape>',
+    '<shape type="ply"><string name="filename" value="tent-le.ply"/><boolean name="flip_tex_coords" value="true"/></shape>',
 ]
 
 
