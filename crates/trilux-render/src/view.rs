@@ -2,7 +2,7 @@
 //! the command line's overrides (another view of the same solution:
 //! `--lookat`, `--fov`, `--width`, `--height`).
 
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 
 use crate::camera::{Camera, FovAxis, look_at};
 use crate::driver::RenderSettings;
@@ -70,12 +70,12 @@ pub fn camera_of(c: &trilux_scene::Camera, o: &ViewOverrides) -> Result<Camera, 
         o.height.unwrap_or(c.height),
     )?
     .with_clip(c.near_clip, c.far_clip)
+    .map(|cam| cam.with_principal_point_offset(DVec2::from(c.principal_point_offset)))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use glam::DVec2;
 
     const SCENE: &str = r#"<scene version="3.0.0">
         <sensor type="perspective">

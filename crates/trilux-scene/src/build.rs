@@ -322,6 +322,20 @@ fn sensor(e: &Element) -> Result<Camera> {
         ),
     };
     let (near_clip, far_clip) = clip_planes(&props)?;
+    let mut principal_point_offset = [0.0; 2];
+    for (k, name) in ["principal_point_offset_x", "principal_point_offset_y"]
+        .iter()
+        .enumerate()
+    {
+        let v = props.float(name)?.unwrap_or(0.0);
+        if !(v.is_finite() && v.abs() <= 1.0) {
+            return Err(SceneError::at(
+                &props.loc(name),
+                format!("{name} must be within [-1, 1] (film sizes), found {v}"),
+            ));
+        }
+        principal_point_offset[k] = v;
+    }
     let mut width = 768;
     let mut height = 576;
     let mut rfilter = ReconstructionFilter::default();
@@ -363,6 +377,7 @@ fn sensor(e: &Element) -> Result<Camera> {
         sample_count,
         near_clip,
         far_clip,
+        principal_point_offset,
         location: e.loc.clone(),
     })
 }

@@ -126,6 +126,10 @@ pub struct Camera {
     /// one, so a far plane that would cut the scene is refused when the
     /// scene is prepared.
     pub far_clip: f64,
+    /// Mitsuba's `principal_point_offset_x`, `_y`: the image centre's
+    /// shift, in film widths and heights (the ray through film position s
+    /// is the unshifted ray through s + offset).
+    pub principal_point_offset: [f64; 2],
     /// Where the `<sensor>` is written.
     #[serde(skip)]
     pub location: SourceLocation,

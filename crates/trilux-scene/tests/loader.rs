@@ -847,6 +847,18 @@ fn clip_planes() {
     assert_eq!((c.near_clip, c.far_clip), (0.01, 1e4));
     let c = camera(r#"<float name="near_clip" value="0.1"/><float name="far_clip" value="100"/>"#);
     assert_eq!((c.near_clip, c.far_clip), (0.1, 100.0));
+    assert_eq!(c.principal_point_offset, [0.0; 2]);
+    let c = camera(
+        r#"<float name="principal_point_offset_x" value="0.1"/><float name="principal_point_offset_y" value="-0.2"/>"#,
+    );
+    assert_eq!(c.principal_point_offset, [0.1, -0.2]);
+    let e = err(
+        r#"<sensor type="perspective"><float name="principal_point_offset_x" value="3"/></sensor>"#,
+    );
+    assert!(
+        e.contains("principal_point_offset_x must be within [-1, 1]"),
+        "{e}"
+    );
     let e = err(r#"<sensor type="perspective"><float name="near_clip" value="0"/></sensor>"#);
     assert!(
         e.contains("near_clip must be a positive number, found 0"),

@@ -398,6 +398,7 @@ fn camera(file: &Arc<Path>, c: &CameraNode) -> Result<Camera> {
         sample_count: 4,
         near_clip,
         far_clip,
+        principal_point_offset: [0.0; 2],
         location,
     })
 }
