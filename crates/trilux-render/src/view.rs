@@ -35,14 +35,7 @@ fn axis(a: trilux_scene::camera::FovAxis) -> FovAxis {
 
 /// The film filter a scene asks for.
 pub fn filter_of(c: &trilux_scene::Camera) -> ReconstructionFilter {
-    use trilux_scene::camera::ReconstructionFilter as F;
-    match c.rfilter {
-        F::Gaussian { stddev } => ReconstructionFilter::Gaussian { stddev },
-        F::Box => ReconstructionFilter::Box,
-        F::Tent { radius } => ReconstructionFilter::Tent { radius },
-        F::Mitchell { b, c } => ReconstructionFilter::Mitchell { b, c },
-        F::Lanczos { lobes } => ReconstructionFilter::Lanczos { lobes },
-    }
+    c.rfilter
 }
 
 impl RenderSettings {

@@ -11,6 +11,7 @@ use glam::{DMat4, DVec3};
 use serde::Serialize;
 
 use crate::error::SourceLocation;
+pub use crate::rfilter::ReconstructionFilter;
 
 /// The image axis along which `fov` is measured.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -50,45 +51,6 @@ impl FovAxis {
             "diagonal" => FovAxis::Diagonal,
             _ => return None,
         })
-    }
-}
-
-/// The film's reconstruction filter (`<rfilter>`), with Mitsuba's
-/// parameters (trilux-render's `filter` evaluates them).
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
-#[serde(rename_all = "lowercase")]
-pub enum ReconstructionFilter {
-    /// `gaussian`: standard deviation `stddev` px (0.5), radius 4·stddev.
-    Gaussian {
-        /// Standard deviation in pixels.
-        stddev: f64,
-    },
-    /// `box`: one pixel.
-    Box,
-    /// `tent`: radius in pixels (1).
-    Tent {
-        /// Radius in pixels.
-        radius: f64,
-    },
-    /// `mitchell` (B = C = 1/3 by default) and `catmullrom` (B = 0,
-    /// C = 1/2): radius 2 px.
-    Mitchell {
-        /// B.
-        b: f64,
-        /// C.
-        c: f64,
-    },
-    /// `lanczos`: `lobes` (3) on each side, the radius in pixels.
-    Lanczos {
-        /// Lobes.
-        lobes: u32,
-    },
-}
-
-impl Default for ReconstructionFilter {
-    /// Mitsuba's default.
-    fn default() -> Self {
-        ReconstructionFilter::Gaussian { stddev: 0.5 }
     }
 }
 

@@ -19,7 +19,7 @@
 //! 2. `resolve`: `<ref id>` replaced by the `<bsdf id>` it names.
 //! 3. `build`: typed parameters (`props`, `value`, [`transform`]) → the
 //!    model: shapes ([`shape`]), materials (`material`), area lights and the
-//!    camera ([`camera`]).
+//!    camera ([`camera`], its film's filter in [`rfilter`]).
 //! 4. [`meshes`]: the OBJ and PLY files the shapes name ([`obj`],
 //!    [`ply`]) and the
 //!    textures' images, read last, so that a command can check the camera
@@ -51,6 +51,7 @@ pub mod obj;
 pub mod ply;
 mod props;
 mod resolve;
+pub mod rfilter;
 pub mod scene;
 pub mod shape;
 mod text;
