@@ -89,7 +89,7 @@ pub(crate) fn build(resolved: Resolved, path: &Path) -> Result<(Scene, Requests)
                 return Err(SceneError::at(
                     &e.loc,
                     format!(
-                        "unsupported element <{other}> in <scene> (supported: shape, bsdf, sensor, integrator, default)"
+                        "unsupported element <{other}> in <scene> (supported: shape, bsdf, sensor, integrator, default, include)"
                     ),
                 ));
             }

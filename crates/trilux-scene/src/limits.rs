@@ -21,6 +21,13 @@ pub const MAX_OBJ_TRIANGLES: usize = 4_000_000;
 /// splitting by position, texture and normal index can make).
 pub const MAX_OBJ_VERTICES: usize = 12_000_000;
 
+/// Most files a scene may `<include>` (all levels together).
+pub const MAX_INCLUDES: usize = 64;
+
+/// Most bytes of all the files a scene includes together (64 MiB, as one
+/// scene file).
+pub const MAX_INCLUDED_BYTES: u64 = 64 << 20;
+
 /// Most XML nodes in a scene file (elements, text and comments).
 pub const MAX_XML_NODES: u32 = 2_000_000;
 

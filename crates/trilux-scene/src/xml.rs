@@ -8,6 +8,13 @@
 //! value has its `$name` references replaced. An undefined `$name` is an error,
 //! as in Mitsuba.
 //!
+//! `<include filename="f.xml"/>` among `<scene>`'s children is replaced by
+//! the children of `f.xml`'s own `<scene>` (Mitsuba 3), `f.xml` named
+//! relative to the folder of the file that includes it. The included file
+//! sees the `$name`s defined so far and its `<default>`s count for what
+//! follows, as Mitsuba's parser shares them; elements keep the file they
+//! came from in their locations.
+//!
 //! Bounded (`crate::limits`): the number of XML nodes, the nesting depth
 //! (checked before each level is entered, so deep nesting is an error, not
 //! a stack overflow), the length of each substituted value and the bytes
@@ -17,7 +24,9 @@ use std::path::Path;
 use std::sync::Arc;
 
 use crate::error::{Result, SceneError, SourceLocation};
-use crate::limits::{MAX_DEPTH, MAX_EXPANDED_BYTES, MAX_VALUE_BYTES, MAX_XML_NODES};
+use crate::limits::{
+    MAX_DEPTH, MAX_EXPANDED_BYTES, MAX_INCLUDED_BYTES, MAX_INCLUDES, MAX_VALUE_BYTES, MAX_XML_NODES,
+};
 
 /// One attribute of an element, after substitution.
 #[derive(Clone, Debug)]
@@ -91,6 +100,31 @@ impl Element {
 /// `params` are caller-given values for `$name` (they take precedence over
 /// `<default>`s, as Mitsuba's `load_file(path, name=value)` does).
 pub(crate) fn parse(text: &str, file: &Arc<Path>, params: &[(String, String)]) -> Result<Element> {
+    let mut shared = Shared {
+        params: params.to_vec(),
+        expanded: 0,
+        chain: vec![file.clone()],
+        included: 0,
+        included_bytes: 0,
+    };
+    parse_file(text, file, &mut shared)
+}
+
+/// What the files of one scene share while they are parsed.
+struct Shared {
+    /// `$name` values: the caller's, then `<default>`s in document order.
+    params: Vec<(String, String)>,
+    /// Bytes produced by `$name` substitution so far.
+    expanded: usize,
+    /// The files being parsed, the scene file first (include cycles).
+    chain: Vec<Arc<Path>>,
+    /// Files included so far, and their bytes.
+    included: usize,
+    included_bytes: u64,
+}
+
+/// Parses one file of the scene (the scene file or an included one).
+fn parse_file(text: &str, file: &Arc<Path>, shared: &mut Shared) -> Result<Element> {
     let options = roxmltree::ParsingOptions {
         allow_dtd: false,
         nodes_limit: MAX_XML_NODES,
@@ -121,8 +155,7 @@ pub(crate) fn parse(text: &str, file: &Arc<Path>, params: &[(String, String)]) -
     let mut ctx = Context {
         doc: &doc,
         file: file.clone(),
-        params: params.to_vec(),
-        expanded: 0,
+        shared,
     };
     let root = doc.root_element();
     let root_loc = ctx.loc(root.range().start);
@@ -137,6 +170,7 @@ pub(crate) fn parse(text: &str, file: &Arc<Path>, params: &[(String, String)]) -
     }
     let tree = ctx
         .element(root, 1)?
+        .pop()
         .ok_or_else(|| SceneError::at(&root_loc, "the root element must be <scene>"))?;
     check_version(&tree)?;
     Ok(tree)
@@ -182,9 +216,7 @@ fn check_version(scene: &Element) -> Result<()> {
 struct Context<'a, 'input> {
     doc: &'a roxmltree::Document<'input>,
     file: Arc<Path>,
-    params: Vec<(String, String)>,
-    /// Bytes produced by `$name` substitution so far.
-    expanded: usize,
+    shared: &'a mut Shared,
 }
 
 impl Context<'_, '_> {
@@ -198,9 +230,10 @@ impl Context<'_, '_> {
         }
     }
 
-    /// Converts one element at nesting `depth` (`<scene>` is 1); `None`
-    /// for a `<default>`, which only defines a parameter.
-    fn element(&mut self, node: roxmltree::Node<'_, '_>, depth: usize) -> Result<Option<Element>> {
+    /// Converts one element at nesting `depth` (`<scene>` is 1): none for
+    /// a `<default>`, which only defines a parameter, an included file's
+    /// elements for an `<include>`, else the one element.
+    fn element(&mut self, node: roxmltree::Node<'_, '_>, depth: usize) -> Result<Vec<Element>> {
         let loc = self.loc(node.range().start);
         if depth > MAX_DEPTH {
             return Err(SceneError::at(
@@ -232,17 +265,18 @@ impl Context<'_, '_> {
             if node.children().any(|c| c.is_element()) {
                 return Err(SceneError::at(&element.loc, "<default> has no children"));
             }
-            if !self.params.iter().any(|(n, _)| *n == name) {
-                self.params.push((name, value));
+            if !self.shared.params.iter().any(|(n, _)| *n == name) {
+                self.shared.params.push((name, value));
             }
-            return Ok(None);
+            return Ok(Vec::new());
+        }
+        if element.tag == "include" {
+            return self.include(&element, node, depth);
         }
         let mut element = element;
         for child in node.children() {
             if child.is_element() {
-                if let Some(e) = self.element(child, depth + 1)? {
-                    element.children.push(e);
-                }
+                element.children.extend(self.element(child, depth + 1)?);
             } else if child.is_text() {
                 let text = child.text().unwrap_or("");
                 if !text.trim().is_empty() {
@@ -253,7 +287,63 @@ impl Context<'_, '_> {
                 }
             }
         }
-        Ok(Some(element))
+        Ok(vec![element])
+    }
+
+    /// The elements of the file an `<include>` names (module docs).
+    fn include(
+        &mut self,
+        e: &Element,
+        node: roxmltree::Node<'_, '_>,
+        depth: usize,
+    ) -> Result<Vec<Element>> {
+        e.check_attrs(&["filename"])?;
+        if depth != 2 {
+            return Err(SceneError::at(
+                &e.loc,
+                "<include> belongs directly in <scene>",
+            ));
+        }
+        if node.children().any(|c| c.is_element()) {
+            return Err(SceneError::at(&e.loc, "<include> has no children"));
+        }
+        let name = e.required("filename")?;
+        let folder = self.file.parent().unwrap_or(Path::new(""));
+        let path: Arc<Path> = Arc::from(folder.join(&name.value));
+        let at = |m: String| SceneError::at(&name.loc, m);
+        let same = |a: &Path| match (a.canonicalize(), path.canonicalize()) {
+            (Ok(a), Ok(b)) => a == b,
+            _ => a == &*path,
+        };
+        if self.shared.chain.iter().any(|f| same(f)) {
+            let names: Vec<String> = self
+                .shared
+                .chain
+                .iter()
+                .chain(std::iter::once(&path))
+                .map(|f| f.display().to_string())
+                .collect();
+            return Err(at(format!("include cycle: {}", names.join(" → "))));
+        }
+        self.shared.included += 1;
+        if self.shared.included > MAX_INCLUDES {
+            return Err(at(format!(
+                "the scene includes more than {MAX_INCLUDES} files, the limit (docs/limits.md)"
+            )));
+        }
+        let left = MAX_INCLUDED_BYTES - self.shared.included_bytes;
+        let bytes = trilux_files::read_limited(&path, left).map_err(|source| {
+            at(format!(
+                "cannot read the included file {}: {source}",
+                path.display()
+            ))
+        })?;
+        self.shared.included_bytes += bytes.len() as u64;
+        let text = crate::text::decode(&bytes, &path)?;
+        self.shared.chain.push(path.clone());
+        let tree = parse_file(text, &path, self.shared)?;
+        self.shared.chain.pop();
+        Ok(tree.children)
     }
 
     /// Replaces every `$name` in `value` by its parameter value, within
@@ -274,7 +364,7 @@ impl Context<'_, '_> {
             if name.is_empty() {
                 return Err(SceneError::at(loc, "a lone '$' in an attribute value"));
             }
-            match self.params.iter().find(|(n, _)| n == name) {
+            match self.shared.params.iter().find(|(n, _)| n == name) {
                 Some((_, v)) => {
                     if out.len() + v.len() > MAX_VALUE_BYTES {
                         return Err(SceneError::at(
@@ -285,8 +375,8 @@ impl Context<'_, '_> {
                             ),
                         ));
                     }
-                    self.expanded += v.len();
-                    if self.expanded > MAX_EXPANDED_BYTES {
+                    self.shared.expanded += v.len();
+                    if self.shared.expanded > MAX_EXPANDED_BYTES {
                         return Err(SceneError::at(
                             loc,
                             format!(
