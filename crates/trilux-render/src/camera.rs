@@ -76,6 +76,10 @@ pub struct Camera {
     far_clip: f64,
     /// Mitsuba's principal point offset, in film sizes.
     offset: DVec2,
+    /// The whole film's size, pixels (`width` × `height` is its crop
+    /// window, at `crop_offset`).
+    film_size: DVec2,
+    crop_offset: DVec2,
 }
 
 /// Mitsuba's `Transform4f.look_at`: camera space (+x left, +y up, +z
@@ -157,6 +161,8 @@ impl Camera {
             near_clip: 0.0,
             far_clip: f64::INFINITY,
             offset: DVec2::ZERO,
+            film_size: DVec2::new(f64::from(width), f64::from(height)),
+            crop_offset: DVec2::ZERO,
         })
     }
 
@@ -170,6 +176,28 @@ impl Camera {
         }
         (self.near_clip, self.far_clip) = (near, far);
         Ok(self)
+    }
+
+    /// The camera rendering only the `size` pixels at `offset` of its film
+    /// (Mitsuba's crop window): the image has the window's size, each
+    /// pixel the ray it has in the whole film.
+    pub fn with_crop(mut self, offset: [u32; 2], size: [u32; 2]) -> Result<Self, RenderError> {
+        let fits =
+            |k: usize, full: f64| size[k] >= 1 && f64::from(offset[k]) + f64::from(size[k]) <= full;
+        if !(fits(0, self.film_size.x) && fits(1, self.film_size.y)) {
+            return Err(RenderError::Camera(format!(
+                "the crop window {} × {} at ({}, {}) must lie within the {} × {} film",
+                size[0], size[1], offset[0], offset[1], self.film_size.x, self.film_size.y
+            )));
+        }
+        (self.width, self.height) = (size[0], size[1]);
+        self.crop_offset = DVec2::new(f64::from(offset[0]), f64::from(offset[1]));
+        Ok(self)
+    }
+
+    /// Width over height of the whole film (not of a crop window).
+    pub fn film_aspect(&self) -> f64 {
+        self.film_size.x / self.film_size.y
     }
 
     /// The camera with its principal point moved by `offset` film widths
@@ -231,12 +259,12 @@ impl Camera {
         self.origin
     }
 
-    /// The ray through the film position `film` given in pixels
+    /// The ray through the image position `film` given in pixels
     /// (x ∈ [0, width], y ∈ [0, height], (0, 0) the top-left corner; pixel
-    /// (i, j) covers [i, i+1] × [j, j+1]).
+    /// (i, j) covers [i, i+1] × [j, j+1]), in the crop window when there
+    /// is one.
     pub fn ray(&self, film: DVec2) -> Ray {
-        let s = DVec2::new(film.x / self.width as f64, film.y / self.height as f64);
-        self.ray_unit(s)
+        self.ray_unit((film + self.crop_offset) / self.film_size)
     }
 
     /// The ray through the film position `s` ∈ \[0,1\]² (Mitsuba's position
@@ -322,6 +350,29 @@ mod tests {
         let d = cam.ray_unit(DVec2::splat(0.5)).dir;
         let mitsuba = DVec3::new(-0.072_580_7, -0.024_193_6, 0.997_069);
         assert!((d - mitsuba).length() < 1e-6, "{d}");
+    }
+
+    /// A crop window renders its part of the film: its pixel (i, j) has the
+    /// whole film's ray at (i + x, j + y); the window must fit the film.
+    #[test]
+    fn a_crop_window_keeps_the_films_rays() {
+        let full = Camera::new(DMat4::IDENTITY, 50.0, FovAxis::X, 80, 64).unwrap();
+        let crop = full.clone().with_crop([20, 10], [40, 30]).unwrap();
+        assert_eq!((crop.width(), crop.height()), (40, 30));
+        assert_eq!(crop.film_aspect(), 80.0 / 64.0);
+        for p in [
+            DVec2::new(0.5, 0.5),
+            DVec2::new(39.2, 29.9),
+            DVec2::new(12.0, 3.3),
+        ] {
+            let (a, b) = (crop.ray(p), full.ray(p + DVec2::new(20.0, 10.0)));
+            assert!(
+                (a.dir - b.dir).length() < 1e-15 && a.origin == b.origin,
+                "{p}"
+            );
+        }
+        assert!(full.clone().with_crop([50, 0], [40, 30]).is_err());
+        assert!(full.with_crop([0, 0], [0, 30]).is_err());
     }
 
     #[test]

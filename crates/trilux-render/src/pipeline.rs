@@ -286,7 +286,7 @@ fn bake<const N: usize>(
         .map(|c| trilux_bake::BakeCamera {
             world_from_camera: c.world_from_camera(),
             yfov: c.yfov(),
-            aspect: f64::from(c.width()) / f64::from(c.height()),
+            aspect: c.film_aspect(),
         });
     let materials = scene.bsdf_params();
     let names: Vec<Option<String>> = scene.shapes.iter().map(|s| s.id.clone()).collect();

@@ -55,15 +55,22 @@ pub fn camera_of(c: &trilux_scene::Camera, o: &ViewOverrides) -> Result<Camera, 
         Some((origin, target, up)) => look_at(origin, target, up.unwrap_or(c.up))?,
         None => c.world_from_camera,
     };
-    Camera::new(
+    let camera = Camera::new(
         world_from_camera,
         o.fov.unwrap_or(c.fov),
         axis(c.fov_axis),
         o.width.unwrap_or(c.width),
         o.height.unwrap_or(c.height),
     )?
-    .with_clip(c.near_clip, c.far_clip)
-    .map(|cam| cam.with_principal_point_offset(DVec2::from(c.principal_point_offset)))
+    .with_clip(c.near_clip, c.far_clip)?
+    .with_principal_point_offset(DVec2::from(c.principal_point_offset));
+    // A film size given on the command line is a new film: no crop.
+    match c.crop {
+        Some(crop) if o.width.is_none() && o.height.is_none() => {
+            camera.with_crop(crop.offset, crop.size)
+        }
+        _ => Ok(camera),
+    }
 }
 
 #[cfg(test)]

@@ -10,7 +10,7 @@ use glam::{DMat4, DVec3};
 use trilux_brdf::BsdfParams;
 use trilux_color::ColorParam;
 
-use crate::camera::{Camera, FovAxis, ReconstructionFilter, default_fov};
+use crate::camera::{Camera, Crop, FovAxis, ReconstructionFilter, default_fov};
 use crate::error::{Result, SceneError};
 use crate::material::{TextureCollector, build_bsdf, check_color};
 use crate::meshes::Requests;
@@ -339,6 +339,7 @@ fn sensor(e: &Element) -> Result<Camera> {
     let mut width = 768;
     let mut height = 576;
     let mut rfilter = ReconstructionFilter::default();
+    let mut crop = None;
     let mut sample_count = 4;
     let mut seen_film = false;
     let mut seen_sampler = false;
@@ -346,7 +347,8 @@ fn sensor(e: &Element) -> Result<Camera> {
         match o.tag.as_str() {
             "film" if !seen_film => {
                 seen_film = true;
-                (width, height, rfilter) = film(o)?;
+                let f = film(o)?;
+                (width, height, rfilter, crop) = (f.width, f.height, f.rfilter, f.crop);
             }
             "sampler" if !seen_sampler => {
                 seen_sampler = true;
@@ -378,6 +380,7 @@ fn sensor(e: &Element) -> Result<Camera> {
         near_clip,
         far_clip,
         principal_point_offset,
+        crop,
         location: e.loc.clone(),
     })
 }
@@ -416,7 +419,15 @@ fn positive_u32(props: &Props<'_>, name: &str, default: u32) -> Result<u32> {
     }
 }
 
-fn film(e: &Element) -> Result<(u32, u32, ReconstructionFilter)> {
+/// What a `<film>` says.
+struct FilmParams {
+    width: u32,
+    height: u32,
+    rfilter: ReconstructionFilter,
+    crop: Option<Crop>,
+}
+
+fn film(e: &Element) -> Result<FilmParams> {
     e.check_attrs(&["type", "id", "name"])?;
     let t = e.plugin_type()?;
     if t != "hdrfilm" {
@@ -439,6 +450,7 @@ fn film(e: &Element) -> Result<(u32, u32, ReconstructionFilter)> {
     // What the output file holds and how it is written: trilux's command
     // line decides (EXR, PNG); radiance is the same.
     props.ignore(&["pixel_format", "component_format", "file_format"]);
+    let crop = crop_window(&props, width, height)?;
     let mut rfilter = ReconstructionFilter::default();
     for (i, o) in props.objects.iter().enumerate() {
         if o.tag != "rfilter" || i > 0 {
@@ -454,7 +466,50 @@ fn film(e: &Element) -> Result<(u32, u32, ReconstructionFilter)> {
         fp.finish()?;
     }
     props.finish()?;
-    Ok((width, height, rfilter))
+    Ok(FilmParams {
+        width,
+        height,
+        rfilter,
+        crop,
+    })
+}
+
+/// Mitsuba's `crop_offset_x`, `crop_offset_y`, `crop_width`,
+/// `crop_height` (the whole film by default), within the film.
+fn crop_window(props: &Props<'_>, width: u32, height: u32) -> Result<Option<Crop>> {
+    let names = [
+        "crop_offset_x",
+        "crop_offset_y",
+        "crop_width",
+        "crop_height",
+    ];
+    if !names.iter().any(|n| props.has(n)) {
+        return Ok(None);
+    }
+    let get =
+        |name: &str, default: i64| -> Result<i64> { Ok(props.integer(name)?.unwrap_or(default)) };
+    let (x, y) = (get(names[0], 0)?, get(names[1], 0)?);
+    let w = get(names[2], i64::from(width) - x)?;
+    let h = get(names[3], i64::from(height) - y)?;
+    let fits = |o: i64, size: i64, full: u32| o >= 0 && size >= 1 && o + size <= i64::from(full);
+    if !fits(x, w, width) || !fits(y, h, height) {
+        let at = names
+            .iter()
+            .rev()
+            .find(|n| props.has(n))
+            .copied()
+            .unwrap_or(names[0]);
+        return Err(SceneError::at(
+            &props.loc(at),
+            format!(
+                "the crop window {w} × {h} at ({x}, {y}) must lie within the {width} × {height} film"
+            ),
+        ));
+    }
+    Ok(Some(Crop {
+        offset: [x as u32, y as u32],
+        size: [w as u32, h as u32],
+    }))
 }
 
 /// Widest reconstruction filter, in pixels: every sample is added to

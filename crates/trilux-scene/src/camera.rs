@@ -54,6 +54,15 @@ impl FovAxis {
     }
 }
 
+/// A crop window of the film, in pixels.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub struct Crop {
+    /// Its top-left pixel.
+    pub offset: [u32; 2],
+    /// Its width and height.
+    pub size: [u32; 2],
+}
+
 /// A perspective camera with its film and sample count.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Camera {
@@ -92,6 +101,9 @@ pub struct Camera {
     /// shift, in film widths and heights (the ray through film position s
     /// is the unshifted ray through s + offset).
     pub principal_point_offset: [f64; 2],
+    /// The part of the film rendered (Mitsuba's `crop_*`); the image has
+    /// its size.
+    pub crop: Option<Crop>,
     /// Where the `<sensor>` is written.
     #[serde(skip)]
     pub location: SourceLocation,

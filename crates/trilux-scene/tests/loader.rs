@@ -833,6 +833,34 @@ fn blackbody_spectra_are_mitsubas() {
     }
 }
 
+/// Mitsuba's crop window: `crop_offset_*` default 0, `crop_width` and
+/// `crop_height` the rest of the film; it must fit in the film.
+#[test]
+fn crop_windows() {
+    let film = |params: &str| {
+        let body = format!(
+            r#"<sensor type="perspective"><film type="hdrfilm"><integer name="width" value="80"/><integer name="height" value="64"/>{params}</film></sensor>"#
+        );
+        try_load(&body).map(|s| s.camera.expect("camera").crop)
+    };
+    assert_eq!(film("").unwrap(), None);
+    let c = film(
+        r#"<integer name="crop_offset_x" value="20"/><integer name="crop_height" value="30"/>"#,
+    )
+    .unwrap()
+    .expect("a crop");
+    assert_eq!((c.offset, c.size), ([20, 0], [60, 30]));
+    let e = film(
+        r#"<integer name="crop_offset_x" value="50"/><integer name="crop_width" value="40"/>"#,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("the crop window 40 × 64 at (50, 0) must lie within the 80 × 64 film"),
+        "{e}"
+    );
+}
+
 /// `near_clip` and `far_clip`, with Mitsuba's defaults (0.01, 10⁴).
 #[test]
 fn clip_planes() {

@@ -399,6 +399,7 @@ fn camera(file: &Arc<Path>, c: &CameraNode) -> Result<Camera> {
         near_clip,
         far_clip,
         principal_point_offset: [0.0; 2],
+        crop: None,
         location,
     })
 }
