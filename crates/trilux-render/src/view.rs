@@ -97,8 +97,7 @@ mod tests {
         assert_eq!((cam.width(), cam.height()), (30, 20));
         let centre = cam.ray_unit(DVec2::splat(0.5));
         assert!((centre.dir - DVec3::new(0.0, 0.0, -1.0)).length() < 1e-12);
-        // On the near plane, Mitsuba's default 0.01 in front of the eye.
-        assert!((centre.origin - DVec3::new(1.0, 2.0, 2.99)).length() < 1e-12);
+        assert!((centre.origin - DVec3::new(1.0, 2.0, 3.0)).length() < 1e-12);
         // fov 40 along y: the top edge of the film is 20° above the axis.
         let top = cam.ray_unit(DVec2::new(0.5, 0.0));
         assert!((top.dir.y.atan2(-top.dir.z).to_degrees() - 20.0).abs() < 1e-9);

@@ -385,12 +385,15 @@ fn sensor(e: &Element) -> Result<Camera> {
     })
 }
 
-/// `near_clip` and `far_clip` (Mitsuba's defaults 0.01 and 10⁴): positive,
-/// finite, near < far.
+/// `near_clip` and `far_clip` as written: positive, finite, near < far.
+/// Unwritten, there is none (0 and ∞), not Mitsuba's 0.01 and 10⁴: those
+/// would hide a scene smaller than a centimetre or larger than 10 km, and
+/// trilux renders scenes from 1e-6 to 1e15 across (docs/limits.md).
 fn clip_planes(props: &Props<'_>) -> Result<(f64, f64)> {
-    let near = props.float("near_clip")?.unwrap_or(0.01);
-    let far = props.float("far_clip")?.unwrap_or(1e4);
+    let near = props.float("near_clip")?;
+    let far = props.float("far_clip")?;
     for (name, v) in [("near_clip", near), ("far_clip", far)] {
+        let Some(v) = v else { continue };
         if !(v.is_finite() && v > 0.0) {
             return Err(SceneError::at(
                 &props.loc(name),
@@ -398,6 +401,7 @@ fn clip_planes(props: &Props<'_>) -> Result<(f64, f64)> {
             ));
         }
     }
+    let (near, far) = (near.unwrap_or(0.0), far.unwrap_or(f64::INFINITY));
     if near >= far {
         return Err(SceneError::at(
             &props.loc("far_clip"),

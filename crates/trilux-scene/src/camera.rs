@@ -89,11 +89,11 @@ pub struct Camera {
     /// Samples per pixel (the sampler's `sample_count`).
     pub sample_count: u32,
     /// Distance of the near clip plane along the view axis (Mitsuba's
-    /// `near_clip`, 0.01 by default; glTF's `znear`): nothing nearer is
-    /// seen.
+    /// `near_clip`, glTF's `znear`; 0 when the file gives none): nothing
+    /// nearer is seen.
     pub near_clip: f64,
-    /// Distance of the far clip plane (Mitsuba's `far_clip`, 10⁴ by
-    /// default; glTF's `zfar`, infinite without it). trilux renders without
+    /// Distance of the far clip plane (Mitsuba's `far_clip`, glTF's
+    /// `zfar`; infinite when the file gives none). trilux renders without
     /// one, so a far plane that would cut the scene is refused when the
     /// scene is prepared.
     pub far_clip: f64,

@@ -861,7 +861,8 @@ fn crop_windows() {
     );
 }
 
-/// `near_clip` and `far_clip`, with Mitsuba's defaults (0.01, 10⁴).
+/// `near_clip` and `far_clip` as written; none when unwritten (not
+/// Mitsuba's 0.01 and 10⁴, which would cut scenes within trilux's range).
 #[test]
 fn clip_planes() {
     let camera = |params: &str| {
@@ -872,7 +873,7 @@ fn clip_planes() {
         .expect("camera")
     };
     let c = camera("");
-    assert_eq!((c.near_clip, c.far_clip), (0.01, 1e4));
+    assert_eq!((c.near_clip, c.far_clip), (0.0, f64::INFINITY));
     let c = camera(r#"<float name="near_clip" value="0.1"/><float name="far_clip" value="100"/>"#);
     assert_eq!((c.near_clip, c.far_clip), (0.1, 100.0));
     assert_eq!(c.principal_point_offset, [0.0; 2]);
