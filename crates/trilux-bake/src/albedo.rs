@@ -18,7 +18,7 @@
 //! The viewer multiplies the two, as glTF defines base colour × `COLOR_0`.
 
 use glam::DVec2;
-use trilux_brdf::{Filter, TexturedBsdf, Wrap};
+use trilux_brdf::{Filter, TexturedBsdf, UvTransform, Wrap};
 use trilux_color::srgb::linear_srgb_to_u8;
 use trilux_geometry::Side;
 
@@ -41,9 +41,16 @@ pub struct AlbedoMap {
 }
 
 /// The albedo map of `side` of a textured material: `None` when that side
-/// reflects no diffuse light anywhere (a black or purely glossy side).
+/// reflects no diffuse light anywhere (a black or purely glossy side), or
+/// when a texture maps the surface's coordinates (`to_uv`,
+/// `KHR_texture_transform`): the map is laid over the surface's own unit
+/// square in the image's resolution, which a tiled, shifted or rotated
+/// texture does not fit. Such a side is baked as vertex colours.
 pub fn albedo_map<const N: usize>(textured: &TexturedBsdf<N>, side: Side) -> Option<AlbedoMap> {
     let slots = textured.slots();
+    if slots.iter().any(|s| s.to_uv != UvTransform::IDENTITY) {
+        return None;
+    }
     let first = slots.first()?;
     let width = slots
         .iter()

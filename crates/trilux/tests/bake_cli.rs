@@ -461,6 +461,35 @@ fn gltf_meshes_bake_to_their_solution() {
     assert!(maps >= 2, "{maps} primitives with albedo maps");
 }
 
+/// A texture whose coordinates are transformed (a checkerboard tiled 4 ×
+/// 4 by `to_uv`) is baked as vertex colours, not as an albedo map laid
+/// over the surface's unit square, and keeps its flux; without the
+/// transform the same side carries a map.
+#[test]
+fn transformed_textures_bake_as_vertex_colours() {
+    let dir = folder("bake-scene-to-uv");
+    let scene = |to_uv: &str| {
+        format!(
+            r#"<scene version="3.0.0">
+  <shape type="rectangle"><transform name="to_world"><rotate x="1" angle="-90"/></transform>
+    <bsdf type="diffuse"><texture type="checkerboard" name="reflectance">{to_uv}</texture></bsdf></shape>
+  <shape type="rectangle"><transform name="to_world"><scale value="0.5"/><rotate x="1" angle="90"/><translate y="2"/></transform>
+    <emitter type="area"><rgb name="radiance" value="10"/></emitter></shape>
+</scene>"#
+        )
+    };
+    let tiled = dir.join("tiled.xml");
+    std::fs::write(
+        &tiled,
+        scene(r#"<transform name="to_uv"><scale value="4"/></transform>"#),
+    )
+    .unwrap();
+    assert_eq!(check_scene(&tiled, "to-uv-tiled"), 0);
+    let plain = dir.join("plain.xml");
+    std::fs::write(&plain, scene("")).unwrap();
+    assert_eq!(check_scene(&plain, "to-uv-plain"), 1);
+}
+
 /// A sphere, a disk and a rectangle light: the curved and polar pieces
 /// with their poles and centre, tessellated finer than their leaves.
 #[test]
