@@ -316,25 +316,21 @@ impl Header {
         let needed = self.elements.iter().try_fold(0usize, |sum, e| {
             sum.checked_add(e.count.checked_mul(e.min_bytes(self.format).max(1))?)
         });
-        if faces > MAX_OBJ_TRIANGLES
-            || vertices > MAX_OBJ_VERTICES
-            || needed.is_none_or(|n| n > file_bytes - self.data_start)
-        {
-            let too_large = faces > MAX_OBJ_TRIANGLES || vertices > MAX_OBJ_VERTICES;
-            return Err(match too_large {
-                true => PlyError::TooLarge {
-                    path: path.to_path_buf(),
-                    faces,
-                    vertices,
-                },
-                false => PlyError::Parse {
-                    path: path.to_path_buf(),
-                    place: format!("line {}", self.lines),
-                    reason: format!(
-                        "the header declares {vertices} vertices and {faces} faces, more than the file's {} bytes of data can hold",
-                        file_bytes - self.data_start
-                    ),
-                },
+        if faces > MAX_OBJ_TRIANGLES || vertices > MAX_OBJ_VERTICES {
+            return Err(PlyError::TooLarge {
+                path: path.to_path_buf(),
+                faces,
+                vertices,
+            });
+        }
+        let data = file_bytes - self.data_start;
+        if needed.is_none_or(|n| n > data) {
+            return Err(PlyError::Parse {
+                path: path.to_path_buf(),
+                place: format!("line {}", self.lines),
+                reason: format!(
+                    "the header declares {vertices} vertices and {faces} faces, more than the file's {data} bytes of data can hold"
+                ),
             });
         }
         Ok(())
@@ -441,8 +437,9 @@ struct RawMesh {
     texcoords: Option<Vec<DVec2>>,
     triangles: Vec<[u32; 3]>,
     /// The largest vertex index a face names (checked once every vertex
-    /// is read, since elements may come in any order).
-    max_index: Option<u32>,
+    /// is read, since elements may come in any order; meaningful once a
+    /// face is read).
+    max_index: u32,
 }
 
 /// Where the vertex element keeps what the mesh needs.
@@ -551,22 +548,21 @@ impl RawMesh {
         if list.len() < 3 {
             return Err(format!("a face with {} vertices (at least 3)", list.len()));
         }
-        let mut ids = Vec::with_capacity(list.len());
         for &i in list {
             if !(0.0..=f64::from(u32::MAX - 1)).contains(&i) {
                 return Err(format!("vertex index {i} is out of range"));
             }
-            ids.push(i as u32);
+            self.max_index = self.max_index.max(i as u32);
         }
-        let max = ids.iter().copied().max().unwrap_or(0);
-        self.max_index = Some(self.max_index.map_or(max, |m| m.max(max)));
-        if self.triangles.len() + ids.len() - 2 > MAX_OBJ_TRIANGLES {
+        if self.triangles.len() + list.len() - 2 > MAX_OBJ_TRIANGLES {
             return Err(format!(
                 "the faces make more than {MAX_OBJ_TRIANGLES} triangles (docs/limits.md)"
             ));
         }
-        for k in 1..ids.len() - 1 {
-            self.triangles.push([ids[0], ids[k], ids[k + 1]]);
+        // Integers within u32 (checked above): `as` is exact.
+        let id = |k: usize| list[k] as u32;
+        for k in 1..list.len() - 1 {
+            self.triangles.push([id(0), id(k), id(k + 1)]);
         }
         Ok(())
     }
@@ -577,9 +573,9 @@ impl RawMesh {
                 path: path.to_path_buf(),
             });
         }
-        if let Some(max) = self.max_index
-            && max as usize >= self.positions.len()
-        {
+        // Checked after the empty case: with a face there is a max_index.
+        let max = self.max_index;
+        if max as usize >= self.positions.len() {
             return Err(PlyError::Parse {
                 path: path.to_path_buf(),
                 place: "faces".into(),
