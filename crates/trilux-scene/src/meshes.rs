@@ -53,11 +53,7 @@ impl Pending {
                 .map_err(|e| SceneError::at(&request.filename, e))?;
             let shape = &mut self.scene.shapes[index].shape;
             shape.kind = ShapeKind::Mesh(mesh);
-            let what = match request.format {
-                crate::shape::MeshFormat::Obj => "<shape type=\"obj\">",
-                crate::shape::MeshFormat::Ply => "<shape type=\"ply\">",
-            };
-            check_area(shape, &request.shape, what)?;
+            check_area(shape, &request.shape, request.format.element())?;
         }
         let mut cache = TextureCache::default();
         let mut textures = self.requests.textures;

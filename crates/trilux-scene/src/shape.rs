@@ -107,6 +107,14 @@ impl MeshFormat {
         }
     }
 
+    /// The shape element that names a file of this format.
+    pub fn element(self) -> &'static str {
+        match self {
+            MeshFormat::Obj => "<shape type=\"obj\">",
+            MeshFormat::Ply => "<shape type=\"ply\">",
+        }
+    }
+
     /// Mitsuba's default `flip_tex_coords`: OBJ's v runs up, PLY's is
     /// taken as written.
     pub fn flips_by_default(self) -> bool {
