@@ -162,6 +162,8 @@ TEXTURES = [
     '<texture type="checkerboard" name="reflectance"/>',
     '<texture type="checkerboard" name="reflectance"><rgb name="color0" value="0.9, 0.5, 0.1"/>'
     '<float name="color1" value="0.05"/><transform name="to_uv"><scale value="4"/></transform></texture>',
+    '<texture type="checkerboard" name="reflectance"><float name="color0" value="0.1"/>'
+    '<rgb name="color1" value="0.8, 0.6, 0.3"/></texture>',
 ]
 TEXTURE_UVS = [(0.1, 0.1), (0.3, 0.15), (0.6, 0.2), (0.85, 0.35), (0.05, 0.8),
                (0.45, 0.6), (0.7, 0.9), (0.93, 0.55)]

@@ -29,6 +29,8 @@ pub fn mkfifo(path: &Path) {
 /// Runs the `trilux` binary with `args`, killing it if it has not ended
 /// after `limit`: a guard against a hang (an input read forever, an
 /// expansion without bound), not a speed figure, so `limit` is generous.
+/// Its output is read once it ends, so it is for commands that print
+/// little (a refusal's one line), not more than a pipe holds (64 KiB).
 pub fn trilux_or_hang(args: &[&str], limit: Duration) -> Output {
     let mut child = Command::new(env!("CARGO_BIN_EXE_trilux"))
         .args(args)
