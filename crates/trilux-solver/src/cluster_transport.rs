@@ -59,7 +59,7 @@ use trilux_geometry::{
 };
 
 use crate::cluster::{ClusterId, ClusterTree};
-use crate::refine::PairLink;
+use crate::link::PairLink;
 
 /// θ: the largest angle (radians, r/d) a far cluster may subtend from
 /// its sender.

@@ -22,7 +22,8 @@ use trilux_color::Spectrum;
 use trilux_geometry::{ElementId, FaceElement, FaceId};
 
 use crate::faces::TransportFace;
-use crate::refine::{PairLink, PairShot, RefineContext, Sender, Sent};
+use crate::link::{PairLink, PairShot, Sender, Sent};
+use crate::refine::RefineContext;
 use crate::solver::Solver;
 
 /// Where a gather link's sender radiance comes from.

@@ -21,7 +21,8 @@ use trilux_brdf::Frame;
 use trilux_color::Spectrum;
 use trilux_geometry::{ElementId, FaceId, Ray};
 
-use crate::refine::{Incidence, PairLink};
+use crate::link::PairLink;
+use crate::refine::Incidence;
 use crate::settings::Transport;
 use crate::solver::Solver;
 use crate::throughput::compute_throughput;

@@ -47,6 +47,7 @@ pub mod gather_links;
 mod glossy;
 mod interaction;
 pub mod ledger;
+mod link;
 pub mod prepared;
 mod radiosity;
 mod refine;

@@ -24,9 +24,8 @@ use trilux_geometry::{ElementId, FaceId, Visibility};
 
 use crate::cluster_transport::{FarField, far_links};
 use crate::interaction::Hierarchy;
-use crate::refine::{
-    Incidence, NodeLink, PairLink, PairShot, RefineContext, Sender, Sent, TripleTask,
-};
+use crate::link::{NodeLink, PairLink, PairShot, Sender, Sent};
+use crate::refine::{Incidence, RefineContext, TripleTask};
 use crate::solver::{Solver, Source};
 
 /// The refinement context over the parts of `s` that refinement reads (a
@@ -121,7 +120,7 @@ fn shot_scale<const N: usize>(
 /// Phase 2: pair links to every receiving face, in parallel: from the
 /// roots of the two surfaces for a Lambertian source, from the root pair
 /// of a stored hierarchy (whose nodes give the unshot radiance of every
-/// sub-pair: `Sender::unshot`).
+/// sub-pair: `Sender::sent_radiance`).
 fn stage_one<const N: usize>(
     ctx: &RefineContext<'_, N>,
     sender: &Sender<'_, N>,

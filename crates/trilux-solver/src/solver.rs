@@ -546,8 +546,7 @@ impl<const N: usize> Solver<N> {
             .sum();
         let hierarchies = self.hierarchies.len() * size_of::<Option<Hierarchy<N>>>();
         let partners: usize = self.partners.values().map(|p| p.capacity() * 4).sum();
-        let link =
-            size_of::<crate::refine::PairLink<N>>().max(size_of::<crate::refine::NodeLink<N>>());
+        let link = size_of::<crate::link::PairLink<N>>().max(size_of::<crate::link::NodeLink<N>>());
         (elements * per_element
             + nodes * size_of::<crate::interaction::Node<N>>()
             + hierarchies
