@@ -40,9 +40,11 @@
 
 mod cluster;
 mod cluster_transport;
+mod discretisation;
 mod divergence;
 pub mod error;
 mod faces;
+mod final_gather;
 pub mod gather_links;
 mod glossy;
 mod interaction;
@@ -52,9 +54,11 @@ pub mod prepared;
 mod radiosity;
 mod refine;
 pub mod settings;
+mod setup;
 mod shot;
 pub mod solution;
 pub mod solver;
+mod state;
 pub mod stats;
 mod textures;
 mod throughput;
