@@ -73,3 +73,5 @@ pub use solution::{FORMAT_VERSION, Solution, SurfaceSite, solve_hash};
 pub use solver::{Progress, Solver};
 pub use stats::SolveStats;
 pub use textures::ElementTextures;
+#[cfg(test)]
+mod test_scenes;

@@ -180,3 +180,154 @@ impl<const N: usize> RefineContext<'_, N> {
         true
     }
 }
+
+#[cfg(test)]
+mod tests {
+    //! The stage-1 oracle against answers that follow from its definition:
+    //! the photometric criterion, refinement down to the depth limit, and
+    //! which element of a pair is split.
+    #![allow(clippy::unwrap_used, clippy::expect_used)] // tests may panic
+
+    use std::collections::HashSet;
+
+    use glam::DVec3;
+    use trilux_color::Spectrum;
+
+    use super::*;
+    use crate::link::Sent;
+    use crate::setup::Setup;
+    use crate::state::ShotState;
+    use crate::test_scenes as ts;
+    use crate::throughput::ThroughputCache;
+
+    /// An emitter (Le = 1 in every band) of side `sender` facing down at
+    /// height 1 over a grey receiver of side `receiver` facing up.
+    fn plates(sender: f64, receiver: f64, depth: u32) -> (Setup<3>, ShotState<3>) {
+        let shapes = [
+            ts::square(DVec3::new(0.0, 0.0, 1.0), sender, true),
+            ts::square(DVec3::ZERO, receiver, false),
+        ];
+        let setup = ts::setup(
+            &shapes,
+            &[ts::diffuse(0.0), ts::diffuse(0.5)],
+            &[Some(1.0), None],
+            ts::settings(depth),
+        );
+        let state = ShotState::new(&setup);
+        (setup, state)
+    }
+
+    /// Stage 1 from the emitter's root to the receiver's root with the
+    /// given photometric threshold and form-factor budget; also the root
+    /// link's flux π T δL (band sum).
+    fn refine(
+        setup: &Setup<3>,
+        state: &ShotState<3>,
+        threshold: impl Fn(f64) -> f64,
+        budget: f64,
+    ) -> (Vec<PairLink<3>>, f64) {
+        let cache = ThroughputCache::new(1 << 16);
+        let mut ctx = setup.refine_context(&cache);
+        let (si, sj) = (ts::front(0), ts::front(1));
+        let (ri, rj) = (ts::root(ctx.forest, si), ts::root(ctx.forest, sj));
+        let root_flux = PI * ctx.throughput(rj, ri).t * 3.0;
+        ctx.flux_threshold = threshold(root_flux);
+        let sender = Sender::Radiosity {
+            field: &state.field,
+            side: si.side(),
+            sent: Sent::Unshot,
+            emission: Spectrum::zero(),
+        };
+        let shot = PairShot {
+            sender: &sender,
+            si,
+            sj,
+        };
+        let mut out = Vec::new();
+        ctx.refine_pair(shot, ri.element, rj.element, budget, &mut out);
+        (out, root_flux)
+    }
+
+    /// Parallel, directly opposed unit squares at distance 1 exchange
+    /// F = 0.199825 (docs/validation.md, closed form (a)): the root link
+    /// carries π · 0.199825 · 3 W. Below a threshold above that, the root
+    /// link is made as it is, however coarse; above, it is refined.
+    #[test]
+    fn a_link_below_the_photometric_threshold_is_not_refined() {
+        let (setup, state) = plates(1.0, 1.0, 3);
+        let flux = PI * 0.199825 * 3.0;
+        let (links, _) = refine(&setup, &state, |_| 1.05 * flux, 0.0);
+        assert_eq!(links.len(), 1, "one root link");
+        let forest = setup.forest();
+        assert_eq!(links[0].i, forest.root(ts::front(0).surface()));
+        assert_eq!(links[0].j, forest.root(ts::front(1).surface()));
+        assert!(
+            (links[0].t - 0.199825).abs() < 0.01 * 0.199825,
+            "{}",
+            links[0].t
+        );
+        assert_eq!(links[0].unshot, Spectrum::splat(1.0));
+        let (links, _) = refine(&setup, &state, |_| 0.95 * flux, 0.0);
+        assert!(links.len() > 1, "refined");
+    }
+
+    /// With no photometric threshold and no form-factor budget, nothing is
+    /// accurate enough: the pair is refined until neither element can
+    /// split. Every link then joins two leaves at their surface's depth
+    /// limit, and the links cover the sender × receiver product exactly
+    /// once (every pair of leaves, none twice), so their throughputs sum
+    /// to the whole pair's, A F = 0.199825.
+    #[test]
+    fn a_link_above_the_threshold_is_refined_to_the_depth_limit() {
+        let depth = 2;
+        let (setup, state) = plates(1.0, 1.0, depth);
+        let forest = setup.forest();
+        assert_eq!(setup.discretisation.depth_limits(), [depth, depth]);
+        let (links, _) = refine(&setup, &state, |_| 0.0, 0.0);
+        let mut pairs = HashSet::new();
+        for l in &links {
+            for e in [l.i, l.j] {
+                assert!(forest.element(e).children().is_none());
+                assert_eq!(forest.element(e).depth, depth);
+            }
+            assert!(pairs.insert((l.i, l.j)), "pair linked twice");
+        }
+        let n = 4usize.pow(depth);
+        assert_eq!(pairs.len(), n * n, "every pair of leaves");
+        let t: f64 = links.iter().map(|l| l.t).sum();
+        assert!((t - 0.199825).abs() < 0.02 * 0.199825, "Σ T = {t}");
+    }
+
+    /// Which element a refined pair splits (docs/solver.md, "Refinement",
+    /// stage 1, step 4): the receiver, unless the sender is more than 4×
+    /// larger. With a threshold of half the root link's flux, the root
+    /// link is refined and each child link (a quarter of it, by symmetry)
+    /// is made at once, so the links show the one split.
+    #[test]
+    fn the_larger_element_is_split() {
+        // (sender side, receiver side, the sender is split)
+        for (sender, receiver, split_sender) in [
+            (1.0, 1.0, false),
+            (4.0, 1.0, true),
+            (1.0, 4.0, false),
+            // 3.6× the area: within the 4× margin, the receiver is split.
+            (1.9, 1.0, false),
+        ] {
+            let (setup, state) = plates(sender, receiver, 3);
+            let forest = setup.forest();
+            let (links, _) = refine(&setup, &state, |f| 0.5 * f, 0.0);
+            let (ri, rj) = (
+                forest.root(ts::front(0).surface()),
+                forest.root(ts::front(1).surface()),
+            );
+            let (split, kept) = if split_sender { (ri, rj) } else { (rj, ri) };
+            let children: HashSet<_> = forest.element(split).children().unwrap().into();
+            assert_eq!(links.len(), 4, "{sender} over {receiver}");
+            for l in &links {
+                let (s, k) = if split_sender { (l.i, l.j) } else { (l.j, l.i) };
+                assert_eq!(k, kept, "{sender} over {receiver}");
+                assert!(children.contains(&s), "{sender} over {receiver}");
+            }
+        }
+    }
+}
