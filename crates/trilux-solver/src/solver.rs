@@ -4,7 +4,7 @@
 //! until CR ≥ target or the shot budget is spent:
 //!     S ← the source with the greatest unshot flux δΦ
 //!     push-pull S (lazily, only now: §4.4)
-//!     refine and link S to every receiver (two stages, see refine.rs)
+//!     refine and link S to every receiver (two stages, see `refine`)
 //!     shoot: every link adds δL·R to its receiver's L^G
 //!     unlink (links live for one shot: memory O(n + k²), §4.2)
 //!     zero δL over S
@@ -15,9 +15,9 @@
 //! module prepares a solve ([`Solver::new`]) and runs the loop; one shot's
 //! phases are in `shot`, the glossy renormalisation in `glossy`.
 //!
-//! A solver is its [`Setup`] (what is fixed before the first shot: the
+//! A solver is its `Setup` (what is fixed before the first shot: the
 //! scene, the discretisation, faces, clusters, partners) and its
-//! [`ShotState`] (what the shots change: unshot radiance, hierarchies,
+//! `ShotState` (what the shots change: unshot radiance, hierarchies,
 //! ledger, statistics).
 
 use std::time::Instant;
