@@ -59,7 +59,7 @@ use trilux_geometry::{
 };
 
 use crate::cluster::{ClusterId, ClusterTree};
-use crate::refine::PairLink;
+use crate::link::PairLink;
 
 /// θ: the largest angle (radians, r/d) a far cluster may subtend from
 /// its sender.
@@ -500,4 +500,130 @@ pub(crate) type FarFields<const N: usize> = PerFace<Option<FarField<N>>>;
 /// blocks are disjoint), as an index into the cut's far list.
 pub(crate) fn block_of(tree: &ClusterTree, cut: &Cut, s: SurfaceId) -> Option<usize> {
     cut.far.iter().position(|b| tree.contains(b.cluster, s))
+}
+
+#[cfg(test)]
+mod tests {
+    //! The cut against its defining property: for every face, its near
+    //! faces and far blocks partition the other input surfaces (each met
+    //! exactly once, through both its faces when near or through one far
+    //! block), except those wholly behind a planar face.
+    #![allow(clippy::unwrap_used, clippy::expect_used)] // tests may panic
+
+    use glam::DVec3;
+
+    use super::*;
+    use crate::test_scenes as ts;
+
+    /// A 5 × 5 grid of small squares on the floor, facing up, under a
+    /// 3 × 3 grid of small squares at height 1, facing down: far enough
+    /// apart that clusters of them are far from each other.
+    fn grids() -> crate::setup::Setup<3> {
+        let mut shapes = Vec::new();
+        for a in 0..5 {
+            for b in 0..5 {
+                let c = DVec3::new(f64::from(a), f64::from(b), 0.0);
+                shapes.push(ts::square(c, 0.1, false));
+            }
+        }
+        for a in 0..3 {
+            for b in 0..3 {
+                let c = DVec3::new(2.0 * f64::from(a), 2.0 * f64::from(b), 1.0);
+                shapes.push(ts::square(c, 0.1, true));
+            }
+        }
+        let n = shapes.len();
+        ts::setup(
+            &shapes,
+            &vec![ts::diffuse(0.5); n],
+            &vec![None; n],
+            ts::settings(1),
+        )
+    }
+
+    /// How many times the cut of face `a` meets every input surface: once
+    /// per near face (both faces of a near surface are listed), once per
+    /// far block holding it.
+    fn coverage(
+        forest: &ElementForest,
+        tree: &ClusterTree,
+        a: FaceId,
+        clustering: bool,
+    ) -> (Vec<u32>, usize) {
+        let root = forest.element(forest.root(a.surface()));
+        let planar = Some((root.centre, root.normal * a.side().sign()));
+        let cut = cut_of(forest, tree, a, planar, clustering, false);
+        let mut count = vec![0u32; forest.geometry().surfaces().len()];
+        for f in &cut.near {
+            if f.side() == Side::Front {
+                count[f.surface().index()] += 1;
+            }
+            assert!(cut.near.contains(&FaceId::new(
+                f.surface(),
+                Side::from_back(!f.side().is_back())
+            )));
+        }
+        for b in &cut.far {
+            for s in tree.members_of(b.cluster) {
+                count[s.index()] += 1;
+            }
+        }
+        (count, cut.far.len())
+    }
+
+    /// Every face of the floor grid (whose front sees everything above or
+    /// beside it) meets every other surface exactly once and never its
+    /// own; with clustering on, some of them through far blocks.
+    #[test]
+    fn near_faces_and_far_blocks_partition_the_other_surfaces() {
+        let setup = grids();
+        let forest = setup.forest();
+        let tree = &setup.clusters.tree;
+        let mut far_blocks = 0;
+        for s in 0..25 {
+            let a = ts::front(s);
+            for clustering in [true, false] {
+                let (count, far) = coverage(forest, tree, a, clustering);
+                for (t, &c) in count.iter().enumerate() {
+                    let expected = u32::from(t != s as usize);
+                    assert_eq!(
+                        c, expected,
+                        "face {s}, surface {t}, clustering {clustering}"
+                    );
+                }
+                if clustering {
+                    far_blocks += far;
+                } else {
+                    assert_eq!(far, 0, "no far blocks without clustering");
+                }
+            }
+        }
+        assert!(far_blocks > 0, "the scene exercises far blocks");
+    }
+
+    /// A planar face gets no near partner wholly behind it: the back of a
+    /// floor square (facing down) meets every other floor square (in its
+    /// plane) exactly once, and a square above at most once, only through a
+    /// far block whose cluster is not wholly behind it.
+    #[test]
+    fn surfaces_behind_a_planar_face_are_left_out() {
+        let setup = grids();
+        let forest = setup.forest();
+        let tree = &setup.clusters.tree;
+        for s in 0..25u32 {
+            let a = FaceId::new(trilux_geometry::SurfaceId(s), Side::Back);
+            let (count, _) = coverage(forest, tree, a, true);
+            let root = forest.element(forest.root(a.surface()));
+            let planar = Some((root.centre, -root.normal));
+            let near = cut_of(forest, tree, a, planar, true, false).near;
+            for (t, &c) in count.iter().enumerate() {
+                if t < 25 {
+                    assert_eq!(c, u32::from(t != s as usize), "face {s} back, surface {t}");
+                } else {
+                    assert!(c <= 1, "face {s} back, surface {t}");
+                    assert!(near.iter().all(|f| f.surface().index() != t));
+                }
+            }
+        }
+    }
 }

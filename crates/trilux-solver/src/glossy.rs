@@ -21,7 +21,8 @@ use trilux_brdf::Frame;
 use trilux_color::Spectrum;
 use trilux_geometry::{ElementId, FaceId, Ray};
 
-use crate::refine::{Incidence, PairLink};
+use crate::link::PairLink;
+use crate::refine::Incidence;
 use crate::settings::Transport;
 use crate::solver::Solver;
 use crate::throughput::compute_throughput;
@@ -83,21 +84,23 @@ impl<const N: usize> Solver<N> {
         arrived: Spectrum<N>,
         glossy: Spectrum<N>,
     ) -> Option<Spectrum<N>> {
-        let face = &self.faces[l.face];
-        if !face.stored || glossy.is_black() || self.settings.transport != Transport::TwoPoint {
+        let face = &self.setup.faces[l.face];
+        if !face.stored || glossy.is_black() || self.setup.settings.transport != Transport::TwoPoint
+        {
             return None;
         }
         let to_light = incidence.and_then(Incidence::direction)?;
         let covered = self.hemisphere_coverage(l.face, l.j);
         // A textured j reflects g(j) times the nominal glossy part.
         let g = self
+            .setup
             .textures
             .as_ref()
             .map_or(Spectrum::splat(1.0), |t| t.glossy(l.face, l.j));
         if covered >= CLOSED_COVERAGE {
-            let normal = self.forest.element(l.j).normal * l.face.side().sign();
+            let normal = self.setup.forest().element(l.j).normal * l.face.side().sign();
             let wi = Frame::from_normal(normal).to_local(to_light);
-            let glossy_albedo = self.albedo[face.shape].albedo(wi) - face.rho_d;
+            let glossy_albedo = self.setup.albedo[face.shape].albedo(wi) - face.rho_d;
             Some((arrived * glossy_albedo * g * covered.min(1.0)).max(Spectrum::zero()))
         } else {
             // An open hemisphere: the share of the lobe that meets a stored
@@ -112,14 +115,14 @@ impl<const N: usize> Solver<N> {
     /// from the unit direction `to_light` (world space): [`LOBE_SAMPLES`]
     /// stratified samples of the BSDF, each traced.
     fn covered_lobe(&self, face: FaceId, to_light: DVec3, j: ElementId) -> Spectrum<N> {
-        let geom = self.forest.geometry();
-        let ts = &self.faces[face];
+        let geom = self.setup.forest().geometry();
+        let ts = &self.setup.faces[face];
         let sign = face.side().sign();
-        let ej = self.forest.element(j);
+        let ej = self.setup.forest().element(j);
         let normal = ej.normal * sign;
         let frame = Frame::from_normal(normal);
         let wi = frame.to_local(to_light);
-        let bsdf = self.scene.material(ts.shape);
+        let bsdf = self.setup.scene.material(ts.shape);
         // The BSDF's frame is the front's: flip z for a back face.
         let to_bsdf = |v: DVec3| DVec3::new(v.x, v.y, v.z * sign);
         let origin = ej.centre + normal * (1e-7 * geom.bounds().diagonal().length());
@@ -149,7 +152,7 @@ impl<const N: usize> Solver<N> {
                     hit.surface,
                     trilux_geometry::Side::from_back(!hit.front_facing(&ray)),
                 );
-                if !self.stored_pairs.contains(&(face, hit_face))
+                if !self.setup.stored_pairs.contains(&(face, hit_face))
                     && !self.far_reaches(face, hit.surface)
                 {
                     continue;
@@ -163,41 +166,58 @@ impl<const N: usize> Solver<N> {
 
     /// True when `face`'s far field sends to surface `s`.
     fn far_reaches(&self, face: FaceId, s: trilux_geometry::SurfaceId) -> bool {
-        self.far[face].is_some()
-            && crate::cluster_transport::block_of(&self.clusters.tree, &self.clusters.cuts[face], s)
-                .is_some()
+        self.state.far[face].is_some()
+            && crate::cluster_transport::block_of(
+                &self.setup.clusters.tree,
+                &self.setup.clusters.cuts[face],
+                s,
+            )
+            .is_some()
     }
 
     /// Σ over the face's stored hierarchies of T(j, K) / A_j: the
     /// cosine-weighted share of j's hemisphere that stored receivers cover
     /// (1 in a closed room). Cached per (face, element).
     fn hemisphere_coverage(&self, face: FaceId, j: ElementId) -> f64 {
-        if let Ok(cache) = self.coverage.lock()
+        if let Ok(cache) = self.state.coverage.lock()
             && let Some(&c) = cache.get(&(face, j))
         {
             return c;
         }
-        let a = self.exposed_area[face.side()][j.index()];
+        let a = self.setup.exposed_area[face.side()][j.index()];
         if a <= 0.0 {
             return 0.0;
         }
-        let vis = trilux_geometry::Visibility::new(&self.forest, self.burial.as_ref());
+        let vis = self.setup.visibility();
         let mut t = 0.0;
-        for h in self.hierarchies.iter().flatten().filter(|h| h.from == face) {
+        for h in self
+            .state
+            .hierarchies
+            .iter()
+            .flatten()
+            .filter(|h| h.from == face)
+        {
             let k = h.to.of(h.nodes[0].to);
-            t += compute_throughput(&vis, k, face.of(j), self.settings.visibility_samples, false).t;
+            t += compute_throughput(
+                &vis,
+                k,
+                face.of(j),
+                self.setup.settings.visibility_samples,
+                false,
+            )
+            .t;
         }
         // The far field's receivers (their T is over the whole face's
         // exposed area, so T / A is its share of the hemisphere).
-        if let Some(field) = &self.far[face] {
-            let root = self.forest.root(face.surface());
-            let area = self.exposed_area[face.side()][root.index()];
+        if let Some(field) = &self.state.far[face] {
+            let root = self.setup.forest().root(face.surface());
+            let area = self.setup.exposed_area[face.side()][root.index()];
             if area > 0.0 {
                 t += a * field.throughput() / area;
             }
         }
         let c = t / a;
-        if let Ok(mut cache) = self.coverage.lock() {
+        if let Ok(mut cache) = self.state.coverage.lock() {
             cache.insert((face, j), c);
         }
         c

@@ -12,6 +12,9 @@
 //!   emitters — shared by the solver, its solution and the renderer.
 //! - [`settings`]: FFErr, FrErr, MinArea, the photometric threshold, CR
 //!   target, quality presets, two-point or uniform transport.
+//! - `discretisation`: each input surface's depth limit and the element
+//!   trees subdivided to it, shared by the solver, its solution and the
+//!   solution file.
 //! - `faces`: the faces of input surfaces that send and receive light.
 //! - `cluster`: the cluster hierarchy above the input surfaces (Smits,
 //!   Arvo & Greenberg 1994); `cluster_transport`: each face's cut through
@@ -25,11 +28,19 @@
 //!   ratio g of textured materials), pushed as irradiance.
 //! - `interaction`: interaction hierarchies (paper §3.2), flux-weighted
 //!   push-pull (§4.4, §5.6), point lookup (§4.5).
-//! - `refine`: RefineAndLink with its three subdivision cases (§3.2.2, §4.3).
-//! - [`solver`]: preparing a solve and the progressive loop (§4, Fig. 7
-//!   and 9); `shot`: one shot's phases; `glossy`: the glossy
-//!   renormalisation.
-//! - [`gather_links`]: the final gather's links, kept for rendering.
+//! - `link`: what a sender sends, and the pair and node links of a shot
+//!   (§4.2).
+//! - `refine`: RefineAndLink (§3.2.2, §4.3): what refinement reads
+//!   (`refine::context`), stage 1's pair links (`refine::pair`), stage
+//!   2's three-point links with their three subdivision cases
+//!   (`refine::triple`) and the sampled narrow lobes (`refine::narrow_lobe`).
+//! - `setup`: what a solve fixes before its first shot (scene,
+//!   discretisation, faces, buried parts, clusters, partners);
+//!   `state`: what the shots change (unshot radiance, hierarchies, ledger).
+//! - [`solver`]: the progressive loop (§4, Fig. 7 and 9); `shot`: one
+//!   shot's phases; `glossy`: the glossy renormalisation.
+//! - [`gather_links`]: the final gather's links, kept for rendering;
+//!   `final_gather`: the refinement that makes them.
 //! - [`ledger`]: where the energy went.
 //! - [`solution`]: the radiance query for final gathering and the file
 //!   format (checksummed, every field validated).
@@ -40,23 +51,32 @@
 
 mod cluster;
 mod cluster_transport;
+mod discretisation;
 mod divergence;
 pub mod error;
 mod faces;
+mod final_gather;
 pub mod gather_links;
 mod glossy;
 mod interaction;
 pub mod ledger;
+mod link;
 pub mod prepared;
 mod radiosity;
 mod refine;
 pub mod settings;
+mod setup;
 mod shot;
 pub mod solution;
 pub mod solver;
+mod state;
 pub mod stats;
 mod textures;
 mod throughput;
+
+/// Small scenes built by the unit tests.
+#[cfg(test)]
+mod test_scenes;
 
 pub use error::SolverError;
 pub use gather_links::{GatherLink, GatherLinks, LinkSource};

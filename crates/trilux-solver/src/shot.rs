@@ -20,37 +20,13 @@ use std::f64::consts::PI;
 
 use rayon::prelude::*;
 use trilux_color::Spectrum;
-use trilux_geometry::{ElementId, FaceId, Visibility};
+use trilux_geometry::{ElementId, FaceId};
 
 use crate::cluster_transport::{FarField, far_links};
 use crate::interaction::Hierarchy;
-use crate::refine::{
-    Incidence, NodeLink, PairLink, PairShot, RefineContext, Sender, Sent, TripleTask,
-};
+use crate::link::{NodeLink, PairLink, PairShot, Sender, Sent};
+use crate::refine::{Incidence, RefineContext, TripleTask};
 use crate::solver::{Solver, Source};
-
-/// The refinement context over the parts of `s` that refinement reads (a
-/// macro of field borrows, so that the hierarchies stay free to borrow
-/// mutably beside it).
-macro_rules! refine_context {
-    ($s:expr) => {
-        RefineContext {
-            forest: &$s.forest,
-            visibility: Visibility::new(&$s.forest, $s.burial.as_ref()),
-            settings: &$s.settings,
-            faces: &$s.faces,
-            materials: $s.scene.materials(),
-            cache: &$s.cache,
-            flux_threshold: $s.settings.flux_eps * $s.emitted.sum(),
-            points: &$s.points,
-            interior: &$s.interior,
-            exposed_area: &$s.exposed_area,
-            textures: $s.textures.as_ref(),
-            clusters: &$s.clusters,
-            albedo: &$s.albedo,
-        }
-    };
-}
 
 /// The most a stored interaction's shot is scaled up to carry its whole
 /// unshot flux (see [`shot_scale`]).
@@ -121,7 +97,7 @@ fn shot_scale<const N: usize>(
 /// Phase 2: pair links to every receiving face, in parallel: from the
 /// roots of the two surfaces for a Lambertian source, from the root pair
 /// of a stored hierarchy (whose nodes give the unshot radiance of every
-/// sub-pair: `Sender::unshot`).
+/// sub-pair: `Sender::sent_radiance`).
 fn stage_one<const N: usize>(
     ctx: &RefineContext<'_, N>,
     sender: &Sender<'_, N>,
@@ -155,9 +131,9 @@ impl<const N: usize> Solver<N> {
             return 0;
         };
         let send_face = sending.face();
-        let root_of = |f: FaceId| self.forest.root(f.surface());
+        let root_of = |f: FaceId| self.setup.forest().root(f.surface());
         let pairs: Vec<(ElementId, FaceId, ElementId)> = match &sending {
-            Sending::Radiosity(f) => self.partners[*f]
+            Sending::Radiosity(f) => self.setup.partners[*f]
                 .iter()
                 .map(|&r| (root_of(*f), r, root_of(r)))
                 .collect(),
@@ -199,8 +175,8 @@ impl<const N: usize> Solver<N> {
         let group_scale = self.receive(&pair_links, &incidences, &node_links, scale, phi);
         self.apply_node_links(&node_links, scale, &group_scale);
         let live = pair_links.len() + node_links.len();
-        self.stats.links_peak = self.stats.links_peak.max(live);
-        self.stats.links_total += live as u64;
+        self.state.stats.links_peak = self.state.stats.links_peak.max(live);
+        self.state.stats.links_total += live as u64;
         self.unlink(sending);
         live
     }
@@ -211,20 +187,20 @@ impl<const N: usize> Solver<N> {
     fn take_source(&mut self, source: Source) -> Option<(Spectrum<N>, Sending<N>)> {
         match source {
             Source::Radiosity(face) => {
-                let phi = std::mem::take(&mut self.face_flux[face]);
-                let root = self.forest.root(face.surface());
+                let phi = std::mem::take(&mut self.state.face_flux[face]);
+                let root = self.setup.forest().root(face.surface());
                 let side = face.side();
-                self.field.push_pull(
-                    &self.forest,
+                self.state.field.push_pull(
+                    self.setup.forest(),
                     root,
                     side,
-                    &self.exposed_area[side],
-                    self.textures.as_ref(),
+                    &self.setup.exposed_area[side],
+                    self.setup.textures.as_ref(),
                 );
                 Some((phi, Sending::Radiosity(face)))
             }
             Source::Stored(index) => {
-                let slot = &mut self.hierarchies[index as usize];
+                let slot = &mut self.state.hierarchies[index as usize];
                 let h = slot.as_mut()?;
                 let phi = std::mem::take(&mut h.unshot_flux);
                 let is_self = h.is_self();
@@ -246,11 +222,11 @@ impl<const N: usize> Solver<N> {
                 Some((phi, sending))
             }
             Source::Far(face) => {
-                let mut field = self.far[face].take()?;
+                let mut field = self.state.far[face].take()?;
                 let phi = std::mem::take(&mut field.unshot_flux);
                 let mut by_surface =
-                    vec![Spectrum::zero(); self.forest.geometry().surfaces().len()];
-                let tree = &self.clusters.tree;
+                    vec![Spectrum::zero(); self.setup.forest().geometry().surfaces().len()];
+                let tree = &self.setup.clusters.tree;
                 for b in &field.blocks {
                     for &s in tree.members_of(b.cluster) {
                         by_surface[s.index()] = b.unshot;
@@ -261,20 +237,15 @@ impl<const N: usize> Solver<N> {
         }
     }
 
-    /// The refinement context (borrowing what refinement reads) beside the
-    /// stored hierarchies that stage 2 refines.
+    /// The refinement context (the setup and the throughput cache) beside
+    /// the stored hierarchies that stage 2 refines.
     fn split_for_shot(&mut self) -> (ShotContext<'_, N>, &mut Vec<Option<Hierarchy<N>>>) {
-        let refine = refine_context!(self);
+        let state = &mut self.state;
         let ctx = ShotContext {
-            refine,
-            field: &self.field,
+            refine: self.setup.refine_context(&state.cache),
+            field: &state.field,
         };
-        (ctx, &mut self.hierarchies)
-    }
-
-    /// The refinement context of this solver (everything refinement reads).
-    pub(crate) fn refine_context(&self) -> RefineContext<'_, N> {
-        refine_context!(self)
+        (ctx, &mut state.hierarchies)
     }
 
     /// Flux that a split could not keep leaves the residual (it is booked
@@ -282,11 +253,11 @@ impl<const N: usize> Solver<N> {
     fn book_lost(&mut self, stage_two: StageTwo<N>) -> Vec<NodeLink<N>> {
         let mut node_links = Vec::new();
         for (links, h, lost) in stage_two {
-            if let Some(hier) = self.hierarchies[h as usize].as_mut() {
+            if let Some(hier) = self.state.hierarchies[h as usize].as_mut() {
                 hier.unshot_flux = (hier.unshot_flux - lost).max(Spectrum::zero());
             }
             for b in 0..N {
-                self.ledger.escaped[b] += lost[b];
+                self.state.ledger.escaped[b] += lost[b];
             }
             node_links.extend(links);
         }
@@ -303,7 +274,7 @@ impl<const N: usize> Solver<N> {
         group_scale: &[(Spectrum<N>, Spectrum<N>)],
     ) {
         for nl in node_links {
-            let Some(hier) = self.hierarchies[nl.hierarchy as usize].as_mut() else {
+            let Some(hier) = self.state.hierarchies[nl.hierarchy as usize].as_mut() else {
                 continue;
             };
             let node = &mut hier.nodes[nl.node as usize];
@@ -320,15 +291,17 @@ impl<const N: usize> Solver<N> {
     fn unlink(&mut self, sending: Sending<N>) {
         match sending {
             Sending::Radiosity(face) => {
-                let root = self.forest.root(face.surface());
-                self.field.clear_unshot(&self.forest, root, face.side());
+                let root = self.setup.forest().root(face.surface());
+                self.state
+                    .field
+                    .clear_unshot(self.setup.forest(), root, face.side());
             }
             Sending::Stored {
                 index,
                 is_self: true,
                 ..
             } => {
-                if let Some(h) = self.hierarchies[index as usize].as_mut() {
+                if let Some(h) = self.state.hierarchies[index as usize].as_mut() {
                     h.clear_unshot();
                 }
             }
@@ -338,14 +311,14 @@ impl<const N: usize> Solver<N> {
                 is_self: false,
             } => {
                 hierarchy.clear_unshot();
-                self.hierarchies[index as usize] = Some(hierarchy);
+                self.state.hierarchies[index as usize] = Some(hierarchy);
             }
             Sending::Far { mut field, .. } => {
                 for b in &mut field.blocks {
                     b.unshot = Spectrum::zero();
                 }
                 let face = field.face;
-                self.far[face] = Some(field);
+                self.state.far[face] = Some(field);
             }
         }
     }
@@ -477,7 +450,7 @@ impl<const N: usize> Solver<N> {
         let mut glossy_flux = vec![Spectrum::<N>::zero(); pair_links.len()];
         let mut sampled_flux = vec![Spectrum::<N>::zero(); pair_links.len()];
         for nl in node_links {
-            if let Some(h) = &self.hierarchies[nl.hierarchy as usize] {
+            if let Some(h) = &self.state.hierarchies[nl.hierarchy as usize] {
                 let t = h.nodes[nl.node as usize].t;
                 let flux = nl.gathered * shot_scale * (PI * t);
                 if nl.sampled {
@@ -495,7 +468,7 @@ impl<const N: usize> Solver<N> {
             .map(|(l, inc)| self.far_reflection(l, inc.as_ref(), shot_scale))
             .collect();
         for (g, adds) in far_adds.iter().enumerate() {
-            if let (Some(adds), Some(field)) = (adds, &self.far[pair_links[g].face]) {
+            if let (Some(adds), Some(field)) = (adds, &self.state.far[pair_links[g].face]) {
                 for (b, dl) in field.blocks.iter().zip(adds) {
                     glossy_flux[g] += *dl * (PI * b.t);
                 }
@@ -511,7 +484,7 @@ impl<const N: usize> Solver<N> {
             // Light spreads over j's exposed area. (No transfer reaches an
             // element that is wholly buried, whose segments all count as
             // blocked; if one did, its light would be absorbed.)
-            let aj = self.exposed_area[l.face.side()][l.j.index()];
+            let aj = self.setup.exposed_area[l.face.side()][l.j.index()];
             let diffuse = if aj > 0.0 {
                 arrived * rho_d
             } else {
@@ -524,18 +497,19 @@ impl<const N: usize> Solver<N> {
             let scale = crate::glossy::group_scale(target, glossy, sampled, room);
             group_scale[g] = scale;
             let absorbed_g = arrived - diffuse - glossy * scale.0 - sampled * scale.1;
-            self.ledger.min_element_absorbed = self
+            self.state.ledger.min_element_absorbed = self
+                .state
                 .ledger
                 .min_element_absorbed
                 .min(absorbed_g.min_value() / arrived.max_value().max(1e-300));
             total_arrived += arrived;
             absorbed += absorbed_g;
-            self.used[l.i.index()] = true;
-            self.used[l.j.index()] = true;
+            self.state.used[l.i.index()] = true;
+            self.state.used[l.j.index()] = true;
         }
         for (g, adds) in far_adds.into_iter().enumerate() {
             let Some(adds) = adds else { continue };
-            let Some(field) = self.far[pair_links[g].face].as_mut() else {
+            let Some(field) = self.state.far[pair_links[g].face].as_mut() else {
                 continue;
             };
             for (b, dl) in field.blocks.iter_mut().zip(adds) {
@@ -547,11 +521,11 @@ impl<const N: usize> Solver<N> {
         }
         let escaped = phi - total_arrived;
         for b in 0..N {
-            self.ledger.escaped[b] += escaped[b];
-            self.ledger.absorbed[b] += absorbed[b];
+            self.state.ledger.escaped[b] += escaped[b];
+            self.state.ledger.absorbed[b] += absorbed[b];
         }
         let rel = escaped.min_value() / phi.max_value().max(1e-300);
-        self.ledger.min_shot_escaped = self.ledger.min_shot_escaped.min(rel);
+        self.state.ledger.min_shot_escaped = self.state.ledger.min_shot_escaped.min(rel);
         group_scale
     }
 
@@ -565,15 +539,15 @@ impl<const N: usize> Solver<N> {
         incidence: Option<&Incidence<N>>,
         shot_scale: Spectrum<N>,
     ) -> Option<Vec<Spectrum<N>>> {
-        let field = self.far[l.face].as_ref()?;
+        let field = self.state.far[l.face].as_ref()?;
         let to_light = incidence?.direction()?;
-        let root = self.forest.root(l.face.surface());
-        let area = self.exposed_area[l.face.side()][root.index()];
+        let root = self.setup.forest().root(l.face.surface());
+        let area = self.setup.exposed_area[l.face.side()][root.index()];
         if area <= 0.0 {
             return None;
         }
-        let bsdf = self.scene.material(self.faces[l.face].shape);
-        let frame = trilux_brdf::Frame::from_normal(self.forest.element(l.j).normal);
+        let bsdf = self.setup.scene.material(self.setup.faces[l.face].shape);
+        let frame = trilux_brdf::Frame::from_normal(self.setup.forest().element(l.j).normal);
         let wi = frame.to_local(to_light);
         let dl = l.unshot * shot_scale * (PI * l.t / area);
         Some(
@@ -598,18 +572,18 @@ impl<const N: usize> Solver<N> {
     /// normal (as Mitsuba does), which changes the irradiance it reflects
     /// (never beyond what arrived). Returns the ρ_d used.
     fn receive_lambertian(&mut self, l: &PairLink<N>, shot_scale: Spectrum<N>) -> Spectrum<N> {
-        let face = &self.faces[l.face];
-        let rho = match &self.textures {
+        let face = &self.setup.faces[l.face];
+        let rho = match &self.setup.textures {
             Some(t) => t.rho(l.face, l.j).unwrap_or(face.rho_d),
             None => face.rho_d,
         };
         let rho_d = (rho * self.shading_factor(l.i, l.j)).min(Spectrum::splat(1.0));
         let side = l.face.side();
-        let aj = self.exposed_area[side][l.j.index()];
+        let aj = self.setup.exposed_area[side][l.j.index()];
         if !rho_d.is_black() && aj > 0.0 {
             let dl = l.unshot * shot_scale * rho_d * (l.t / aj);
-            self.field.gathered[side][l.j.index()] += dl;
-            self.face_flux[l.face] += dl * (PI * aj);
+            self.state.field.gathered[side][l.j.index()] += dl;
+            self.state.face_flux[l.face] += dl * (PI * aj);
         }
         rho_d
     }
@@ -618,10 +592,10 @@ impl<const N: usize> Solver<N> {
     /// geometric normals, for light from i's centre (1 where shading and
     /// geometric normals agree): (Σ A n_s · d)/(Σ A n_g · d), in [¼, 4].
     fn shading_factor(&self, i: ElementId, j: ElementId) -> f64 {
-        let Some((s, g)) = self.shading[j.index()] else {
+        let Some((s, g)) = self.setup.shading[j.index()] else {
             return 1.0;
         };
-        let d = self.forest.element(i).centre - self.forest.element(j).centre;
+        let d = self.setup.forest().element(i).centre - self.setup.forest().element(j).centre;
         let (ds, dg) = (s.dot(d), g.dot(d));
         if dg.abs() <= 1e-12 * g.length() * d.length() || ds * dg <= 0.0 {
             return 1.0;

@@ -1,4 +1,4 @@
-//! Mutated solution files (issue 14): 12 000 corruptions of a real file —
+//! Mutated solution files: 12 000 corruptions of a real file —
 //! bit flips, random and extreme integers, NaN, infinite and negative
 //! floats, truncations, insertions, deletions — nine in ten with the
 //! header's length and checksum recomputed so that the parser itself is

@@ -35,12 +35,12 @@ use trilux_color::Spectrum;
 use trilux_geometry::{ElementId, FaceId, Sided};
 
 use super::{Parts, Solution};
+use crate::discretisation::Discretisation;
 use crate::error::SolverError;
 use crate::gather_links::{GatherLink, GatherLinks, LinkSource};
 use crate::interaction::{Hierarchy, NO_CHILD, Node, Split};
 use crate::prepared::{Fnv1a, PreparedScene};
 use crate::settings::SolverSettings;
-use crate::solver::{depth_limits, presubdivided};
 use crate::stats::SolveStats;
 
 const MAGIC: &[u8; 8] = b"TRILUXS\0";
@@ -200,8 +200,9 @@ impl<const N: usize> Solution<N> {
         })?;
         w.u64(stats.len() as u64);
         w.0.extend_from_slice(&stats);
-        w.u32(self.depth_of.len() as u32);
-        for &d in &self.depth_of {
+        let depths = self.discretisation.depth_limits();
+        w.u32(depths.len() as u32);
+        for &d in depths {
             w.u32(d);
         }
         w.u64(self.radiance.front.len() as u64);
@@ -294,17 +295,21 @@ impl<const N: usize> Solution<N> {
         }
         let stats: SolveStats =
             serde_json::from_slice(r.take(len)?).map_err(|e| format!("corrupt statistics: {e}"))?;
-        let depth_of = depth_limits(scene.geometry(), settings);
+        // The file records the depth limits its elements were made with:
+        // they must be this discretisation's, or the element indexes below
+        // would mean other elements.
+        let discretisation = Discretisation::new(scene.geometry(), settings);
+        let depths = discretisation.depth_limits();
         let surfaces = r.u32()? as usize;
-        if surfaces != depth_of.len() {
+        if surfaces != depths.len() {
             return Err("surface count differs from the scene".into());
         }
-        for &d in &depth_of {
+        for &d in depths {
             if r.u32()? != d {
                 return Err("element depth limits differ from the scene's".into());
             }
         }
-        let forest = presubdivided(Arc::clone(scene.geometry()), &depth_of);
+        let forest = discretisation.forest();
         let elements = r.u64()?;
         if elements != forest.element_count() as u64 {
             return Err("element count differs from the scene".into());
@@ -321,9 +326,8 @@ impl<const N: usize> Solution<N> {
         }
         Ok(Solution::assemble(Parts {
             scene,
-            forest,
+            discretisation,
             settings: settings.clone(),
-            depth_of,
             exposed_area,
             radiance,
             hierarchies,

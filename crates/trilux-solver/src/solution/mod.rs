@@ -10,11 +10,11 @@ use trilux_color::Spectrum;
 use trilux_geometry::{ElementForest, FaceId, Side, Sided, SurfaceCoord, SurfaceId};
 
 use crate::cluster::{ClusterId, ClusterTree};
+use crate::discretisation::Discretisation;
 use crate::gather_links::{GatherLink, GatherLinks, link_radiance};
 use crate::interaction::Hierarchy;
 use crate::prepared::PreparedScene;
 use crate::settings::SolverSettings;
-use crate::solver::Solver;
 use crate::stats::SolveStats;
 
 pub use file::{FORMAT_VERSION, MAX_FILE_BYTES, solve_hash};
@@ -22,9 +22,10 @@ pub use file::{FORMAT_VERSION, MAX_FILE_BYTES, solve_hash};
 /// A view-independent solution of the scene's light.
 pub struct Solution<const N: usize> {
     scene: Arc<PreparedScene<N>>,
-    forest: ElementForest,
+    /// The depth limits and element trees the solve used (the file
+    /// records the limits).
+    discretisation: Discretisation,
     settings: SolverSettings,
-    depth_of: Vec<u32>,
     /// Exposed area of every element's faces, per side
     /// (`trilux_geometry::burial`).
     exposed_area: Sided<Vec<f64>>,
@@ -81,9 +82,8 @@ pub(crate) struct FarRecord<const N: usize> {
 /// What a solution is made of, before its derived indexes.
 pub(crate) struct Parts<const N: usize> {
     pub scene: Arc<PreparedScene<N>>,
-    pub forest: ElementForest,
+    pub discretisation: Discretisation,
     pub settings: SolverSettings,
-    pub depth_of: Vec<u32>,
     pub exposed_area: Sided<Vec<f64>>,
     pub radiance: Sided<Vec<Spectrum<N>>>,
     pub hierarchies: Vec<Hierarchy<N>>,
@@ -102,43 +102,10 @@ fn index_by_faces<const N: usize>(hierarchies: &[Hierarchy<N>]) -> HashMap<(Face
 }
 
 impl<const N: usize> Solution<N> {
-    pub(crate) fn from_solver(solver: Solver<N>, links: GatherLinks) -> Self {
-        let hierarchies: Vec<Hierarchy<N>> = solver.hierarchies.into_iter().flatten().collect();
-        let far = solver
-            .far
-            .values()
-            .flatten()
-            .map(|f| FarRecord {
-                face: f.face,
-                blocks: f.blocks.iter().map(|b| (b.cluster, b.radiance)).collect(),
-            })
-            .collect();
-        let mut stats = solver.stats;
-        // The ledger's per-element and per-shot minima are diagnostics worth
-        // keeping beside the stats.
-        if solver.ledger.min_shot_escaped < -1e-9 {
-            stats.warnings.push(format!(
-                "a shot created energy: escaped flux {} of its source",
-                solver.ledger.min_shot_escaped
-            ));
-        }
-        Solution::assemble(Parts {
-            scene: solver.scene,
-            forest: solver.forest,
-            settings: solver.settings,
-            depth_of: solver.depth_of,
-            exposed_area: solver.exposed_area,
-            radiance: solver.field.radiance,
-            hierarchies,
-            far,
-            links,
-            stats,
-        })
-    }
-
     /// A solution from its parts (a solve's or a file's), with the indexes
     /// derived from them.
-    fn assemble(p: Parts<N>) -> Self {
+    pub(crate) fn assemble(p: Parts<N>) -> Self {
+        let forest = p.discretisation.forest();
         let link_radiance = p
             .links
             .iter()
@@ -147,7 +114,7 @@ impl<const N: usize> Solution<N> {
                     l,
                     &p.radiance,
                     p.scene.emission(),
-                    |f| p.forest.geometry().surface(f.surface()).shape as usize,
+                    |f| forest.geometry().surface(f.surface()).shape as usize,
                     |h, n| {
                         p.hierarchies
                             .get(h as usize)
@@ -162,22 +129,21 @@ impl<const N: usize> Solution<N> {
             .iter()
             .flat_map(|r| r.blocks.iter().map(|&(c, l)| ((r.face, c), l)))
             .collect();
-        let mut far_faces = vec![false; 2 * p.forest.geometry().surfaces().len()];
+        let mut far_faces = vec![false; 2 * forest.geometry().surfaces().len()];
         for r in &p.far {
             if let Some(f) = far_faces.get_mut(r.face.index()) {
                 *f = true;
             }
         }
         Solution {
-            tree: ClusterTree::build(p.forest.geometry()),
+            tree: ClusterTree::build(forest.geometry()),
             far: p.far,
             far_index,
             far_faces,
             by_faces: index_by_faces(&p.hierarchies),
             scene: p.scene,
-            forest: p.forest,
+            discretisation: p.discretisation,
             settings: p.settings,
-            depth_of: p.depth_of,
             exposed_area: p.exposed_area,
             radiance: p.radiance,
             hierarchies: p.hierarchies,
@@ -223,7 +189,7 @@ impl<const N: usize> Solution<N> {
     /// The element trees the solution refers to (with the solve's
     /// subdivisions).
     pub fn forest(&self) -> &ElementForest {
-        &self.forest
+        self.discretisation.forest()
     }
 
     /// The settings of the solve.
@@ -236,7 +202,7 @@ impl<const N: usize> Solution<N> {
     /// the stored part from the deepest node of hierarchy (from, to) whose
     /// elements contain both points (paper Fig. 11c).
     pub fn radiance(&self, from: &SurfaceSite, to: &SurfaceSite) -> Spectrum<N> {
-        let leaf = self.forest.locate(from.face.surface(), from.coord);
+        let leaf = self.forest().locate(from.face.surface(), from.coord);
         self.radiance[from.face.side()][leaf.index()] + self.stored_radiance(from, to)
     }
 
@@ -247,7 +213,7 @@ impl<const N: usize> Solution<N> {
     /// neither exists.
     pub fn stored_radiance(&self, from: &SurfaceSite, to: &SurfaceSite) -> Spectrum<N> {
         if let Some(&h) = self.by_faces.get(&(from.face, to.face)) {
-            return self.hierarchies[h as usize].radiance_at(&self.forest, from.coord, to.coord);
+            return self.hierarchies[h as usize].radiance_at(self.forest(), from.coord, to.coord);
         }
         self.far_radiance(from.face, to.face)
     }
@@ -269,7 +235,7 @@ impl<const N: usize> Solution<N> {
     pub fn face_radiance(&self, face: FaceId, e: trilux_geometry::ElementId) -> Spectrum<N> {
         let le = match face.side() {
             Side::Front => {
-                let shape = self.forest.geometry().surface(face.surface()).shape as usize;
+                let shape = self.forest().geometry().surface(face.surface()).shape as usize;
                 self.scene.emission()[shape]
             }
             Side::Back => Spectrum::zero(),
@@ -287,12 +253,12 @@ impl<const N: usize> Solution<N> {
     /// and glossy ratio), as the solve took them; `None` when no material
     /// is textured.
     pub fn element_textures(&self) -> Option<crate::ElementTextures<N>> {
-        crate::ElementTextures::new(&self.forest, &self.scene, &self.exposed_area)
+        crate::ElementTextures::new(self.forest(), &self.scene, &self.exposed_area)
     }
 
     /// The Lambertian (two-point) reflected radiance alone at a point.
     pub fn lambertian_radiance(&self, from: &SurfaceSite) -> Spectrum<N> {
-        let leaf = self.forest.locate(from.face.surface(), from.coord);
+        let leaf = self.forest().locate(from.face.surface(), from.coord);
         self.radiance[from.face.side()][leaf.index()]
     }
 
@@ -305,10 +271,10 @@ impl<const N: usize> Solution<N> {
     pub fn surface_mean_radiance(&self, face: FaceId) -> Spectrum<N> {
         let mut sum = Spectrum::<N>::zero();
         let mut area = 0.0;
-        let mut stack = vec![self.forest.root(face.surface())];
+        let mut stack = vec![self.forest().root(face.surface())];
         let side = face.side();
         while let Some(id) = stack.pop() {
-            let e = self.forest.element(id);
+            let e = self.forest().element(id);
             if let Some(children) = e.children() {
                 stack.extend(children);
             } else {
@@ -324,7 +290,7 @@ impl<const N: usize> Solution<N> {
     pub fn shape_mean_radiance(&self, shape: u32, side: Side) -> Spectrum<N> {
         let mut sum = Spectrum::<N>::zero();
         let mut area = 0.0;
-        let geom = self.forest.geometry();
+        let geom = self.forest().geometry();
         for s in geom.surfaces_of_shape(shape) {
             let a = geom.surface(s).area();
             sum += self.surface_mean_radiance(FaceId::new(s, side)) * a;

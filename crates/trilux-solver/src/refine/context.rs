@@ -1,0 +1,147 @@
+//! What refinement reads ([`RefineContext`]): the element trees, the
+//! scene's faces and materials, the throughput cache and the photometric
+//! threshold, shared by the parallel tasks of a shot; T through the cache
+//! and the point-to-disc form-factor estimates both stages use.
+
+use std::f64::consts::PI;
+
+use glam::DVec3;
+use trilux_brdf::{AlbedoTable, Bsdf};
+use trilux_geometry::{ElementForest, FaceElement, PerFace, Sided, Visibility};
+
+use crate::cluster_transport::{Clusters, FarContext};
+use crate::faces::TransportFace;
+use crate::settings::SolverSettings;
+use crate::textures::ElementTextures;
+use crate::throughput::{Throughput, ThroughputCache, compute_throughput};
+
+/// How many times the rays a pair with a partly buried or cut-off element
+/// gets (see `RefineContext::throughput`).
+const CUT_OFF_VISIBILITY: u32 = 9;
+
+/// The shadow rays for a pair: `base`, or [`CUT_OFF_VISIBILITY`]× that
+/// when an element of the pair is partly cut off by a crossing (see
+/// `RefineContext::throughput`).
+pub(crate) fn visibility_samples_for(
+    partly_cut: &Sided<Vec<bool>>,
+    pair: [FaceElement; 2],
+    base: u32,
+) -> u32 {
+    let cut = |e: FaceElement| {
+        partly_cut[e.side]
+            .get(e.element.index())
+            .copied()
+            .unwrap_or(false)
+    };
+    if pair.into_iter().any(cut) {
+        base * CUT_OFF_VISIBILITY
+    } else {
+        base
+    }
+}
+
+/// Everything refinement reads, shared by the parallel tasks of a shot.
+pub(crate) struct RefineContext<'a, const N: usize> {
+    pub forest: &'a ElementForest,
+    /// Shadow-ray visibility, with the scene's buried parts.
+    pub visibility: Visibility<'a>,
+    pub settings: &'a SolverSettings,
+    pub faces: &'a PerFace<TransportFace<N>>,
+    pub materials: &'a [Bsdf<N>],
+    pub cache: &'a ThroughputCache,
+    /// Photometric threshold in watts (band sum): flux_eps × IF.
+    pub flux_threshold: f64,
+    /// `element_points` of every element, computed once.
+    pub points: &'a [[DVec3; 5]],
+    /// The centres of every element's 2×2 quadrants (its midpoint rule).
+    pub interior: &'a [[DVec3; 4]],
+    /// Exposed area of every element's faces, `[back][element]`.
+    pub exposed_area: &'a Sided<Vec<f64>>,
+    /// ρ_d and g of textured elements (`crate::textures`).
+    pub textures: Option<&'a ElementTextures<N>>,
+    /// The cluster hierarchy and every face's cut (`cluster_transport`).
+    pub clusters: &'a Clusters,
+    /// Directional albedo per material (the sampled lobes' scale).
+    pub albedo: &'a [AlbedoTable<N>],
+}
+
+impl<'a, const N: usize> RefineContext<'a, N> {
+    /// What far links read.
+    pub fn far(&self) -> FarContext<'a> {
+        FarContext {
+            forest: self.forest,
+            tree: &self.clusters.tree,
+            exposed_area: self.exposed_area,
+            burial: self.visibility.burial(),
+            enclosed: &self.clusters.enclosed,
+        }
+    }
+}
+
+/// Point-to-disc estimate of F_{a→b} (Hanrahan, Salzman & Aupperle 1991): b seen from a's
+/// centre as a disc of the same area.
+pub(super) fn disc_estimate(pa: DVec3, na: DVec3, pb: DVec3, nb: DVec3, area_b: f64) -> f64 {
+    let d = pb - pa;
+    let r2 = d.length_squared();
+    if r2 <= 0.0 {
+        return 1.0;
+    }
+    let r = r2.sqrt();
+    let ca = (na.dot(d) / r).max(0.0);
+    let cb = (-nb.dot(d) / r).max(0.0);
+    // Elements that do not face each other at their centres may still
+    // exchange light near their edges: use the larger cosines' bound.
+    let (ca, cb) = if ca == 0.0 || cb == 0.0 {
+        (1.0, 1.0)
+    } else {
+        (ca, cb)
+    };
+    (area_b * ca * cb / (PI * r2 + area_b)).min(1.0)
+}
+
+impl<const N: usize> RefineContext<'_, N> {
+    /// T through the cache, for `recv` receiving from `send` (T is
+    /// symmetric; the spread is over the receiver).
+    pub fn throughput(&self, recv: FaceElement, send: FaceElement) -> Throughput {
+        let (a, b) = (recv, send);
+        if let Some(t) = self.cache.get(a, b) {
+            return t;
+        }
+        // A pair inside a pair that all its shadow rays (64 or more at the
+        // levels refinement starts from) found unoccluded is unoccluded too:
+        // its sub-segments lie in the parent pair's shaft.
+        let parent_visible =
+            |x: FaceElement, y: FaceElement| self.cache.get(x, y).is_some_and(|t| t.v >= 1.0);
+        let up = |s: FaceElement| self.forest.element(s.element).parent.map(|p| s.with(p));
+        let visible = up(a).is_some_and(|pa| parent_visible(pa, b))
+            || up(b).is_some_and(|pb| parent_visible(a, pb));
+        // Segments that end on a buried or cut-off part count as blocked,
+        // which leaves the visible fraction of an element pair that is
+        // partly cut off (a floor element across a wall that crosses it) a
+        // ratio of two noisy sums, biased low by a few per cent at 16 rays
+        // (docs/solver.md, "Crossings"): such pairs of crossed surfaces get
+        // [`CUT_OFF_VISIBILITY`]× the rays.
+        let samples = visibility_samples_for(
+            &self.clusters.partly_cut,
+            [a, b],
+            self.settings.visibility_samples,
+        );
+        let t = compute_throughput(&self.visibility, a, b, samples, visible);
+        self.cache.insert(a, b, t);
+        t
+    }
+
+    /// Both point-to-disc estimates F̂_{a→b} and F̂_{b→a}.
+    pub(super) fn ff_estimates(&self, a: FaceElement, b: FaceElement) -> (f64, f64) {
+        let (ea, eb) = (
+            self.forest.element(a.element),
+            self.forest.element(b.element),
+        );
+        let na = ea.normal * a.side.sign();
+        let nb = eb.normal * b.side.sign();
+        (
+            disc_estimate(ea.centre, na, eb.centre, nb, eb.area),
+            disc_estimate(eb.centre, nb, ea.centre, na, ea.area),
+        )
+    }
+}

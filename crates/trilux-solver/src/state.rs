@@ -1,0 +1,160 @@
+//! The state of the shooting loop: what the shots change — every face's
+//! two-point radiance and unshot radiance, the unshot flux that selects
+//! the next source, the stored interaction hierarchies, the far fields of
+//! glossy faces, the ledger and the statistics — with the caches filled
+//! as the shots go (throughput, hemisphere coverage). It starts from the
+//! emitters' unshot light (paper §6) and root interactions of zero
+//! radiance; what is fixed before the first shot is in `setup`.
+
+use std::collections::HashMap;
+use std::sync::Mutex;
+
+use rayon::prelude::*;
+use trilux_color::Spectrum;
+use trilux_geometry::{ElementId, FaceElement, FaceId, PerFace, Visibility};
+
+use crate::cluster_transport::{FarContext, FarField, FarFields};
+use crate::interaction::Hierarchy;
+use crate::ledger::Ledger;
+use crate::radiosity::ElementRadiance;
+use crate::setup::{Setup, emitted_flux};
+use crate::stats::SolveStats;
+use crate::throughput::{ThroughputCache, compute_throughput};
+
+/// What the shots change (module docs).
+pub(crate) struct ShotState<const N: usize> {
+    /// Two-point radiance: gathered, unshot and final, per side and
+    /// element.
+    pub field: ElementRadiance<N>,
+    /// Unshot flux of every face's two-point tree (the selection key).
+    pub face_flux: PerFace<Spectrum<N>>,
+    /// The stored hierarchies, in the order of the setup's root pairs;
+    /// `None` only for the one sending in a shot.
+    pub hierarchies: Vec<Option<Hierarchy<N>>>,
+    /// The far fields of glossy faces (`None` while one sends).
+    pub far: FarFields<N>,
+    /// T of every element pair refinement has met.
+    pub cache: ThroughputCache,
+    /// Σ_K T(j, K) / A_j per (face, element): how much of j's hemisphere
+    /// the face's stored receivers cover (`glossy`).
+    pub coverage: Mutex<HashMap<(FaceId, ElementId), f64>>,
+    /// Where the energy went.
+    pub ledger: Ledger,
+    /// Statistics so far.
+    pub stats: SolveStats,
+    /// Elements that a link or a stored node has used.
+    pub used: Vec<bool>,
+}
+
+impl<const N: usize> ShotState<N> {
+    /// The state before the first shot: the emitters' unshot light, the
+    /// root interactions and the far fields, with nothing gathered yet.
+    pub fn new(setup: &Setup<N>) -> Self {
+        let forest = setup.forest();
+        let far = far_fields(setup);
+        let vis = setup.visibility();
+        let samples = |pair| {
+            crate::refine::visibility_samples_for(
+                &setup.clusters.partly_cut,
+                pair,
+                setup.settings.visibility_samples,
+            )
+        };
+        let hierarchies = root_interactions(&vis, &setup.root_pairs, samples);
+        let (field, face_flux) = emission(setup);
+        let stats = initial_stats(setup, hierarchies.len());
+        let count = forest.element_count();
+        ShotState {
+            hierarchies: hierarchies.into_iter().map(Some).collect(),
+            used: vec![false; count],
+            ledger: Ledger::new(setup.emitted.to_array().to_vec()),
+            cache: ThroughputCache::new(1 << 22),
+            coverage: Mutex::new(HashMap::new()),
+            far,
+            field,
+            face_flux,
+            stats,
+        }
+    }
+}
+
+/// The far field of every glossy face that has far blocks.
+fn far_fields<const N: usize>(setup: &Setup<N>) -> FarFields<N> {
+    let clusters = &setup.clusters;
+    let ctx = FarContext {
+        forest: setup.forest(),
+        tree: &clusters.tree,
+        exposed_area: &setup.exposed_area,
+        burial: setup.burial.as_ref(),
+        enclosed: &clusters.enclosed,
+    };
+    let faces = &setup.faces;
+    let ids: Vec<FaceId> = faces.iter().map(|(f, _)| f).collect();
+    let fields: Vec<Option<FarField<N>>> = ids
+        .par_iter()
+        .map(|&f| {
+            let cut = &clusters.cuts[f];
+            (faces[f].stored && !cut.far.is_empty()).then(|| FarField::new(&ctx, f, cut))
+        })
+        .collect();
+    PerFace::from(fields)
+}
+
+/// The root interactions of the setup's root pairs (sender face, receiver
+/// face): one node each, joining the two surfaces' roots, with nothing
+/// gathered yet.
+fn root_interactions<const N: usize>(
+    vis: &Visibility<'_>,
+    roots: &[(FaceId, FaceId)],
+    samples: impl Fn([FaceElement; 2]) -> u32 + Sync,
+) -> Vec<Hierarchy<N>> {
+    let forest = vis.forest();
+    let root_of = |f: FaceId| f.of(forest.root(f.surface()));
+    roots
+        .par_iter()
+        .map(|&(a, b)| {
+            let pair = [root_of(b), root_of(a)];
+            let t = compute_throughput(vis, pair[0], pair[1], samples(pair), false);
+            Hierarchy::new(a, b, root_of(a).element, root_of(b).element, t)
+        })
+        .collect()
+}
+
+/// Emission: every element of an emitting face starts with δL = Le; the
+/// face's unshot flux is IF = π A Le over its exposed area (paper §6).
+fn emission<const N: usize>(setup: &Setup<N>) -> (ElementRadiance<N>, PerFace<Spectrum<N>>) {
+    let forest = setup.forest();
+    let mut field = ElementRadiance::new(forest.element_count());
+    let mut face_flux = PerFace::from_fn(forest.geometry().surfaces().len(), |_| Spectrum::zero());
+    for (face, f) in setup.faces.iter() {
+        if f.emission.is_black() {
+            continue;
+        }
+        let root = forest.root(face.surface());
+        let flux = emitted_flux(forest, face, f, &setup.exposed_area);
+        let mut stack = vec![root];
+        while let Some(e) = stack.pop() {
+            field.unshot[face.side()][e.index()] = f.emission;
+            if let Some(c) = forest.element(e).children() {
+                stack.extend(c);
+            }
+        }
+        face_flux[face] = flux;
+    }
+    (field, face_flux)
+}
+
+/// The statistics known before the first shot.
+fn initial_stats<const N: usize>(setup: &Setup<N>, root_interactions: usize) -> SolveStats {
+    let potential = setup.discretisation.potential_elements();
+    SolveStats {
+        input_surfaces: setup.forest().geometry().surfaces().len(),
+        potential_elements: potential,
+        potential_interactions: potential.saturating_mul(potential),
+        root_interactions,
+        bands: N,
+        wavelengths_nm: (N != 3).then(trilux_color::Bands::<N>::edges),
+        warnings: setup.warnings.clone(),
+        ..SolveStats::default()
+    }
+}
