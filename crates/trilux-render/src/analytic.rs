@@ -10,8 +10,12 @@
 
 use std::f64::consts::PI;
 
-use crate::gather::{BsdfSample, GatherScene, LightSample, SurfacePoint};
 use glam::{DVec2, DVec3};
+use trilux_geometry::FaceElement;
+
+use crate::link_sum::LinkCache;
+use crate::records::{BsdfSample, GatherStats, LightSample, LinkVisibility, SurfacePoint};
+use crate::scene::{GatherScene, SolutionGather};
 
 /// An orthonormal frame around `n` (Duff et al. 2017).
 pub fn frame(n: DVec3) -> (DVec3, DVec3) {
@@ -164,11 +168,62 @@ impl<const N: usize> GatherScene<N> for Furnace {
     fn reflected(&self, _from: &SurfacePoint<usize>, _towards: &SurfacePoint<usize>) -> [f64; N] {
         [self.reflected; N]
     }
+    fn lobe_solid_angle(&self, _at: &SurfacePoint<usize>, _wo: DVec3) -> f64 {
+        2.0 * PI
+    }
+}
+
+/// No links, no glossy part, flat shading: the path gather alone.
+impl<const N: usize> SolutionGather<N> for Furnace {
     fn element_size(&self, _at: &SurfacePoint<usize>) -> f64 {
         self.element
     }
-    fn lobe_solid_angle(&self, _at: &SurfacePoint<usize>, _wo: DVec3) -> f64 {
-        2.0 * PI
+    fn shading_differs(&self, _at: &SurfacePoint<usize>) -> bool {
+        false
+    }
+    fn has_links(&self) -> bool {
+        false
+    }
+    fn has_glossy_faces(&self) -> bool {
+        false
+    }
+    fn diffuse_albedo(&self, _at: &SurfacePoint<usize>, _wo: DVec3) -> [f64; N] {
+        [0.0; N]
+    }
+    fn solution_irradiance(
+        &self,
+        _at: &SurfacePoint<usize>,
+        _wo: DVec3,
+        _visibility: LinkVisibility<'_>,
+        _cache: &mut LinkCache<N>,
+        _stats: &mut GatherStats,
+    ) -> Option<[f64; N]> {
+        None
+    }
+    fn near_correction(
+        &self,
+        _at: &SurfacePoint<usize>,
+        _wo: DVec3,
+        _coarse_near: &[FaceElement],
+        _cache: &mut LinkCache<N>,
+        _stats: &mut GatherStats,
+    ) -> Option<[f64; N]> {
+        None
+    }
+    fn is_glossy(&self, _at: &SurfacePoint<usize>, _wo: DVec3) -> bool {
+        false
+    }
+    fn glossy_cos(&self, _at: &SurfacePoint<usize>, _wi: DVec3, _wo: DVec3) -> [f64; N] {
+        [0.0; N]
+    }
+    fn reflected_glossy(&self, _from: &SurfacePoint<usize>, _to: &SurfacePoint<usize>) -> [f64; N] {
+        [0.0; N]
+    }
+    fn sample_cosine(&self, _at: &SurfacePoint<usize>, _wo: DVec3, _u: DVec2) -> Option<DVec3> {
+        None
+    }
+    fn mirror(&self, _at: &SurfacePoint<usize>, _wo: DVec3) -> Option<(DVec3, [f64; N])> {
+        None
     }
 }
 
@@ -304,10 +359,61 @@ impl<const N: usize> GatherScene<N> for LitFloor {
     fn reflected(&self, _from: &SurfacePoint<u8>, _towards: &SurfacePoint<u8>) -> [f64; N] {
         [0.0; N]
     }
+    fn lobe_solid_angle(&self, _at: &SurfacePoint<u8>, _wo: DVec3) -> f64 {
+        2.0 * PI
+    }
+}
+
+/// No links, no glossy part, flat shading: the path gather alone.
+impl<const N: usize> SolutionGather<N> for LitFloor {
     fn element_size(&self, _at: &SurfacePoint<u8>) -> f64 {
         0.1
     }
-    fn lobe_solid_angle(&self, _at: &SurfacePoint<u8>, _wo: DVec3) -> f64 {
-        2.0 * PI
+    fn shading_differs(&self, _at: &SurfacePoint<u8>) -> bool {
+        false
+    }
+    fn has_links(&self) -> bool {
+        false
+    }
+    fn has_glossy_faces(&self) -> bool {
+        false
+    }
+    fn diffuse_albedo(&self, _at: &SurfacePoint<u8>, _wo: DVec3) -> [f64; N] {
+        [0.0; N]
+    }
+    fn solution_irradiance(
+        &self,
+        _at: &SurfacePoint<u8>,
+        _wo: DVec3,
+        _visibility: LinkVisibility<'_>,
+        _cache: &mut LinkCache<N>,
+        _stats: &mut GatherStats,
+    ) -> Option<[f64; N]> {
+        None
+    }
+    fn near_correction(
+        &self,
+        _at: &SurfacePoint<u8>,
+        _wo: DVec3,
+        _coarse_near: &[FaceElement],
+        _cache: &mut LinkCache<N>,
+        _stats: &mut GatherStats,
+    ) -> Option<[f64; N]> {
+        None
+    }
+    fn is_glossy(&self, _at: &SurfacePoint<u8>, _wo: DVec3) -> bool {
+        false
+    }
+    fn glossy_cos(&self, _at: &SurfacePoint<u8>, _wi: DVec3, _wo: DVec3) -> [f64; N] {
+        [0.0; N]
+    }
+    fn reflected_glossy(&self, _from: &SurfacePoint<u8>, _to: &SurfacePoint<u8>) -> [f64; N] {
+        [0.0; N]
+    }
+    fn sample_cosine(&self, _at: &SurfacePoint<u8>, _wo: DVec3, _u: DVec2) -> Option<DVec3> {
+        None
+    }
+    fn mirror(&self, _at: &SurfacePoint<u8>, _wo: DVec3) -> Option<(DVec3, [f64; N])> {
+        None
     }
 }

@@ -37,31 +37,15 @@
 //!
 //! [`link_sum`]: crate::link_sum
 
-use glam::{DVec2, DVec3};
+use glam::DVec3;
 
 use crate::bands;
-use crate::gather::{FinalGather, GatherScene, GatherStats, SurfacePoint, power_heuristic};
+use crate::gather::FinalGather;
 use crate::link_sum::LinkCache;
+use crate::mis::{hit_emission, light_sample};
+use crate::records::{GatherStats, LinkVisibility, SurfacePoint};
 use crate::sampler::{PixelSampler, dims, hammersley};
-
-/// How the link sum at a point resolves partial visibility.
-#[derive(Clone, Copy, Debug)]
-pub enum LinkVisibility<'a> {
-    /// The visible fraction the solve measured for each link.
-    Cached,
-    /// As `Cached`, and near senders taken at their link's level without
-    /// the near field's cut: for gather hits, whose error reaches the eye
-    /// weighted by a reflection.
-    Secondary,
-    /// Shadow rays from the point to samples of each partly visible
-    /// sender, drawn from `sampler` from dimension `dim` on.
-    Traced {
-        /// The pixel's sample sequence.
-        sampler: &'a PixelSampler,
-        /// First dimension the rays may use.
-        dim: u32,
-    },
-}
+use crate::scene::SolutionGather;
 
 /// What one camera sample of the link gather may reuse: the pixel's link
 /// cache (primary hits) and a scratch cache (gather hits).
@@ -106,7 +90,7 @@ impl<S> LinkGather<'_, S> {
         stats: &mut GatherStats,
     ) -> [f64; N]
     where
-        S: GatherScene<N>,
+        S: SolutionGather<N>,
     {
         if !self.scene.has_links() {
             return self.fallback.camera_sample(origin, dir, sampler, stats);
@@ -161,7 +145,7 @@ impl<S> LinkGather<'_, S> {
         w: &mut Walk<'_, N>,
     ) -> [f64; N]
     where
-        S: GatherScene<N>,
+        S: SolutionGather<N>,
     {
         let correct = level == 0 && !w.caches.pixel.coarse_near().is_empty();
         if !self.glossy_scene && !correct {
@@ -209,12 +193,13 @@ impl<S> LinkGather<'_, S> {
         w: &mut Walk<'_, N>,
     ) -> [f64; N]
     where
-        S: GatherScene<N>,
+        S: SolutionGather<N>,
     {
         let scene = self.scene;
         let base = dims::GATHER + level * dims::PER_LEVEL;
         let (pick, u) = (w.sampler.get1(base), w.sampler.get2(base + 1));
-        let mut l = light_sample(scene, x, wo, pick, u, true, w.stats);
+        let fr = |wi| scene.glossy_cos(x, wi, wo);
+        let mut l = light_sample(scene, x, wo, pick, u, fr, true, w.stats);
         let Some(bs) = scene.sample_bsdf(x, wo, w.sampler.get2(base + 3)) else {
             return l;
         };
@@ -231,16 +216,8 @@ impl<S> LinkGather<'_, S> {
         };
         let back = -bs.wi;
         let weight = bands::scale(f, 1.0 / bs.pdf);
-        let le = scene.emitted(&xd, back);
-        if !bands::is_black(&le) {
-            let cos_d = xd.normal.dot(back).abs();
-            let pdf_area = scene.light_pdf_area(&xd);
-            let mis = if pdf_area > 0.0 && cos_d > 0.0 {
-                power_heuristic(bs.pdf, pdf_area * xd.t * xd.t / cos_d)
-            } else {
-                1.0
-            };
-            l = bands::add(l, bands::scale(bands::mul(weight, le), mis));
+        if let Some(le) = hit_emission(scene, &xd, back, bs.pdf, weight) {
+            l = bands::add(l, le);
         }
         let lr = self.reflected_at(&xd, x, back, level + 1, w);
         bands::add(l, bands::mul(weight, lr))
@@ -259,7 +236,7 @@ impl<S> LinkGather<'_, S> {
         w: &mut Walk<'_, N>,
     ) -> [f64; N]
     where
-        S: GatherScene<N>,
+        S: SolutionGather<N>,
     {
         let scene = self.scene;
         if level > LINK_LEVELS {
@@ -301,7 +278,7 @@ impl<S> Preview<'_, S> {
         stats: &mut GatherStats,
     ) -> [f64; N]
     where
-        S: GatherScene<N>,
+        S: SolutionGather<N>,
     {
         stats.camera_rays += 1;
         let scene = self.scene;
@@ -342,7 +319,7 @@ const PREVIEW_LIGHT_POINTS: u32 = 16;
 /// quadrature over the emitters (the same [`PREVIEW_LIGHT_POINTS`] points
 /// of a Hammersley set at every pixel: no noise, and highlights of rough
 /// lobes; a narrow lobe sees the points as separate glints).
-fn preview_direct<S: GatherScene<N>, const N: usize>(
+fn preview_direct<S: SolutionGather<N>, const N: usize>(
     scene: &S,
     x: &SurfacePoint<S::Locator>,
     wo: DVec3,
@@ -352,14 +329,15 @@ fn preview_direct<S: GatherScene<N>, const N: usize>(
     for k in 0..PREVIEW_LIGHT_POINTS {
         let u = hammersley(k, PREVIEW_LIGHT_POINTS);
         let pick = (0.5 + f64::from(k) * 0.618_033_988_749_895).fract();
-        sum = bands::add(sum, light_sample(scene, x, wo, pick, u, false, stats));
+        let fr = |wi| scene.glossy_cos(x, wi, wo);
+        sum = bands::add(sum, light_sample(scene, x, wo, pick, u, fr, false, stats));
     }
     bands::scale(sum, 1.0 / f64::from(PREVIEW_LIGHT_POINTS))
 }
 
 /// ρ_d(xd) times the link sum at `xd` with the links' own visibility
 /// (`None` where the scene has no links).
-fn lambertian_at<S: GatherScene<N>, const N: usize>(
+fn lambertian_at<S: SolutionGather<N>, const N: usize>(
     scene: &S,
     xd: &SurfacePoint<S::Locator>,
     towards: DVec3,
@@ -373,54 +351,6 @@ fn lambertian_at<S: GatherScene<N>, const N: usize>(
     scene
         .solution_irradiance(xd, towards, LinkVisibility::Secondary, scratch, stats)
         .map(|e| bands::mul(rho, e))
-}
-
-/// One light sample for the glossy part at `x` (fr_glossy only), from the
-/// emitter `pick` and the point `u` on it; weighted by the power heuristic
-/// against BSDF sampling when `mis`.
-fn light_sample<S: GatherScene<N>, const N: usize>(
-    scene: &S,
-    x: &SurfacePoint<S::Locator>,
-    wo: DVec3,
-    pick: f64,
-    u: DVec2,
-    mis: bool,
-    stats: &mut GatherStats,
-) -> [f64; N] {
-    let Some(ls) = scene.sample_light(x, pick, u) else {
-        return bands::zero();
-    };
-    let d = ls.point - x.point;
-    let dist2 = d.length_squared();
-    let dist = dist2.sqrt();
-    if dist.is_nan()
-        || dist <= 0.0
-        || ls.pdf_area.is_nan()
-        || ls.pdf_area <= 0.0
-        || bands::is_black(&ls.radiance)
-    {
-        return bands::zero();
-    }
-    let wi = d / dist;
-    let cos_light = ls.normal.dot(-wi);
-    if cos_light <= 0.0 {
-        return bands::zero();
-    }
-    let f = scene.glossy_cos(x, wi, wo);
-    if bands::is_black(&f) {
-        return bands::zero();
-    }
-    stats.shadow_rays += 1;
-    if !scene.unoccluded(x, ls.point) {
-        return bands::zero();
-    }
-    let pdf_light = ls.pdf_area * dist2 / cos_light;
-    let w = if mis {
-        power_heuristic(pdf_light, scene.bsdf_pdf(x, wo, wi))
-    } else {
-        1.0
-    };
-    bands::scale(bands::mul(f, ls.radiance), w / pdf_light)
 }
 
 fn finite_or_dropped<const N: usize>(l: [f64; N], stats: &mut GatherStats) -> [f64; N] {

@@ -11,10 +11,13 @@
 use glam::{DVec2, DVec3};
 use trilux_brdf::{Bsdf, BsdfParams, Distribution, RoughConductorParams};
 use trilux_color::ColorParam;
+use trilux_geometry::FaceElement;
 use trilux_render::camera::look_at;
+use trilux_render::link_sum::LinkCache;
 use trilux_render::{
-    BsdfSample, Camera, Estimator, ExtraBounce, FovAxis, GatherScene, LightSample,
-    ReconstructionFilter, RenderSettings, SurfacePoint, render_image,
+    BsdfSample, Camera, Estimator, ExtraBounce, FovAxis, GatherScene, GatherStats, LightSample,
+    LinkVisibility, ReconstructionFilter, RenderSettings, SolutionGather, SurfacePoint,
+    render_image,
 };
 
 /// Floor z = 0 with a glossy BSDF (normal +z: world = local frame) under a
@@ -133,17 +136,64 @@ impl GatherScene<3> for GlossyFloor {
     fn reflected(&self, _: &SurfacePoint<u8>, _: &SurfacePoint<u8>) -> [f64; 3] {
         [0.0; 3]
     }
+    fn lobe_solid_angle(&self, _: &SurfacePoint<u8>, _: DVec3) -> f64 {
+        0.1
+    }
+}
+
+/// A glossy floor without solution links: the link gather and the
+/// preview read its glossy part and fall back to the path gather for the
+/// rest.
+impl SolutionGather<3> for GlossyFloor {
     fn element_size(&self, _: &SurfacePoint<u8>) -> f64 {
         0.1
     }
-    fn lobe_solid_angle(&self, _: &SurfacePoint<u8>, _: DVec3) -> f64 {
-        0.1
+    fn shading_differs(&self, _: &SurfacePoint<u8>) -> bool {
+        false
+    }
+    fn has_links(&self) -> bool {
+        false
+    }
+    fn has_glossy_faces(&self) -> bool {
+        false
+    }
+    fn diffuse_albedo(&self, _: &SurfacePoint<u8>, _: DVec3) -> [f64; 3] {
+        [0.0; 3]
+    }
+    fn solution_irradiance(
+        &self,
+        _: &SurfacePoint<u8>,
+        _: DVec3,
+        _: LinkVisibility<'_>,
+        _: &mut LinkCache<3>,
+        _: &mut GatherStats,
+    ) -> Option<[f64; 3]> {
+        None
+    }
+    fn near_correction(
+        &self,
+        _: &SurfacePoint<u8>,
+        _: DVec3,
+        _: &[FaceElement],
+        _: &mut LinkCache<3>,
+        _: &mut GatherStats,
+    ) -> Option<[f64; 3]> {
+        None
     }
     fn is_glossy(&self, at: &SurfacePoint<u8>, _: DVec3) -> bool {
         at.locator == 0
     }
     fn glossy_cos(&self, at: &SurfacePoint<u8>, wi: DVec3, wo: DVec3) -> [f64; 3] {
         self.bsdf_cos(at, wi, wo)
+    }
+    fn reflected_glossy(&self, _: &SurfacePoint<u8>, _: &SurfacePoint<u8>) -> [f64; 3] {
+        [0.0; 3]
+    }
+    fn sample_cosine(&self, _: &SurfacePoint<u8>, _: DVec3, _: DVec2) -> Option<DVec3> {
+        None
+    }
+    fn mirror(&self, _: &SurfacePoint<u8>, _: DVec3) -> Option<(DVec3, [f64; 3])> {
+        None
     }
 }
 

@@ -61,7 +61,7 @@ fn gather_of_a_constant_solution_is_exact() {
 
 #[test]
 fn furnace_renders_two_at_64_spp() {
-    // Issue 5: emission 1, albedo 0.5, solution (reflected) 1 → L = 2.
+    // The furnace: emission 1, albedo 0.5, solution (reflected) 1 → L = 2.
     // Mean within 0.5 %, 99 % of pixels within 2 %, for every extra-bounce
     // rule (the extra bounce changes the estimator, not its expectation).
     for extra in [
