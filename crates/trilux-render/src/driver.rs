@@ -11,6 +11,7 @@ use std::time::Instant;
 
 use glam::DVec2;
 use rayon::prelude::*;
+use trilux_color::Spectrum;
 
 use crate::camera::Camera;
 use crate::error::RenderError;
@@ -162,7 +163,7 @@ impl<'a, S> Estimators<'a, S> {
         sampler: &PixelSampler,
         caches: &mut Caches<N>,
         stats: &mut GatherStats,
-    ) -> [f64; N]
+    ) -> Spectrum<N>
     where
         S: SolutionGather<N>,
     {
@@ -205,7 +206,7 @@ pub fn render_image<S, const N: usize>(
     scene: &S,
     camera: &Camera,
     settings: &RenderSettings,
-    to_rgb: impl Fn(&[f64; N]) -> [f64; 3] + Sync,
+    to_rgb: impl Fn(&Spectrum<N>) -> [f64; 3] + Sync,
     progress: impl Fn(usize, usize) + Sync,
 ) -> Result<(Image, RenderStats), RenderError>
 where
@@ -267,7 +268,7 @@ fn pilot_mean<S: SolutionGather<N>, const N: usize>(
     estimators: &Estimators<'_, S>,
     camera: &Camera,
     seed: u32,
-    to_rgb: &(impl Fn(&[f64; N]) -> [f64; 3] + Sync),
+    to_rgb: &(impl Fn(&Spectrum<N>) -> [f64; 3] + Sync),
 ) -> (f64, GatherStats) {
     const P: u32 = 32;
     let (w, h) = (f64::from(camera.width()), f64::from(camera.height()));
@@ -321,7 +322,7 @@ impl<S, F> TileJob<'_, S, F> {
     ) -> Result<(Film, GatherStats), RenderError>
     where
         S: SolutionGather<N>,
-        F: Fn(&[f64; N]) -> [f64; 3] + Sync,
+        F: Fn(&Spectrum<N>) -> [f64; 3] + Sync,
     {
         let border = self.settings.filter.radius().ceil() as i64;
         let mut film = Film::new(
@@ -353,7 +354,7 @@ impl<S, F> TileJob<'_, S, F> {
         stats: &mut GatherStats,
     ) where
         S: SolutionGather<N>,
-        F: Fn(&[f64; N]) -> [f64; 3] + Sync,
+        F: Fn(&Spectrum<N>) -> [f64; 3] + Sync,
     {
         let mut sampler = PixelSampler::new(self.settings.seed, x, y);
         let (mut n, mut mean, mut m2) = (0u32, 0.0f64, 0.0f64);
@@ -392,11 +393,5 @@ pub fn render<const N: usize, S: RadianceSolution<N>>(
     progress: impl Fn(usize, usize) + Sync,
 ) -> Result<(Image, RenderStats), RenderError> {
     let solved = SolvedScene::new(solution);
-    render_image::<_, N>(
-        &solved,
-        camera,
-        settings,
-        |l| trilux_color::Spectrum::<N>(*l).to_linear_srgb(),
-        progress,
-    )
+    render_image::<_, N>(&solved, camera, settings, |l| l.to_linear_srgb(), progress)
 }

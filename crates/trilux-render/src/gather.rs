@@ -38,11 +38,11 @@
 
 use glam::DVec3;
 
-use crate::bands;
 use crate::mis::{hit_emission, light_sample};
 use crate::records::{GatherStats, SurfacePoint};
 use crate::sampler::{PixelSampler, dims};
 use crate::scene::SolutionGather;
+use trilux_color::Spectrum;
 
 /// A gather hit whose BSDF lobe subtends less than this solid angle (sr)
 /// is near-specular: the path continues through it instead of reading the
@@ -95,23 +95,23 @@ impl<'a, S> FinalGather<'a, S> {
         dir: DVec3,
         sampler: &PixelSampler,
         stats: &mut GatherStats,
-    ) -> [f64; N]
+    ) -> Spectrum<N>
     where
         S: SolutionGather<N>,
     {
         stats.camera_rays += 1;
         let Some(xs) = self.scene.intersect(origin, dir) else {
-            return bands::zero();
+            return Spectrum::zero();
         };
         let wo = -dir;
         let le = self.scene.emitted(&xs, wo);
         let lr = self.gather(&xs, wo, 0, sampler, stats);
-        let l = bands::add(le, lr);
-        if bands::is_finite(&l) {
+        let l = le + lr;
+        if l.is_finite() {
             l
         } else {
             stats.dropped += 1;
-            bands::zero()
+            Spectrum::zero()
         }
     }
 
@@ -125,7 +125,7 @@ impl<'a, S> FinalGather<'a, S> {
         level: u32,
         sampler: &PixelSampler,
         stats: &mut GatherStats,
-    ) -> [f64; N]
+    ) -> Spectrum<N>
     where
         S: SolutionGather<N>,
     {
@@ -144,7 +144,7 @@ impl<'a, S> FinalGather<'a, S> {
         let Some(bs) = scene.sample_bsdf(x, wo, sampler.get2(base + 3)) else {
             return l;
         };
-        if bs.pdf.is_nan() || bs.pdf <= 0.0 || bands::is_black(&bs.weight) {
+        if bs.pdf.is_nan() || bs.pdf <= 0.0 || bs.weight.is_black() {
             return l;
         }
         stats.gather_rays += 1;
@@ -154,7 +154,7 @@ impl<'a, S> FinalGather<'a, S> {
         let back = -bs.wi;
         // Emission at the gather hit, with the BSDF-sampling MIS weight.
         if let Some(le) = hit_emission(scene, &xd, back, bs.pdf, bs.weight) {
-            l = bands::add(l, le);
+            l += le;
         }
         // Reflected radiance at the gather hit: the solution, or one more
         // bounce where its steps would show, or through a near-specular
@@ -167,7 +167,7 @@ impl<'a, S> FinalGather<'a, S> {
         } else {
             scene.reflected(&xd, x)
         };
-        bands::add(l, bands::mul(bs.weight, lr))
+        l + bs.weight * lr
     }
 
     /// The extra-bounce rule: would the piecewise-constant solution show here?

@@ -42,12 +42,10 @@
 //!   with a non-finite pixel; written through `trilux-files`).
 //! - [`analytic`]: analytic scenes with known answers (tests, benches).
 //! - [`mod@compare`]: relative RMSE and mean ratio against a reference image.
-//! - [`bands`]: small helpers on per-band radiance arrays.
 //! - [`error`]: the error type, [`RenderError`].
 #![forbid(unsafe_code)]
 
 pub mod analytic;
-pub mod bands;
 pub mod camera;
 pub mod compare;
 pub mod driver;

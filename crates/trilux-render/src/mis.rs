@@ -10,9 +10,9 @@
 
 use glam::{DVec2, DVec3};
 
-use crate::bands;
 use crate::records::{GatherStats, SurfacePoint};
 use crate::scene::GatherScene;
+use trilux_color::Spectrum;
 
 /// The power heuristic (β = 2) weight of a strategy with density `a`
 /// against one with density `b`.
@@ -42,12 +42,12 @@ pub fn light_sample<S: GatherScene<N>, const N: usize>(
     wo: DVec3,
     pick: f64,
     u: DVec2,
-    fr: impl FnOnce(DVec3) -> [f64; N],
+    fr: impl FnOnce(DVec3) -> Spectrum<N>,
     mis: bool,
     stats: &mut GatherStats,
-) -> [f64; N] {
+) -> Spectrum<N> {
     let Some(ls) = scene.sample_light(x, pick, u) else {
-        return bands::zero();
+        return Spectrum::zero();
     };
     let d = ls.point - x.point;
     let dist2 = d.length_squared();
@@ -57,17 +57,17 @@ pub fn light_sample<S: GatherScene<N>, const N: usize>(
     } else {
         0.0
     };
-    if !(cos_light > 0.0 && ls.pdf_area > 0.0) || bands::is_black(&ls.radiance) {
-        return bands::zero();
+    if !(cos_light > 0.0 && ls.pdf_area > 0.0) || ls.radiance.is_black() {
+        return Spectrum::zero();
     }
     let wi = d / dist;
     let f = fr(wi);
-    if bands::is_black(&f) {
-        return bands::zero();
+    if f.is_black() {
+        return Spectrum::zero();
     }
     stats.shadow_rays += 1;
     if !scene.unoccluded(x, ls.point) {
-        return bands::zero();
+        return Spectrum::zero();
     }
     let pdf_light = ls.pdf_area * dist2 / cos_light;
     let w = if mis {
@@ -75,7 +75,7 @@ pub fn light_sample<S: GatherScene<N>, const N: usize>(
     } else {
         1.0
     };
-    bands::scale(bands::mul(f, ls.radiance), w / pdf_light)
+    f * ls.radiance * (w / pdf_light)
 }
 
 /// The emission a BSDF-sampled ray brings from its hit `xd` (seen from
@@ -88,10 +88,10 @@ pub fn hit_emission<S: GatherScene<N>, const N: usize>(
     xd: &SurfacePoint<S::Locator>,
     back: DVec3,
     pdf: f64,
-    weight: [f64; N],
-) -> Option<[f64; N]> {
+    weight: Spectrum<N>,
+) -> Option<Spectrum<N>> {
     let le = scene.emitted(xd, back);
-    if bands::is_black(&le) {
+    if le.is_black() {
         return None;
     }
     let cos_d = xd.normal.dot(back).abs();
@@ -101,5 +101,5 @@ pub fn hit_emission<S: GatherScene<N>, const N: usize>(
     } else {
         1.0
     };
-    Some(bands::scale(bands::mul(weight, le), w))
+    Some(weight * le * w)
 }

@@ -8,6 +8,7 @@
 //! (`scene`) and every estimator can name it.
 
 use glam::DVec3;
+use trilux_color::Spectrum;
 
 use crate::sampler::PixelSampler;
 
@@ -34,7 +35,7 @@ pub struct LightSample<const N: usize> {
     pub normal: DVec3,
     /// Emitted radiance from `point` towards the reference point (zero when
     /// the reference lies behind the emitter).
-    pub radiance: [f64; N],
+    pub radiance: Spectrum<N>,
     /// Density of this point with respect to area, including the
     /// probability of having picked its emitter.
     pub pdf_area: f64,
@@ -46,7 +47,7 @@ pub struct BsdfSample<const N: usize> {
     /// Unit incident direction (towards where light comes from), world space.
     pub wi: DVec3,
     /// fr(ω_i, ω_o)·|cos θ_i| / pdf.
-    pub weight: [f64; N],
+    pub weight: Spectrum<N>,
     /// Density of `wi` w.r.t. solid angle.
     pub pdf: f64,
 }

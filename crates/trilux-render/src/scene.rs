@@ -17,6 +17,7 @@
 //! comes from (trilux-brdf's convention).
 
 use glam::{DVec2, DVec3};
+use trilux_color::Spectrum;
 use trilux_geometry::FaceElement;
 
 use crate::link_sum::LinkCache;
@@ -38,7 +39,7 @@ pub trait GatherScene<const N: usize>: Sync {
 
     /// Radiance emitted from `at` in direction `wo` (zero if `at` is not on
     /// an emitter or `wo` leaves its back side).
-    fn emitted(&self, at: &SurfacePoint<Self::Locator>, wo: DVec3) -> [f64; N];
+    fn emitted(&self, at: &SurfacePoint<Self::Locator>, wo: DVec3) -> Spectrum<N>;
 
     /// Samples a point on an emitter as seen from `reference`; `pick` picks
     /// the emitter, `u` the point on it. `None` when there is nothing to
@@ -55,7 +56,7 @@ pub trait GatherScene<const N: usize>: Sync {
     fn light_pdf_area(&self, at: &SurfacePoint<Self::Locator>) -> f64;
 
     /// fr(ω_i, ω_o)·|cos θ_i| at `at` (cosine with the shading normal).
-    fn bsdf_cos(&self, at: &SurfacePoint<Self::Locator>, wi: DVec3, wo: DVec3) -> [f64; N];
+    fn bsdf_cos(&self, at: &SurfacePoint<Self::Locator>, wi: DVec3, wo: DVec3) -> Spectrum<N>;
 
     /// Samples ω_i from fr·cos at `at` for the viewer direction `wo`.
     fn sample_bsdf(
@@ -74,7 +75,7 @@ pub trait GatherScene<const N: usize>: Sync {
         &self,
         from: &SurfacePoint<Self::Locator>,
         towards: &SurfacePoint<Self::Locator>,
-    ) -> [f64; N];
+    ) -> Spectrum<N>;
 
     /// Solid angle (sr) of the BSDF lobe at `at` for viewer direction `wo`;
     /// 2π for a diffuse surface.
@@ -103,7 +104,7 @@ pub trait SolutionGather<const N: usize>: GatherScene<N> {
 
     /// The Lambertian part's reflectance ρ_d at `at` on the side of `wo`
     /// (zero where there is none).
-    fn diffuse_albedo(&self, at: &SurfacePoint<Self::Locator>, wo: DVec3) -> [f64; N];
+    fn diffuse_albedo(&self, at: &SurfacePoint<Self::Locator>, wo: DVec3) -> Spectrum<N>;
 
     /// The radiance arriving at `at` (on the side of `wo`) from the
     /// solution's senders, Σ_i L_i F(x → i) V(x, i), so that ρ_d times it
@@ -117,7 +118,7 @@ pub trait SolutionGather<const N: usize>: GatherScene<N> {
         visibility: LinkVisibility<'_>,
         cache: &mut LinkCache<N>,
         stats: &mut GatherStats,
-    ) -> Option<[f64; N]>;
+    ) -> Option<Spectrum<N>>;
 
     /// Where the gather hit `at` (seen from `wo`) lies in one of
     /// `coarse_near`, the senders a link sum took at their average close to
@@ -132,14 +133,14 @@ pub trait SolutionGather<const N: usize>: GatherScene<N> {
         coarse_near: &[FaceElement],
         cache: &mut LinkCache<N>,
         stats: &mut GatherStats,
-    ) -> Option<[f64; N]>;
+    ) -> Option<Spectrum<N>>;
 
     /// True when the BSDF at `at` has a glossy part on the side of `wo`.
     fn is_glossy(&self, at: &SurfacePoint<Self::Locator>, wo: DVec3) -> bool;
 
     /// The glossy part fr_glossy(ω_i, ω_o)·|cos θ_i| of
     /// [`GatherScene::bsdf_cos`].
-    fn glossy_cos(&self, at: &SurfacePoint<Self::Locator>, wi: DVec3, wo: DVec3) -> [f64; N];
+    fn glossy_cos(&self, at: &SurfacePoint<Self::Locator>, wi: DVec3, wo: DVec3) -> Spectrum<N>;
 
     /// The solution's reflected radiance at `from` towards `towards`
     /// without its Lambertian part (the stored glossy radiance).
@@ -147,7 +148,7 @@ pub trait SolutionGather<const N: usize>: GatherScene<N> {
         &self,
         from: &SurfacePoint<Self::Locator>,
         towards: &SurfacePoint<Self::Locator>,
-    ) -> [f64; N];
+    ) -> Spectrum<N>;
 
     /// A direction sampled with density cos θ/π about the normal on the
     /// side of `wo` (the Lambertian part's importance), `None` below the
@@ -157,5 +158,5 @@ pub trait SolutionGather<const N: usize>: GatherScene<N> {
 
     /// The mirror direction of `wo` about the shading normal at `at` and
     /// the glossy part's directional albedo there (for previews).
-    fn mirror(&self, at: &SurfacePoint<Self::Locator>, wo: DVec3) -> Option<(DVec3, [f64; N])>;
+    fn mirror(&self, at: &SurfacePoint<Self::Locator>, wo: DVec3) -> Option<(DVec3, Spectrum<N>)>;
 }

@@ -216,11 +216,11 @@ impl<const N: usize, S: RadianceSolution<N>> GatherScene<N> for SolvedScene<'_, 
         !self.geom().occluded(from.point, to)
     }
 
-    fn emitted(&self, at: &SurfacePoint<HitLocator>, wo: DVec3) -> [f64; N] {
+    fn emitted(&self, at: &SurfacePoint<HitLocator>, wo: DVec3) -> Spectrum<N> {
         if at.normal.dot(wo) > 0.0 {
-            self.scene.emission()[at.locator.shape as usize].0
+            self.scene.emission()[at.locator.shape as usize]
         } else {
-            [0.0; N]
+            Spectrum::zero()
         }
     }
 
@@ -245,7 +245,7 @@ impl<const N: usize, S: RadianceSolution<N>> GatherScene<N> for SolvedScene<'_, 
         Some(LightSample {
             point: s.point,
             normal: s.normal,
-            radiance: if front { le.0 } else { [0.0; N] },
+            radiance: if front { le } else { Spectrum::zero() },
             pdf_area: self.light_density[surface.index()],
         })
     }
@@ -254,10 +254,10 @@ impl<const N: usize, S: RadianceSolution<N>> GatherScene<N> for SolvedScene<'_, 
         self.light_density[at.locator.surface.index()]
     }
 
-    fn bsdf_cos(&self, at: &SurfacePoint<HitLocator>, wi: DVec3, wo: DVec3) -> [f64; N] {
+    fn bsdf_cos(&self, at: &SurfacePoint<HitLocator>, wi: DVec3, wo: DVec3) -> Spectrum<N> {
         let frame = Frame::from_normal(at.locator.shading_normal);
         let (wi, wo) = (frame.to_local(wi), frame.to_local(wo));
-        (self.bsdf(at).eval(wi, wo) * wi.z.abs()).0
+        self.bsdf(at).eval(wi, wo) * wi.z.abs()
     }
 
     fn sample_bsdf(
@@ -276,7 +276,7 @@ impl<const N: usize, S: RadianceSolution<N>> GatherScene<N> for SolvedScene<'_, 
         }
         Some(BsdfSample {
             wi,
-            weight: s.weight.0,
+            weight: s.weight,
             pdf: s.pdf,
         })
     }
@@ -290,9 +290,9 @@ impl<const N: usize, S: RadianceSolution<N>> GatherScene<N> for SolvedScene<'_, 
         &self,
         from: &SurfacePoint<HitLocator>,
         towards: &SurfacePoint<HitLocator>,
-    ) -> [f64; N] {
+    ) -> Spectrum<N> {
         let (from, towards) = Self::sites(from, towards);
-        self.solution.reflected(&from, &towards).0
+        self.solution.reflected(&from, &towards)
     }
 
     fn lobe_solid_angle(&self, at: &SurfacePoint<HitLocator>, wo: DVec3) -> f64 {
@@ -313,8 +313,8 @@ impl<const N: usize, S: RadianceSolution<N>> SolutionGather<N> for SolvedScene<'
         at.locator.shading_normal.dot(at.normal).abs() < 0.9998
     }
 
-    fn diffuse_albedo(&self, at: &SurfacePoint<HitLocator>, wo: DVec3) -> [f64; N] {
-        self.bsdf(at).diffuse_albedo(viewer_side(at, wo)).0
+    fn diffuse_albedo(&self, at: &SurfacePoint<HitLocator>, wo: DVec3) -> Spectrum<N> {
+        self.bsdf(at).diffuse_albedo(viewer_side(at, wo))
     }
 
     fn solution_irradiance(
@@ -324,7 +324,7 @@ impl<const N: usize, S: RadianceSolution<N>> SolutionGather<N> for SolvedScene<'
         visibility: LinkVisibility<'_>,
         cache: &mut LinkCache<N>,
         stats: &mut GatherStats,
-    ) -> Option<[f64; N]> {
+    ) -> Option<Spectrum<N>> {
         if !self.solution.has_links() {
             return None;
         }
@@ -333,7 +333,7 @@ impl<const N: usize, S: RadianceSolution<N>> SolutionGather<N> for SolvedScene<'
             .solution
             .forest()
             .locate(at.locator.surface, at.locator.coord);
-        Some(self.link_sum_at(at, side, leaf, visibility, cache, stats).0)
+        Some(self.link_sum_at(at, side, leaf, visibility, cache, stats))
     }
 
     fn near_correction(
@@ -343,7 +343,7 @@ impl<const N: usize, S: RadianceSolution<N>> SolutionGather<N> for SolvedScene<'
         coarse_near: &[FaceElement],
         cache: &mut LinkCache<N>,
         stats: &mut GatherStats,
-    ) -> Option<[f64; N]> {
+    ) -> Option<Spectrum<N>> {
         let side = viewer_side(at, wo);
         let forest = self.solution.forest();
         let leaf = forest.locate(at.locator.surface, at.locator.coord);
@@ -363,26 +363,26 @@ impl<const N: usize, S: RadianceSolution<N>> SolutionGather<N> for SolvedScene<'
             Side::Back => Spectrum::zero(),
         };
         let average = self.solution.face_radiance(face, sender) - le;
-        Some((rho * sum - average).0)
+        Some(rho * sum - average)
     }
 
     fn is_glossy(&self, at: &SurfacePoint<HitLocator>, wo: DVec3) -> bool {
         self.bsdf(at).has_glossy(viewer_side(at, wo))
     }
 
-    fn glossy_cos(&self, at: &SurfacePoint<HitLocator>, wi: DVec3, wo: DVec3) -> [f64; N] {
+    fn glossy_cos(&self, at: &SurfacePoint<HitLocator>, wi: DVec3, wo: DVec3) -> Spectrum<N> {
         let frame = Frame::from_normal(at.locator.shading_normal);
         let (wi, wo) = (frame.to_local(wi), frame.to_local(wo));
-        (self.bsdf(at).eval_glossy(wi, wo) * wi.z.abs()).0
+        self.bsdf(at).eval_glossy(wi, wo) * wi.z.abs()
     }
 
     fn reflected_glossy(
         &self,
         from: &SurfacePoint<HitLocator>,
         towards: &SurfacePoint<HitLocator>,
-    ) -> [f64; N] {
+    ) -> Spectrum<N> {
         let (from, towards) = Self::sites(from, towards);
-        self.solution.reflected_glossy(&from, &towards).0
+        self.solution.reflected_glossy(&from, &towards)
     }
 
     fn sample_cosine(&self, at: &SurfacePoint<HitLocator>, wo: DVec3, u: DVec2) -> Option<DVec3> {
@@ -400,7 +400,7 @@ impl<const N: usize, S: RadianceSolution<N>> SolutionGather<N> for SolvedScene<'
         self.solution.has_links()
     }
 
-    fn mirror(&self, at: &SurfacePoint<HitLocator>, wo: DVec3) -> Option<(DVec3, [f64; N])> {
+    fn mirror(&self, at: &SurfacePoint<HitLocator>, wo: DVec3) -> Option<(DVec3, Spectrum<N>)> {
         let n = at.locator.shading_normal;
         let wi = 2.0 * n.dot(wo) * n - wo;
         if wi.dot(at.normal) * wo.dot(at.normal) <= 0.0 {
@@ -417,7 +417,7 @@ impl<const N: usize, S: RadianceSolution<N>> SolutionGather<N> for SolvedScene<'
             .sum::<Spectrum<N>>()
             * (1.0 / f64::from(MIRROR_ALBEDO_POINTS));
         let glossy = albedo - bsdf.diffuse_albedo(viewer_side(at, wo));
-        Some((wi, glossy.max(Spectrum::zero()).0))
+        Some((wi, glossy.max(Spectrum::zero())))
     }
 }
 
