@@ -105,7 +105,8 @@ struct Term<const N: usize> {
 /// bilinearly in its logarithm where all four are positive: far-field
 /// irradiance falls off about as a power of distance, which a linear
 /// interpolation overestimates (by up to 0.7 % over a leaf of 1/8 at twice
-/// a light's size away; 0.09 % in the logarithm: tests/link_gather.rs).
+/// a light's size away; 0.09 % in the logarithm:
+/// crates/trilux/tests/link_gather.rs).
 #[derive(Clone, Debug)]
 struct CornerValues<const N: usize> {
     values: [Spectrum<N>; 4],
