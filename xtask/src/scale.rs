@@ -22,7 +22,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
-use trilux_render::{Observer, Plan, SolutionSource};
+use trilux::{Observer, Plan, SolutionSource};
 use trilux_solver::{Quality, SolverSettings};
 
 use crate::counting_alloc;
@@ -111,7 +111,7 @@ fn run_file(path: &std::path::Path, settings: &SolverSettings) -> Result<Row> {
         solve: &mut on_shot,
         render: &|_, _| {},
     };
-    let outcome = trilux_render::pipeline::run(&scene, &plan, observer)?;
+    let outcome = trilux::pipeline::run(&scene, &plan, observer)?;
     let seconds = start.elapsed().as_secs_f64();
     let s = &outcome.solve;
     let name = path
@@ -144,7 +144,7 @@ fn compare(case: Case, dir: &std::path::Path) -> Result<()> {
     use trilux_solver::Solver;
     let path = write_case(case, dir)?;
     let scene = trilux_scene::load(&path).map_err(|e| anyhow::anyhow!("{e}"))?;
-    let prepared = trilux_render::prepare::<3>(&scene)?;
+    let prepared = trilux::prepare::<3>(&scene)?;
     let mut solutions = Vec::new();
     for clustering in [true, false] {
         let mut settings = SolverSettings::preset(Quality::Default);

@@ -36,7 +36,8 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use anyhow::{Context, Result, bail};
-use trilux_render::{Image, RenderSettings, SolutionSource, compare};
+use trilux::SolutionSource;
+use trilux_render::{Image, RenderSettings, compare};
 
 use crate::golden::{Reference, TriluxSpec, estimator, quality, references, root, run_trilux};
 

@@ -22,10 +22,9 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use anyhow::{Context, Result, bail};
+use trilux::{Observer, Plan, RenderPlan, SolutionSource, ViewOverrides};
 use trilux_brdf::BsdfParams;
-use trilux_render::{
-    Estimator, Observer, Plan, RenderPlan, RenderSettings, SolutionSource, ViewOverrides,
-};
+use trilux_render::Estimator;
 use trilux_solver::{Quality, SolverSettings};
 
 use crate::golden::root;
@@ -96,7 +95,7 @@ fn bake_scene(path: &Path, dir: &Path, solutions: Option<&Path>) -> Result<Vec<R
     let name = name_of(path);
     let scene = trilux_scene::load(path).map_err(|e| anyhow::anyhow!("{e}"))?;
     let render = scene.camera.as_ref().map(|camera| {
-        let mut settings = RenderSettings::for_scene(camera);
+        let mut settings = trilux::render_settings(camera);
         settings.estimator = Estimator::Preview;
         settings.spp = 1;
         RenderPlan {
@@ -121,7 +120,7 @@ fn bake_scene(path: &Path, dir: &Path, solutions: Option<&Path>) -> Result<Vec<R
         bake: Some(trilux_bake::BakeOptions::default()),
         render,
     };
-    let outcome = Observer::quiet(|o| trilux_render::pipeline::run(&scene, &plan, o))?;
+    let outcome = Observer::quiet(|o| trilux::pipeline::run(&scene, &plan, o))?;
     if let Some(image) = &outcome.image {
         std::fs::write(
             dir.join(format!("{name}-preview.png")),
@@ -156,7 +155,7 @@ fn bake_scene(path: &Path, dir: &Path, solutions: Option<&Path>) -> Result<Vec<R
             albedo_maps: false,
             ..Default::default()
         });
-        let outcome = Observer::quiet(|o| trilux_render::pipeline::run(&scene, &plan, o))?;
+        let outcome = Observer::quiet(|o| trilux::pipeline::run(&scene, &plan, o))?;
         let baked = outcome.baked.context("the plan bakes")?;
         rows.push(row(format!("{name}-vertex"), false, baked)?);
     }

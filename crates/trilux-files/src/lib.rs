@@ -18,8 +18,11 @@
 //! - [`identity`]: whether two paths name the same file (hard links,
 //!   symbolic links, `a/../b`, files that do not exist yet), so that a
 //!   command can refuse an output that would overwrite one of its inputs.
+//! - [`film`]: the largest film a render may allocate (pixels a side and
+//!   in all), checked where a scene file or a command line sets one.
 #![forbid(unsafe_code)]
 
+pub mod film;
 pub mod identity;
 pub mod read;
 pub mod write;

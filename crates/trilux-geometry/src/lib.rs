@@ -89,6 +89,10 @@
 //!   burial map.
 //! - [`visibility`]: visible fractions from stratified shadow segments
 //!   ([`Visibility`], which takes the burial map explicitly).
+//! - [`sensor`]: the camera's plain data shared by the scene loader and
+//!   the renderer: Mitsuba's `look_at` ([`look_at`]), the field of view's
+//!   axis ([`FovAxis`]) and the film's reconstruction filters
+//!   ([`ReconstructionFilter`]).
 //! - `quadrature`, `sequence` and `transform` (private): integration rules,
 //!   seeded Sobol points and affine maps.
 #![forbid(unsafe_code)]
@@ -110,6 +114,7 @@ pub mod limits;
 mod patch;
 mod quadrature;
 pub mod sampling;
+pub mod sensor;
 mod sequence;
 pub mod shape;
 pub mod surface;
@@ -134,6 +139,7 @@ pub use form_factor::{
 pub use geometry::{BvhStats, Geometry, Hit, RAY_EPSILON, Ray};
 pub use ids::{ElementId, SurfaceId};
 pub use sampling::SurfaceSample;
+pub use sensor::{FovAxis, LookAtError, ReconstructionFilter, look_at};
 pub use shape::{Shape, ShapeKind, TriangleMesh};
 pub use surface::{InputSurface, SurfaceCoord, SurfaceKind, SurfacePoint};
 pub use visibility::Visibility;

@@ -32,7 +32,7 @@ fn bench(c: &mut Criterion) {
     let mut g = c.benchmark_group("final_gather");
     g.throughput(Throughput::Elements(64 * 64 * 16));
     g.bench_function("furnace_64x64_16spp", |b| {
-        b.iter(|| render_image::<_, 3>(&scene, &cam, &settings, |l| *l, |_, _| {}).unwrap())
+        b.iter(|| render_image::<_, 3>(&scene, &cam, &settings, |l| l.0, |_, _| {}).unwrap())
     });
     g.finish();
 }

@@ -28,7 +28,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         spp: 64,
         ..Default::default()
     };
-    let (image, stats) = render_image::<_, 3>(&scene, &camera, &settings, |l| *l, |_, _| {})?;
+    let (image, stats) = render_image::<_, 3>(&scene, &camera, &settings, |l| l.0, |_, _| {})?;
     std::fs::create_dir_all("out")?;
     image.write_exr(Path::new("out/analytic-floor.exr"))?;
     image.write_png(Path::new("out/analytic-floor.png"), 0.0)?;

@@ -10,8 +10,13 @@
 
 use std::f64::consts::PI;
 
-use crate::gather::{BsdfSample, GatherScene, LightSample, SurfacePoint};
 use glam::{DVec2, DVec3};
+use trilux_color::Spectrum;
+use trilux_geometry::FaceElement;
+
+use crate::link_sum::LinkCache;
+use crate::records::{BsdfSample, GatherStats, LightSample, LinkVisibility, SurfacePoint};
+use crate::scene::{GatherScene, SolutionGather};
 
 /// An orthonormal frame around `n` (Duff et al. 2017).
 pub fn frame(n: DVec3) -> (DVec3, DVec3) {
@@ -58,7 +63,7 @@ fn diffuse_sample<const N: usize>(
     }
     Some(BsdfSample {
         wi,
-        weight: [rho; N],
+        weight: Spectrum::splat(rho),
         pdf: c / PI,
     })
 }
@@ -117,11 +122,11 @@ impl<const N: usize> GatherScene<N> for Furnace {
     fn unoccluded(&self, _from: &SurfacePoint<usize>, _to: DVec3) -> bool {
         true // convex: nothing inside
     }
-    fn emitted(&self, at: &SurfacePoint<usize>, wo: DVec3) -> [f64; N] {
+    fn emitted(&self, at: &SurfacePoint<usize>, wo: DVec3) -> Spectrum<N> {
         if at.normal.dot(wo) > 0.0 {
-            [self.le; N]
+            Spectrum::splat(self.le)
         } else {
-            [0.0; N]
+            Spectrum::zero()
         }
     }
     fn sample_light(&self, r: &SurfacePoint<usize>, pick: f64, u: DVec2) -> Option<LightSample<N>> {
@@ -138,9 +143,9 @@ impl<const N: usize> GatherScene<N> for Furnace {
         let mut n = DVec3::ZERO;
         n[a] = -sign;
         let radiance = if n.dot(r.point - p) > 0.0 {
-            [self.le; N]
+            Spectrum::splat(self.le)
         } else {
-            [0.0; N]
+            Spectrum::zero()
         };
         Some(LightSample {
             point: p,
@@ -152,8 +157,8 @@ impl<const N: usize> GatherScene<N> for Furnace {
     fn light_pdf_area(&self, _at: &SurfacePoint<usize>) -> f64 {
         if self.le == 0.0 { 0.0 } else { 1.0 / 24.0 }
     }
-    fn bsdf_cos(&self, at: &SurfacePoint<usize>, wi: DVec3, wo: DVec3) -> [f64; N] {
-        [diffuse_cos(self.rho, at.normal, wi, wo); N]
+    fn bsdf_cos(&self, at: &SurfacePoint<usize>, wi: DVec3, wo: DVec3) -> Spectrum<N> {
+        Spectrum::splat(diffuse_cos(self.rho, at.normal, wi, wo))
     }
     fn sample_bsdf(&self, at: &SurfacePoint<usize>, wo: DVec3, u: DVec2) -> Option<BsdfSample<N>> {
         diffuse_sample(self.rho, at.normal, wo, u)
@@ -161,14 +166,73 @@ impl<const N: usize> GatherScene<N> for Furnace {
     fn bsdf_pdf(&self, at: &SurfacePoint<usize>, wo: DVec3, wi: DVec3) -> f64 {
         diffuse_pdf(at.normal, wo, wi)
     }
-    fn reflected(&self, _from: &SurfacePoint<usize>, _towards: &SurfacePoint<usize>) -> [f64; N] {
-        [self.reflected; N]
-    }
-    fn element_size(&self, _at: &SurfacePoint<usize>) -> f64 {
-        self.element
+    fn reflected(
+        &self,
+        _from: &SurfacePoint<usize>,
+        _towards: &SurfacePoint<usize>,
+    ) -> Spectrum<N> {
+        Spectrum::splat(self.reflected)
     }
     fn lobe_solid_angle(&self, _at: &SurfacePoint<usize>, _wo: DVec3) -> f64 {
         2.0 * PI
+    }
+}
+
+/// No links, no glossy part, flat shading: the path gather alone.
+impl<const N: usize> SolutionGather<N> for Furnace {
+    fn element_size(&self, _at: &SurfacePoint<usize>) -> f64 {
+        self.element
+    }
+    fn shading_differs(&self, _at: &SurfacePoint<usize>) -> bool {
+        false
+    }
+    fn has_links(&self) -> bool {
+        false
+    }
+    fn has_glossy_faces(&self) -> bool {
+        false
+    }
+    fn diffuse_albedo(&self, _at: &SurfacePoint<usize>, _wo: DVec3) -> Spectrum<N> {
+        Spectrum::zero()
+    }
+    fn solution_irradiance(
+        &self,
+        _at: &SurfacePoint<usize>,
+        _wo: DVec3,
+        _visibility: LinkVisibility<'_>,
+        _cache: &mut LinkCache<N>,
+        _stats: &mut GatherStats,
+    ) -> Option<Spectrum<N>> {
+        None
+    }
+    fn near_correction(
+        &self,
+        _at: &SurfacePoint<usize>,
+        _wo: DVec3,
+        _coarse_near: &[FaceElement],
+        _cache: &mut LinkCache<N>,
+        _stats: &mut GatherStats,
+    ) -> Option<Spectrum<N>> {
+        None
+    }
+    fn is_glossy(&self, _at: &SurfacePoint<usize>, _wo: DVec3) -> bool {
+        false
+    }
+    fn glossy_cos(&self, _at: &SurfacePoint<usize>, _wi: DVec3, _wo: DVec3) -> Spectrum<N> {
+        Spectrum::zero()
+    }
+    fn reflected_glossy(
+        &self,
+        _from: &SurfacePoint<usize>,
+        _to: &SurfacePoint<usize>,
+    ) -> Spectrum<N> {
+        Spectrum::zero()
+    }
+    fn sample_cosine(&self, _at: &SurfacePoint<usize>, _wo: DVec3, _u: DVec2) -> Option<DVec3> {
+        None
+    }
+    fn mirror(&self, _at: &SurfacePoint<usize>, _wo: DVec3) -> Option<(DVec3, Spectrum<N>)> {
+        None
     }
 }
 
@@ -251,11 +315,11 @@ impl<const N: usize> GatherScene<N> for LitFloor {
     fn unoccluded(&self, _from: &SurfacePoint<u8>, _to: DVec3) -> bool {
         true
     }
-    fn emitted(&self, at: &SurfacePoint<u8>, wo: DVec3) -> [f64; N] {
+    fn emitted(&self, at: &SurfacePoint<u8>, wo: DVec3) -> Spectrum<N> {
         if at.locator == 1 && at.normal.dot(wo) > 0.0 {
-            [self.le; N]
+            Spectrum::splat(self.le)
         } else {
-            [0.0; N]
+            Spectrum::zero()
         }
     }
     fn sample_light(&self, r: &SurfacePoint<u8>, _pick: f64, u: DVec2) -> Option<LightSample<N>> {
@@ -265,9 +329,9 @@ impl<const N: usize> GatherScene<N> for LitFloor {
             self.h,
         );
         let radiance = if r.point.z < self.h {
-            [self.le; N]
+            Spectrum::splat(self.le)
         } else {
-            [0.0; N]
+            Spectrum::zero()
         };
         Some(LightSample {
             point: p,
@@ -283,9 +347,9 @@ impl<const N: usize> GatherScene<N> for LitFloor {
             0.0
         }
     }
-    fn bsdf_cos(&self, at: &SurfacePoint<u8>, wi: DVec3, wo: DVec3) -> [f64; N] {
+    fn bsdf_cos(&self, at: &SurfacePoint<u8>, wi: DVec3, wo: DVec3) -> Spectrum<N> {
         let rho = if at.locator == 0 { self.rho } else { 0.0 };
-        [diffuse_cos(rho, at.normal, wi, wo); N]
+        Spectrum::splat(diffuse_cos(rho, at.normal, wi, wo))
     }
     fn sample_bsdf(&self, at: &SurfacePoint<u8>, wo: DVec3, u: DVec2) -> Option<BsdfSample<N>> {
         if at.locator == 0 {
@@ -301,13 +365,64 @@ impl<const N: usize> GatherScene<N> for LitFloor {
             0.0
         }
     }
-    fn reflected(&self, _from: &SurfacePoint<u8>, _towards: &SurfacePoint<u8>) -> [f64; N] {
-        [0.0; N]
-    }
-    fn element_size(&self, _at: &SurfacePoint<u8>) -> f64 {
-        0.1
+    fn reflected(&self, _from: &SurfacePoint<u8>, _towards: &SurfacePoint<u8>) -> Spectrum<N> {
+        Spectrum::zero()
     }
     fn lobe_solid_angle(&self, _at: &SurfacePoint<u8>, _wo: DVec3) -> f64 {
         2.0 * PI
+    }
+}
+
+/// No links, no glossy part, flat shading: the path gather alone.
+impl<const N: usize> SolutionGather<N> for LitFloor {
+    fn element_size(&self, _at: &SurfacePoint<u8>) -> f64 {
+        0.1
+    }
+    fn shading_differs(&self, _at: &SurfacePoint<u8>) -> bool {
+        false
+    }
+    fn has_links(&self) -> bool {
+        false
+    }
+    fn has_glossy_faces(&self) -> bool {
+        false
+    }
+    fn diffuse_albedo(&self, _at: &SurfacePoint<u8>, _wo: DVec3) -> Spectrum<N> {
+        Spectrum::zero()
+    }
+    fn solution_irradiance(
+        &self,
+        _at: &SurfacePoint<u8>,
+        _wo: DVec3,
+        _visibility: LinkVisibility<'_>,
+        _cache: &mut LinkCache<N>,
+        _stats: &mut GatherStats,
+    ) -> Option<Spectrum<N>> {
+        None
+    }
+    fn near_correction(
+        &self,
+        _at: &SurfacePoint<u8>,
+        _wo: DVec3,
+        _coarse_near: &[FaceElement],
+        _cache: &mut LinkCache<N>,
+        _stats: &mut GatherStats,
+    ) -> Option<Spectrum<N>> {
+        None
+    }
+    fn is_glossy(&self, _at: &SurfacePoint<u8>, _wo: DVec3) -> bool {
+        false
+    }
+    fn glossy_cos(&self, _at: &SurfacePoint<u8>, _wi: DVec3, _wo: DVec3) -> Spectrum<N> {
+        Spectrum::zero()
+    }
+    fn reflected_glossy(&self, _from: &SurfacePoint<u8>, _to: &SurfacePoint<u8>) -> Spectrum<N> {
+        Spectrum::zero()
+    }
+    fn sample_cosine(&self, _at: &SurfacePoint<u8>, _wo: DVec3, _u: DVec2) -> Option<DVec3> {
+        None
+    }
+    fn mirror(&self, _at: &SurfacePoint<u8>, _wo: DVec3) -> Option<(DVec3, Spectrum<N>)> {
+        None
     }
 }

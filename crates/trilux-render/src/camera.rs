@@ -4,7 +4,8 @@
 //! `tests/data/mitsuba_camera.py` and the test `camera_matches_mitsuba`):
 //! - camera space looks along **+z**, with **+y up and +x to the left**;
 //!   `lookat(origin, target, up)` builds the columns
-//!   (left = normalize(up × dir), up' = dir × left, dir, origin);
+//!   (left = normalize(up × dir), up' = dir × left, dir, origin)
+//!   ([`trilux_geometry::look_at`], shared with the scene loader);
 //! - a film position (s_x, s_y) ∈ \[0,1\]², (0, 0) being the top-left corner of
 //!   the film, maps to the camera-space direction
 //!   ((1 − 2 s_x)·tan(fov_x/2), (1 − 2 s_y)·tan(fov_x/2)/aspect, 1),
@@ -20,45 +21,9 @@
 
 use glam::{DMat4, DVec2, DVec3};
 
+pub use trilux_geometry::{FovAxis, Ray, look_at};
+
 use crate::error::RenderError;
-
-/// Which film axis the field of view is measured along (Mitsuba `fov_axis`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum FovAxis {
-    /// Horizontal (Mitsuba's default).
-    X,
-    /// Vertical.
-    Y,
-    /// The shorter side of the film.
-    Smaller,
-    /// The longer side of the film.
-    Larger,
-    /// The film's diagonal.
-    Diagonal,
-}
-
-impl FovAxis {
-    /// Parses Mitsuba's spelling (`x`, `y`, `smaller`, `larger`, `diagonal`).
-    pub fn parse(s: &str) -> Option<Self> {
-        match s {
-            "x" => Some(Self::X),
-            "y" => Some(Self::Y),
-            "smaller" => Some(Self::Smaller),
-            "larger" => Some(Self::Larger),
-            "diagonal" => Some(Self::Diagonal),
-            _ => None,
-        }
-    }
-}
-
-/// A ray in world space; `dir` has unit length.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Ray {
-    /// Start point.
-    pub origin: DVec3,
-    /// Unit direction.
-    pub dir: DVec3,
-}
 
 /// A pinhole camera with Mitsuba 3's conventions.
 #[derive(Clone, Debug, PartialEq)]
@@ -80,25 +45,6 @@ pub struct Camera {
     /// window, at `crop_offset`).
     film_size: DVec2,
     crop_offset: DVec2,
-}
-
-/// Mitsuba's `Transform4f.look_at`: camera space (+x left, +y up, +z
-/// forward) to world space.
-pub fn look_at(origin: DVec3, target: DVec3, up: DVec3) -> Result<DMat4, RenderError> {
-    let dir = (target - origin).normalize_or_zero();
-    let left = up.cross(dir).normalize_or_zero();
-    if dir == DVec3::ZERO || left == DVec3::ZERO || !origin.is_finite() {
-        return Err(RenderError::Camera(format!(
-            "lookat origin {origin}, target {target}, up {up} is degenerate"
-        )));
-    }
-    let new_up = dir.cross(left);
-    Ok(DMat4::from_cols(
-        left.extend(0.0),
-        new_up.extend(0.0),
-        dir.extend(0.0),
-        origin.extend(1.0),
-    ))
 }
 
 /// Mitsuba's `parse_fov`: the horizontal field of view (degrees) that
@@ -132,7 +78,7 @@ impl Camera {
         width: u32,
         height: u32,
     ) -> Result<Self, RenderError> {
-        trilux_scene::limits::check_film(width, height).map_err(RenderError::Camera)?;
+        trilux_files::film::check_film(width, height).map_err(RenderError::Camera)?;
         if !(fov_deg.is_finite() && fov_deg > 0.0 && fov_deg < 180.0) {
             return Err(RenderError::Camera(format!(
                 "fov {fov_deg} must lie strictly between 0 and 180 degrees"
@@ -259,7 +205,8 @@ impl Camera {
         self.origin
     }
 
-    /// The ray through the image position `film` given in pixels
+    /// The ray (with a unit direction) through the image position `film`
+    /// given in pixels
     /// (x ∈ [0, width], y ∈ [0, height], (0, 0) the top-left corner; pixel
     /// (i, j) covers [i, i+1] × [j, j+1]), in the crop window when there
     /// is one.
@@ -267,8 +214,9 @@ impl Camera {
         self.ray_unit((film + self.crop_offset) / self.film_size)
     }
 
-    /// The ray through the film position `s` ∈ \[0,1\]² (Mitsuba's position
-    /// sample: (0, 0) is the top-left corner).
+    /// The ray (with a unit direction) through the film position
+    /// `s` ∈ \[0,1\]² (Mitsuba's position sample: (0, 0) is the top-left
+    /// corner).
     pub fn ray_unit(&self, s: DVec2) -> Ray {
         let s = s + self.offset;
         let d_cam = DVec3::new(

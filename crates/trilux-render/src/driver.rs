@@ -11,15 +11,20 @@ use std::time::Instant;
 
 use glam::DVec2;
 use rayon::prelude::*;
+use trilux_color::Spectrum;
 
 use crate::camera::Camera;
 use crate::error::RenderError;
 use crate::film::Film;
 use crate::filter::ReconstructionFilter;
-use crate::gather::{ExtraBounce, FinalGather, GatherScene, GatherStats};
+use crate::gather::{ExtraBounce, FinalGather};
 use crate::image::Image;
 use crate::link_gather::{Caches, LinkGather, Preview};
+use crate::records::GatherStats;
 use crate::sampler::{MAX_SAMPLES, PixelSampler, dims};
+use crate::scene::SolutionGather;
+use crate::solution::RadianceSolution;
+use crate::solved::SolvedScene;
 
 /// How a camera sample reads the solution.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -132,7 +137,7 @@ struct Estimators<'a, S> {
 impl<'a, S> Estimators<'a, S> {
     fn new<const N: usize>(scene: &'a S, settings: &RenderSettings) -> Self
     where
-        S: GatherScene<N>,
+        S: SolutionGather<N>,
     {
         let paths = || FinalGather {
             scene,
@@ -158,9 +163,9 @@ impl<'a, S> Estimators<'a, S> {
         sampler: &PixelSampler,
         caches: &mut Caches<N>,
         stats: &mut GatherStats,
-    ) -> [f64; N]
+    ) -> Spectrum<N>
     where
-        S: GatherScene<N>,
+        S: SolutionGather<N>,
     {
         let ray = camera.ray(film_pos);
         let (o, d) = (ray.origin, ray.dir);
@@ -201,11 +206,11 @@ pub fn render_image<S, const N: usize>(
     scene: &S,
     camera: &Camera,
     settings: &RenderSettings,
-    to_rgb: impl Fn(&[f64; N]) -> [f64; 3] + Sync,
+    to_rgb: impl Fn(&Spectrum<N>) -> [f64; 3] + Sync,
     progress: impl Fn(usize, usize) + Sync,
 ) -> Result<(Image, RenderStats), RenderError>
 where
-    S: GatherScene<N>,
+    S: SolutionGather<N>,
 {
     settings.validate()?;
     let start = Instant::now();
@@ -259,11 +264,11 @@ where
 /// The image's mean luminance from a 32 × 32 pilot at one sample a pixel
 /// (the floor adaptive sampling holds dark pixels to), with what the
 /// pilot traced.
-fn pilot_mean<S: GatherScene<N>, const N: usize>(
+fn pilot_mean<S: SolutionGather<N>, const N: usize>(
     estimators: &Estimators<'_, S>,
     camera: &Camera,
     seed: u32,
-    to_rgb: &(impl Fn(&[f64; N]) -> [f64; 3] + Sync),
+    to_rgb: &(impl Fn(&Spectrum<N>) -> [f64; 3] + Sync),
 ) -> (f64, GatherStats) {
     const P: u32 = 32;
     let (w, h) = (f64::from(camera.width()), f64::from(camera.height()));
@@ -316,8 +321,8 @@ impl<S, F> TileJob<'_, S, F> {
         (tx, ty, tw, th): (u32, u32, u32, u32),
     ) -> Result<(Film, GatherStats), RenderError>
     where
-        S: GatherScene<N>,
-        F: Fn(&[f64; N]) -> [f64; 3] + Sync,
+        S: SolutionGather<N>,
+        F: Fn(&Spectrum<N>) -> [f64; 3] + Sync,
     {
         let border = self.settings.filter.radius().ceil() as i64;
         let mut film = Film::new(
@@ -348,8 +353,8 @@ impl<S, F> TileJob<'_, S, F> {
         caches: &mut Caches<N>,
         stats: &mut GatherStats,
     ) where
-        S: GatherScene<N>,
-        F: Fn(&[f64; N]) -> [f64; 3] + Sync,
+        S: SolutionGather<N>,
+        F: Fn(&Spectrum<N>) -> [f64; 3] + Sync,
     {
         let mut sampler = PixelSampler::new(self.settings.seed, x, y);
         let (mut n, mut mean, mut m2) = (0u32, 0.0f64, 0.0f64);
@@ -381,18 +386,12 @@ impl<S, F> TileJob<'_, S, F> {
 /// Renders the scene of `solution` through `camera` with `settings`.
 /// Spectral solutions (N ≠ 3) are converted per sample to linear sRGB
 /// through CIE XYZ.
-pub fn render<const N: usize, S: crate::solved::RadianceSolution<N>>(
+pub fn render<const N: usize, S: RadianceSolution<N>>(
     solution: &S,
     camera: &Camera,
     settings: &RenderSettings,
     progress: impl Fn(usize, usize) + Sync,
 ) -> Result<(Image, RenderStats), RenderError> {
-    let solved = crate::solved::SolvedScene::new(solution);
-    render_image::<_, N>(
-        &solved,
-        camera,
-        settings,
-        |l| trilux_color::Spectrum::<N>(*l).to_linear_srgb(),
-        progress,
-    )
+    let solved = SolvedScene::new(solution);
+    render_image::<_, N>(&solved, camera, settings, |l| l.to_linear_srgb(), progress)
 }

@@ -11,23 +11,6 @@ pub enum RenderError {
     /// A render setting is out of range (samples per pixel, tile size).
     #[error("invalid render setting: {0}")]
     Settings(String),
-    /// The scene cannot be prepared as written (a material or emitter that
-    /// does not convert, a shape the geometry refuses), at its place in the
-    /// file.
-    #[error(transparent)]
-    Scene(#[from] trilux_scene::SceneError),
-    /// The scene has no camera to render from.
-    #[error("{}: the scene has no <sensor> to render from", path.display())]
-    NoCamera {
-        /// The scene file.
-        path: PathBuf,
-    },
-    /// Solving, or saving or loading a solution, failed.
-    #[error(transparent)]
-    Solver(#[from] trilux_solver::SolverError),
-    /// The solution could not be baked.
-    #[error(transparent)]
-    Bake(#[from] trilux_bake::BakeError),
     /// An output could not be written; the file is as it was.
     #[error(transparent)]
     Output(#[from] trilux_files::WriteError),

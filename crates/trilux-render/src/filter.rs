@@ -1,5 +1,5 @@
-//! The film's reconstruction filters: the scene model's type, whose
-//! weights are Mitsuba 3's (`trilux_scene::rfilter`, with its tests
-//! against Mitsuba's own values).
+//! The film's reconstruction filters: the sensor's plain data, whose
+//! weights are Mitsuba 3's (`trilux_geometry::sensor::rfilter`, with its
+//! tests against Mitsuba's own values), shared with the scene loader.
 
-pub use trilux_scene::rfilter::ReconstructionFilter;
+pub use trilux_geometry::sensor::ReconstructionFilter;

@@ -1,8 +1,10 @@
 //! # trilux-render — final gathering from a solution
 //!
-//! Layer: the top library layer. It may depend on every trilux library crate
-//! (`trilux-color`, `trilux-files`, `trilux-geometry`, `trilux-brdf`,
-//! `trilux-scene`, `trilux-solver`); nothing depends on it but the `trilux` command and
+//! Layer: the top library layer. It depends on `trilux-color`,
+//! `trilux-files` (image outputs, the film's limits), `trilux-geometry`,
+//! `trilux-brdf` and `trilux-solver`, not on the scene model or the bake:
+//! the orchestration from a scene file to an image is the `trilux` crate's
+//! (`trilux::pipeline`). Nothing depends on it but the `trilux` crate and
 //! `xtask`.
 //!
 //! A view-independent solution (paper §3–§5) says how much light leaves every
@@ -16,32 +18,34 @@
 //!
 //! Contents, in the order an image is made:
 //! - [`camera`]: Mitsuba 3's `perspective` sensor (fov, `fov_axis`, `lookat`).
-//! - [`view`]: the scene's sensor as a [`Camera`], with command-line
-//!   overrides (`--lookat`, `--fov`, film size).
 //! - [`sampler`]: Owen-scrambled Sobol samples (sobol_burley), one sequence
 //!   per pixel, decorrelated by the seed.
-//! - [`gather`]: the abstraction the integrator is written against
-//!   ([`GatherScene`]) and the final-gather estimator itself.
-//! - [`link_gather`]: rendering from the solution's gather links (the
-//!   default) and the noise-free preview; [`link_sum`]: the sum over the
-//!   links at one point.
-//! - [`solved`]: [`GatherScene`] for trilux's geometry, BRDFs and a
-//!   solution ([`RadianceSolution`]).
-//! - [`pipeline`]: the one orchestration — prepare a loaded scene in its
-//!   mode, solve it or load a saved solution, save it, render a view.
-//! - [`filter`]: reconstruction filters (Mitsuba's Gaussian, box).
+//! - [`records`]: the records passed between a scene and the estimators
+//!   (hits, light and BSDF samples, link visibility, counters).
+//! - [`solution`]: what the renderer reads from a solution
+//!   ([`RadianceSolution`]; the solver's, or [`DirectOnly`]).
+//! - [`link_sum`]: the sum over the solution's gather links at one point.
+//! - [`scene`]: what the estimators ask of a scene: the core
+//!   [`GatherScene`] and, for a scene backed by a full solution,
+//!   [`SolutionGather`].
+//! - [`mis`]: light sampling and BSDF-hit emission with multiple importance
+//!   sampling, shared by the estimators.
+//! - [`gather`]: the path gather of paper §4.5 (the default estimator).
+//! - [`link_gather`]: rendering from the solution's gather links, and the
+//!   noise-free preview.
+//! - [`solved`]: [`GatherScene`] and [`SolutionGather`] for trilux's
+//!   geometry, BRDFs and a solution ([`SolvedScene`]).
+//! - [`filter`]: reconstruction filters (Mitsuba's Gaussian, box, ...).
 //! - [`film`]: splatting samples through the filter, per-pixel normalisation.
 //! - [`driver`]: tiles rendered in parallel (rayon), merged deterministically.
 //! - [`image`]: the finished [`Image`], its EXR (ZIP) and PNG files (never
 //!   with a non-finite pixel; written through `trilux-files`).
 //! - [`analytic`]: analytic scenes with known answers (tests, benches).
 //! - [`mod@compare`]: relative RMSE and mean ratio against a reference image.
-//! - [`bands`]: small helpers on per-band radiance arrays.
 //! - [`error`]: the error type, [`RenderError`].
 #![forbid(unsafe_code)]
 
 pub mod analytic;
-pub mod bands;
 pub mod camera;
 pub mod compare;
 pub mod driver;
@@ -52,10 +56,12 @@ pub mod gather;
 pub mod image;
 pub mod link_gather;
 pub mod link_sum;
-pub mod pipeline;
+pub mod mis;
+pub mod records;
 pub mod sampler;
+pub mod scene;
+pub mod solution;
 pub mod solved;
-pub mod view;
 
 pub use camera::{Camera, FovAxis, Ray};
 pub use compare::{Comparison, compare};
@@ -63,11 +69,11 @@ pub use driver::{Estimator, RenderSettings, RenderStats, render, render_image};
 pub use error::RenderError;
 pub use film::Film;
 pub use filter::ReconstructionFilter;
-pub use gather::{
-    BsdfSample, ExtraBounce, GatherScene, GatherStats, LightSample, SurfacePoint, power_heuristic,
-};
+pub use gather::ExtraBounce;
 pub use image::Image;
-pub use pipeline::{Observer, Outcome, Plan, RenderPlan, SolutionSource, prepare, scene_camera};
+pub use mis::power_heuristic;
+pub use records::{BsdfSample, GatherStats, LightSample, LinkVisibility, SurfacePoint};
 pub use sampler::PixelSampler;
-pub use solved::{DirectOnly, RadianceSolution, SolvedScene};
-pub use view::{ViewOverrides, camera_of, filter_of};
+pub use scene::{GatherScene, SolutionGather};
+pub use solution::{DirectOnly, RadianceSolution};
+pub use solved::SolvedScene;

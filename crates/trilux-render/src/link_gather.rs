@@ -37,31 +37,15 @@
 //!
 //! [`link_sum`]: crate::link_sum
 
-use glam::{DVec2, DVec3};
+use glam::DVec3;
 
-use crate::bands;
-use crate::gather::{FinalGather, GatherScene, GatherStats, SurfacePoint, power_heuristic};
+use crate::gather::FinalGather;
 use crate::link_sum::LinkCache;
+use crate::mis::{hit_emission, light_sample};
+use crate::records::{GatherStats, LinkVisibility, SurfacePoint};
 use crate::sampler::{PixelSampler, dims, hammersley};
-
-/// How the link sum at a point resolves partial visibility.
-#[derive(Clone, Copy, Debug)]
-pub enum LinkVisibility<'a> {
-    /// The visible fraction the solve measured for each link.
-    Cached,
-    /// As `Cached`, and near senders taken at their link's level without
-    /// the near field's cut: for gather hits, whose error reaches the eye
-    /// weighted by a reflection.
-    Secondary,
-    /// Shadow rays from the point to samples of each partly visible
-    /// sender, drawn from `sampler` from dimension `dim` on.
-    Traced {
-        /// The pixel's sample sequence.
-        sampler: &'a PixelSampler,
-        /// First dimension the rays may use.
-        dim: u32,
-    },
-}
+use crate::scene::SolutionGather;
+use trilux_color::Spectrum;
 
 /// What one camera sample of the link gather may reuse: the pixel's link
 /// cache (primary hits) and a scratch cache (gather hits).
@@ -104,16 +88,16 @@ impl<S> LinkGather<'_, S> {
         sampler: &PixelSampler,
         caches: &mut Caches<N>,
         stats: &mut GatherStats,
-    ) -> [f64; N]
+    ) -> Spectrum<N>
     where
-        S: GatherScene<N>,
+        S: SolutionGather<N>,
     {
         if !self.scene.has_links() {
             return self.fallback.camera_sample(origin, dir, sampler, stats);
         }
         stats.camera_rays += 1;
         let Some(xs) = self.scene.intersect(origin, dir) else {
-            return bands::zero();
+            return Spectrum::zero();
         };
         let wo = -dir;
         let scene = self.scene;
@@ -124,25 +108,25 @@ impl<S> LinkGather<'_, S> {
         };
         let mut l = scene.emitted(&xs, wo);
         let rho = scene.diffuse_albedo(&xs, wo);
-        if !bands::is_black(&rho) {
+        if !rho.is_black() {
             let visibility = LinkVisibility::Traced {
                 sampler,
                 dim: dims::LINKS,
             };
             match scene.solution_irradiance(&xs, wo, visibility, &mut w.caches.pixel, w.stats) {
                 Some(e) => {
-                    let e = bands::add(e, self.cosine_ray(&xs, wo, 0, &mut w));
-                    l = bands::add(l, bands::mul(rho, e));
+                    let e = e + self.cosine_ray(&xs, wo, 0, &mut w);
+                    l += rho * e;
                 }
                 // No links here: the path gather serves the whole BSDF.
                 None => {
                     let lr = self.fallback.gather(&xs, wo, 0, sampler, w.stats);
-                    return finite_or_dropped(bands::add(l, lr), w.stats);
+                    return finite_or_dropped(l + lr, w.stats);
                 }
             }
         }
         if scene.is_glossy(&xs, wo) {
-            l = bands::add(l, self.glossy(&xs, wo, 0, &mut w));
+            l += self.glossy(&xs, wo, 0, &mut w);
         }
         finite_or_dropped(l, w.stats)
     }
@@ -159,26 +143,26 @@ impl<S> LinkGather<'_, S> {
         wo: DVec3,
         level: u32,
         w: &mut Walk<'_, N>,
-    ) -> [f64; N]
+    ) -> Spectrum<N>
     where
-        S: GatherScene<N>,
+        S: SolutionGather<N>,
     {
         let correct = level == 0 && !w.caches.pixel.coarse_near().is_empty();
         if !self.glossy_scene && !correct {
-            return bands::zero();
+            return Spectrum::zero();
         }
         let scene = self.scene;
         let u = w.sampler.get2(dims::GLOSSY_SENDERS + 2 * level);
         let Some(wi) = scene.sample_cosine(x, wo, u) else {
-            return bands::zero();
+            return Spectrum::zero();
         };
         w.stats.gather_rays += 1;
         let Some(xd) = scene.intersect(x.point, wi) else {
-            return bands::zero();
+            return Spectrum::zero();
         };
         let back = -wi;
         // With density cos θ/π the estimate of (1/π) ∫ L cos dω is L.
-        let mut e = bands::zero();
+        let mut e = Spectrum::zero();
         if correct {
             let Caches { pixel, scratch } = &mut *w.caches;
             let near = pixel.coarse_near();
@@ -193,7 +177,7 @@ impl<S> LinkGather<'_, S> {
             } else {
                 scene.reflected_glossy(&xd, x)
             };
-            e = bands::add(e, g);
+            e += g;
         }
         e
     }
@@ -207,14 +191,15 @@ impl<S> LinkGather<'_, S> {
         wo: DVec3,
         level: u32,
         w: &mut Walk<'_, N>,
-    ) -> [f64; N]
+    ) -> Spectrum<N>
     where
-        S: GatherScene<N>,
+        S: SolutionGather<N>,
     {
         let scene = self.scene;
         let base = dims::GATHER + level * dims::PER_LEVEL;
         let (pick, u) = (w.sampler.get1(base), w.sampler.get2(base + 1));
-        let mut l = light_sample(scene, x, wo, pick, u, true, w.stats);
+        let fr = |wi| scene.glossy_cos(x, wi, wo);
+        let mut l = light_sample(scene, x, wo, pick, u, fr, true, w.stats);
         let Some(bs) = scene.sample_bsdf(x, wo, w.sampler.get2(base + 3)) else {
             return l;
         };
@@ -222,7 +207,7 @@ impl<S> LinkGather<'_, S> {
             return l;
         }
         let f = scene.glossy_cos(x, bs.wi, wo);
-        if bands::is_black(&f) {
+        if f.is_black() {
             return l;
         }
         w.stats.gather_rays += 1;
@@ -230,20 +215,12 @@ impl<S> LinkGather<'_, S> {
             return l;
         };
         let back = -bs.wi;
-        let weight = bands::scale(f, 1.0 / bs.pdf);
-        let le = scene.emitted(&xd, back);
-        if !bands::is_black(&le) {
-            let cos_d = xd.normal.dot(back).abs();
-            let pdf_area = scene.light_pdf_area(&xd);
-            let mis = if pdf_area > 0.0 && cos_d > 0.0 {
-                power_heuristic(bs.pdf, pdf_area * xd.t * xd.t / cos_d)
-            } else {
-                1.0
-            };
-            l = bands::add(l, bands::scale(bands::mul(weight, le), mis));
+        let weight = f * (1.0 / bs.pdf);
+        if let Some(le) = hit_emission(scene, &xd, back, bs.pdf, weight) {
+            l += le;
         }
         let lr = self.reflected_at(&xd, x, back, level + 1, w);
-        bands::add(l, bands::mul(weight, lr))
+        l + weight * lr
     }
 
     /// The reflected radiance leaving a gather hit `xd` towards `x` (in
@@ -257,9 +234,9 @@ impl<S> LinkGather<'_, S> {
         towards: DVec3,
         level: u32,
         w: &mut Walk<'_, N>,
-    ) -> [f64; N]
+    ) -> Spectrum<N>
     where
-        S: GatherScene<N>,
+        S: SolutionGather<N>,
     {
         let scene = self.scene;
         if level > LINK_LEVELS {
@@ -271,16 +248,16 @@ impl<S> LinkGather<'_, S> {
             return scene.reflected(xd, x);
         };
         let rho = scene.diffuse_albedo(xd, towards);
-        if !bands::is_black(&rho) {
+        if !rho.is_black() {
             let e_g = self.cosine_ray(xd, towards, level, w);
-            lambertian = bands::add(lambertian, bands::mul(rho, e_g));
+            lambertian += rho * e_g;
         }
         let glossy = if scene.is_glossy(xd, towards) {
             self.glossy(xd, towards, level, w)
         } else {
-            bands::zero()
+            Spectrum::zero()
         };
-        bands::add(lambertian, glossy)
+        lambertian + glossy
     }
 }
 
@@ -299,26 +276,26 @@ impl<S> Preview<'_, S> {
         dir: DVec3,
         caches: &mut Caches<N>,
         stats: &mut GatherStats,
-    ) -> [f64; N]
+    ) -> Spectrum<N>
     where
-        S: GatherScene<N>,
+        S: SolutionGather<N>,
     {
         stats.camera_rays += 1;
         let scene = self.scene;
         let Some(xs) = scene.intersect(origin, dir) else {
-            return bands::zero();
+            return Spectrum::zero();
         };
         let wo = -dir;
         let mut l = scene.emitted(&xs, wo);
         let rho = scene.diffuse_albedo(&xs, wo);
-        if !bands::is_black(&rho)
+        if !rho.is_black()
             && let Some(e) =
                 scene.solution_irradiance(&xs, wo, LinkVisibility::Cached, &mut caches.pixel, stats)
         {
-            l = bands::add(l, bands::mul(rho, e));
+            l += rho * e;
         }
         if scene.is_glossy(&xs, wo) {
-            l = bands::add(l, preview_direct(scene, &xs, wo, stats));
+            l += preview_direct(scene, &xs, wo, stats);
             if let Some((wi, albedo)) = scene.mirror(&xs, wo)
                 && let Some(xd) = scene.intersect(xs.point, wi)
             {
@@ -326,9 +303,9 @@ impl<S> Preview<'_, S> {
                 let reflected = lambertian_at(scene, &xd, -wi, &mut caches.scratch, stats)
                     .map_or_else(
                         || scene.reflected(&xd, &xs),
-                        |l| bands::add(l, scene.reflected_glossy(&xd, &xs)),
+                        |l| l + scene.reflected_glossy(&xd, &xs),
                     );
-                l = bands::add(l, bands::mul(albedo, reflected));
+                l += albedo * reflected;
             }
         }
         finite_or_dropped(l, stats)
@@ -342,92 +319,45 @@ const PREVIEW_LIGHT_POINTS: u32 = 16;
 /// quadrature over the emitters (the same [`PREVIEW_LIGHT_POINTS`] points
 /// of a Hammersley set at every pixel: no noise, and highlights of rough
 /// lobes; a narrow lobe sees the points as separate glints).
-fn preview_direct<S: GatherScene<N>, const N: usize>(
+fn preview_direct<S: SolutionGather<N>, const N: usize>(
     scene: &S,
     x: &SurfacePoint<S::Locator>,
     wo: DVec3,
     stats: &mut GatherStats,
-) -> [f64; N] {
-    let mut sum = bands::zero();
+) -> Spectrum<N> {
+    let mut sum = Spectrum::zero();
     for k in 0..PREVIEW_LIGHT_POINTS {
         let u = hammersley(k, PREVIEW_LIGHT_POINTS);
         let pick = (0.5 + f64::from(k) * 0.618_033_988_749_895).fract();
-        sum = bands::add(sum, light_sample(scene, x, wo, pick, u, false, stats));
+        let fr = |wi| scene.glossy_cos(x, wi, wo);
+        sum += light_sample(scene, x, wo, pick, u, fr, false, stats);
     }
-    bands::scale(sum, 1.0 / f64::from(PREVIEW_LIGHT_POINTS))
+    sum * (1.0 / f64::from(PREVIEW_LIGHT_POINTS))
 }
 
 /// ρ_d(xd) times the link sum at `xd` with the links' own visibility
 /// (`None` where the scene has no links).
-fn lambertian_at<S: GatherScene<N>, const N: usize>(
+fn lambertian_at<S: SolutionGather<N>, const N: usize>(
     scene: &S,
     xd: &SurfacePoint<S::Locator>,
     towards: DVec3,
     scratch: &mut LinkCache<N>,
     stats: &mut GatherStats,
-) -> Option<[f64; N]> {
+) -> Option<Spectrum<N>> {
     let rho = scene.diffuse_albedo(xd, towards);
-    if bands::is_black(&rho) {
-        return Some(bands::zero());
+    if rho.is_black() {
+        return Some(Spectrum::zero());
     }
     scene
         .solution_irradiance(xd, towards, LinkVisibility::Secondary, scratch, stats)
-        .map(|e| bands::mul(rho, e))
+        .map(|e| rho * e)
 }
 
-/// One light sample for the glossy part at `x` (fr_glossy only), from the
-/// emitter `pick` and the point `u` on it; weighted by the power heuristic
-/// against BSDF sampling when `mis`.
-fn light_sample<S: GatherScene<N>, const N: usize>(
-    scene: &S,
-    x: &SurfacePoint<S::Locator>,
-    wo: DVec3,
-    pick: f64,
-    u: DVec2,
-    mis: bool,
-    stats: &mut GatherStats,
-) -> [f64; N] {
-    let Some(ls) = scene.sample_light(x, pick, u) else {
-        return bands::zero();
-    };
-    let d = ls.point - x.point;
-    let dist2 = d.length_squared();
-    let dist = dist2.sqrt();
-    if dist.is_nan()
-        || dist <= 0.0
-        || ls.pdf_area.is_nan()
-        || ls.pdf_area <= 0.0
-        || bands::is_black(&ls.radiance)
-    {
-        return bands::zero();
-    }
-    let wi = d / dist;
-    let cos_light = ls.normal.dot(-wi);
-    if cos_light <= 0.0 {
-        return bands::zero();
-    }
-    let f = scene.glossy_cos(x, wi, wo);
-    if bands::is_black(&f) {
-        return bands::zero();
-    }
-    stats.shadow_rays += 1;
-    if !scene.unoccluded(x, ls.point) {
-        return bands::zero();
-    }
-    let pdf_light = ls.pdf_area * dist2 / cos_light;
-    let w = if mis {
-        power_heuristic(pdf_light, scene.bsdf_pdf(x, wo, wi))
-    } else {
-        1.0
-    };
-    bands::scale(bands::mul(f, ls.radiance), w / pdf_light)
-}
-
-fn finite_or_dropped<const N: usize>(l: [f64; N], stats: &mut GatherStats) -> [f64; N] {
-    if bands::is_finite(&l) {
+fn finite_or_dropped<const N: usize>(l: Spectrum<N>, stats: &mut GatherStats) -> Spectrum<N> {
+    if l.is_finite() {
         l
     } else {
         stats.dropped += 1;
-        bands::zero()
+        Spectrum::zero()
     }
 }

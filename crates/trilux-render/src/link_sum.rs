@@ -9,7 +9,7 @@
 //! 2. **Far field.** Over a leaf, far senders' contributions L_i F(x → i)
 //!    vary smoothly (their distance exceeds both sizes), so the sum of the
 //!    fully visible ones is computed exactly at the leaf's four corners and
-//!    interpolated bilinearly at x, in its logarithm ([`CornerValues`]);
+//!    interpolated bilinearly at x, in its logarithm (`CornerValues`);
 //!    the same for the partly visible ones with the links' own visible
 //!    fractions. On mesh clusters, which have no (u, v) corners, the far
 //!    terms are evaluated at x.
@@ -51,9 +51,8 @@ use trilux_color::Spectrum;
 use trilux_geometry::{Element, FaceElement, PointFormFactors, Side, SurfaceCoord};
 use trilux_solver::LinkSource;
 
-use crate::gather::GatherStats;
-use crate::link_gather::LinkVisibility;
-use crate::solved::RadianceSolution;
+use crate::records::{GatherStats, LinkVisibility};
+use crate::solution::RadianceSolution;
 
 /// A sender closer to a receiving leaf than this many times their sizes is
 /// evaluated at the point, and may be refined into its children.
@@ -106,7 +105,8 @@ struct Term<const N: usize> {
 /// bilinearly in its logarithm where all four are positive: far-field
 /// irradiance falls off about as a power of distance, which a linear
 /// interpolation overestimates (by up to 0.7 % over a leaf of 1/8 at twice
-/// a light's size away; 0.09 % in the logarithm: tests/link_gather.rs).
+/// a light's size away; 0.09 % in the logarithm:
+/// crates/trilux/tests/link_gather.rs).
 #[derive(Clone, Debug)]
 struct CornerValues<const N: usize> {
     values: [Spectrum<N>; 4],
@@ -320,7 +320,7 @@ impl<const N: usize> LinkCache<N> {
     }
 
     /// The near senders the last link sum took at their average
-    /// ([`LeafSum::coarse_near`]).
+    /// (`LeafSum::coarse_near`).
     pub fn coarse_near(&self) -> &[FaceElement] {
         self.last
             .map_or(&[], |k| self.entries[k].coarse_near.as_slice())

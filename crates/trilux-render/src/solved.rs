@@ -1,5 +1,5 @@
 //! The final gather wired to trilux's own layers: [`SolvedScene`]
-//! implements [`GatherScene`] with a prepared scene (geometry, materials,
+//! implements [`GatherScene`] and [`SolutionGather`] with a prepared scene (geometry, materials,
 //! emitters: `trilux_solver::PreparedScene`) and a solution
 //! ([`RadianceSolution`]: the solver's, or a stand-in).
 //!
@@ -31,79 +31,13 @@ use trilux_color::Spectrum;
 use trilux_geometry::{
     ElementForest, ElementId, FaceElement, FaceId, Geometry, Ray, Side, SurfaceCoord, SurfaceId,
 };
-use trilux_solver::{GatherLink, PreparedScene, SurfaceSite};
+use trilux_solver::{PreparedScene, SurfaceSite};
 
-use crate::gather::{BsdfSample, GatherScene, GatherStats, LightSample, SurfacePoint};
-use crate::link_gather::LinkVisibility;
+use crate::link_sum::{LinkCache, LinkField, Receiver, link_sum};
+use crate::records::{BsdfSample, GatherStats, LightSample, LinkVisibility, SurfacePoint};
 use crate::sampler::hammersley;
-
-/// What the renderer needs of a view-independent solution.
-pub trait RadianceSolution<const N: usize>: Sync {
-    /// The scene the solution is of (geometry, materials, emitters).
-    fn scene(&self) -> &PreparedScene<N>;
-    /// The element trees the solution refers to (with the solve's
-    /// subdivisions), over the scene's geometry.
-    fn forest(&self) -> &ElementForest;
-    /// Reflected radiance (emission excluded) leaving `from` towards `to`.
-    fn reflected(&self, from: &SurfaceSite, to: &SurfaceSite) -> Spectrum<N>;
-
-    /// True when the solution has gather links (`trilux_solver::gather_links`).
-    fn has_links(&self) -> bool {
-        false
-    }
-
-    /// Calls `f` with every gather link into element `e` and the radiance
-    /// its sender sends.
-    fn for_each_link(&self, _e: FaceElement, _f: &mut dyn FnMut(&GatherLink, Spectrum<N>)) {}
-
-    /// The final radiance L + Le element `e` of `face` sends (for refining
-    /// a sender near the point being shaded).
-    fn face_radiance(&self, _face: FaceId, _e: ElementId) -> Spectrum<N> {
-        Spectrum::zero()
-    }
-
-    /// The stored (glossy) part alone of [`Self::reflected`].
-    fn reflected_glossy(&self, _from: &SurfaceSite, _to: &SurfaceSite) -> Spectrum<N> {
-        Spectrum::zero()
-    }
-}
-
-/// A stand-in solution that knows no indirect light (every reflected
-/// radiance is zero): the final gather then renders direct lighting only.
-/// Also answers a constant, for tests (`constant`).
-pub struct DirectOnly<const N: usize> {
-    scene: Arc<PreparedScene<N>>,
-    forest: ElementForest,
-    constant: Spectrum<N>,
-}
-
-impl<const N: usize> DirectOnly<N> {
-    /// Direct light only: every reflected radiance is zero.
-    pub fn new(scene: Arc<PreparedScene<N>>) -> Self {
-        Self::constant(scene, Spectrum::zero())
-    }
-
-    /// A solution that answers `constant` everywhere (for tests).
-    pub fn constant(scene: Arc<PreparedScene<N>>, constant: Spectrum<N>) -> Self {
-        DirectOnly {
-            forest: ElementForest::new(Arc::clone(scene.geometry())),
-            scene,
-            constant,
-        }
-    }
-}
-
-impl<const N: usize> RadianceSolution<N> for DirectOnly<N> {
-    fn scene(&self) -> &PreparedScene<N> {
-        &self.scene
-    }
-    fn forest(&self) -> &ElementForest {
-        &self.forest
-    }
-    fn reflected(&self, _from: &SurfaceSite, _to: &SurfaceSite) -> Spectrum<N> {
-        self.constant
-    }
-}
+use crate::scene::{GatherScene, SolutionGather};
+use crate::solution::RadianceSolution;
 
 /// Where a ray met the scene, as [`SolvedScene`] needs it.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -139,7 +73,7 @@ pub struct SolvedScene<'a, const N: usize, S> {
     /// Pick probability / area, by surface index (0 when not emitting).
     light_density: Vec<f64>,
     /// The link sums' point form factors and leaf links.
-    links: crate::link_sum::LinkField<N>,
+    links: LinkField<N>,
     /// Some material has a glossy part on some side.
     glossy_faces: bool,
 }
@@ -181,10 +115,10 @@ impl<'a, const N: usize, S: RadianceSolution<N>> SolvedScene<'a, N, S> {
         let links = if solution.has_links() {
             let forest = solution.forest();
             let ff = trilux_geometry::PointFormFactors::new(forest);
-            crate::link_sum::LinkField::new(ff, forest.element_count())
+            LinkField::new(ff, forest.element_count())
         } else {
             let forest = ElementForest::new(Arc::clone(scene.geometry()));
-            crate::link_sum::LinkField::new(trilux_geometry::PointFormFactors::new(&forest), 0)
+            LinkField::new(trilux_geometry::PointFormFactors::new(&forest), 0)
         };
         let glossy_faces = scene
             .materials()
@@ -238,16 +172,16 @@ impl<'a, const N: usize, S: RadianceSolution<N>> SolvedScene<'a, N, S> {
         side: Side,
         leaf: ElementId,
         visibility: LinkVisibility<'_>,
-        cache: &mut crate::link_sum::LinkCache<N>,
+        cache: &mut LinkCache<N>,
         stats: &mut GatherStats,
     ) -> Spectrum<N> {
-        let receiver = crate::link_sum::Receiver {
+        let receiver = Receiver {
             x: at.point,
             n: at.locator.shading_normal * side.sign(),
             coord: at.locator.coord,
             leaf: FaceElement::new(leaf, side),
         };
-        crate::link_sum::link_sum(
+        link_sum(
             self.solution,
             &self.links,
             &receiver,
@@ -282,11 +216,11 @@ impl<const N: usize, S: RadianceSolution<N>> GatherScene<N> for SolvedScene<'_, 
         !self.geom().occluded(from.point, to)
     }
 
-    fn emitted(&self, at: &SurfacePoint<HitLocator>, wo: DVec3) -> [f64; N] {
+    fn emitted(&self, at: &SurfacePoint<HitLocator>, wo: DVec3) -> Spectrum<N> {
         if at.normal.dot(wo) > 0.0 {
-            self.scene.emission()[at.locator.shape as usize].0
+            self.scene.emission()[at.locator.shape as usize]
         } else {
-            [0.0; N]
+            Spectrum::zero()
         }
     }
 
@@ -311,7 +245,7 @@ impl<const N: usize, S: RadianceSolution<N>> GatherScene<N> for SolvedScene<'_, 
         Some(LightSample {
             point: s.point,
             normal: s.normal,
-            radiance: if front { le.0 } else { [0.0; N] },
+            radiance: if front { le } else { Spectrum::zero() },
             pdf_area: self.light_density[surface.index()],
         })
     }
@@ -320,10 +254,10 @@ impl<const N: usize, S: RadianceSolution<N>> GatherScene<N> for SolvedScene<'_, 
         self.light_density[at.locator.surface.index()]
     }
 
-    fn bsdf_cos(&self, at: &SurfacePoint<HitLocator>, wi: DVec3, wo: DVec3) -> [f64; N] {
+    fn bsdf_cos(&self, at: &SurfacePoint<HitLocator>, wi: DVec3, wo: DVec3) -> Spectrum<N> {
         let frame = Frame::from_normal(at.locator.shading_normal);
         let (wi, wo) = (frame.to_local(wi), frame.to_local(wo));
-        (self.bsdf(at).eval(wi, wo) * wi.z.abs()).0
+        self.bsdf(at).eval(wi, wo) * wi.z.abs()
     }
 
     fn sample_bsdf(
@@ -342,7 +276,7 @@ impl<const N: usize, S: RadianceSolution<N>> GatherScene<N> for SolvedScene<'_, 
         }
         Some(BsdfSample {
             wi,
-            weight: s.weight.0,
+            weight: s.weight,
             pdf: s.pdf,
         })
     }
@@ -356,20 +290,22 @@ impl<const N: usize, S: RadianceSolution<N>> GatherScene<N> for SolvedScene<'_, 
         &self,
         from: &SurfacePoint<HitLocator>,
         towards: &SurfacePoint<HitLocator>,
-    ) -> [f64; N] {
+    ) -> Spectrum<N> {
         let (from, towards) = Self::sites(from, towards);
-        self.solution.reflected(&from, &towards).0
-    }
-
-    fn element_size(&self, at: &SurfacePoint<HitLocator>) -> f64 {
-        let forest = self.solution.forest();
-        let e = forest.locate(at.locator.surface, at.locator.coord);
-        forest.element(e).area.sqrt()
+        self.solution.reflected(&from, &towards)
     }
 
     fn lobe_solid_angle(&self, at: &SurfacePoint<HitLocator>, wo: DVec3) -> f64 {
         let back = usize::from(at.normal.dot(wo) < 0.0);
         self.lobe_sr[at.locator.shape as usize][back]
+    }
+}
+
+impl<const N: usize, S: RadianceSolution<N>> SolutionGather<N> for SolvedScene<'_, N, S> {
+    fn element_size(&self, at: &SurfacePoint<HitLocator>) -> f64 {
+        let forest = self.solution.forest();
+        let e = forest.locate(at.locator.surface, at.locator.coord);
+        forest.element(e).area.sqrt()
     }
 
     fn shading_differs(&self, at: &SurfacePoint<HitLocator>) -> bool {
@@ -377,8 +313,8 @@ impl<const N: usize, S: RadianceSolution<N>> GatherScene<N> for SolvedScene<'_, 
         at.locator.shading_normal.dot(at.normal).abs() < 0.9998
     }
 
-    fn diffuse_albedo(&self, at: &SurfacePoint<HitLocator>, wo: DVec3) -> [f64; N] {
-        self.bsdf(at).diffuse_albedo(viewer_side(at, wo)).0
+    fn diffuse_albedo(&self, at: &SurfacePoint<HitLocator>, wo: DVec3) -> Spectrum<N> {
+        self.bsdf(at).diffuse_albedo(viewer_side(at, wo))
     }
 
     fn solution_irradiance(
@@ -386,9 +322,9 @@ impl<const N: usize, S: RadianceSolution<N>> GatherScene<N> for SolvedScene<'_, 
         at: &SurfacePoint<HitLocator>,
         wo: DVec3,
         visibility: LinkVisibility<'_>,
-        cache: &mut crate::link_sum::LinkCache<N>,
+        cache: &mut LinkCache<N>,
         stats: &mut GatherStats,
-    ) -> Option<[f64; N]> {
+    ) -> Option<Spectrum<N>> {
         if !self.solution.has_links() {
             return None;
         }
@@ -397,7 +333,7 @@ impl<const N: usize, S: RadianceSolution<N>> GatherScene<N> for SolvedScene<'_, 
             .solution
             .forest()
             .locate(at.locator.surface, at.locator.coord);
-        Some(self.link_sum_at(at, side, leaf, visibility, cache, stats).0)
+        Some(self.link_sum_at(at, side, leaf, visibility, cache, stats))
     }
 
     fn near_correction(
@@ -405,9 +341,9 @@ impl<const N: usize, S: RadianceSolution<N>> GatherScene<N> for SolvedScene<'_, 
         at: &SurfacePoint<HitLocator>,
         wo: DVec3,
         coarse_near: &[FaceElement],
-        cache: &mut crate::link_sum::LinkCache<N>,
+        cache: &mut LinkCache<N>,
         stats: &mut GatherStats,
-    ) -> Option<[f64; N]> {
+    ) -> Option<Spectrum<N>> {
         let side = viewer_side(at, wo);
         let forest = self.solution.forest();
         let leaf = forest.locate(at.locator.surface, at.locator.coord);
@@ -427,26 +363,26 @@ impl<const N: usize, S: RadianceSolution<N>> GatherScene<N> for SolvedScene<'_, 
             Side::Back => Spectrum::zero(),
         };
         let average = self.solution.face_radiance(face, sender) - le;
-        Some((rho * sum - average).0)
+        Some(rho * sum - average)
     }
 
     fn is_glossy(&self, at: &SurfacePoint<HitLocator>, wo: DVec3) -> bool {
         self.bsdf(at).has_glossy(viewer_side(at, wo))
     }
 
-    fn glossy_cos(&self, at: &SurfacePoint<HitLocator>, wi: DVec3, wo: DVec3) -> [f64; N] {
+    fn glossy_cos(&self, at: &SurfacePoint<HitLocator>, wi: DVec3, wo: DVec3) -> Spectrum<N> {
         let frame = Frame::from_normal(at.locator.shading_normal);
         let (wi, wo) = (frame.to_local(wi), frame.to_local(wo));
-        (self.bsdf(at).eval_glossy(wi, wo) * wi.z.abs()).0
+        self.bsdf(at).eval_glossy(wi, wo) * wi.z.abs()
     }
 
     fn reflected_glossy(
         &self,
         from: &SurfacePoint<HitLocator>,
         towards: &SurfacePoint<HitLocator>,
-    ) -> [f64; N] {
+    ) -> Spectrum<N> {
         let (from, towards) = Self::sites(from, towards);
-        self.solution.reflected_glossy(&from, &towards).0
+        self.solution.reflected_glossy(&from, &towards)
     }
 
     fn sample_cosine(&self, at: &SurfacePoint<HitLocator>, wo: DVec3, u: DVec2) -> Option<DVec3> {
@@ -464,7 +400,7 @@ impl<const N: usize, S: RadianceSolution<N>> GatherScene<N> for SolvedScene<'_, 
         self.solution.has_links()
     }
 
-    fn mirror(&self, at: &SurfacePoint<HitLocator>, wo: DVec3) -> Option<(DVec3, [f64; N])> {
+    fn mirror(&self, at: &SurfacePoint<HitLocator>, wo: DVec3) -> Option<(DVec3, Spectrum<N>)> {
         let n = at.locator.shading_normal;
         let wi = 2.0 * n.dot(wo) * n - wo;
         if wi.dot(at.normal) * wo.dot(at.normal) <= 0.0 {
@@ -481,41 +417,14 @@ impl<const N: usize, S: RadianceSolution<N>> GatherScene<N> for SolvedScene<'_, 
             .sum::<Spectrum<N>>()
             * (1.0 / f64::from(MIRROR_ALBEDO_POINTS));
         let glossy = albedo - bsdf.diffuse_albedo(viewer_side(at, wo));
-        Some((wi, glossy.max(Spectrum::zero()).0))
+        Some((wi, glossy.max(Spectrum::zero())))
     }
 }
 
-/// BSDF samples of the preview's albedo estimate ([`GatherScene::mirror`]).
+/// BSDF samples of the preview's albedo estimate ([`SolutionGather::mirror`]).
 const MIRROR_ALBEDO_POINTS: u32 = 16;
 
 /// The side of `at`'s surface the viewer direction `wo` is on (geometric).
 fn viewer_side(at: &SurfacePoint<HitLocator>, wo: DVec3) -> Side {
     Side::from_back(at.normal.dot(wo) < 0.0)
-}
-
-/// The solver's solution answers the renderer's queries directly.
-impl<const N: usize> RadianceSolution<N> for trilux_solver::Solution<N> {
-    fn scene(&self) -> &PreparedScene<N> {
-        trilux_solver::Solution::scene(self)
-    }
-    fn forest(&self) -> &ElementForest {
-        trilux_solver::Solution::forest(self)
-    }
-    fn reflected(&self, from: &SurfaceSite, to: &SurfaceSite) -> Spectrum<N> {
-        self.radiance(from, to)
-    }
-    fn has_links(&self) -> bool {
-        !self.all_gather_links().is_empty()
-    }
-    fn for_each_link(&self, e: FaceElement, f: &mut dyn FnMut(&GatherLink, Spectrum<N>)) {
-        for (link, l) in self.gather_links(e) {
-            f(link, l);
-        }
-    }
-    fn face_radiance(&self, face: FaceId, e: ElementId) -> Spectrum<N> {
-        trilux_solver::Solution::face_radiance(self, face, e)
-    }
-    fn reflected_glossy(&self, from: &SurfaceSite, to: &SurfaceSite) -> Spectrum<N> {
-        self.stored_radiance(from, to)
-    }
 }

@@ -27,7 +27,7 @@ fn camera_matches_mitsuba() {
             "cam" => {
                 // cam i fov F axis A w W h H origin x y z target x y z up x y z
                 let fov: f64 = w[3].parse().unwrap();
-                let axis = FovAxis::parse(w[5]).unwrap();
+                let axis = FovAxis::from_name(w[5]).unwrap();
                 let (width, height): (u32, u32) = (w[7].parse().unwrap(), w[9].parse().unwrap());
                 let o = nums(&w[11..14]);
                 let t = nums(&w[15..18]);

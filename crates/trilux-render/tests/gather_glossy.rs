@@ -10,11 +10,14 @@
 
 use glam::{DVec2, DVec3};
 use trilux_brdf::{Bsdf, BsdfParams, Distribution, RoughConductorParams};
-use trilux_color::ColorParam;
+use trilux_color::{ColorParam, Spectrum};
+use trilux_geometry::FaceElement;
 use trilux_render::camera::look_at;
+use trilux_render::link_sum::LinkCache;
 use trilux_render::{
-    BsdfSample, Camera, Estimator, ExtraBounce, FovAxis, GatherScene, LightSample,
-    ReconstructionFilter, RenderSettings, SurfacePoint, render_image,
+    BsdfSample, Camera, Estimator, ExtraBounce, FovAxis, GatherScene, GatherStats, LightSample,
+    LinkVisibility, ReconstructionFilter, RenderSettings, SolutionGather, SurfacePoint,
+    render_image,
 };
 
 /// Floor z = 0 with a glossy BSDF (normal +z: world = local frame) under a
@@ -74,11 +77,11 @@ impl GatherScene<3> for GlossyFloor {
     fn unoccluded(&self, _: &SurfacePoint<u8>, _: DVec3) -> bool {
         true
     }
-    fn emitted(&self, at: &SurfacePoint<u8>, wo: DVec3) -> [f64; 3] {
+    fn emitted(&self, at: &SurfacePoint<u8>, wo: DVec3) -> Spectrum<3> {
         if at.locator == 1 && wo.z < 0.0 {
-            [self.le; 3]
+            Spectrum::splat(self.le)
         } else {
-            [0.0; 3]
+            Spectrum::zero()
         }
     }
     fn sample_light(&self, r: &SurfacePoint<u8>, _: f64, u: DVec2) -> Option<LightSample<3>> {
@@ -88,9 +91,9 @@ impl GatherScene<3> for GlossyFloor {
             self.h,
         );
         let radiance = if r.point.z < self.h {
-            [self.le; 3]
+            Spectrum::splat(self.le)
         } else {
-            [0.0; 3]
+            Spectrum::zero()
         };
         Some(LightSample {
             point: p,
@@ -106,11 +109,11 @@ impl GatherScene<3> for GlossyFloor {
             0.0
         }
     }
-    fn bsdf_cos(&self, at: &SurfacePoint<u8>, wi: DVec3, wo: DVec3) -> [f64; 3] {
+    fn bsdf_cos(&self, at: &SurfacePoint<u8>, wi: DVec3, wo: DVec3) -> Spectrum<3> {
         if at.locator != 0 {
-            return [0.0; 3];
+            return Spectrum::zero();
         }
-        (self.bsdf.eval(wi, wo) * wi.z.abs()).0
+        self.bsdf.eval(wi, wo) * wi.z.abs()
     }
     fn sample_bsdf(&self, at: &SurfacePoint<u8>, wo: DVec3, u: DVec2) -> Option<BsdfSample<3>> {
         if at.locator != 0 {
@@ -119,7 +122,7 @@ impl GatherScene<3> for GlossyFloor {
         let s = self.bsdf.sample(wo, u)?;
         Some(BsdfSample {
             wi: s.wi,
-            weight: s.weight.0,
+            weight: s.weight,
             pdf: s.pdf,
         })
     }
@@ -130,20 +133,67 @@ impl GatherScene<3> for GlossyFloor {
             0.0
         }
     }
-    fn reflected(&self, _: &SurfacePoint<u8>, _: &SurfacePoint<u8>) -> [f64; 3] {
-        [0.0; 3]
-    }
-    fn element_size(&self, _: &SurfacePoint<u8>) -> f64 {
-        0.1
+    fn reflected(&self, _: &SurfacePoint<u8>, _: &SurfacePoint<u8>) -> Spectrum<3> {
+        Spectrum::zero()
     }
     fn lobe_solid_angle(&self, _: &SurfacePoint<u8>, _: DVec3) -> f64 {
         0.1
     }
+}
+
+/// A glossy floor without solution links: the link gather and the
+/// preview read its glossy part and fall back to the path gather for the
+/// rest.
+impl SolutionGather<3> for GlossyFloor {
+    fn element_size(&self, _: &SurfacePoint<u8>) -> f64 {
+        0.1
+    }
+    fn shading_differs(&self, _: &SurfacePoint<u8>) -> bool {
+        false
+    }
+    fn has_links(&self) -> bool {
+        false
+    }
+    fn has_glossy_faces(&self) -> bool {
+        false
+    }
+    fn diffuse_albedo(&self, _: &SurfacePoint<u8>, _: DVec3) -> Spectrum<3> {
+        Spectrum::zero()
+    }
+    fn solution_irradiance(
+        &self,
+        _: &SurfacePoint<u8>,
+        _: DVec3,
+        _: LinkVisibility<'_>,
+        _: &mut LinkCache<3>,
+        _: &mut GatherStats,
+    ) -> Option<Spectrum<3>> {
+        None
+    }
+    fn near_correction(
+        &self,
+        _: &SurfacePoint<u8>,
+        _: DVec3,
+        _: &[FaceElement],
+        _: &mut LinkCache<3>,
+        _: &mut GatherStats,
+    ) -> Option<Spectrum<3>> {
+        None
+    }
     fn is_glossy(&self, at: &SurfacePoint<u8>, _: DVec3) -> bool {
         at.locator == 0
     }
-    fn glossy_cos(&self, at: &SurfacePoint<u8>, wi: DVec3, wo: DVec3) -> [f64; 3] {
+    fn glossy_cos(&self, at: &SurfacePoint<u8>, wi: DVec3, wo: DVec3) -> Spectrum<3> {
         self.bsdf_cos(at, wi, wo)
+    }
+    fn reflected_glossy(&self, _: &SurfacePoint<u8>, _: &SurfacePoint<u8>) -> Spectrum<3> {
+        Spectrum::zero()
+    }
+    fn sample_cosine(&self, _: &SurfacePoint<u8>, _: DVec3, _: DVec2) -> Option<DVec3> {
+        None
+    }
+    fn mirror(&self, _: &SurfacePoint<u8>, _: DVec3) -> Option<(DVec3, Spectrum<3>)> {
+        None
     }
 }
 
@@ -176,7 +226,7 @@ fn preview_glossy_direct_light_matches_brute_force() {
             estimator: Estimator::Preview,
             ..Default::default()
         };
-        let (img, _) = render_image::<_, 3>(&scene, &cam, &settings, |l| *l, |_, _| {}).unwrap();
+        let (img, _) = render_image::<_, 3>(&scene, &cam, &settings, |l| l.0, |_, _| {}).unwrap();
         let expected = scene.brute_force(target, (eye - target).normalize());
         let got = img.get(0, 0)[0] as f64;
         assert!(
@@ -214,7 +264,7 @@ fn glossy_direct_light_matches_brute_force() {
             extra_bounce: ExtraBounce::Never,
             ..Default::default()
         };
-        let (img, _) = render_image::<_, 3>(&scene, &cam, &settings, |l| *l, |_, _| {}).unwrap();
+        let (img, _) = render_image::<_, 3>(&scene, &cam, &settings, |l| l.0, |_, _| {}).unwrap();
         let expected = scene.brute_force(target, (eye - target).normalize());
         let got = img.get(1, 1)[0] as f64;
         assert!(

@@ -2,14 +2,15 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 use glam::DVec3;
+use trilux_color::Spectrum;
 use trilux_render::analytic::{Furnace, LitFloor};
 use trilux_render::camera::look_at;
 use trilux_render::{
     Camera, ExtraBounce, FovAxis, Image, ReconstructionFilter, RenderSettings, render_image,
 };
 
-fn rgb3(l: &[f64; 3]) -> [f64; 3] {
-    *l
+fn rgb3(l: &Spectrum<3>) -> [f64; 3] {
+    l.0
 }
 
 fn furnace_camera(w: u32, h: u32) -> Camera {
@@ -61,7 +62,7 @@ fn gather_of_a_constant_solution_is_exact() {
 
 #[test]
 fn furnace_renders_two_at_64_spp() {
-    // Issue 5: emission 1, albedo 0.5, solution (reflected) 1 → L = 2.
+    // The furnace: emission 1, albedo 0.5, solution (reflected) 1 → L = 2.
     // Mean within 0.5 %, 99 % of pixels within 2 %, for every extra-bounce
     // rule (the extra bounce changes the estimator, not its expectation).
     for extra in [
@@ -246,11 +247,11 @@ fn non_finite_samples_are_counted_and_left_out() {
         ..Default::default()
     };
     let k = AtomicU64::new(0);
-    let poison = |l: &[f64; 3]| {
+    let poison = |l: &Spectrum<3>| {
         if k.fetch_add(1, Ordering::Relaxed).is_multiple_of(7) {
             [f64::NAN; 3]
         } else {
-            *l
+            l.0
         }
     };
     let (img, stats) = render_image::<_, 3>(

@@ -11,48 +11,7 @@ use glam::{DMat4, DVec3};
 use serde::Serialize;
 
 use crate::error::SourceLocation;
-pub use crate::rfilter::ReconstructionFilter;
-
-/// The image axis along which `fov` is measured.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "lowercase")]
-pub enum FovAxis {
-    /// The horizontal axis (Mitsuba's default).
-    X,
-    /// The vertical axis.
-    Y,
-    /// Whichever of x and y is shorter.
-    Smaller,
-    /// Whichever of x and y is longer.
-    Larger,
-    /// The image diagonal.
-    Diagonal,
-}
-
-impl FovAxis {
-    /// The name used in scene files.
-    pub fn name(self) -> &'static str {
-        match self {
-            FovAxis::X => "x",
-            FovAxis::Y => "y",
-            FovAxis::Smaller => "smaller",
-            FovAxis::Larger => "larger",
-            FovAxis::Diagonal => "diagonal",
-        }
-    }
-
-    /// Parses a scene-file name.
-    pub fn from_name(name: &str) -> Option<Self> {
-        Some(match name {
-            "x" => FovAxis::X,
-            "y" => FovAxis::Y,
-            "smaller" => FovAxis::Smaller,
-            "larger" => FovAxis::Larger,
-            "diagonal" => FovAxis::Diagonal,
-            _ => return None,
-        })
-    }
-}
+pub use trilux_geometry::sensor::{FovAxis, ReconstructionFilter};
 
 /// A crop window of the film, in pixels.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]

@@ -51,7 +51,9 @@ pub mod obj;
 pub mod ply;
 mod props;
 mod resolve;
-pub mod rfilter;
+/// The film's reconstruction filters (defined beside the rest of the
+/// sensor's plain data in `trilux_geometry::sensor`).
+pub use trilux_geometry::sensor::rfilter;
 pub mod scene;
 pub mod shape;
 mod text;

@@ -177,29 +177,16 @@ fn parse_lookat(op: &Element) -> Result<LookAt> {
     Ok(LookAt { origin, target, up })
 }
 
-/// Mitsuba's `look_at` matrix: columns (left, up', dir, origin), so the camera
-/// looks down its +z axis with +x to the left and +y up.
+/// Mitsuba's `look_at` matrix ([`trilux_geometry::look_at`], the one the
+/// command line's `--lookat` uses too), refused at `loc` when up is
+/// parallel to the viewing direction.
 pub(crate) fn world_from_camera(l: &LookAt, loc: &SourceLocation) -> Result<DMat4> {
-    let dir = (l.target - l.origin).normalize();
-    // Only up's direction matters: scaled to at most 1, a huge up does not
-    // overflow the cross product.
-    let scale = l.up.abs().max_element();
-    let up = if scale > 1.0 { l.up / scale } else { l.up };
-    let left = up.cross(dir);
-    if left.length_squared() <= 1e-20 || !left.is_finite() {
-        return Err(SceneError::at(
+    trilux_geometry::look_at(l.origin, l.target, l.up).map_err(|_| {
+        SceneError::at(
             loc,
             "<lookat> up is parallel to the viewing direction (or zero)",
-        ));
-    }
-    let left = left.normalize();
-    let new_up = dir.cross(left);
-    Ok(DMat4::from_cols(
-        left.extend(0.0),
-        new_up.extend(0.0),
-        dir.extend(0.0),
-        DVec4::new(l.origin.x, l.origin.y, l.origin.z, 1.0),
-    ))
+        )
+    })
 }
 
 /// Duff et al.'s branchless orthonormal basis around the unit vector `n`, as

@@ -5,13 +5,11 @@
 
 use std::path::PathBuf;
 
+use crate::options::{Product, SolveOptions, parse_exposure, parse_threads};
+use crate::output::{Outputs, bake_stats_json};
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use trilux_bake::BakeOptions;
-use trilux_render::Plan;
-
-use crate::options::{SolveOptions, parse_exposure, parse_threads};
-use crate::output::{Outputs, bake_stats_json};
 
 /// Arguments of `trilux bake`.
 #[derive(Debug, Args)]
@@ -73,18 +71,13 @@ pub fn run(args: &BakeArgs) -> Result<()> {
     inputs.extend(args.solution.as_deref());
     let outputs = Outputs::plan(&outputs, &inputs, None)?;
     let pending = trilux_scene::open_with_params(&args.scene, &args.params.define)?;
-    let plan = Plan {
-        mode: args.options.mode(pending.scene()),
-        solver: args.options.settings(),
-        source: crate::options::source(args.solution.as_deref()),
-        save: None,
-        solution_file: false,
-        bake: Some(BakeOptions {
-            exposure: args.exposure,
-            albedo_maps: !args.no_albedo_maps,
-        }),
-        render: None,
-    };
+    let bake = Product::Bake(BakeOptions {
+        exposure: args.exposure,
+        albedo_maps: !args.no_albedo_maps,
+    });
+    let plan = args
+        .options
+        .plan(pending.scene(), args.solution.as_deref(), bake);
     let mut outcome = crate::progress::run_plan(pending, &plan)?;
     let baked = outcome.baked.take().context("the bake produced no file")?;
     let mut files = vec![baked.glb.clone()];

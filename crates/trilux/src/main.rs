@@ -4,7 +4,7 @@
 //! 1; command-line usage errors (unknown options, malformed values) keep
 //! clap's message and exit with status 2, before any file is read.
 //! Subcommands live one per module; the work itself is
-//! `trilux_render::pipeline`'s. Every output is planned before any work and
+//! the library's (`trilux::pipeline`). Every output is planned before any work and
 //! written all or none at the end (`output`); the scene's meshes are read
 //! only once the camera and options are checked (`trilux_scene::open`). Number-list options whose values may begin
 //! with '-' (`--lookat -0.5,1,2,...`) need `#[arg(allow_hyphen_values =
@@ -76,7 +76,7 @@ pub fn set_threads(threads: Option<u32>) {
 
 /// Prints the warnings of a finished command: the solve's (caps reached,
 /// clamped reflectances) and the render's samples left out.
-pub fn warn(outcome: &trilux_render::Outcome) {
+pub fn warn(outcome: &trilux::Outcome) {
     for w in &outcome.solve.warnings {
         eprintln!("warning: {w}");
     }

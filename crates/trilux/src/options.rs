@@ -4,6 +4,7 @@
 
 use clap::{Args, ValueEnum};
 use glam::DVec3;
+use trilux::pipeline::{Plan, RenderPlan, SolutionSource};
 use trilux_color::Mode;
 use trilux_solver::{Quality, SolverSettings};
 
@@ -89,6 +90,43 @@ impl SolveOptions {
             None => scene.mode(),
         }
     }
+
+    /// The plan of a command (`solve`, `render`, `bake`): these options'
+    /// mode and solver settings, the saved `solution` to load (else a
+    /// solve), and what the command makes of the solution.
+    pub fn plan<'p>(
+        &self,
+        scene: &trilux_scene::Scene,
+        solution: Option<&'p std::path::Path>,
+        product: Product,
+    ) -> Plan<'p> {
+        let mut plan = Plan {
+            mode: self.mode(scene),
+            solver: self.settings(),
+            source: source(solution),
+            save: None,
+            solution_file: false,
+            bake: None,
+            render: None,
+        };
+        match product {
+            Product::SolutionFile => plan.solution_file = true,
+            Product::Render(r) => plan.render = Some(r),
+            Product::Bake(b) => plan.bake = Some(b),
+        }
+        plan
+    }
+}
+
+/// What a command makes of its solution.
+#[derive(Debug)]
+pub enum Product {
+    /// The solution file's bytes (`trilux solve`).
+    SolutionFile,
+    /// A rendered view (`trilux render`).
+    Render(RenderPlan),
+    /// A glTF bake (`trilux bake`).
+    Bake(trilux_bake::BakeOptions),
 }
 
 /// A finite number for which `ok` holds, `range` naming the values
@@ -186,9 +224,9 @@ pub fn parse_lookat(text: &str) -> Result<LookAt, String> {
 
 /// Where a command's solution comes from: the saved one given by
 /// `--solution`, else a solve.
-pub fn source(solution: Option<&std::path::Path>) -> trilux_render::SolutionSource<'_> {
+fn source(solution: Option<&std::path::Path>) -> SolutionSource<'_> {
     match solution {
-        Some(path) => trilux_render::SolutionSource::Load(path),
-        None => trilux_render::SolutionSource::Solve,
+        Some(path) => SolutionSource::Load(path),
+        None => SolutionSource::Solve,
     }
 }

@@ -73,17 +73,17 @@ impl Bars {
 /// `pipeline::run`): what `solve`, `render` and `bake` share.
 pub fn run_plan(
     pending: trilux_scene::Pending,
-    plan: &trilux_render::Plan<'_>,
-) -> anyhow::Result<trilux_render::Outcome> {
-    trilux_render::pipeline::check(pending.scene(), plan)?;
+    plan: &trilux::Plan<'_>,
+) -> anyhow::Result<trilux::Outcome> {
+    trilux::pipeline::check(pending.scene(), plan)?;
     let scene = pending.finish()?;
     let bars = Bars::new(plan.render.is_some());
     let mut on_shot = |p: &Progress| bars.solve(p);
     let on_tile = |done: usize, total: usize| bars.render(done, total);
-    let outcome = trilux_render::pipeline::run(
+    let outcome = trilux::pipeline::run(
         &scene,
         plan,
-        trilux_render::Observer {
+        trilux::Observer {
             solve: &mut on_shot,
             render: &on_tile,
         },

@@ -5,11 +5,13 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
-use trilux_render::{Estimator, ExtraBounce, Plan, RenderPlan, RenderSettings, ViewOverrides};
+use trilux::pipeline::RenderPlan;
+use trilux::view::{ViewOverrides, render_settings};
+use trilux_render::{Estimator, ExtraBounce};
 
 use crate::options::{
-    LookAt, SolveOptions, parse_exposure, parse_film_edge, parse_fov, parse_lookat, parse_spp,
-    parse_target_error, parse_threads,
+    LookAt, Product, SolveOptions, parse_exposure, parse_film_edge, parse_fov, parse_lookat,
+    parse_spp, parse_target_error, parse_threads,
 };
 use crate::output::{Outputs, stats_json};
 
@@ -132,7 +134,7 @@ impl RenderArgs {
 
     /// Samples, seed, filter and extra-bounce rule of this render.
     fn render_plan(&self, camera: &trilux_scene::Camera) -> RenderPlan {
-        let mut settings = RenderSettings::for_scene(camera);
+        let mut settings = render_settings(camera);
         settings.spp = self
             .spp
             .unwrap_or(if self.preview { 1 } else { settings.spp });
@@ -177,15 +179,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             args.scene.display()
         )
     })?;
-    let plan = Plan {
-        mode: args.options.mode(pending.scene()),
-        solver: args.options.settings(),
-        source: crate::options::source(args.solution.as_deref()),
-        save: None,
-        solution_file: false,
-        bake: None,
-        render: Some(args.render_plan(camera)),
-    };
+    let render = Product::Render(args.render_plan(camera));
+    let plan = args
+        .options
+        .plan(pending.scene(), args.solution.as_deref(), render);
     let outcome = crate::progress::run_plan(pending, &plan)?;
     let image = outcome
         .image

@@ -3,12 +3,10 @@
 
 use std::path::PathBuf;
 
+use crate::options::{Product, SolveOptions, parse_threads};
+use crate::output::{Outputs, stats_json};
 use anyhow::{Context, Result};
 use clap::Args;
-use trilux_render::{Plan, SolutionSource};
-
-use crate::options::{SolveOptions, parse_threads};
-use crate::output::{Outputs, stats_json};
 
 /// Arguments of `trilux solve`.
 #[derive(Debug, Args)]
@@ -37,15 +35,9 @@ pub fn run(args: &SolveArgs) -> Result<()> {
     outputs.extend(args.stats.as_deref().map(|p| (p, "statistics")));
     let outputs = Outputs::plan(&outputs, &[args.scene.as_path()], None)?;
     let pending = trilux_scene::open_with_params(&args.scene, &args.params.define)?;
-    let plan = Plan {
-        mode: args.options.mode(pending.scene()),
-        solver: args.options.settings(),
-        source: SolutionSource::Solve,
-        save: None,
-        solution_file: true,
-        bake: None,
-        render: None,
-    };
+    let plan = args
+        .options
+        .plan(pending.scene(), None, Product::SolutionFile);
     let mut outcome = crate::progress::run_plan(pending, &plan)?;
     let solution = outcome
         .solution_file

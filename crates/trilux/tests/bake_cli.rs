@@ -381,7 +381,7 @@ impl WithBands for Verify<'_> {
     type Output = f64;
 
     fn run<const N: usize>(self) -> f64 {
-        let prepared = trilux_render::prepare::<N>(self.scene).unwrap();
+        let prepared = trilux::prepare::<N>(self.scene).unwrap();
         let settings = SolverSettings::preset(Quality::Draft);
         let solution = Solution::<N>::load(self.sol, prepared, &settings).unwrap();
         let largest = self

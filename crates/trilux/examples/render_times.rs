@@ -3,12 +3,13 @@
 //! timed: the view-independent solve is shared by every view). Prints a
 //! Markdown table for docs/results.md.
 //!
-//! Run: `cargo run --release -p trilux-render --example render_times [-- SCENE.xml ...]`
+//! Run: `cargo run --release -p trilux --example render_times [-- SCENE.xml ...]`
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 use std::path::PathBuf;
 
-use trilux_render::{Observer, Plan, RenderPlan, RenderSettings, SolutionSource, ViewOverrides};
+use trilux::{Observer, Plan, RenderPlan, SolutionSource, ViewOverrides};
+use trilux_render::RenderSettings;
 use trilux_solver::{Quality, SolverSettings};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -36,7 +37,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             bake: None,
             render: None,
         };
-        let solved = Observer::quiet(|o| trilux_render::pipeline::run(&scene, &plan, o))?;
+        let solved = Observer::quiet(|o| trilux::pipeline::run(&scene, &plan, o))?;
         plan.source = SolutionSource::Load(&file);
         plan.save = None;
         let mut times = Vec::new();
@@ -49,10 +50,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 },
                 settings: RenderSettings {
                     spp,
-                    ..RenderSettings::for_scene(camera)
+                    ..trilux::render_settings(camera)
                 },
             });
-            let r = Observer::quiet(|o| trilux_render::pipeline::run(&scene, &plan, o))?;
+            let r = Observer::quiet(|o| trilux::pipeline::run(&scene, &plan, o))?;
             times.push(r.render_seconds);
         }
         let name = p

@@ -3,11 +3,8 @@
 //! `--lookat`, `--fov`, `--width`, `--height`).
 
 use glam::{DVec2, DVec3};
-
-use crate::camera::{Camera, FovAxis, look_at};
-use crate::driver::RenderSettings;
-use crate::error::RenderError;
-use crate::filter::ReconstructionFilter;
+use trilux_geometry::look_at;
+use trilux_render::{Camera, ReconstructionFilter, RenderError, RenderSettings};
 
 /// Changes to the scene's camera asked for on the command line.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -22,43 +19,37 @@ pub struct ViewOverrides {
     pub height: Option<u32>,
 }
 
-fn axis(a: trilux_scene::camera::FovAxis) -> FovAxis {
-    use trilux_scene::camera::FovAxis as S;
-    match a {
-        S::X => FovAxis::X,
-        S::Y => FovAxis::Y,
-        S::Smaller => FovAxis::Smaller,
-        S::Larger => FovAxis::Larger,
-        S::Diagonal => FovAxis::Diagonal,
-    }
-}
-
 /// The film filter a scene asks for.
 pub fn filter_of(c: &trilux_scene::Camera) -> ReconstructionFilter {
     c.rfilter
 }
 
-impl RenderSettings {
-    /// The scene's own sample count and film filter, other settings default.
-    pub fn for_scene(camera: &trilux_scene::Camera) -> Self {
-        Self {
-            spp: camera.sample_count.max(1),
-            filter: filter_of(camera),
-            ..Self::default()
-        }
+/// The scene's own sample count and film filter, other settings default.
+pub fn render_settings(camera: &trilux_scene::Camera) -> RenderSettings {
+    RenderSettings {
+        spp: camera.sample_count.max(1),
+        filter: filter_of(camera),
+        ..RenderSettings::default()
     }
 }
 
 /// The camera of the scene's sensor, with overrides applied.
 pub fn camera_of(c: &trilux_scene::Camera, o: &ViewOverrides) -> Result<Camera, RenderError> {
     let world_from_camera = match o.lookat {
-        Some((origin, target, up)) => look_at(origin, target, up.unwrap_or(c.up))?,
+        Some((origin, target, up)) => {
+            let up = up.unwrap_or(c.up);
+            look_at(origin, target, up).map_err(|_| {
+                RenderError::Camera(format!(
+                    "lookat origin {origin}, target {target}, up {up} is degenerate"
+                ))
+            })?
+        }
         None => c.world_from_camera,
     };
     let camera = Camera::new(
         world_from_camera,
         o.fov.unwrap_or(c.fov),
-        axis(c.fov_axis),
+        c.fov_axis,
         o.width.unwrap_or(c.width),
         o.height.unwrap_or(c.height),
     )?

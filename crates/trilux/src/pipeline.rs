@@ -18,10 +18,9 @@ use trilux_solver::{
     SolverError, SolverSettings,
 };
 
-use crate::camera::Camera;
-use crate::driver::{RenderSettings, RenderStats, render};
-use crate::error::RenderError;
-use crate::image::Image;
+use trilux_render::{Camera, Image, RenderError, RenderSettings, RenderStats, render};
+
+use crate::error::PipelineError;
 use crate::view::{ViewOverrides, camera_of};
 
 /// Where the solution comes from.
@@ -107,21 +106,24 @@ impl Observer<'_> {
 /// The scene's camera with `view`'s overrides (an error when the scene has
 /// no sensor or the view is invalid; at the `<sensor>` when the scene's own
 /// values are at fault).
-pub fn scene_camera(scene: &Scene, view: &ViewOverrides) -> Result<Camera, RenderError> {
-    let cam = scene.camera.as_ref().ok_or_else(|| RenderError::NoCamera {
-        path: scene.path.clone(),
-    })?;
+pub fn scene_camera(scene: &Scene, view: &ViewOverrides) -> Result<Camera, PipelineError> {
+    let cam = scene
+        .camera
+        .as_ref()
+        .ok_or_else(|| PipelineError::NoCamera {
+            path: scene.path.clone(),
+        })?;
     camera_of(cam, view).map_err(|e| match e {
         RenderError::Camera(m) if *view == ViewOverrides::default() => {
             SceneError::at(&cam.location, m).into()
         }
-        e => e,
+        e => e.into(),
     })
 }
 
 /// The scene prepared for `N` bands; errors point at the shape (or its
 /// emitter) in the file.
-pub fn prepare<const N: usize>(scene: &Scene) -> Result<Arc<PreparedScene<N>>, RenderError> {
+pub fn prepare<const N: usize>(scene: &Scene) -> Result<Arc<PreparedScene<N>>, PipelineError> {
     let (shapes, bsdfs, emission) = (
         scene.geometry_shapes(),
         scene.bsdf_params(),
@@ -157,7 +159,7 @@ fn located(scene: &Scene, e: &PrepareError) -> SceneError {
 pub fn check(
     scene: &Scene,
     plan: &Plan<'_>,
-) -> Result<Option<(Camera, RenderSettings)>, RenderError> {
+) -> Result<Option<(Camera, RenderSettings)>, PipelineError> {
     let view = match &plan.render {
         Some(r) => {
             r.settings.validate()?;
@@ -172,7 +174,7 @@ pub fn check(
 }
 
 /// A solver error at its place in the scene file, when it names a shape.
-fn located_solver(scene: &Scene, e: SolverError) -> RenderError {
+fn located_solver(scene: &Scene, e: SolverError) -> PipelineError {
     match e {
         SolverError::NoFiniteSolution { shape, band, bands } => {
             let location = scene.shapes.get(shape).map_or_else(
@@ -195,7 +197,11 @@ fn located_solver(scene: &Scene, e: SolverError) -> RenderError {
 }
 
 /// Carries out `plan` on `scene` (module docs).
-pub fn run(scene: &Scene, plan: &Plan<'_>, observer: Observer<'_>) -> Result<Outcome, RenderError> {
+pub fn run(
+    scene: &Scene,
+    plan: &Plan<'_>,
+    observer: Observer<'_>,
+) -> Result<Outcome, PipelineError> {
     let view = check(scene, plan)?;
     plan.mode.with_bands(Run {
         scene,
@@ -214,7 +220,7 @@ struct Run<'a, 'o> {
 }
 
 impl WithBands for Run<'_, '_> {
-    type Output = Result<Outcome, RenderError>;
+    type Output = Result<Outcome, PipelineError>;
 
     fn run<const N: usize>(self) -> Self::Output {
         let start = Instant::now();
@@ -222,7 +228,7 @@ impl WithBands for Run<'_, '_> {
         if let Some((camera, _)) = &self.view {
             let located = |e| match (e, &self.scene.camera) {
                 (RenderError::Camera(m), Some(c)) => SceneError::at(&c.location, m).into(),
-                (e, _) => e,
+                (e, _) => PipelineError::from(e),
             };
             camera
                 .check_far_clip(&prepared.geometry().bounds())
@@ -280,7 +286,7 @@ fn bake<const N: usize>(
     scene: &Scene,
     solution: &Solution<N>,
     options: &trilux_bake::BakeOptions,
-) -> Result<trilux_bake::Baked, RenderError> {
+) -> Result<trilux_bake::Baked, PipelineError> {
     let camera = scene_camera(scene, &ViewOverrides::default())
         .ok()
         .map(|c| trilux_bake::BakeCamera {

@@ -1,6 +1,6 @@
-//! Reconstruction filters (`<rfilter>`), exactly as Mitsuba 3's `hdrfilm`
-//! applies them: the parameters a scene gives and the weights the film
-//! (trilux-render) splats with.
+//! Reconstruction filters (a scene's `<rfilter>`), exactly as Mitsuba 3's
+//! `hdrfilm` applies them: the parameters a scene gives (trilux-scene) and
+//! the weights the film (trilux-render) splats with.
 //!
 //! A sample at film position p (pixels) contributes to every pixel whose
 //! centre c lies within the filter's radius on both axes, with the separable

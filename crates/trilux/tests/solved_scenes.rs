@@ -4,8 +4,9 @@
 
 use std::path::PathBuf;
 
+use trilux::{ViewOverrides, prepare, scene_camera};
 use trilux_color::Spectrum;
-use trilux_render::{DirectOnly, RenderSettings, ViewOverrides, prepare, render, scene_camera};
+use trilux_render::{DirectOnly, RenderSettings, render};
 
 fn scene(name: &str) -> trilux_scene::Scene {
     let p = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -25,13 +26,13 @@ fn small(w: u32) -> ViewOverrides {
 #[test]
 fn furnace_file_renders_two_with_a_solution_that_knows_the_answer() {
     // scenes/furnace.xml: Le = 1, ρ = 0.5. A stand-in solution answering the
-    // exact reflected radiance 1 everywhere: image 2.0 (issue 5's furnace
+    // exact reflected radiance 1 everywhere: image 2.0 (the furnace
     // criterion: mean within 0.5 %, 99 % of pixels within 2 %, 64 spp).
     let s = scene("furnace.xml");
     let sol = DirectOnly::<3>::constant(prepare(&s).unwrap(), Spectrum::splat(1.0));
     let settings = RenderSettings {
         spp: 64,
-        ..RenderSettings::for_scene(s.camera.as_ref().unwrap())
+        ..trilux::render_settings(s.camera.as_ref().unwrap())
     };
     let camera = scene_camera(&s, &small(64)).unwrap();
     let (img, stats) = render(&sol, &camera, &settings, |_, _| {}).unwrap();
@@ -62,7 +63,7 @@ fn every_scene_renders_direct_light_without_nan_in_both_modes() {
         let s = scene(name);
         let settings = RenderSettings {
             spp: 4,
-            ..RenderSettings::for_scene(s.camera.as_ref().unwrap())
+            ..trilux::render_settings(s.camera.as_ref().unwrap())
         };
         let camera = scene_camera(&s, &small(24)).unwrap();
         let rgb = DirectOnly::<3>::new(prepare(&s).unwrap());

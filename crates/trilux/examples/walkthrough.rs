@@ -2,7 +2,7 @@
 //! renders a short walkthrough (the camera moves along a line and turns
 //! towards a fixed target) into `out/walkthrough-NN.png` and `.exr`.
 //!
-//! Run: `cargo run --release -p trilux-render --example walkthrough [-- SCENE.xml [FRAMES] [SIZE] [SPP]]`
+//! Run: `cargo run --release -p trilux --example walkthrough [-- SCENE.xml [FRAMES] [SIZE] [SPP]]`
 //! (default scenes/paper-scene1.xml, 6 frames, 128×128, 32 spp).
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
@@ -10,7 +10,8 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use glam::DVec3;
-use trilux_render::{Observer, Plan, RenderPlan, RenderSettings, SolutionSource, ViewOverrides};
+use trilux::{Observer, Plan, RenderPlan, SolutionSource, ViewOverrides};
+use trilux_render::RenderSettings;
 use trilux_solver::{Quality, SolverSettings};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -39,7 +40,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         render: None,
     };
     let t = Instant::now();
-    Observer::quiet(|o| trilux_render::pipeline::run(&scene, &plan, o))?;
+    Observer::quiet(|o| trilux::pipeline::run(&scene, &plan, o))?;
     println!("solved once in {:.2} s", t.elapsed().as_secs_f64());
     plan.source = SolutionSource::Load(&file);
     plan.save = None;
@@ -52,7 +53,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     std::fs::create_dir_all("out")?;
     let settings = RenderSettings {
         spp,
-        ..RenderSettings::for_scene(&camera)
+        ..trilux::render_settings(&camera)
     };
     for k in 0..frames {
         let s = if frames > 1 {
@@ -70,7 +71,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             },
             settings,
         });
-        let frame = Observer::quiet(|o| trilux_render::pipeline::run(&scene, &plan, o))?;
+        let frame = Observer::quiet(|o| trilux::pipeline::run(&scene, &plan, o))?;
         let image = frame.image.ok_or("the plan renders")?;
         image.write_png(Path::new(&format!("out/walkthrough-{k:02}.png")), 0.0)?;
         image.write_exr(Path::new(&format!("out/walkthrough-{k:02}.exr")))?;

@@ -2,16 +2,14 @@
 //! knows no indirect light), e.g. to compare with Mitsuba 3's path tracer at
 //! `max_depth` 2.
 //!
-//! Run: `cargo run --release -p trilux-render --example direct_light -- SCENE.xml OUT.exr [SIZE] [SPP] [rgb|spectral]`
+//! Run: `cargo run --release -p trilux --example direct_light -- SCENE.xml OUT.exr [SIZE] [SPP] [rgb|spectral]`
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 use std::path::Path;
 
+use trilux::{PipelineError, ViewOverrides, prepare, scene_camera};
 use trilux_color::{Mode, WithBands};
-use trilux_render::{
-    DirectOnly, ExtraBounce, Image, RenderError, RenderSettings, RenderStats, ViewOverrides,
-    prepare, render, scene_camera,
-};
+use trilux_render::{DirectOnly, ExtraBounce, Image, RenderSettings, RenderStats, render};
 
 /// The render, once the band count is known.
 struct Direct<'a> {
@@ -21,11 +19,11 @@ struct Direct<'a> {
 }
 
 impl WithBands for Direct<'_> {
-    type Output = Result<(Image, RenderStats), RenderError>;
+    type Output = Result<(Image, RenderStats), PipelineError>;
     fn run<const N: usize>(self) -> Self::Output {
         let camera = scene_camera(self.scene, &self.view)?;
         let solution = DirectOnly::<N>::new(prepare::<N>(self.scene)?);
-        render(&solution, &camera, &self.settings, |_, _| {})
+        Ok(render(&solution, &camera, &self.settings, |_, _| {})?)
     }
 }
 
@@ -42,7 +40,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     let scene = trilux_scene::load(scene)?;
     let camera = scene.camera.as_ref().ok_or("the scene has no camera")?;
-    let mut settings = RenderSettings::for_scene(camera);
+    let mut settings = trilux::render_settings(camera);
     settings.spp = spp.unwrap_or(settings.spp);
     settings.extra_bounce = ExtraBounce::Never;
     let view = ViewOverrides {

@@ -4,14 +4,15 @@
 //! the file, timing each step. The file stores radiance in f32, so the two
 //! images agree to f32 rounding (printed as a relative RMSE).
 //!
-//! Run: `cargo run --release -p trilux-render --example saved_solution [-- SCENE.xml [SIZE] [SPP]]`
+//! Run: `cargo run --release -p trilux --example saved_solution [-- SCENE.xml [SIZE] [SPP]]`
 //! (default scenes/cornell-box.xml in RGB mode, 128×128, 64 spp).
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 use std::path::PathBuf;
 
+use trilux::{Observer, Plan, RenderPlan, SolutionSource, ViewOverrides};
 use trilux_color::Mode;
-use trilux_render::{Observer, Plan, RenderPlan, RenderSettings, SolutionSource, ViewOverrides};
+use trilux_render::RenderSettings;
 use trilux_solver::{Quality, SolverSettings};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -32,7 +33,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         },
         settings: RenderSettings {
             spp,
-            ..RenderSettings::for_scene(&camera)
+            ..trilux::render_settings(&camera)
         },
     };
     let mut plan = Plan {
@@ -44,10 +45,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         bake: None,
         render: Some(render),
     };
-    let solved = Observer::quiet(|o| trilux_render::pipeline::run(&scene, &plan, o))?;
+    let solved = Observer::quiet(|o| trilux::pipeline::run(&scene, &plan, o))?;
     plan.source = SolutionSource::Load(&file);
     plan.save = None;
-    let loaded = Observer::quiet(|o| trilux_render::pipeline::run(&scene, &plan, o))?;
+    let loaded = Observer::quiet(|o| trilux::pipeline::run(&scene, &plan, o))?;
     let _ = std::fs::remove_file(&file);
     let (Some(a), Some(b)) = (&solved.image, &loaded.image) else {
         return Err("both plans render".into());

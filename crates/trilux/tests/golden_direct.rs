@@ -13,17 +13,15 @@
 //! Tolerances, at 256 spp: relative RMSE (emitter pixels masked) ≤ 4 % —
 //! the gather's own noise at 256 spp, measured at 0.6–2.5 % on these
 //! scenes (glossy highlights the most), plus the reference's; mean ratio
-//! within 1 % (issue 5's energy-bias bound). A wrong convention (camera
+//! within 1 % (the energy-bias bound). A wrong convention (camera
 //! axis, fov, filter, BRDF normalisation, a missing MIS weight) moves both
 //! far beyond.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 use std::path::PathBuf;
 
-use trilux_render::{
-    DirectOnly, ExtraBounce, Image, RenderSettings, ViewOverrides, compare, prepare, render,
-    scene_camera,
-};
+use trilux::{ViewOverrides, prepare, scene_camera};
+use trilux_render::{DirectOnly, ExtraBounce, Image, RenderSettings, compare, render};
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
@@ -47,7 +45,7 @@ fn direct_light_matches_mitsuba_max_depth_2() {
         let settings = RenderSettings {
             spp: 256,
             extra_bounce: ExtraBounce::Never,
-            ..RenderSettings::for_scene(scene.camera.as_ref().unwrap())
+            ..trilux::render_settings(scene.camera.as_ref().unwrap())
         };
         let view = ViewOverrides {
             width: Some(reference.width()),

@@ -20,10 +20,11 @@
 use std::f64::consts::PI;
 
 use glam::{DVec2, DVec3};
+use trilux::prepare;
 use trilux_geometry::{FaceElement, PointFormFactors, Side, SurfaceCoord, SurfaceId};
-use trilux_render::link_gather::LinkVisibility;
+use trilux_render::LinkVisibility;
 use trilux_render::link_sum::{LinkCache, LinkField, Receiver, link_sum};
-use trilux_render::{GatherStats, PixelSampler, prepare};
+use trilux_render::{GatherStats, PixelSampler};
 use trilux_solver::{Quality, Solution, Solver, SolverSettings};
 
 fn scene_xml(occluder: bool) -> String {

@@ -1,6 +1,6 @@
 //! Solves a scene file and renders it by final gathering.
 //!
-//! Run: `cargo run --release -p trilux-render --example render_scene -- SCENE.xml OUT.exr [SIZE] [SPP] [draft|default|high] [never|auto|always]`
+//! Run: `cargo run --release -p trilux --example render_scene -- SCENE.xml OUT.exr [SIZE] [SPP] [draft|default|high] [never|auto|always]`
 //!
 //! Prints the solve and render times and the image mean. Spectral scenes
 //! solve and render in their spectral bands. OUT ending in `.png` writes an
@@ -9,9 +9,8 @@
 
 use std::path::Path;
 
-use trilux_render::{
-    ExtraBounce, Observer, Plan, RenderPlan, RenderSettings, SolutionSource, ViewOverrides,
-};
+use trilux::{Observer, Plan, RenderPlan, SolutionSource, ViewOverrides};
+use trilux_render::ExtraBounce;
 use trilux_solver::{Quality, SolverSettings};
 
 fn print_stats(s: &trilux_solver::SolveStats) {
@@ -49,7 +48,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     let scene = trilux_scene::load(scene)?;
     let camera = scene.camera.as_ref().ok_or("the scene has no camera")?;
-    let mut settings = RenderSettings::for_scene(camera);
+    let mut settings = trilux::render_settings(camera);
     settings.spp = spp.unwrap_or(settings.spp);
     settings.extra_bounce = extra;
     // Single solver settings may be overridden for experiments
@@ -72,7 +71,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             settings,
         }),
     };
-    let outcome = Observer::quiet(|o| trilux_render::pipeline::run(&scene, &plan, o))?;
+    let outcome = Observer::quiet(|o| trilux::pipeline::run(&scene, &plan, o))?;
     print_stats(&outcome.solve);
     let (Some(image), Some(stats)) = (&outcome.image, &outcome.render) else {
         return Err("the plan renders an image".into());

@@ -2,14 +2,15 @@
 //! timing, then the final gather of its camera at 128×128, 16 spp (camera,
 //! shadow and gather rays through trilux-geometry: the renderer's ray cost).
 //!
-//! Run: `cargo bench -p trilux-render --bench render`
+//! Run: `cargo bench -p trilux --bench render`
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 use std::path::PathBuf;
 
 use criterion::{Criterion, criterion_group, criterion_main};
+use trilux::{ViewOverrides, prepare, scene_camera};
 use trilux_color::WithBands;
-use trilux_render::{RenderSettings, ViewOverrides, prepare, render, scene_camera};
+use trilux_render::{RenderSettings, render};
 use trilux_scene::Scene;
 use trilux_solver::{Quality, Solver, SolverSettings};
 
@@ -46,7 +47,7 @@ impl WithBands for Bench<'_, '_> {
         let camera = scene_camera(self.scene, &view).expect("camera");
         let settings = RenderSettings {
             spp: 16,
-            ..RenderSettings::for_scene(self.scene.camera.as_ref().expect("camera"))
+            ..trilux::render_settings(self.scene.camera.as_ref().expect("camera"))
         };
         let mut group = self.c.benchmark_group("render");
         group.sample_size(10);

@@ -1,4 +1,5 @@
-//! Issue 5's furnace criterion through the whole pipeline: scenes/furnace.xml
+//! The furnace criterion (mean within 0.5 %, 99 % of pixels within 2 %)
+//! through the whole pipeline: scenes/furnace.xml
 //! (a closed cube, every inner face emitting 1 and reflecting 0.5 diffusely)
 //! is solved by trilux-solver at the default quality (CR ≥ 0.99) and
 //! rendered by each estimator (the path gather and the link gather at 64
@@ -11,10 +12,9 @@
 
 use std::path::PathBuf;
 
+use trilux::{Observer, Plan, RenderPlan, SolutionSource, ViewOverrides};
 use trilux_render::driver::MIN_ADAPTIVE_SPP;
-use trilux_render::{
-    Estimator, Observer, Plan, RenderPlan, RenderSettings, SolutionSource, ViewOverrides,
-};
+use trilux_render::{Estimator, RenderSettings};
 use trilux_solver::{Quality, SolverSettings};
 
 #[test]
@@ -74,7 +74,7 @@ fn furnace(estimator: Estimator, spp: u32, target_error: Option<f64>) -> ([f64; 
         spp,
         estimator,
         target_error,
-        ..RenderSettings::for_scene(scene.camera.as_ref().unwrap())
+        ..trilux::render_settings(scene.camera.as_ref().unwrap())
     };
     let view = ViewOverrides {
         width: Some(64),
@@ -90,7 +90,7 @@ fn furnace(estimator: Estimator, spp: u32, target_error: Option<f64>) -> ([f64; 
         bake: None,
         render: Some(RenderPlan { view, settings }),
     };
-    let outcome = Observer::quiet(|o| trilux_render::pipeline::run(&scene, &plan, o)).unwrap();
+    let outcome = Observer::quiet(|o| trilux::pipeline::run(&scene, &plan, o)).unwrap();
     assert!(outcome.solve.convergence_ratio >= 0.99);
     let img = outcome.image.unwrap();
     let within = img

@@ -1,0 +1,105 @@
+//! The two halves of multiple importance sampling that both estimators
+//! (the path gather, `gather`, and the link gather's glossy part,
+//! `link_gather`) share, written once:
+//!
+//! - [`light_sample`]: a point sampled on an emitter with a shadow ray,
+//!   fr·cos·Le / p_light weighted by the power heuristic against the BSDF's
+//!   density (Veach 1997, §9.2);
+//! - [`hit_emission`]: the emission met by a BSDF-sampled ray, weighted by
+//!   the power heuristic against light sampling's density at the hit.
+
+use glam::{DVec2, DVec3};
+
+use crate::records::{GatherStats, SurfacePoint};
+use crate::scene::GatherScene;
+use trilux_color::Spectrum;
+
+/// The power heuristic (β = 2) weight of a strategy with density `a`
+/// against one with density `b`.
+pub fn power_heuristic(a: f64, b: f64) -> f64 {
+    let a2 = a * a;
+    let b2 = b * b;
+    if a2 + b2 > 0.0 && (a2 + b2).is_finite() {
+        a2 / (a2 + b2)
+    } else if a.is_infinite() {
+        1.0
+    } else {
+        0.0
+    }
+}
+
+/// One light sample at `x` for the viewer direction `wo`: the emitter
+/// `pick` and the point `u` on it, its radiance times `fr(ω_i)` (the
+/// BSDF's fr·|cos θ_i|, or a part of it) over the light's solid-angle
+/// density, weighted by the power heuristic against BSDF sampling when
+/// `mis`. Zero when the point is behind the emitter, at x, of zero density
+/// or black, or hidden; a value that is not a number (the emitter's
+/// cosine, the density) counts as zero.
+#[allow(clippy::too_many_arguments)]
+pub fn light_sample<S: GatherScene<N>, const N: usize>(
+    scene: &S,
+    x: &SurfacePoint<S::Locator>,
+    wo: DVec3,
+    pick: f64,
+    u: DVec2,
+    fr: impl FnOnce(DVec3) -> Spectrum<N>,
+    mis: bool,
+    stats: &mut GatherStats,
+) -> Spectrum<N> {
+    let Some(ls) = scene.sample_light(x, pick, u) else {
+        return Spectrum::zero();
+    };
+    let d = ls.point - x.point;
+    let dist2 = d.length_squared();
+    let dist = dist2.sqrt();
+    let cos_light = if dist > 0.0 {
+        ls.normal.dot(-d / dist)
+    } else {
+        0.0
+    };
+    if !(cos_light > 0.0 && ls.pdf_area > 0.0) || ls.radiance.is_black() {
+        return Spectrum::zero();
+    }
+    let wi = d / dist;
+    let f = fr(wi);
+    if f.is_black() {
+        return Spectrum::zero();
+    }
+    stats.shadow_rays += 1;
+    if !scene.unoccluded(x, ls.point) {
+        return Spectrum::zero();
+    }
+    let pdf_light = ls.pdf_area * dist2 / cos_light;
+    let w = if mis {
+        power_heuristic(pdf_light, scene.bsdf_pdf(x, wo, wi))
+    } else {
+        1.0
+    };
+    f * ls.radiance * (w / pdf_light)
+}
+
+/// The emission a BSDF-sampled ray brings from its hit `xd` (seen from
+/// direction `back`): Le times the sample's `weight` (fr·cos/pdf, or a part
+/// of it), weighted by the power heuristic of the BSDF density `pdf`
+/// against light sampling's density at `xd` (1 where light sampling cannot
+/// reach it). `None` where `xd` does not emit towards the ray.
+pub fn hit_emission<S: GatherScene<N>, const N: usize>(
+    scene: &S,
+    xd: &SurfacePoint<S::Locator>,
+    back: DVec3,
+    pdf: f64,
+    weight: Spectrum<N>,
+) -> Option<Spectrum<N>> {
+    let le = scene.emitted(xd, back);
+    if le.is_black() {
+        return None;
+    }
+    let cos_d = xd.normal.dot(back).abs();
+    let pdf_area = scene.light_pdf_area(xd);
+    let w = if pdf_area > 0.0 && cos_d > 0.0 {
+        power_heuristic(pdf, pdf_area * xd.t * xd.t / cos_d)
+    } else {
+        1.0
+    };
+    Some(weight * le * w)
+}

@@ -1,0 +1,104 @@
+//! The records the final gather passes between a scene and its estimators
+//! (Mitsuba 3 keeps its in `records.h`): a hit ([`SurfacePoint`]), a point
+//! sampled on a light ([`LightSample`]), a direction sampled from a BSDF
+//! ([`BsdfSample`]), how a link sum treats partial visibility
+//! ([`LinkVisibility`]) and the counters of a render ([`GatherStats`]).
+//!
+//! A leaf: it names no estimator and no scene, so that the scene traits
+//! (`scene`) and every estimator can name it.
+
+use glam::DVec3;
+use trilux_color::Spectrum;
+
+use crate::sampler::PixelSampler;
+
+/// Where a ray met a surface.
+#[derive(Clone, Copy, Debug)]
+pub struct SurfacePoint<L> {
+    /// The hit point in world space.
+    pub point: DVec3,
+    /// Unit geometric normal of the surface's front side.
+    pub normal: DVec3,
+    /// Distance along the ray.
+    pub t: f64,
+    /// What the scene needs to find this point's material, emitter and
+    /// solution elements again (for trilux: surface id and surface coordinate).
+    pub locator: L,
+}
+
+/// A point sampled on an emitter for light sampling.
+#[derive(Clone, Copy, Debug)]
+pub struct LightSample<const N: usize> {
+    /// The point on the emitter.
+    pub point: DVec3,
+    /// Unit front normal of the emitter at the point.
+    pub normal: DVec3,
+    /// Emitted radiance from `point` towards the reference point (zero when
+    /// the reference lies behind the emitter).
+    pub radiance: Spectrum<N>,
+    /// Density of this point with respect to area, including the
+    /// probability of having picked its emitter.
+    pub pdf_area: f64,
+}
+
+/// A direction sampled from a BSDF at a surface point.
+#[derive(Clone, Copy, Debug)]
+pub struct BsdfSample<const N: usize> {
+    /// Unit incident direction (towards where light comes from), world space.
+    pub wi: DVec3,
+    /// fr(ω_i, ω_o)·|cos θ_i| / pdf.
+    pub weight: Spectrum<N>,
+    /// Density of `wi` w.r.t. solid angle.
+    pub pdf: f64,
+}
+
+/// How the link sum at a point resolves partial visibility.
+#[derive(Clone, Copy, Debug)]
+pub enum LinkVisibility<'a> {
+    /// The visible fraction the solve measured for each link.
+    Cached,
+    /// As `Cached`, and near senders taken at their link's level without
+    /// the near field's cut: for gather hits, whose error reaches the eye
+    /// weighted by a reflection.
+    Secondary,
+    /// Shadow rays from the point to samples of each partly visible
+    /// sender, drawn from `sampler` from dimension `dim` on.
+    Traced {
+        /// The pixel's sample sequence.
+        sampler: &'a PixelSampler,
+        /// First dimension the rays may use.
+        dim: u32,
+    },
+}
+
+/// Counters of one render.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct GatherStats {
+    /// Camera rays traced.
+    pub camera_rays: u64,
+    /// Gather rays traced (all levels).
+    pub gather_rays: u64,
+    /// Shadow rays traced.
+    pub shadow_rays: u64,
+    /// Gather hits that continued one bounce instead of reading the solution.
+    pub extra_bounces: u64,
+    /// Samples dropped because a value was not finite (should stay 0).
+    pub dropped: u64,
+    /// Senders of gather links evaluated (point form factors).
+    pub link_senders: u64,
+    /// Cosine rays that corrected a near sender's average.
+    pub near_corrections: u64,
+}
+
+impl GatherStats {
+    /// Adds another set of counters.
+    pub fn add(&mut self, o: &GatherStats) {
+        self.camera_rays += o.camera_rays;
+        self.gather_rays += o.gather_rays;
+        self.shadow_rays += o.shadow_rays;
+        self.extra_bounces += o.extra_bounces;
+        self.dropped += o.dropped;
+        self.link_senders += o.link_senders;
+        self.near_corrections += o.near_corrections;
+    }
+}
