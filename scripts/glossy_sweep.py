@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Glossy lobes from wide to mirror: trilux against Mitsuba 3 (issue 13).
+"""Glossy lobes from wide to mirror: trilux against Mitsuba 3, swept over roughness.
 
 Writes, into a temporary folder, the bundled glossy tube
 (scenes/glossy-tube.xml) with its roughconductor's alpha replaced by each

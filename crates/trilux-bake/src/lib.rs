@@ -1,7 +1,7 @@
 //! # trilux-bake — the solution's light as a glTF 2.0 binary
 //!
 //! Layer: above `trilux-solver` (it reads a [`trilux_solver::Solution`])
-//! and below `trilux-render`, whose pipeline calls it. Depends on
+//! and beside `trilux-render`; the `trilux` crate's pipeline calls it. Depends on
 //! `trilux-color`, `trilux-geometry`, `trilux-brdf` and `trilux-solver`.
 //!
 //! A view-independent solution is what a walkthrough needs: solve once,

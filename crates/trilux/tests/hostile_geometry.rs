@@ -1,4 +1,4 @@
-//! Extents and units through the binary (issue 14): scenes beyond the
+//! Extents and units through the binary: scenes beyond the
 //! float pipeline's range are refused with their location, and within the
 //! documented range (docs/limits.md) the image does not depend on the
 //! scene's unit.

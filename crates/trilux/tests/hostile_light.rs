@@ -1,4 +1,4 @@
-//! Light that would overflow or never settle, through the binary (issue 14,
+//! Light that would overflow or never settle, through the binary (against
 //! "silent garbage"): radiance beyond the limit is refused where it is
 //! written; radiance at the limit renders with finite pixels; a closed
 //! scene that reflects everything is refused before the solve; a solve

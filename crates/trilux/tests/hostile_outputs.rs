@@ -1,4 +1,4 @@
-//! Hostile outputs through the binary (issue 14, "data loss and damage"):
+//! Hostile outputs through the binary (against data loss and damage):
 //! a symbolic link stays a link, a FIFO stays a FIFO, an output equal to
 //! an input or to another output is refused before any work, an unrelated
 //! file is never touched by the temporary file, and a failing output

@@ -1,4 +1,4 @@
-//! Hostile scene files through the binary (issue 14, "crashes" and
+//! Hostile scene files through the binary (against crashes, and for
 //! "errors a person can act on"): deep nesting, exponential `$name` and
 //! `<ref>` expansion, files that never end or are too large, other
 //! encodings, malformed versions and megabyte values all give one line

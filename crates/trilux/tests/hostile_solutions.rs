@@ -1,4 +1,4 @@
-//! Corrupted solution files through the binary (issue 14): a valid header
+//! Corrupted solution files through the binary: a valid header
 //! over a corrupted payload — a depth field that once made the reader
 //! allocate gigabytes, a NaN, infinite or negative radiance that once
 //! changed the image silently — truncated, extended or foreign files, and
