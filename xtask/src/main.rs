@@ -1,5 +1,5 @@
 //! Project automation: `cargo xtask ci` runs everything the tests need
-//! (fmt, clippy, the workspace's tests in release mode, the colour check and
+//! (fmt, the structure check, clippy, the workspace's tests in release mode, the colour check and
 //! the golden images); `cargo xtask color` checks trilux's colorimetry
 //! against colour-science; `cargo xtask golden` compares renders of every
 //! bundled scene with stored Mitsuba 3 references; `cargo xtask sweep`
@@ -12,6 +12,7 @@ mod golden;
 mod rays;
 mod scale;
 mod scale_scenes;
+mod structure;
 mod sweep;
 mod viewer;
 
@@ -39,6 +40,9 @@ fn run(program: &str, args: &[&str]) -> Result<()> {
 
 fn ci() -> Result<()> {
     run("cargo", &["fmt", "--all", "--", "--check"])?;
+    // Module cycles, long files and long functions: read from the source
+    // text, before anything is compiled.
+    structure::main()?;
     run(
         "cargo",
         &[
@@ -76,13 +80,16 @@ fn main() -> Result<()> {
     match args.first().map(String::as_str) {
         Some("ci") => ci(),
         Some("color") => color::color(),
+        Some("structure") => structure::main(),
         Some("golden") => golden::main(&args[1..]),
         Some("sweep") => sweep::main(&args[1..]),
         Some("rays") => rays::main(&args[1..]),
         Some("scale") => scale::main(&args[1..]),
         Some("viewer") => viewer::main(&args[1..]),
         _ => {
-            eprintln!("usage: cargo xtask ci | color | golden | sweep | rays | scale | viewer");
+            eprintln!(
+                "usage: cargo xtask ci | structure | color | golden | sweep | rays | scale | viewer"
+            );
             std::process::exit(2);
         }
     }
