@@ -8,6 +8,7 @@
 //! size on generated scenes.
 
 mod counting_alloc;
+mod deps;
 mod golden;
 mod rays;
 mod scale;
@@ -38,22 +39,53 @@ fn run(program: &str, args: &[&str]) -> Result<()> {
     Ok(())
 }
 
+/// [`run`] with one environment variable set.
+fn run_env(var: (&str, &str), program: &str, args: &[&str]) -> Result<()> {
+    eprintln!("xtask: {}={} {program} {}", var.0, var.1, args.join(" "));
+    let status = Command::new(program)
+        .env(var.0, var.1)
+        .args(args)
+        .status()
+        .with_context(|| format!("could not start {program}"))?;
+    if !status.success() {
+        bail!("{program} {} failed ({status})", args.join(" "));
+    }
+    Ok(())
+}
+
 fn ci() -> Result<()> {
     run("cargo", &["fmt", "--all", "--", "--check"])?;
     // Module cycles, long files and long functions: read from the source
     // text, before anything is compiled.
     structure::main()?;
+    // Every declared dependency used (a text check, see deps.rs for why
+    // not cargo-machete).
+    deps::main()?;
+    // Every feature on, so that optional code (`trace-stats`) compiles.
+    // The MSRV is checked here too: clippy's `incompatible_msrv` lint
+    // (on by default) refuses any standard-library item newer than the
+    // `rust-version` each crate inherits from the workspace manifest, the
+    // one way to check it with the single toolchain CI has.
     run(
         "cargo",
         &[
             "clippy",
             "--workspace",
             "--all-targets",
+            "--all-features",
             "--",
             "-D",
             "warnings",
         ],
     )?;
+    run_env(
+        ("RUSTDOCFLAGS", "-D warnings"),
+        "cargo",
+        &["doc", "--workspace", "--no-deps"],
+    )?;
+    // The unit tests once in debug mode, where overflow checks and
+    // debug assertions are on (the release pass below runs everything).
+    run("cargo", &["test", "--workspace", "--lib", "--bins"])?;
     run("cargo", &["test", "--workspace", "--release"])?;
     color::color()?;
     // Every bundled scene against its stored Mitsuba 3 reference (issue 5's
@@ -81,6 +113,7 @@ fn main() -> Result<()> {
         Some("ci") => ci(),
         Some("color") => color::color(),
         Some("structure") => structure::main(),
+        Some("deps") => deps::main(),
         Some("golden") => golden::main(&args[1..]),
         Some("sweep") => sweep::main(&args[1..]),
         Some("rays") => rays::main(&args[1..]),
@@ -88,7 +121,7 @@ fn main() -> Result<()> {
         Some("viewer") => viewer::main(&args[1..]),
         _ => {
             eprintln!(
-                "usage: cargo xtask ci | structure | color | golden | sweep | rays | scale | viewer"
+                "usage: cargo xtask ci | structure | deps | color | golden | sweep | rays | scale | viewer"
             );
             std::process::exit(2);
         }

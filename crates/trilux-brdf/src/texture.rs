@@ -241,12 +241,6 @@ impl Texture {
     }
 }
 
-/// Luminance of linear sRGB (Rec. 709 weights, Mitsuba's `luminance`):
-/// the value of an RGB texture used as a scalar (a blend weight).
-pub fn luminance(rgb: [f64; 3]) -> f64 {
-    0.212_671 * rgb[0] + 0.715_160 * rgb[1] + 0.072_169 * rgb[2]
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

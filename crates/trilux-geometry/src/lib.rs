@@ -89,10 +89,14 @@
 //!   burial map.
 //! - [`visibility`]: visible fractions from stratified shadow segments
 //!   ([`Visibility`], which takes the burial map explicitly).
+//! - [`basis`]: the orthonormal basis around a unit vector
+//!   ([`coordinate_system`], Duff et al.), the one tangent frame every
+//!   crate builds on.
 //! - `quadrature`, `sequence` and `transform` (private): integration rules,
 //!   seeded Sobol points and affine maps.
 #![forbid(unsafe_code)]
 
+pub mod basis;
 pub mod bounds;
 pub mod build;
 pub mod burial;
@@ -116,6 +120,7 @@ pub mod surface;
 mod transform;
 pub mod visibility;
 
+pub use basis::coordinate_system;
 pub use bounds::Bounds;
 pub use burial::{BurialMap, BurialRequest};
 #[cfg(feature = "trace-stats")]

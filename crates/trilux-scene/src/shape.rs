@@ -17,11 +17,11 @@ use std::path::Path;
 
 use glam::{DMat3, DMat4, DVec3};
 use trilux_geometry::limits::{MAX_COORDINATE, within};
-use trilux_geometry::{Shape, ShapeKind};
+use trilux_geometry::{Shape, ShapeKind, coordinate_system};
 
 use crate::error::{Result, SceneError, SourceLocation};
 use crate::props::Props;
-use crate::transform::{coordinate_system, linear_part};
+use crate::transform::linear_part;
 
 /// Surface area of a shape in world space (one side).
 ///
