@@ -64,8 +64,9 @@ fn ci() -> Result<()> {
     // Every feature on, so that optional code (`trace-stats`) compiles.
     // The MSRV is checked here too: clippy's `incompatible_msrv` lint
     // (on by default) refuses any standard-library item newer than the
-    // `rust-version` each crate inherits from the workspace manifest, the
-    // one way to check it with the single toolchain CI has.
+    // `rust-version` each package inherits from the workspace manifest
+    // (xtask included), the one way to check it with the single toolchain
+    // CI has. It checks library items, not language features.
     run(
         "cargo",
         &[
@@ -88,7 +89,7 @@ fn ci() -> Result<()> {
     run("cargo", &["test", "--workspace", "--lib", "--bins"])?;
     run("cargo", &["test", "--workspace", "--release"])?;
     color::color()?;
-    // Every bundled scene against its stored Mitsuba 3 reference (issue 5's
+    // Every bundled scene against its stored Mitsuba 3 reference (the
     // golden test: relative RMSE ≤ 0.05, mean within 1 %).
     // Its solutions are saved for the viewer step, which bakes them.
     let solutions = "target/ci-solutions".to_string();
@@ -99,7 +100,7 @@ fn ci() -> Result<()> {
         solutions.clone(),
     ])?;
     // Every bundled scene baked, validated (Khronos glTF validator) and
-    // photographed in docs/viewer beside its preview (issue 12).
+    // photographed in docs/viewer beside its preview.
     // (.ci/run installs Chromium and the viewer's npm packages.)
     run("node", &["docs/viewer/scripts/vendor.mjs", "--check"])?;
     run("node", &["--test", "docs/viewer/test/viewer.test.mjs"])?;

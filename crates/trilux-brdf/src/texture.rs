@@ -55,7 +55,7 @@ impl Wrap {
 }
 
 /// An affine map of texture coordinates, Mitsuba's `to_uv`:
-/// (u, v) ↦ (m[0]·u + m[1]·v + m[2], m[3]·u + m[4]·v + m[5]), applied
+/// (u, v) ↦ (`m[0]·u + m[1]·v + m[2]`, `m[3]·u + m[4]·v + m[5]`), applied
 /// before the lookup (a scale of 4 tiles the image 4 times).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct UvTransform(pub [f64; 6]);

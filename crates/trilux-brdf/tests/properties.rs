@@ -1,5 +1,5 @@
-//! Invariants of every model, by proptest over directions and parameters
-//! (issue 3): reciprocity fr(wi, wo) = fr(wo, wi), non-negativity, no NaN or
+//! Invariants of every model, by proptest over directions and parameters:
+//! reciprocity fr(wi, wo) = fr(wo, wi), non-negativity, no NaN or
 //! infinity (grazing angles included), consistent sample/pdf, albedo ≤ 1.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 

@@ -3,7 +3,7 @@
 //! ([`crate::build`]) and shared by everything that follows (element
 //! forests, visibility, the solver, the renderer).
 //!
-//! Ray queries are answered here: the BVH ([`crate::bvh`]) finds the
+//! Ray queries are answered here: the BVH (the private `bvh` module) finds the
 //! primitive, and this module turns it into a [`Hit`] on an input surface.
 //! The self-intersection rule: a ray ignores hits closer than
 //! ε = [`RAY_EPSILON`] × (|origin|∞ + scene extent), measured along the ray;

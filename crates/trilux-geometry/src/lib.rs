@@ -78,7 +78,7 @@
 //! - `bvh` (private): one obvhs CWBVH over every primitive, f64 watertight
 //!   triangle tests, exact analytic shapes (robustness rules documented
 //!   there).
-//! - [`form_factor`]: element-to-element form factors with error estimates
+//! - [`form_factor`](mod@form_factor): element-to-element form factors with error estimates
 //!   (Lambert's point-to-polygon formula integrated adaptively; pair
 //!   cubature for curved pieces and disks; stratified sampling for large
 //!   clusters), face to face ([`FaceElement`]).

@@ -9,7 +9,7 @@ use serde::Serialize;
 use trilux_geometry::limits::{beyond, within};
 
 use crate::error::{Result, SceneError, SourceLocation};
-use crate::value::{parse_f64, parse_list, parse_n, parse_xyz};
+use crate::numbers::{parse_f64, parse_list, parse_n, parse_xyz};
 use crate::xml::Element;
 
 /// A camera placement as written in `<lookat origin target up>`.
