@@ -1,5 +1,5 @@
 //! Project automation: `cargo xtask ci` runs everything the tests need
-//! (fmt, clippy, the workspace's tests in release mode, the colour check and
+//! (fmt, the structure check, clippy, the workspace's tests in release mode, the colour check and
 //! the golden images); `cargo xtask color` checks trilux's colorimetry
 //! against colour-science; `cargo xtask golden` compares renders of every
 //! bundled scene with stored Mitsuba 3 references; `cargo xtask sweep`
@@ -8,10 +8,12 @@
 //! size on generated scenes.
 
 mod counting_alloc;
+mod deps;
 mod golden;
 mod rays;
 mod scale;
 mod scale_scenes;
+mod structure;
 mod sweep;
 mod viewer;
 
@@ -37,22 +39,57 @@ fn run(program: &str, args: &[&str]) -> Result<()> {
     Ok(())
 }
 
+/// [`run`] with one environment variable set.
+fn run_env(var: (&str, &str), program: &str, args: &[&str]) -> Result<()> {
+    eprintln!("xtask: {}={} {program} {}", var.0, var.1, args.join(" "));
+    let status = Command::new(program)
+        .env(var.0, var.1)
+        .args(args)
+        .status()
+        .with_context(|| format!("could not start {program}"))?;
+    if !status.success() {
+        bail!("{program} {} failed ({status})", args.join(" "));
+    }
+    Ok(())
+}
+
 fn ci() -> Result<()> {
     run("cargo", &["fmt", "--all", "--", "--check"])?;
+    // Module cycles, long files and long functions: read from the source
+    // text, before anything is compiled.
+    structure::main()?;
+    // Every declared dependency used (a text check, see deps.rs for why
+    // not cargo-machete).
+    deps::main()?;
+    // Every feature on, so that optional code (`trace-stats`) compiles.
+    // The MSRV is checked here too: clippy's `incompatible_msrv` lint
+    // (on by default) refuses any standard-library item newer than the
+    // `rust-version` each package inherits from the workspace manifest
+    // (xtask included), the one way to check it with the single toolchain
+    // CI has. It checks library items, not language features.
     run(
         "cargo",
         &[
             "clippy",
             "--workspace",
             "--all-targets",
+            "--all-features",
             "--",
             "-D",
             "warnings",
         ],
     )?;
+    run_env(
+        ("RUSTDOCFLAGS", "-D warnings"),
+        "cargo",
+        &["doc", "--workspace", "--no-deps"],
+    )?;
+    // The unit tests once in debug mode, where overflow checks and
+    // debug assertions are on (the release pass below runs everything).
+    run("cargo", &["test", "--workspace", "--lib", "--bins"])?;
     run("cargo", &["test", "--workspace", "--release"])?;
     color::color()?;
-    // Every bundled scene against its stored Mitsuba 3 reference (issue 5's
+    // Every bundled scene against its stored Mitsuba 3 reference (the
     // golden test: relative RMSE ≤ 0.05, mean within 1 %).
     // Its solutions are saved for the viewer step, which bakes them.
     let solutions = "target/ci-solutions".to_string();
@@ -63,7 +100,7 @@ fn ci() -> Result<()> {
         solutions.clone(),
     ])?;
     // Every bundled scene baked, validated (Khronos glTF validator) and
-    // photographed in docs/viewer beside its preview (issue 12).
+    // photographed in docs/viewer beside its preview.
     // (.ci/run installs Chromium and the viewer's npm packages.)
     run("node", &["docs/viewer/scripts/vendor.mjs", "--check"])?;
     run("node", &["--test", "docs/viewer/test/viewer.test.mjs"])?;
@@ -76,13 +113,17 @@ fn main() -> Result<()> {
     match args.first().map(String::as_str) {
         Some("ci") => ci(),
         Some("color") => color::color(),
+        Some("structure") => structure::main(),
+        Some("deps") => deps::main(),
         Some("golden") => golden::main(&args[1..]),
         Some("sweep") => sweep::main(&args[1..]),
         Some("rays") => rays::main(&args[1..]),
         Some("scale") => scale::main(&args[1..]),
         Some("viewer") => viewer::main(&args[1..]),
         _ => {
-            eprintln!("usage: cargo xtask ci | color | golden | sweep | rays | scale | viewer");
+            eprintln!(
+                "usage: cargo xtask ci | structure | deps | color | golden | sweep | rays | scale | viewer"
+            );
             std::process::exit(2);
         }
     }

@@ -5,7 +5,7 @@
 //! `trilux-color`, `trilux-geometry`, `trilux-brdf` and `trilux-solver`.
 //!
 //! A view-independent solution is what a walkthrough needs: solve once,
-//! look around freely. [`bake`] writes the solution's view-independent
+//! look around freely. [`bake()`](bake()) writes the solution's view-independent
 //! (Lambertian) light as a `.glb` that any glTF viewer shows: every input
 //! surface tessellated at its leaf elements, the outgoing radiance as
 //! linear vertex colours (`COLOR_0`), materials unlit

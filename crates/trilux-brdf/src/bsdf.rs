@@ -285,7 +285,7 @@ mod tests {
             first: Box::new(diffuse(0.5)),
             second: Box::new(diffuse(0.5)),
         };
-        assert!(Bsdf::<10>::new(&w).is_err());
+        assert!(Bsdf::<{ trilux_color::SPECTRAL_BANDS }>::new(&w).is_err());
         assert!(Bsdf::<3>::new(&diffuse(-0.5)).is_err());
     }
 }

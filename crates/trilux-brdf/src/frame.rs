@@ -18,14 +18,11 @@ pub struct Frame {
 }
 
 impl Frame {
-    /// A frame around the unit normal `n` (Duff et al. 2017, branchless and
-    /// continuous except across n.z = 0's sign change).
+    /// A frame around the unit normal `n`: its tangents are
+    /// [`trilux_geometry::coordinate_system`]'s (Duff et al. 2017,
+    /// branchless and continuous except across n.z = 0's sign change).
     pub fn from_normal(n: DVec3) -> Frame {
-        let sign = 1f64.copysign(n.z);
-        let a = -1.0 / (sign + n.z);
-        let b = n.x * n.y * a;
-        let s = DVec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x);
-        let t = DVec3::new(b, sign + n.y * n.y * a, -n.y);
+        let (s, t) = trilux_geometry::coordinate_system(n);
         Frame { s, t, n }
     }
 

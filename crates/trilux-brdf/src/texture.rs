@@ -55,7 +55,7 @@ impl Wrap {
 }
 
 /// An affine map of texture coordinates, Mitsuba's `to_uv`:
-/// (u, v) ↦ (m[0]·u + m[1]·v + m[2], m[3]·u + m[4]·v + m[5]), applied
+/// (u, v) ↦ (`m[0]·u + m[1]·v + m[2]`, `m[3]·u + m[4]·v + m[5]`), applied
 /// before the lookup (a scale of 4 tiles the image 4 times).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct UvTransform(pub [f64; 6]);
@@ -239,12 +239,6 @@ impl Texture {
             }
         }
     }
-}
-
-/// Luminance of linear sRGB (Rec. 709 weights, Mitsuba's `luminance`):
-/// the value of an RGB texture used as a scalar (a blend weight).
-pub fn luminance(rgb: [f64; 3]) -> f64 {
-    0.212_671 * rgb[0] + 0.715_160 * rgb[1] + 0.072_169 * rgb[2]
 }
 
 #[cfg(test)]

@@ -29,13 +29,13 @@ use std::sync::Arc;
 
 use glam::{DVec2, DVec3};
 use serde::Serialize;
-use trilux_color::{ColorParam, Role, Spectrum};
+use trilux_color::{ColorParam, Role, Spectrum, luminance};
 use trilux_geometry::{Side, Sided};
 
 use crate::bsdf::{Bsdf, BsdfSample};
 use crate::error::BrdfError;
 use crate::params::BsdfParams;
-use crate::texture::{Texture, UvTransform, luminance};
+use crate::texture::{Texture, UvTransform};
 
 /// One step from a BSDF to a BSDF nested in it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]

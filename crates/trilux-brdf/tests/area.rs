@@ -12,6 +12,7 @@ use trilux_brdf::area::Element;
 use trilux_brdf::{
     Bsdf, BsdfParams, Distribution, ElementPoints, Frame, area_reflectance, brdf_variation,
 };
+use trilux_color::SPECTRAL_BANDS;
 
 /// A square element of side `s` centred at `c` with normal `n`: corners and
 /// centre.
@@ -66,7 +67,7 @@ fn lambertian_part_is_rho_times_form_factor() {
 /// R(I→J→K)·F_JK = R(K→J→I)·F_JI (docs/solver.md, "Area reflectance"), from the BRDF's reciprocity.
 #[test]
 fn area_reflectance_reciprocity() {
-    let b = Bsdf::<10>::new(&BsdfParams::Blend {
+    let b = Bsdf::<SPECTRAL_BANDS>::new(&BsdfParams::Blend {
         weight: 0.5,
         first: Box::new(diffuse(0.3)),
         second: Box::new(common::gold(Distribution::Beckmann, 0.25)),
@@ -80,7 +81,7 @@ fn area_reflectance_reciprocity() {
     let (f_ji, f_jk) = (0.07, 0.11);
     let a = area_reflectance(&b, f_ji, i, j, DVec3::Z, k).total() * f_jk;
     let c = area_reflectance(&b, f_jk, k, j, DVec3::Z, i).total() * f_ji;
-    for n in 0..10 {
+    for n in 0..SPECTRAL_BANDS {
         assert!((a[n] - c[n]).abs() <= 1e-12 * a[n].abs(), "{a:?} {c:?}");
     }
 }
@@ -158,6 +159,9 @@ fn mirror_direction_inside_k_is_caught() {
     };
     let v = brdf_variation(&b, &ie, &je, &ke);
     assert!(v.mirror_in_k);
+    // The mirror direction costs one evaluation beyond the centre and the
+    // four corners of each element.
+    assert_eq!(v.evaluations, evaluations_at_corners(4, 4, 4) + 1);
     // Peak of the lobe (D(0) G F / (4 cos²) = 1/(π α²)/(4·0.5)) ≈ 1591.
     assert!(v.fr_max[0] > 1000.0, "{v:?}");
     // Every other sample point sees only the far tail.
@@ -216,7 +220,20 @@ fn variation_shrinks_with_element_size() {
     assert!(small.delta_r(0.1) < 0.05 * big_i.delta_r(0.1));
     assert_eq!(big_i.driver(), Element::I);
     assert_eq!(big_j.driver(), Element::J);
-    assert_eq!(small.evaluations, 13);
+    // No mirror direction inside K here, so fr was evaluated only at the
+    // centres (once, shared by the three spreads) and at each corner.
+    for v in [small, big_i, big_j] {
+        assert!(!v.mirror_in_k);
+        assert_eq!(v.evaluations, evaluations_at_corners(4, 4, 4));
+    }
+}
+
+/// What the variation estimate should cost when the mirror direction is
+/// not in K: fr at the three centres once (the value every spread starts
+/// from), then once per point of I, J and K with the other two elements
+/// held at their centres.
+fn evaluations_at_corners(i: u32, j: u32, k: u32) -> u32 {
+    1 + i + j + k
 }
 
 mod random {

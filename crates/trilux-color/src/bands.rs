@@ -12,7 +12,6 @@
 //! All tables here are computed at compile time from the 1 nm CIE table.
 
 use crate::cie::{CIE_MAX_NM, CIE_MIN_NM, CIE_Y_INTEGRAL, d65_integral, table_integral};
-use crate::spectrum::Spectrum;
 
 /// Band layout and band-integrated CIE data for `N` spectral bands.
 #[derive(Clone, Copy, Debug)]
@@ -75,26 +74,29 @@ impl<const N: usize> Bands<N> {
         (0..=N).map(|i| band_edge(N, i)).collect()
     }
 
-    /// CIE XYZ of a band spectrum (equal-energy 1 → Y = 1).
-    pub fn to_xyz(&self, s: &Spectrum<N>) -> [f64; 3] {
+    /// CIE XYZ of a band spectrum's values (equal-energy 1 → Y = 1).
+    /// ([`Spectrum::to_xyz`](crate::Spectrum::to_xyz) calls this: the
+    /// tables work on plain band values, the spectrum type sits above.)
+    pub fn to_xyz(&self, s: &[f64; N]) -> [f64; 3] {
         let mut xyz = [0.0; 3];
         for b in 0..N {
             for k in 0..3 {
-                xyz[k] += s.0[b] * self.cmf[b][k];
+                xyz[k] += s[b] * self.cmf[b][k];
             }
         }
         xyz
     }
 
-    /// The band D65 spectrum (luminance 1).
-    pub fn d65_spectrum(&self) -> Spectrum<N> {
-        Spectrum(self.d65)
+    /// The band values of D65 (luminance 1).
+    pub fn d65(&self) -> [f64; N] {
+        self.d65
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::mode::SPECTRAL_BANDS;
 
     #[test]
     fn ten_bands_layout() {
@@ -104,12 +106,21 @@ mod tests {
         assert_eq!(e[1], 430.0);
         assert_eq!(e[9], 670.0);
         assert_eq!(e[10], 830.0);
+        // The default layout: 400–700 nm in 300/N nm steps, outer bands
+        // stretched to the CIE table's ends.
+        let e = Bands::<SPECTRAL_BANDS>::edges();
+        let step = 300.0 / SPECTRAL_BANDS as f64;
+        assert_eq!(e.len(), SPECTRAL_BANDS + 1);
+        assert_eq!((e[0], e[SPECTRAL_BANDS]), (360.0, 830.0));
+        for i in 1..SPECTRAL_BANDS {
+            assert!((e[i] - (400.0 + step * i as f64)).abs() < 1e-12, "{e:?}");
+        }
     }
 
     #[test]
     fn flat_spectrum_is_exact() {
-        let b = Bands::<10>::get();
-        let xyz = b.to_xyz(&Spectrum::splat(1.0));
+        let b = Bands::<SPECTRAL_BANDS>::get();
+        let xyz = b.to_xyz(&[1.0; SPECTRAL_BANDS]);
         assert!((xyz[1] - 1.0).abs() < 1e-12);
         let sum: f64 = xyz.iter().sum();
         assert!((xyz[0] / sum - 0.333314).abs() < 2e-6);
@@ -119,7 +130,7 @@ mod tests {
     #[test]
     fn d65_band_spectrum_is_white() {
         let b = Bands::<10>::get();
-        let rgb = crate::srgb::xyz_to_linear_srgb(b.to_xyz(&b.d65_spectrum()));
+        let rgb = crate::srgb::xyz_to_linear_srgb(b.to_xyz(&b.d65()));
         // Averaging the spiky D65 over 30 nm bands (the first one 360–430 nm)
         // costs about 3.4% in blue: measured (0.9958, 1.0047, 0.9658).
         for c in rgb {

@@ -147,6 +147,7 @@ pub fn equal_energy_rgb() -> [f64; 3] {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::mode::SPECTRAL_BANDS;
 
     const CORNELL_WHITE: &str = "400:0.343, 404:0.445, 408:0.551, 412:0.624, 416:0.665, 420:0.687, 424:0.708, 428:0.723, 432:0.715, 436:0.71, 440:0.745, 444:0.758, 448:0.739, 452:0.767, 456:0.777, 460:0.765, 464:0.751, 468:0.745, 472:0.748, 476:0.729, 480:0.745, 484:0.757, 488:0.753, 492:0.75, 496:0.746, 500:0.747, 504:0.735, 508:0.732, 512:0.739, 516:0.734, 520:0.725, 524:0.721, 528:0.733, 532:0.725, 536:0.732, 540:0.743, 544:0.744, 548:0.748, 552:0.728, 556:0.716, 560:0.733, 564:0.726, 568:0.713, 572:0.74, 576:0.754, 580:0.764, 584:0.752, 588:0.736, 592:0.734, 596:0.741, 600:0.74, 604:0.732, 608:0.745, 612:0.755, 616:0.751, 620:0.744, 624:0.731, 628:0.733, 632:0.744, 636:0.731, 640:0.712, 644:0.708, 648:0.729, 652:0.73, 656:0.727, 660:0.707, 664:0.703, 668:0.729, 672:0.75, 676:0.76, 680:0.751, 684:0.739, 688:0.724, 692:0.73, 696:0.74, 700:0.737";
 
@@ -206,16 +207,26 @@ mod tests {
 
     #[test]
     fn spectral_mode_rules() {
-        let w: Spectrum<10> = parse(CORNELL_WHITE).reflectance().unwrap();
-        assert!(w.min_value() > 0.6 && w.max_value() < 0.78, "{w:?}");
-        // 400:0.343 … the first band (360–430) averages in the zero below 400.
-        let ee: Spectrum<10> = ColorParam::Constant(1.0).emission().unwrap();
-        assert_eq!(ee.0, [1.0; 10]);
-        let f: Spectrum<10> = ColorParam::Float(1.0).emission().unwrap();
+        let w: Spectrum<SPECTRAL_BANDS> = parse(CORNELL_WHITE).reflectance().unwrap();
+        // Bands inside 400–700 nm average the data (0.665…0.777 past
+        // 416 nm, 0.343 at 400); the outer bands (from 360 nm, to 830 nm)
+        // average in the zero outside the data, so they are darker.
+        let inner = Spectrum::<{ SPECTRAL_BANDS - 2 }>(std::array::from_fn(|i| w.0[i + 1]));
+        assert!(inner.min_value() > 0.6 && inner.max_value() < 0.78, "{w:?}");
+        for outer in [w.0[0], w.0[SPECTRAL_BANDS - 1]] {
+            assert!(outer > 0.0 && outer < inner.min_value(), "{w:?}");
+        }
+        let ee: Spectrum<SPECTRAL_BANDS> = ColorParam::Constant(1.0).emission().unwrap();
+        assert_eq!(ee.0, [1.0; SPECTRAL_BANDS]);
+        let f: Spectrum<SPECTRAL_BANDS> = ColorParam::Float(1.0).emission().unwrap();
         close(f.to_linear_srgb(), [1.0, 1.0, 1.0], 3e-3);
-        let r: Spectrum<10> = ColorParam::Rgb([0.5, 0.4, 0.3]).emission().unwrap();
+        let r: Spectrum<SPECTRAL_BANDS> = ColorParam::Rgb([0.5, 0.4, 0.3]).emission().unwrap();
         close(r.to_linear_srgb(), [0.5, 0.4, 0.3], 1e-9);
-        assert!(ColorParam::Float(-1.0).reflectance::<10>().is_err());
+        assert!(
+            ColorParam::Float(-1.0)
+                .reflectance::<SPECTRAL_BANDS>()
+                .is_err()
+        );
         assert!(
             ColorParam::Rgb([f64::NAN, 0.0, 0.0])
                 .reflectance::<3>()

@@ -18,7 +18,8 @@
 //!   360 and 830 nm) and their band-integrated colour-matching functions.
 //! - [`upsample`]: RGB → smooth band spectrum for RGB values in a spectral
 //!   scene, with its measured round-trip error.
-//! - [`srgb`]: XYZ → linear sRGB → sRGB-encoded 8-bit values.
+//! - [`srgb`]: XYZ → linear sRGB → sRGB-encoded 8-bit values, and RGB
+//!   luminance ([`luminance`], the one definition).
 #![forbid(unsafe_code)]
 // Band and channel loops index several arrays in step; iterators would hide that.
 #![allow(clippy::needless_range_loop)]
@@ -48,3 +49,4 @@ pub const MAX_RADIANCE: f64 = 1e20;
 pub use mode::{Mode, SPECTRAL_BANDS, WithBands};
 pub use param::ColorParam;
 pub use spectrum::{Rgb, Spectrum};
+pub use srgb::luminance;

@@ -38,6 +38,17 @@ pub fn linear_srgb_to_xyz(rgb: [f64; 3]) -> [f64; 3] {
     mul(&SRGB_TO_XYZ, rgb)
 }
 
+/// Luminance Y of linear sRGB: the middle row of [`SRGB_TO_XYZ`], Rec. 709
+/// weights to six decimals (Mitsuba 3's `luminance`). The one definition of
+/// RGB luminance in trilux: equal, bit for bit, to
+/// [`Spectrum::<3>::luminance`](crate::Spectrum::luminance) and to the `Y`
+/// of [`linear_srgb_to_xyz`]. No clamping: a non-finite channel gives a
+/// non-finite luminance.
+pub fn luminance(rgb: [f64; 3]) -> f64 {
+    let w = SRGB_TO_XYZ[1];
+    w[0] * rgb[0] + w[1] * rgb[1] + w[2] * rgb[2]
+}
+
 /// The sRGB transfer function (IEC 61966-2-1): 12.92·C for C ≤ 0.0031308,
 /// else 1.055·C^(1/2.4) − 0.055. Input clamped to [0, 1]; NaN gives 0.
 pub fn encode_srgb(c: f64) -> f64 {
@@ -72,6 +83,20 @@ pub fn xyz_to_srgb_u8(xyz: [f64; 3]) -> [u8; 3] {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn luminance_is_the_y_of_xyz_and_white_is_one() {
+        for rgb in [[1.0, 0.0, 0.0], [0.25, 0.5, 0.75], [3.0, -1.0, 2.0]] {
+            // Bit for bit the Y that the XYZ conversion and the RGB-mode
+            // spectrum compute.
+            assert_eq!(luminance(rgb), linear_srgb_to_xyz(rgb)[1]);
+            assert_eq!(luminance(rgb), crate::Spectrum::<3>(rgb).luminance());
+        }
+        // Rec. 709: the weights sum to 1 (to the matrix's six decimals), so
+        // white has luminance 1, and green weighs most.
+        assert!((luminance([1.0; 3]) - 1.0).abs() < 1e-5);
+        assert!(luminance([0.0, 1.0, 0.0]) > 0.7);
+    }
+
     use super::*;
 
     #[test]

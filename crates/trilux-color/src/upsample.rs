@@ -77,7 +77,7 @@ pub fn smooth_unbounded<const N: usize>(rgb: [f64; 3]) -> Spectrum<N> {
 /// emission D65 × s is `rgb` (exact unless s had to be clamped at 0).
 pub fn smooth_emission<const N: usize>(rgb: [f64; 3]) -> Spectrum<N> {
     let s = smoothest(&reflectance_to_srgb_matrix::<N>(), rgb, 0.0, f64::INFINITY);
-    s * Bands::<N>::get().d65_spectrum()
+    s * Spectrum(Bands::<N>::get().d65())
 }
 
 /// The smoothest spectrum with m s = rgb and lo ≤ s ≤ hi, by a small
@@ -236,6 +236,7 @@ pub fn reflectance_round_trip_stats<const N: usize>() -> (f64, f64, f64) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::mode::SPECTRAL_BANDS;
 
     #[test]
     fn exact_round_trip_before_clamping() {
@@ -245,7 +246,7 @@ mod tests {
             [0.9, 0.1, 0.4],
             [1.0, 1.0, 1.0],
         ] {
-            let s = smooth_reflectance::<10>(rgb);
+            let s = smooth_reflectance::<SPECTRAL_BANDS>(rgb);
             let back = reflectance_to_srgb(&s);
             for c in 0..3 {
                 assert!(
@@ -258,16 +259,16 @@ mod tests {
 
     #[test]
     fn grey_is_nearly_flat() {
-        let s = smooth_reflectance::<10>([0.5, 0.5, 0.5]);
+        let s = smooth_reflectance::<SPECTRAL_BANDS>([0.5, 0.5, 0.5]);
         assert!(s.max_value() - s.min_value() < 1e-12, "{s:?}");
-        let w = smooth_reflectance::<10>([1.0, 1.0, 1.0]);
+        let w = smooth_reflectance::<SPECTRAL_BANDS>([1.0, 1.0, 1.0]);
         assert!((w.min_value() - 1.0).abs() < 1e-12 && (w.max_value() - 1.0).abs() < 1e-12);
     }
 
     #[test]
     fn emission_colour_is_exact() {
         for rgb in [[1.0, 1.0, 1.0], [0.5, 0.4, 0.3], [5.0, 2.0, 1.0]] {
-            let e = smooth_emission::<10>(rgb);
+            let e = smooth_emission::<SPECTRAL_BANDS>(rgb);
             let back = e.to_linear_srgb();
             for c in 0..3 {
                 assert!(
@@ -277,7 +278,7 @@ mod tests {
             }
         }
         // A saturated green needs bands held at zero; still exact.
-        let back = smooth_emission::<10>([0.2, 0.6, 0.3]).to_linear_srgb();
+        let back = smooth_emission::<SPECTRAL_BANDS>([0.2, 0.6, 0.3]).to_linear_srgb();
         for (c, want) in [0.2, 0.6, 0.3].into_iter().enumerate() {
             assert!((back[c] - want).abs() < 1e-9, "{back:?}");
         }
@@ -299,5 +300,13 @@ mod tests {
         assert!(exact > 0.99, "only {exact} exact");
         assert!(mean < 1e-3);
         assert_eq!(reflectance_round_trip_error::<10>(), e);
+        // The default band count is held to the same bounds.
+        let (e, mean, exact) = reflectance_round_trip_stats::<SPECTRAL_BANDS>();
+        assert!(
+            e < 0.01,
+            "{SPECTRAL_BANDS} bands: worst round-trip error {e}"
+        );
+        assert!(exact > 0.99, "{SPECTRAL_BANDS} bands: only {exact} exact");
+        assert!(mean < 1e-3, "{SPECTRAL_BANDS} bands: mean {mean}");
     }
 }

@@ -3,7 +3,7 @@
 //! ([`crate::build`]) and shared by everything that follows (element
 //! forests, visibility, the solver, the renderer).
 //!
-//! Ray queries are answered here: the BVH ([`crate::bvh`]) finds the
+//! Ray queries are answered here: the BVH (the private `bvh` module) finds the
 //! primitive, and this module turns it into a [`Hit`] on an input surface.
 //! The self-intersection rule: a ray ignores hits closer than
 //! ε = [`RAY_EPSILON`] × (|origin|∞ + scene extent), measured along the ray;
@@ -16,6 +16,7 @@ use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
 use crate::bounds::Bounds;
+pub use crate::bvh::BvhStats;
 use crate::bvh::{Bvh, Prim, PrimHit, QueryRay, TriOwner};
 use crate::chart::MeshData;
 use crate::ids::SurfaceId;
@@ -62,19 +63,6 @@ impl Hit {
     pub fn front_facing(&self, ray: &Ray) -> bool {
         ray.dir.dot(self.geometric_normal) < 0.0
     }
-}
-
-/// Size and build time of a scene's BVH.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct BvhStats {
-    /// Inner nodes (eight children each).
-    pub nodes: usize,
-    /// Leaves (up to four primitives each).
-    pub leaves: usize,
-    /// Longest root-to-leaf path, in inner nodes.
-    pub depth: usize,
-    /// Wall-clock seconds of the build (binary tree, collapse, leaves).
-    pub build_seconds: f64,
 }
 
 /// The immutable geometry of a scene: input surfaces, meshes, BVH.

@@ -78,7 +78,7 @@
 //! - `bvh` (private): one obvhs CWBVH over every primitive, f64 watertight
 //!   triangle tests, exact analytic shapes (robustness rules documented
 //!   there).
-//! - [`form_factor`]: element-to-element form factors with error estimates
+//! - [`form_factor`](mod@form_factor): element-to-element form factors with error estimates
 //!   (Lambert's point-to-polygon formula integrated adaptively; pair
 //!   cubature for curved pieces and disks; stratified sampling for large
 //!   clusters), face to face ([`FaceElement`]).
@@ -89,6 +89,9 @@
 //!   burial map.
 //! - [`visibility`]: visible fractions from stratified shadow segments
 //!   ([`Visibility`], which takes the burial map explicitly).
+//! - [`basis`]: the orthonormal basis around a unit vector
+//!   ([`coordinate_system`], Duff et al.), the one tangent frame every
+//!   crate builds on.
 //! - [`sensor`]: the camera's plain data shared by the scene loader and
 //!   the renderer: Mitsuba's `look_at` ([`look_at`]), the field of view's
 //!   axis ([`FovAxis`]) and the film's reconstruction filters
@@ -97,6 +100,7 @@
 //!   seeded Sobol points and affine maps.
 #![forbid(unsafe_code)]
 
+pub mod basis;
 pub mod bounds;
 pub mod build;
 pub mod burial;
@@ -121,6 +125,7 @@ pub mod surface;
 mod transform;
 pub mod visibility;
 
+pub use basis::coordinate_system;
 pub use bounds::Bounds;
 pub use burial::{BurialMap, BurialRequest};
 #[cfg(feature = "trace-stats")]

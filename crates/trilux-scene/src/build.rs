@@ -264,7 +264,35 @@ fn sensor(e: &Element) -> Result<Camera> {
         ));
     }
     let props = Props::new(e)?;
-    let (fov, fov_axis) = match props.float("fov")? {
+    let (fov, fov_axis) = sensor_fov(&props)?;
+    let pose = sensor_pose(&props)?;
+    let (near_clip, far_clip) = clip_planes(&props)?;
+    let principal_point_offset = principal_point_offset(&props)?;
+    let children = sensor_children(&props)?;
+    props.finish()?;
+    Ok(Camera {
+        origin: pose.origin,
+        target: pose.target,
+        up: pose.up,
+        world_from_camera: pose.world_from_camera,
+        fov,
+        fov_axis,
+        width: children.film.width,
+        height: children.film.height,
+        rfilter: children.film.rfilter,
+        sample_count: children.sample_count,
+        near_clip,
+        far_clip,
+        principal_point_offset,
+        crop: children.film.crop,
+        location: e.loc.clone(),
+    })
+}
+
+/// The sensor's `fov` (strictly between 0 and 180 degrees) and the axis it
+/// spans; unwritten, Mitsuba's 50 mm lens along the diagonal.
+fn sensor_fov(props: &Props<'_>) -> Result<(f64, FovAxis)> {
+    match props.float("fov")? {
         Some(fov) => {
             if !(fov > 0.0 && fov < 180.0) {
                 return Err(SceneError::at(
@@ -281,17 +309,30 @@ fn sensor(e: &Element) -> Result<Camera> {
                     )
                 })?,
             };
-            (fov, axis)
+            Ok((fov, axis))
         }
         // Mitsuba's default: a 50 mm lens, fov along the diagonal.
-        None if props.has("fov_axis") => {
-            return Err(SceneError::at(
-                &props.loc("fov_axis"),
-                "fov_axis needs a fov (without fov, Mitsuba uses its 50 mm lens along the diagonal)",
-            ));
-        }
-        None => (default_fov(), FovAxis::Diagonal),
-    };
+        None if props.has("fov_axis") => Err(SceneError::at(
+            &props.loc("fov_axis"),
+            "fov_axis needs a fov (without fov, Mitsuba uses its 50 mm lens along the diagonal)",
+        )),
+        None => Ok((default_fov(), FovAxis::Diagonal)),
+    }
+}
+
+/// Where the sensor stands and looks: its `to_world` (a rigid motion) and
+/// the target and up vector of its `<lookat>`, or else those its matrix
+/// implies (the camera looks along +z with +y up).
+struct SensorPose {
+    world_from_camera: DMat4,
+    origin: DVec3,
+    target: DVec3,
+    up: DVec3,
+}
+
+/// The sensor's [`SensorPose`]: its `to_world` must not scale and must
+/// place the camera within the geometry's coordinate limits.
+fn sensor_pose(props: &Props<'_>) -> Result<SensorPose> {
     let transform = props.transform("to_world")?;
     let world_from_camera = transform.as_ref().map_or(DMat4::IDENTITY, |t| t.matrix);
     let l = crate::transform::linear_part(&world_from_camera);
@@ -321,7 +362,16 @@ fn sensor(e: &Element) -> Result<Camera> {
             world_from_camera.transform_vector3(DVec3::Y),
         ),
     };
-    let (near_clip, far_clip) = clip_planes(&props)?;
+    Ok(SensorPose {
+        world_from_camera,
+        origin,
+        target,
+        up,
+    })
+}
+
+/// `principal_point_offset_x` and `_y`, in film sizes, each within [-1, 1].
+fn principal_point_offset(props: &Props<'_>) -> Result<[f64; 2]> {
     let mut principal_point_offset = [0.0; 2];
     for (k, name) in ["principal_point_offset_x", "principal_point_offset_y"]
         .iter()
@@ -336,10 +386,25 @@ fn sensor(e: &Element) -> Result<Camera> {
         }
         principal_point_offset[k] = v;
     }
-    let mut width = 768;
-    let mut height = 576;
-    let mut rfilter = ReconstructionFilter::default();
-    let mut crop = None;
+    Ok(principal_point_offset)
+}
+
+/// What a sensor's children set: its `<film>` and its `<sampler>`'s
+/// sample count (each at most once; Mitsuba's defaults when absent).
+struct SensorChildren {
+    film: FilmParams,
+    sample_count: u32,
+}
+
+/// Reads a sensor's one `<film>` and one `<sampler>`; anything else, or a
+/// second of either, is an error.
+fn sensor_children(props: &Props<'_>) -> Result<SensorChildren> {
+    let mut film_params = FilmParams {
+        width: 768,
+        height: 576,
+        rfilter: ReconstructionFilter::default(),
+        crop: None,
+    };
     let mut sample_count = 4;
     let mut seen_film = false;
     let mut seen_sampler = false;
@@ -347,8 +412,7 @@ fn sensor(e: &Element) -> Result<Camera> {
         match o.tag.as_str() {
             "film" if !seen_film => {
                 seen_film = true;
-                let f = film(o)?;
-                (width, height, rfilter, crop) = (f.width, f.height, f.rfilter, f.crop);
+                film_params = film(o)?;
             }
             "sampler" if !seen_sampler => {
                 seen_sampler = true;
@@ -365,23 +429,9 @@ fn sensor(e: &Element) -> Result<Camera> {
             }
         }
     }
-    props.finish()?;
-    Ok(Camera {
-        origin,
-        target,
-        up,
-        world_from_camera,
-        fov,
-        fov_axis,
-        width,
-        height,
-        rfilter,
+    Ok(SensorChildren {
+        film: film_params,
         sample_count,
-        near_clip,
-        far_clip,
-        principal_point_offset,
-        crop,
-        location: e.loc.clone(),
     })
 }
 

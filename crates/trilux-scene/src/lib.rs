@@ -8,7 +8,7 @@
 //! Two formats load into the same model: glTF 2.0 (`.gltf`, `.glb`: the
 //! [`gltf`] module, with its material mapping in docs/gltf.md) and the
 //! Mitsuba 3 XML subset below. Textures (PNG, JPEG: [`image`]) are read
-//! with the meshes, last ([`textures`]).
+//! with the meshes, last (the private `textures` module).
 //!
 //! The XML loader reads the subset of Mitsuba 3's XML listed in the README with Mitsuba's semantics and defaults, and refuses
 //! anything else with an error that displays as `FILE:LINE:COL: what is
@@ -17,7 +17,8 @@
 //! 1. `xml`: XML text → an intermediate tree of elements and attributes,
 //!    each with its source location; `<default>` and `$name` substitution.
 //! 2. `resolve`: `<ref id>` replaced by the `<bsdf id>` it names.
-//! 3. `build`: typed parameters (`props`, `value`, [`transform`]) → the
+//! 3. `build`: typed parameters (`props`, `value`, [`transform`], their
+//!    numbers read by `numbers`) → the
 //!    model: shapes ([`shape`]), materials (`material`), area lights and the
 //!    camera ([`camera`], its film's filter in [`rfilter`]).
 //! 4. [`meshes`]: the OBJ and PLY files the shapes name ([`obj`],
@@ -47,6 +48,7 @@ pub mod image;
 pub mod limits;
 mod material;
 pub mod meshes;
+mod numbers;
 pub mod obj;
 pub mod ply;
 mod props;
@@ -90,7 +92,7 @@ pub fn open_with_camera(
 ) -> Result<Pending, SceneError> {
     let path = path.as_ref();
     if gltf::is_gltf(path) && params.is_empty() {
-        return gltf::open(path, camera);
+        return gltf::open(path, camera).map(Pending::gltf);
     }
     if let Some(name) = camera {
         return Err(SceneError::at(
@@ -111,7 +113,7 @@ pub fn open_with_camera(
 /// Reads a glTF or GLB file from bytes in memory; `path` names it in errors
 /// and anchors relative URIs (for fuzzing and tests).
 pub fn open_gltf_bytes(bytes: &[u8], path: impl AsRef<Path>) -> Result<Pending, SceneError> {
-    gltf::open_bytes(bytes, &Arc::from(path.as_ref()), None)
+    gltf::open_bytes(bytes, &Arc::from(path.as_ref()), None).map(Pending::gltf)
 }
 
 /// Loads a scene file with values for its `$name` parameters (they override
@@ -141,7 +143,7 @@ pub fn open_with_params(
                 "$name parameters are for Mitsuba XML scenes, not glTF",
             ));
         }
-        return gltf::open(path, None);
+        return gltf::open(path, None).map(Pending::gltf);
     }
     let bytes = trilux_files::read_limited(path, limits::MAX_SCENE_BYTES).map_err(|source| {
         SceneError::Read {

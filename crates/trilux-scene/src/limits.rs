@@ -7,19 +7,21 @@
 /// ones are kilobytes; the parsed tree takes several times the text.
 pub const MAX_SCENE_BYTES: u64 = 64 << 20;
 
-/// Largest OBJ file (256 MiB, about 4 million triangles): the mesh in
-/// memory takes several times the text, and the solver's charts and
-/// elements more again.
-pub const MAX_OBJ_BYTES: u64 = 256 << 20;
+/// Largest mesh file, OBJ or PLY (256 MiB, about 4 million triangles of
+/// OBJ text): the mesh in memory takes several times the text, and the
+/// solver's charts and elements more again.
+pub const MAX_MESH_BYTES: u64 = 256 << 20;
 
-/// Most triangles of one OBJ mesh (4 million): a file of short lines
-/// (`f 1 2 3`) holds 30 million in [`MAX_OBJ_BYTES`], and every triangle
-/// costs a few hundred bytes once built into charts, elements and the BVH.
-pub const MAX_OBJ_TRIANGLES: usize = 4_000_000;
+/// Most triangles of one mesh, from any file format (4 million): an OBJ
+/// file of short lines (`f 1 2 3`) holds 30 million in [`MAX_MESH_BYTES`],
+/// and every triangle costs a few hundred bytes once built into charts,
+/// elements and the BVH.
+pub const MAX_MESH_TRIANGLES: usize = 4_000_000;
 
-/// Most vertices of one OBJ mesh (12 million: three per triangle, what
-/// splitting by position, texture and normal index can make).
-pub const MAX_OBJ_VERTICES: usize = 12_000_000;
+/// Most vertices of one mesh, from any file format (12 million: three
+/// per triangle, what splitting an OBJ by position, texture and normal
+/// index can make).
+pub const MAX_MESH_VERTICES: usize = 12_000_000;
 
 /// Most files a scene may `<include>` (all levels together).
 pub const MAX_INCLUDES: usize = 64;

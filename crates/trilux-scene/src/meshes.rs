@@ -38,6 +38,17 @@ impl Pending {
         Pending { scene, requests }
     }
 
+    /// A glTF scene whose buffers and images `meshes` will read.
+    pub(crate) fn gltf((scene, meshes): (Scene, GltfMeshes)) -> Self {
+        Pending::new(
+            scene,
+            Requests {
+                gltf: Some(meshes),
+                ..Requests::default()
+            },
+        )
+    }
+
     /// The scene as the file states it; mesh shapes have empty meshes.
     pub fn scene(&self) -> &Scene {
         &self.scene

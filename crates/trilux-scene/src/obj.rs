@@ -11,13 +11,13 @@
 //! the weighting Mitsuba's `recompute_vertex_normals` uses). With
 //! `face_normals` there are none.
 //!
-//! The file must be a regular file of at most [`MAX_OBJ_BYTES`]
+//! The file must be a regular file of at most [`MAX_MESH_BYTES`]
 //! (`/dev/zero` is an error, not an endless read); [`parse_obj`] reads the
 //! same format from bytes already in memory.
 
 use std::path::Path;
 
-use crate::limits::MAX_OBJ_BYTES;
+use crate::limits::MAX_MESH_BYTES;
 
 use glam::{DVec2, DVec3};
 use trilux_geometry::TriangleMesh;
@@ -50,7 +50,7 @@ pub enum ObjError {
         path: std::path::PathBuf,
     },
     /// The mesh has more triangles or vertices than the loader takes.
-    #[error("OBJ file {} has {triangles} triangles and {vertices} vertices; the limits are {} and {} (docs/limits.md)", path.display(), crate::limits::MAX_OBJ_TRIANGLES, crate::limits::MAX_OBJ_VERTICES)]
+    #[error("OBJ file {} has {triangles} triangles and {vertices} vertices; the limits are {} and {} (docs/limits.md)", path.display(), crate::limits::MAX_MESH_TRIANGLES, crate::limits::MAX_MESH_VERTICES)]
     TooLarge {
         /// The OBJ file.
         path: std::path::PathBuf,
@@ -74,10 +74,11 @@ pub fn load_obj(
     face_normals: bool,
     flip_tex_coords: bool,
 ) -> Result<TriangleMesh, ObjError> {
-    let bytes = trilux_files::read_limited(path, MAX_OBJ_BYTES).map_err(|source| ObjError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let bytes =
+        trilux_files::read_limited(path, MAX_MESH_BYTES).map_err(|source| ObjError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
     parse_obj(&bytes, path, face_normals, flip_tex_coords)
 }
 
@@ -91,7 +92,7 @@ pub fn parse_obj(
     // Before tobj spends memory on them: every face line makes at least
     // one triangle, every vertex line one position.
     let (faces, positions) = count_lines(bytes);
-    if faces > crate::limits::MAX_OBJ_TRIANGLES || positions > crate::limits::MAX_OBJ_VERTICES {
+    if faces > crate::limits::MAX_MESH_TRIANGLES || positions > crate::limits::MAX_MESH_VERTICES {
         return Err(ObjError::TooLarge {
             path: path.to_path_buf(),
             triangles: faces,
@@ -104,6 +105,13 @@ pub fn parse_obj(
             reason: format!("a face refers to vertex index {index}, which no vertex line has"),
         });
     }
+    let models = load_models(bytes, path)?;
+    merge_models(&models, path, face_normals, flip_tex_coords)
+}
+
+/// The OBJ's models as tobj reads them (triangulated, one index per
+/// vertex), refused beyond the mesh limits.
+fn load_models(bytes: &[u8], path: &Path) -> Result<Vec<tobj::Model>, ObjError> {
     let options = tobj::LoadOptions {
         single_index: true,
         triangulate: true,
@@ -120,13 +128,26 @@ pub fn parse_obj(
 
     let triangles: usize = models.iter().map(|m| m.mesh.indices.len() / 3).sum();
     let vertices: usize = models.iter().map(|m| m.mesh.positions.len() / 3).sum();
-    if triangles > crate::limits::MAX_OBJ_TRIANGLES || vertices > crate::limits::MAX_OBJ_VERTICES {
+    if triangles > crate::limits::MAX_MESH_TRIANGLES || vertices > crate::limits::MAX_MESH_VERTICES
+    {
         return Err(ObjError::TooLarge {
             path: path.to_path_buf(),
             triangles,
             vertices,
         });
     }
+    Ok(models)
+}
+
+/// One [`TriangleMesh`] from all the models: positions, normals (kept
+/// only if every model has them, else computed per vertex) and texture
+/// coordinates (kept only if every model has them, `v` flipped if asked).
+fn merge_models(
+    models: &[tobj::Model],
+    path: &Path,
+    face_normals: bool,
+    flip_tex_coords: bool,
+) -> Result<TriangleMesh, ObjError> {
     let mut mesh = TriangleMesh {
         face_normals,
         ..Default::default()
@@ -135,7 +156,7 @@ pub fn parse_obj(
     let mut all_have_normals = true;
     let mut texcoords = Vec::new();
     let mut all_have_texcoords = true;
-    for model in &models {
+    for model in models {
         let m = &model.mesh;
         let base = mesh.positions.len() as u32;
         let count = m.positions.len() / 3;

@@ -13,7 +13,7 @@
 //! recomputed, none with `face_normals`.
 //!
 //! Memory is bounded before it is spent: the file is at most
-//! [`MAX_OBJ_BYTES`] and the counts the header declares must fit in the
+//! [`MAX_MESH_BYTES`] and the counts the header declares must fit in the
 //! file and within the mesh limits.
 
 use std::path::{Path, PathBuf};
@@ -21,7 +21,7 @@ use std::path::{Path, PathBuf};
 use glam::{DVec2, DVec3};
 use trilux_geometry::TriangleMesh;
 
-use crate::limits::{MAX_OBJ_BYTES, MAX_OBJ_TRIANGLES, MAX_OBJ_VERTICES};
+use crate::limits::{MAX_MESH_BYTES, MAX_MESH_TRIANGLES, MAX_MESH_VERTICES};
 use crate::obj::vertex_normals;
 
 /// Why a PLY file could not be read (the caller adds the scene location).
@@ -55,7 +55,7 @@ pub enum PlyError {
         path: PathBuf,
     },
     /// The header declares more than the loader takes.
-    #[error("PLY file {} declares {faces} faces and {vertices} vertices; the limits are {MAX_OBJ_TRIANGLES} triangles and {MAX_OBJ_VERTICES} vertices (docs/limits.md)", path.display())]
+    #[error("PLY file {} declares {faces} faces and {vertices} vertices; the limits are {MAX_MESH_TRIANGLES} triangles and {MAX_MESH_VERTICES} vertices (docs/limits.md)", path.display())]
     TooLarge {
         /// The PLY file.
         path: PathBuf,
@@ -79,10 +79,11 @@ pub fn load_ply(
     face_normals: bool,
     flip_tex_coords: bool,
 ) -> Result<TriangleMesh, PlyError> {
-    let bytes = trilux_files::read_limited(path, MAX_OBJ_BYTES).map_err(|source| PlyError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let bytes =
+        trilux_files::read_limited(path, MAX_MESH_BYTES).map_err(|source| PlyError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
     parse_ply(&bytes, path, face_normals, flip_tex_coords)
 }
 
@@ -316,7 +317,7 @@ impl Header {
         let needed = self.elements.iter().try_fold(0usize, |sum, e| {
             sum.checked_add(e.count.checked_mul(e.min_bytes(self.format).max(1))?)
         });
-        if faces > MAX_OBJ_TRIANGLES || vertices > MAX_OBJ_VERTICES {
+        if faces > MAX_MESH_TRIANGLES || vertices > MAX_MESH_VERTICES {
             return Err(PlyError::TooLarge {
                 path: path.to_path_buf(),
                 faces,
@@ -554,9 +555,9 @@ impl RawMesh {
             }
             self.max_index = self.max_index.max(i as u32);
         }
-        if self.triangles.len() + list.len() - 2 > MAX_OBJ_TRIANGLES {
+        if self.triangles.len() + list.len() - 2 > MAX_MESH_TRIANGLES {
             return Err(format!(
-                "the faces make more than {MAX_OBJ_TRIANGLES} triangles (docs/limits.md)"
+                "the faces make more than {MAX_MESH_TRIANGLES} triangles (docs/limits.md)"
             ));
         }
         // Integers within u32 (checked above): `as` is exact.

@@ -15,13 +15,13 @@
 
 use std::path::Path;
 
-use glam::{DMat3, DVec3};
+use glam::{DMat3, DMat4, DVec3};
 use trilux_geometry::limits::{MAX_COORDINATE, within};
-use trilux_geometry::{Shape, ShapeKind};
+use trilux_geometry::{Shape, ShapeKind, coordinate_system};
 
 use crate::error::{Result, SceneError, SourceLocation};
 use crate::props::Props;
-use crate::transform::{coordinate_system, linear_part};
+use crate::transform::linear_part;
 
 /// Surface area of a shape in world space (one side).
 ///
@@ -153,7 +153,44 @@ pub(crate) fn build_shape(
         .map(|t| t.matrix)
         .unwrap_or_default();
     let flip_normals = props.boolean("flip_normals")?.unwrap_or(false);
-    let l: DMat3 = linear_part(&to_world);
+    let l = check_to_world(props, &to_world)?;
+    let mut request = None;
+    let plugin = e.plugin_type()?;
+    let kind = match plugin {
+        "rectangle" => ShapeKind::Rectangle,
+        "cube" => ShapeKind::Cube,
+        "disk" => ShapeKind::Disk,
+        "sphere" => sphere(props, &l)?,
+        "cylinder" => cylinder(props, &l)?,
+        "obj" | "ply" => {
+            let (kind, mesh) = mesh(props, plugin, folder)?;
+            request = Some(mesh);
+            kind
+        }
+        other => {
+            return Err(SceneError::at(
+                &e.required("type")?.loc,
+                format!(
+                    "unknown shape plugin \"{other}\" (supported: rectangle, cube, disk, sphere, cylinder, obj, ply)"
+                ),
+            ));
+        }
+    };
+    let shape = Shape {
+        kind,
+        world_from_object: to_world,
+        flip_normals,
+    };
+    if request.is_none() {
+        check_area(&shape, &e.loc, &e.describe())?;
+    }
+    Ok((shape, request))
+}
+
+/// Refuses a `to_world` beyond the coordinate limits or singular; returns
+/// its linear part.
+fn check_to_world(props: &Props<'_>, to_world: &DMat4) -> Result<DMat3> {
+    let l: DMat3 = linear_part(to_world);
     let largest = to_world
         .to_cols_array()
         .into_iter()
@@ -174,103 +211,93 @@ pub(crate) fn build_shape(
             "to_world is singular (a zero scale?): the shape would have no area or no normal",
         ));
     }
-    let positive = |name: &str, default: f64| -> Result<f64> {
-        let v = props.float(name)?.unwrap_or(default);
-        if v <= 0.0 {
-            return Err(SceneError::at(
-                &props.loc(name),
-                format!("{name} must be positive, found {v}"),
-            ));
-        }
-        Ok(v)
-    };
-    let mut request = None;
-    let plugin = e.plugin_type()?;
-    let kind = match plugin {
-        "rectangle" => ShapeKind::Rectangle,
-        "cube" => ShapeKind::Cube,
-        "disk" => ShapeKind::Disk,
-        "sphere" => {
-            let center = props.vec3("center")?.unwrap_or(DVec3::ZERO);
-            let radius = positive("radius", 1.0)?;
-            if !(same_length_orthogonal(l.x_axis, l.y_axis)
-                && same_length_orthogonal(l.y_axis, l.z_axis)
-                && same_length_orthogonal(l.x_axis, l.z_axis))
-            {
-                return Err(SceneError::at(
-                    &props.loc("to_world"),
-                    "a sphere's to_world must scale uniformly (no non-uniform scale or shear)",
-                ));
-            }
-            ShapeKind::Sphere { center, radius }
-        }
-        "cylinder" => {
-            let p0 = props.vec3("p0")?.unwrap_or(DVec3::ZERO);
-            let p1 = props.vec3("p1")?.unwrap_or(DVec3::Z);
-            let radius = positive("radius", 1.0)?;
-            let (s, t, n) = cylinder_frame(p0, p1);
-            if n == DVec3::ZERO {
-                return Err(SceneError::at(
-                    &props.loc("p1"),
-                    "cylinder p0 and p1 are the same point (zero length)",
-                ));
-            }
-            let (ws, wt, wn) = (l * s, l * t, l * n);
-            let tol = 1e-6 * ws.length() * wn.length();
-            if !same_length_orthogonal(ws, wt) || ws.dot(wn).abs() > tol || wt.dot(wn).abs() > tol {
-                return Err(SceneError::at(
-                    &props.loc("to_world"),
-                    "a cylinder's to_world must keep its cross-section circular and its axis perpendicular to it",
-                ));
-            }
-            ShapeKind::Cylinder { p0, p1, radius }
-        }
-        "obj" | "ply" => {
-            let name = props.string("filename")?.ok_or_else(|| {
-                SceneError::at(
-                    &e.loc,
-                    format!("<shape type=\"{plugin}\"> needs <string name=\"filename\">"),
-                )
-            })?;
-            let face_normals = props.boolean("face_normals")?.unwrap_or(false);
-            let format = match plugin {
-                "obj" => MeshFormat::Obj,
-                _ => MeshFormat::Ply,
-            };
-            let flip_tex_coords = props
-                .boolean("flip_tex_coords")?
-                .unwrap_or(format.flips_by_default());
-            request = Some(MeshRequest {
-                format,
-                path: folder.join(&name),
-                face_normals,
-                flip_tex_coords,
-                filename: props.loc("filename"),
-                shape: e.loc.clone(),
-            });
-            ShapeKind::Mesh(trilux_geometry::TriangleMesh {
-                face_normals,
-                ..Default::default()
-            })
-        }
-        other => {
-            return Err(SceneError::at(
-                &e.required("type")?.loc,
-                format!(
-                    "unknown shape plugin \"{other}\" (supported: rectangle, cube, disk, sphere, cylinder, obj, ply)"
-                ),
-            ));
-        }
-    };
-    let shape = Shape {
-        kind,
-        world_from_object: to_world,
-        flip_normals,
-    };
-    if request.is_none() {
-        check_area(&shape, &e.loc, &e.describe())?;
+    Ok(l)
+}
+
+/// The float parameter `name` (else `default`), which must be positive.
+fn positive(props: &Props<'_>, name: &str, default: f64) -> Result<f64> {
+    let v = props.float(name)?.unwrap_or(default);
+    if v <= 0.0 {
+        return Err(SceneError::at(
+            &props.loc(name),
+            format!("{name} must be positive, found {v}"),
+        ));
     }
-    Ok((shape, request))
+    Ok(v)
+}
+
+/// A `sphere`: its centre and radius; `l` (its `to_world`'s linear part)
+/// must scale uniformly, or it would be an ellipsoid.
+fn sphere(props: &Props<'_>, l: &DMat3) -> Result<ShapeKind> {
+    let center = props.vec3("center")?.unwrap_or(DVec3::ZERO);
+    let radius = positive(props, "radius", 1.0)?;
+    if !(same_length_orthogonal(l.x_axis, l.y_axis)
+        && same_length_orthogonal(l.y_axis, l.z_axis)
+        && same_length_orthogonal(l.x_axis, l.z_axis))
+    {
+        return Err(SceneError::at(
+            &props.loc("to_world"),
+            "a sphere's to_world must scale uniformly (no non-uniform scale or shear)",
+        ));
+    }
+    Ok(ShapeKind::Sphere { center, radius })
+}
+
+/// A `cylinder` from `p0` to `p1`; `l` must keep its cross-section a
+/// circle perpendicular to its axis.
+fn cylinder(props: &Props<'_>, l: &DMat3) -> Result<ShapeKind> {
+    let p0 = props.vec3("p0")?.unwrap_or(DVec3::ZERO);
+    let p1 = props.vec3("p1")?.unwrap_or(DVec3::Z);
+    let radius = positive(props, "radius", 1.0)?;
+    let (s, t, n) = cylinder_frame(p0, p1);
+    if n == DVec3::ZERO {
+        return Err(SceneError::at(
+            &props.loc("p1"),
+            "cylinder p0 and p1 are the same point (zero length)",
+        ));
+    }
+    let (ws, wt, wn) = (*l * s, *l * t, *l * n);
+    let tol = 1e-6 * ws.length() * wn.length();
+    if !same_length_orthogonal(ws, wt) || ws.dot(wn).abs() > tol || wt.dot(wn).abs() > tol {
+        return Err(SceneError::at(
+            &props.loc("to_world"),
+            "a cylinder's to_world must keep its cross-section circular and its axis perpendicular to it",
+        ));
+    }
+    Ok(ShapeKind::Cylinder { p0, p1, radius })
+}
+
+/// An `obj` or `ply` shape: an empty mesh (with its `face_normals` choice)
+/// and the request to read its file, relative to `folder`.
+fn mesh(props: &Props<'_>, plugin: &str, folder: &Path) -> Result<(ShapeKind, MeshRequest)> {
+    let e = props.owner();
+    let name = props.string("filename")?.ok_or_else(|| {
+        SceneError::at(
+            &e.loc,
+            format!("<shape type=\"{plugin}\"> needs <string name=\"filename\">"),
+        )
+    })?;
+    let face_normals = props.boolean("face_normals")?.unwrap_or(false);
+    let format = match plugin {
+        "obj" => MeshFormat::Obj,
+        _ => MeshFormat::Ply,
+    };
+    let flip_tex_coords = props
+        .boolean("flip_tex_coords")?
+        .unwrap_or(format.flips_by_default());
+    let request = MeshRequest {
+        format,
+        path: folder.join(&name),
+        face_normals,
+        flip_tex_coords,
+        filename: props.loc("filename"),
+        shape: e.loc.clone(),
+    };
+    let kind = ShapeKind::Mesh(trilux_geometry::TriangleMesh {
+        face_normals,
+        ..Default::default()
+    });
+    Ok((kind, request))
 }
 
 /// Refuses a shape of zero (or non-finite) area, at `loc`.

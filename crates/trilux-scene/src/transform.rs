@@ -9,7 +9,7 @@ use serde::Serialize;
 use trilux_geometry::limits::{beyond, within};
 
 use crate::error::{Result, SceneError, SourceLocation};
-use crate::value::{parse_f64, parse_list, parse_n, parse_xyz};
+use crate::numbers::{parse_f64, parse_list, parse_n, parse_xyz};
 use crate::xml::Element;
 
 /// A camera placement as written in `<lookat origin target up>`.
@@ -172,7 +172,7 @@ fn parse_lookat(op: &Element) -> Result<LookAt> {
     let up = match vec3_attr(op, "up")? {
         Some(up) => up,
         // Mitsuba picks the first vector of its orthonormal basis around dir.
-        None => coordinate_system(dir.normalize()).0,
+        None => trilux_geometry::coordinate_system(dir.normalize()).0,
     };
     Ok(LookAt { origin, target, up })
 }
@@ -187,18 +187,6 @@ pub(crate) fn world_from_camera(l: &LookAt, loc: &SourceLocation) -> Result<DMat
             "<lookat> up is parallel to the viewing direction (or zero)",
         )
     })
-}
-
-/// Duff et al.'s branchless orthonormal basis around the unit vector `n`, as
-/// Mitsuba's `coordinate_system` computes it.
-pub(crate) fn coordinate_system(n: DVec3) -> (DVec3, DVec3) {
-    let sign = 1f64.copysign(n.z);
-    let a = -1.0 / (sign + n.z);
-    let b = n.x * n.y * a;
-    (
-        DVec3::new(n.x * n.x * a * sign + 1.0, b * sign, -n.x * sign),
-        DVec3::new(b, sign + n.y * n.y * a, -n.y),
-    )
 }
 
 /// The linear 3×3 part of an affine transform.

@@ -142,6 +142,19 @@ pub(crate) struct PrimHit {
     pub bary: DVec2,
 }
 
+/// Size and build time of a scene's BVH.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BvhStats {
+    /// Inner nodes (eight children each).
+    pub nodes: usize,
+    /// Leaves (up to four primitives each).
+    pub leaves: usize,
+    /// Longest root-to-leaf path, in inner nodes.
+    pub depth: usize,
+    /// Wall-clock seconds of the build (binary tree, collapse, leaves).
+    pub build_seconds: f64,
+}
+
 /// The BVH and the primitives it holds.
 #[derive(Clone, Debug)]
 pub(crate) struct Bvh {
@@ -271,8 +284,8 @@ impl Bvh {
     }
 
     /// Size and build time of the tree.
-    pub(crate) fn stats(&self) -> crate::geometry::BvhStats {
-        crate::geometry::BvhStats {
+    pub(crate) fn stats(&self) -> BvhStats {
+        BvhStats {
             nodes: self.wide.nodes.len(),
             leaves: self.wide.leaves.len(),
             depth: self.wide.depth,

@@ -44,11 +44,10 @@
 //! pairs. `spread` is max − min of the point estimates of F_{from→to} seen
 //! during the integration: how much the transfer varies over the integrated
 //! element, the usual refinement oracle.
-
 //!
-//! Submodules: [`cubature`] (integration domains and adaptive rules),
+//! Submodules: `cubature` (integration domains and adaptive rules),
 //! [`lambert`] (the point-to-polygon closed form and its clipping),
-//! [`sampled`] (the stratified estimate for large clusters); this module
+//! `sampled` (the stratified estimate for large clusters); this module
 //! turns elements into domains and polygons and picks the method.
 
 pub(crate) mod cubature;

@@ -98,6 +98,52 @@ pub(crate) fn map(file: &Arc<Path>, m: &gltf::Material<'_>) -> Result<Mapped> {
         )
     };
     refuse_unsupported(m, &at)?;
+    let lobes = lobes(m, &at)?;
+    let pbr = m.pbr_metallic_roughness();
+    let base_texture = pbr
+        .base_color_texture()
+        .map(|t| {
+            let suffix = "/pbrMetallicRoughness/baseColorTexture";
+            let location = SourceLocation::json(file, format!("{base}{suffix}"));
+            texture_info(&t, &at, suffix, location)
+        })
+        .transpose()?;
+    let (bsdf, mut types, mut textures) = lobe_bsdf(&lobes, base_texture.as_ref());
+    let bsdf = if m.double_sided() {
+        types.push("twosided");
+        for t in &mut textures {
+            t.path.insert(0, Branch::Front);
+        }
+        BsdfParams::TwoSided {
+            front: Box::new(bsdf),
+            back: None,
+        }
+    } else {
+        bsdf
+    };
+    Ok(Mapped {
+        bsdf,
+        textures,
+        emission: emission(m, &at)?,
+        types,
+    })
+}
+
+/// The material's two lobes as the module's header derives them: the
+/// diffuse part D = d_scale ⊙ texture and the specular part
+/// S = s_offset + s_scale ⊙ texture, with their largest values D̂ and Ŝ.
+struct Lobes {
+    rough: f64,
+    d_scale: [f64; 3],
+    s_scale: [f64; 3],
+    s_offset: [f64; 3],
+    d_hat: f64,
+    s_hat: f64,
+}
+
+/// The [`Lobes`] of `m`'s factors (clamped to [0, 1]; refused unless
+/// finite).
+fn lobes(m: &gltf::Material<'_>, at: &At<'_>) -> Result<Lobes> {
     let pbr = m.pbr_metallic_roughness();
     let f = pbr.base_color_factor();
     let b = [f[0], f[1], f[2]].map(|v| f64::from(v).clamp(0.0, 1.0));
@@ -126,14 +172,34 @@ pub(crate) fn map(file: &Arc<Path>, m: &gltf::Material<'_>) -> Result<Mapped> {
     let s_offset = f0.map(|c| (1.0 - metal) * c);
     let d_hat = (1.0 - metal) * (1.0 - fmax) * bmax;
     let s_hat = (0..3).map(|c| s_offset[c] + s_scale[c]).fold(0.0, f64::max);
-    let base_texture = pbr
-        .base_color_texture()
-        .map(|t| {
-            let suffix = "/pbrMetallicRoughness/baseColorTexture";
-            let location = SourceLocation::json(file, format!("{base}{suffix}"));
-            texture_info(&t, &at, suffix, location)
-        })
-        .transpose()?;
+    Ok(Lobes {
+        rough,
+        d_scale,
+        s_scale,
+        s_offset,
+        d_hat,
+        s_hat,
+    })
+}
+
+/// The base colour texture as [`texture_info`] reads it.
+type BaseTexture = (usize, Sampling, UvTransform, SourceLocation);
+
+/// The BSDF of the lobes (diffuse alone, conductor alone, or their blend),
+/// its BSDF type names, and the uses of the base colour texture (one per
+/// slot it scales).
+fn lobe_bsdf(
+    lobes: &Lobes,
+    base_texture: Option<&BaseTexture>,
+) -> (BsdfParams, Vec<&'static str>, Vec<TextureUse>) {
+    let Lobes {
+        rough,
+        d_scale,
+        s_scale,
+        s_offset,
+        d_hat,
+        s_hat,
+    } = *lobes;
     let conductor = |spec: [f64; 3]| {
         BsdfParams::RoughConductor(RoughConductorParams {
             distribution: Distribution::Ggx,
@@ -144,7 +210,7 @@ pub(crate) fn map(file: &Arc<Path>, m: &gltf::Material<'_>) -> Result<Mapped> {
     };
     let mut textures = Vec::new();
     let mut add = |path: Vec<Branch>, kind, scale: [f64; 3], offset: [f64; 3]| {
-        if let Some((image, sampling, to_uv, location)) = &base_texture
+        if let Some((image, sampling, to_uv, location)) = base_texture
             && scale.iter().any(|&s| s > 0.0)
         {
             textures.push(TextureUse {
@@ -159,7 +225,7 @@ pub(crate) fn map(file: &Arc<Path>, m: &gltf::Material<'_>) -> Result<Mapped> {
             });
         }
     };
-    let (bsdf, mut types) = if s_hat <= 0.0 {
+    let (bsdf, types) = if s_hat <= 0.0 {
         add(vec![], SlotKind::Reflectance, d_scale, [0.0; 3]);
         (
             BsdfParams::Diffuse {
@@ -187,24 +253,7 @@ pub(crate) fn map(file: &Arc<Path>, m: &gltf::Material<'_>) -> Result<Mapped> {
         };
         (blend, vec!["blendbsdf", "diffuse", "roughconductor"])
     };
-    let bsdf = if m.double_sided() {
-        types.push("twosided");
-        for t in &mut textures {
-            t.path.insert(0, Branch::Front);
-        }
-        BsdfParams::TwoSided {
-            front: Box::new(bsdf),
-            back: None,
-        }
-    } else {
-        bsdf
-    };
-    Ok(Mapped {
-        bsdf,
-        textures,
-        emission: emission(m, &at)?,
-        types,
-    })
+    (bsdf, types, textures)
 }
 
 type At<'a> = dyn Fn(&str, String) -> SceneError + 'a;

@@ -2,16 +2,16 @@
 //! `.glb`) into the same [`Scene`] as the Mitsuba XML subset, with the
 //! `gltf` crate's JSON parsing and validation (indices in range, required
 //! fields) and without its `import` feature: buffers and images are
-//! resolved here, with bounded reads ([`buffers`]).
+//! resolved here, with bounded reads (`buffers`).
 //!
 //! Stages, as for XML:
-//! 1. [`open`]: the file (bounded), its JSON validated, required extensions
-//!    checked, the default scene's node hierarchy walked ([`nodes`]): every
+//! 1. `open`: the file (bounded), its JSON validated, required extensions
+//!    checked, the default scene's node hierarchy walked (`nodes`): every
 //!    mesh primitive of every node becomes one shape (one input-surface
 //!    chart set per primitive, as an OBJ), its material mapped
-//!    ([`material`]), the camera chosen. Nothing large is read yet.
-//! 2. [`GltfMeshes::finish`] (from [`crate::Pending::finish`]): the buffers
-//!    are read, the accessors checked and read ([`accessor`]), each mesh
+//!    (`material`), the camera chosen. Nothing large is read yet.
+//! 2. `GltfMeshes::finish` (from [`crate::Pending::finish`]): the buffers
+//!    are read, the accessors checked and read (`accessor`), each mesh
 //!    put into world space (so a mirroring node keeps glTF's winding rule),
 //!    and the textures requested.
 //!
@@ -27,7 +27,7 @@ use std::sync::Arc;
 
 use crate::error::{Result, SceneError, SourceLocation};
 use crate::limits::{MAX_GLB_BYTES, MAX_SCENE_BYTES};
-use crate::meshes::{Pending, Requests};
+use crate::scene::Scene;
 
 pub(crate) use nodes::GltfMeshes;
 
@@ -47,10 +47,10 @@ pub fn is_gltf(path: &Path) -> bool {
         .is_some_and(|e| e.eq_ignore_ascii_case("gltf") || e.eq_ignore_ascii_case("glb"))
 }
 
-/// Reads and checks a glTF file, all but its buffers and images; `camera`
-/// names the camera to use (a camera's or its node's name), else the first
-/// one in the scene.
-pub(crate) fn open(path: &Path, camera: Option<&str>) -> Result<Pending> {
+/// Reads and checks a glTF file, all but its buffers and images (the
+/// returned [`GltfMeshes`] read them); `camera` names the camera to use (a
+/// camera's or its node's name), else the first one in the scene.
+pub(crate) fn open(path: &Path, camera: Option<&str>) -> Result<(Scene, GltfMeshes)> {
     let file: Arc<Path> = Arc::from(path);
     let glb = path
         .extension()
@@ -66,7 +66,11 @@ pub(crate) fn open(path: &Path, camera: Option<&str>) -> Result<Pending> {
 
 /// [`open`] on the bytes of a glTF or GLB file; `file` names it in errors
 /// and anchors relative URIs.
-pub(crate) fn open_bytes(bytes: &[u8], file: &Arc<Path>, camera: Option<&str>) -> Result<Pending> {
+pub(crate) fn open_bytes(
+    bytes: &[u8],
+    file: &Arc<Path>,
+    camera: Option<&str>,
+) -> Result<(Scene, GltfMeshes)> {
     let gltf = parse(bytes, file)?;
     if let Some(ext) = gltf
         .document
@@ -81,14 +85,7 @@ pub(crate) fn open_bytes(bytes: &[u8], file: &Arc<Path>, camera: Option<&str>) -
             ),
         ));
     }
-    let (scene, meshes) = nodes::build(file, gltf, camera)?;
-    Ok(Pending::new(
-        scene,
-        Requests {
-            gltf: Some(meshes),
-            ..Requests::default()
-        },
-    ))
+    nodes::build(file, gltf, camera)
 }
 
 /// A `gltf` crate error as one located line.

@@ -38,7 +38,7 @@ use super::material::{Mapped, TextureUse, map};
 use crate::camera::{Camera, FovAxis, ReconstructionFilter};
 use crate::error::{Result, SceneError, SourceLocation};
 use crate::limits::{
-    MAX_GLTF_NODES, MAX_GLTF_TRIANGLES, MAX_NODE_DEPTH, MAX_OBJ_TRIANGLES, MAX_OBJ_VERTICES,
+    MAX_GLTF_NODES, MAX_GLTF_TRIANGLES, MAX_MESH_TRIANGLES, MAX_MESH_VERTICES, MAX_NODE_DEPTH,
 };
 use crate::scene::{AreaEmitter, Scene, SceneShape};
 use crate::shape::check_area;
@@ -505,9 +505,9 @@ impl GltfMeshes {
         let pos_acc = get(gltf::Semantic::Positions).ok_or_else(|| at("no POSITION".into()))?;
         let pos = accessor::read(&self.file, buffers, &pos_acc, Kind::Vec3, "POSITION")?;
         let n = pos.len() / 3;
-        if n > MAX_OBJ_VERTICES {
+        if n > MAX_MESH_VERTICES {
             return Err(at(format!(
-                "{n} vertices; the limit is {MAX_OBJ_VERTICES} (docs/limits.md)"
+                "{n} vertices; the limit is {MAX_MESH_VERTICES} (docs/limits.md)"
             )));
         }
         let mut attribute =
@@ -543,9 +543,9 @@ impl GltfMeshes {
                 indices.len()
             )));
         }
-        if indices.len() / 3 > MAX_OBJ_TRIANGLES {
+        if indices.len() / 3 > MAX_MESH_TRIANGLES {
             return Err(at(format!(
-                "{} triangles; the limit is {MAX_OBJ_TRIANGLES} (docs/limits.md)",
+                "{} triangles; the limit is {MAX_MESH_TRIANGLES} (docs/limits.md)",
                 indices.len() / 3
             )));
         }
