@@ -130,6 +130,7 @@ fn module_of(relative: &Path) -> Vec<String> {
 /// Runs the three checks on one crate's files.
 fn check_crate(files: &[SourceFile], report: &mut Report) {
     let mut references = Vec::new();
+    let mut test_only: Vec<Vec<String>> = Vec::new();
     for file in files {
         let lines = file.text.lines().count();
         if lines > MAX_FILE_LINES {
@@ -157,11 +158,63 @@ fn check_crate(files: &[SourceFile], report: &mut Report) {
                 report.longest_fn = Some((file.path.clone(), f.name.clone(), f.lines));
             }
         }
-        for r in module_references(&tokens, &file.module) {
+        let (production, test_modules) = without_test_code(&tokens);
+        test_only.extend(test_modules.into_iter().map(|name| {
+            let mut m = file.module.clone();
+            m.push(name);
+            m
+        }));
+        for r in module_references(&production, &file.module) {
             references.push((file, r));
         }
     }
+    // A test module may build on any part of its crate: only the code that
+    // ships counts towards the module graph.
+    references.retain(|(f, _)| !test_only.iter().any(|m| f.module.starts_with(m)));
     report.offences.extend(cycles(files, &references));
+}
+
+/// The token stream without the items marked `#[cfg(test)]` (an inline
+/// `mod tests { … }`, a test-only function, a `mod name;` declaration),
+/// and the names of the test-only modules declared in other files.
+fn without_test_code(tokens: &[(Token, usize)]) -> (Vec<(Token, usize)>, Vec<String>) {
+    let ident = |t: &Token, w: &str| matches!(t, Token::Ident(x) if x == w);
+    let is_cfg_test = |k: usize| {
+        let want = ["#", "[", "cfg", "(", "test", ")", "]"];
+        want.iter().enumerate().all(|(i, w)| {
+            tokens.get(k + i).is_some_and(|(t, _)| match t {
+                Token::Punct(c) => c.to_string() == *w,
+                Token::Ident(x) => x == w,
+                Token::PathSep => false,
+            })
+        })
+    };
+    let (mut kept, mut test_modules) = (Vec::new(), Vec::new());
+    let mut k = 0;
+    while k < tokens.len() {
+        if !is_cfg_test(k) {
+            kept.push(tokens[k].clone());
+            k += 1;
+            continue;
+        }
+        // Skip the attribute, then the item: to its `;` or its body's end.
+        let mut j = k + 7;
+        while j < tokens.len() && !matches!(tokens[j].0, Token::Punct(';' | '{')) {
+            j += 1;
+        }
+        if tokens.get(j).is_some_and(|(t, _)| *t == Token::Punct(';')) {
+            if let (Some((m, _)), Some((Token::Ident(name), _))) =
+                (tokens.get(j.wrapping_sub(2)), tokens.get(j.wrapping_sub(1)))
+                && ident(m, "mod")
+            {
+                test_modules.push(name.clone());
+            }
+            k = j + 1;
+        } else {
+            k = matching_brace(tokens, j).map_or(tokens.len(), |e| e + 1);
+        }
+    }
+    (kept, test_modules)
 }
 
 /// The module cycles among siblings, for every directory module (and the
@@ -753,6 +806,28 @@ mod tests {
         let offences = check(&nested).offences;
         assert_eq!(offences.len(), 2, "{offences:?}");
         assert!(offences[0].contains("module cycle in crate::d {x, y}"));
+    }
+
+    #[test]
+    fn test_code_does_not_count_towards_the_module_graph() {
+        let files = vec![
+            file("src/lib.rs", &[], "mod a; mod b;\n#[cfg(test)]\nmod fixtures;"),
+            file("src/a.rs", &["a"], "use crate::b::X;"),
+            file(
+                "src/b.rs",
+                &["b"],
+                "pub struct X;\n#[cfg(test)]\nmod tests {\n use crate::a::f;\n}",
+            ),
+            file("src/fixtures.rs", &["fixtures"], "use crate::a::f; use crate::b::X;"),
+        ];
+        assert!(check(&files).offences.is_empty());
+        // The same reference outside a test module is a cycle.
+        let files = vec![
+            file("src/lib.rs", &[], "mod a; mod b;"),
+            file("src/a.rs", &["a"], "use crate::b::X;"),
+            file("src/b.rs", &["b"], "pub struct X;\nmod tests {\n use crate::a::f;\n}"),
+        ];
+        assert_eq!(check(&files).offences.len(), 2);
     }
 
     #[test]
