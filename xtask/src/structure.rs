@@ -811,21 +811,33 @@ mod tests {
     #[test]
     fn test_code_does_not_count_towards_the_module_graph() {
         let files = vec![
-            file("src/lib.rs", &[], "mod a; mod b;\n#[cfg(test)]\nmod fixtures;"),
+            file(
+                "src/lib.rs",
+                &[],
+                "mod a; mod b;\n#[cfg(test)]\nmod fixtures;",
+            ),
             file("src/a.rs", &["a"], "use crate::b::X;"),
             file(
                 "src/b.rs",
                 &["b"],
                 "pub struct X;\n#[cfg(test)]\nmod tests {\n use crate::a::f;\n}",
             ),
-            file("src/fixtures.rs", &["fixtures"], "use crate::a::f; use crate::b::X;"),
+            file(
+                "src/fixtures.rs",
+                &["fixtures"],
+                "use crate::a::f; use crate::b::X;",
+            ),
         ];
         assert!(check(&files).offences.is_empty());
         // The same reference outside a test module is a cycle.
         let files = vec![
             file("src/lib.rs", &[], "mod a; mod b;"),
             file("src/a.rs", &["a"], "use crate::b::X;"),
-            file("src/b.rs", &["b"], "pub struct X;\nmod tests {\n use crate::a::f;\n}"),
+            file(
+                "src/b.rs",
+                &["b"],
+                "pub struct X;\nmod tests {\n use crate::a::f;\n}",
+            ),
         ];
         assert_eq!(check(&files).offences.len(), 2);
     }
