@@ -61,7 +61,18 @@ fn ci() -> Result<()> {
     // Every declared dependency used (a text check, see deps.rs for why
     // not cargo-machete).
     deps::main()?;
-    // Every feature on, so that optional code (`trace-stats`) compiles.
+    run(
+        "cargo",
+        &[
+            "clippy",
+            "--workspace",
+            "--all-targets",
+            "--",
+            "-D",
+            "warnings",
+        ],
+    )?;
+    // Every feature on too, so that optional code (`trace-stats`) compiles.
     // The MSRV is checked here too: clippy's `incompatible_msrv` lint
     // (on by default) refuses any standard-library item newer than the
     // `rust-version` each package inherits from the workspace manifest
