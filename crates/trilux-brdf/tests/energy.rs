@@ -10,7 +10,7 @@ use trilux_brdf::{Bsdf, Distribution};
 
 /// docs/validation.md, "Microfacet directional albedo", separable Smith column
 /// (computed there with the exact Smith G1; Mitsuba's rational Beckmann G1
-/// differs by < 0.35%, inside the 0.005 tolerance of issue 3).
+/// differs by < 0.35%, inside this test's 0.005 tolerance).
 const TABLE: [(Distribution, f64, [f64; 4]); 8] = [
     (Distribution::Beckmann, 0.1, [1.000, 1.000, 1.000, 0.938]),
     (Distribution::Beckmann, 0.3, [1.000, 0.967, 0.923, 0.913]),

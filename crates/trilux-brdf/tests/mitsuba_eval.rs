@@ -3,7 +3,7 @@
 //! The reference values were made once by
 //! `crates/trilux-brdf/tools/gen_mitsuba_eval.py` (Mitsuba 3, scalar_rgb) and
 //! are stored in `tests/data/mitsuba_eval.json`: Mitsuba's eval divided by
-//! |cosθ| of the light direction. Tolerance (issue 3): 1e-4 relative or 1e-6
+//! |cosθ| of the light direction. Tolerance: 1e-4 relative or 1e-6
 //! absolute per channel; Mitsuba computes in f32, so agreement to ~1e-6
 //! relative is what exact formulas give.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic

@@ -18,22 +18,11 @@ use crate::link_sum::LinkCache;
 use crate::records::{BsdfSample, GatherStats, LightSample, LinkVisibility, SurfacePoint};
 use crate::scene::{GatherScene, SolutionGather};
 
-/// An orthonormal frame around `n` (Duff et al. 2017).
-pub fn frame(n: DVec3) -> (DVec3, DVec3) {
-    let s = 1f64.copysign(n.z);
-    let a = -1.0 / (s + n.z);
-    let b = n.x * n.y * a;
-    (
-        DVec3::new(1.0 + s * n.x * n.x * a, s * b, -s * n.x),
-        DVec3::new(b, s + n.y * n.y * a, -n.y),
-    )
-}
-
 /// Cosine-weighted hemisphere direction around `n`.
 pub fn cosine_sample(n: DVec3, u: DVec2) -> DVec3 {
     let r = u.x.sqrt();
     let phi = 2.0 * PI * u.y;
-    let (t, b) = frame(n);
+    let (t, b) = trilux_geometry::coordinate_system(n);
     (t * (r * phi.cos()) + b * (r * phi.sin()) + n * (1.0 - u.x).max(0.0).sqrt()).normalize()
 }
 

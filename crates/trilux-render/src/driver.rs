@@ -298,9 +298,10 @@ fn pilot_mean<S: SolutionGather<N>, const N: usize>(
     ((sum / f64::from(P * P)).max(0.0), stats)
 }
 
-/// Rec. 709 luminance of linear sRGB (0 for a non-finite value).
+/// The luminance of linear sRGB ([`trilux_color::luminance`]), 0 for a
+/// non-finite value: a dropped sample must not poison the running variance.
 fn luminance(rgb: [f64; 3]) -> f64 {
-    let y = 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2];
+    let y = trilux_color::luminance(rgb);
     if y.is_finite() { y } else { 0.0 }
 }
 

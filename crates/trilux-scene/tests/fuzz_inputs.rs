@@ -1,4 +1,4 @@
-//! Mutated OBJ and PLY meshes and scene files (issue 14): 12 000
+//! Mutated OBJ and PLY meshes and scene files: 12 000
 //! corruptions of real OBJ files, 6 000 of ASCII and binary PLY files — bytes, tokens such as `1e30`, `nan`, `-7`, `99999999`
 //! and whole lines of them — each parsed and, when it parses, built into
 //! geometry and a BVH; and 10 000 of the bundled Cornell box, loaded. None
