@@ -18,6 +18,86 @@ use crate::link_sum::LinkCache;
 use crate::records::{BsdfSample, GatherStats, LightSample, LinkVisibility, SurfacePoint};
 use crate::scene::{GatherScene, SolutionGather};
 
+/// [`SolutionGather`] for an analytic scene with no links, no glossy part
+/// and flat shading, whose elements all have the linear size `$size`: the
+/// estimators read nothing from it but the path gather. Stated per scene
+/// (the trait has no defaults), written once.
+macro_rules! path_gather_only {
+    ($scene:ty, $locator:ty, |$this:ident| $size:expr) => {
+        impl<const N: usize> SolutionGather<N> for $scene {
+            fn element_size(&self, _at: &SurfacePoint<$locator>) -> f64 {
+                let $this = self;
+                $size
+            }
+            fn shading_differs(&self, _at: &SurfacePoint<$locator>) -> bool {
+                false
+            }
+            fn has_links(&self) -> bool {
+                false
+            }
+            fn has_glossy_faces(&self) -> bool {
+                false
+            }
+            fn diffuse_albedo(&self, _at: &SurfacePoint<$locator>, _wo: DVec3) -> Spectrum<N> {
+                Spectrum::zero()
+            }
+            fn solution_irradiance(
+                &self,
+                _at: &SurfacePoint<$locator>,
+                _wo: DVec3,
+                _visibility: LinkVisibility<'_>,
+                _cache: &mut LinkCache<N>,
+                _stats: &mut GatherStats,
+            ) -> Option<Spectrum<N>> {
+                None
+            }
+            fn near_correction(
+                &self,
+                _at: &SurfacePoint<$locator>,
+                _wo: DVec3,
+                _coarse_near: &[FaceElement],
+                _cache: &mut LinkCache<N>,
+                _stats: &mut GatherStats,
+            ) -> Option<Spectrum<N>> {
+                None
+            }
+            fn is_glossy(&self, _at: &SurfacePoint<$locator>, _wo: DVec3) -> bool {
+                false
+            }
+            fn glossy_cos(
+                &self,
+                _at: &SurfacePoint<$locator>,
+                _wi: DVec3,
+                _wo: DVec3,
+            ) -> Spectrum<N> {
+                Spectrum::zero()
+            }
+            fn reflected_glossy(
+                &self,
+                _from: &SurfacePoint<$locator>,
+                _to: &SurfacePoint<$locator>,
+            ) -> Spectrum<N> {
+                Spectrum::zero()
+            }
+            fn sample_cosine(
+                &self,
+                _at: &SurfacePoint<$locator>,
+                _wo: DVec3,
+                _u: DVec2,
+            ) -> Option<DVec3> {
+                None
+            }
+            fn mirror(
+                &self,
+                _at: &SurfacePoint<$locator>,
+                _wo: DVec3,
+            ) -> Option<(DVec3, Spectrum<N>)> {
+                None
+            }
+        }
+    };
+}
+
 /// Cosine-weighted hemisphere direction around `n`.
 pub fn cosine_sample(n: DVec3, u: DVec2) -> DVec3 {
     let r = u.x.sqrt();
@@ -167,63 +247,7 @@ impl<const N: usize> GatherScene<N> for Furnace {
     }
 }
 
-/// No links, no glossy part, flat shading: the path gather alone.
-impl<const N: usize> SolutionGather<N> for Furnace {
-    fn element_size(&self, _at: &SurfacePoint<usize>) -> f64 {
-        self.element
-    }
-    fn shading_differs(&self, _at: &SurfacePoint<usize>) -> bool {
-        false
-    }
-    fn has_links(&self) -> bool {
-        false
-    }
-    fn has_glossy_faces(&self) -> bool {
-        false
-    }
-    fn diffuse_albedo(&self, _at: &SurfacePoint<usize>, _wo: DVec3) -> Spectrum<N> {
-        Spectrum::zero()
-    }
-    fn solution_irradiance(
-        &self,
-        _at: &SurfacePoint<usize>,
-        _wo: DVec3,
-        _visibility: LinkVisibility<'_>,
-        _cache: &mut LinkCache<N>,
-        _stats: &mut GatherStats,
-    ) -> Option<Spectrum<N>> {
-        None
-    }
-    fn near_correction(
-        &self,
-        _at: &SurfacePoint<usize>,
-        _wo: DVec3,
-        _coarse_near: &[FaceElement],
-        _cache: &mut LinkCache<N>,
-        _stats: &mut GatherStats,
-    ) -> Option<Spectrum<N>> {
-        None
-    }
-    fn is_glossy(&self, _at: &SurfacePoint<usize>, _wo: DVec3) -> bool {
-        false
-    }
-    fn glossy_cos(&self, _at: &SurfacePoint<usize>, _wi: DVec3, _wo: DVec3) -> Spectrum<N> {
-        Spectrum::zero()
-    }
-    fn reflected_glossy(
-        &self,
-        _from: &SurfacePoint<usize>,
-        _to: &SurfacePoint<usize>,
-    ) -> Spectrum<N> {
-        Spectrum::zero()
-    }
-    fn sample_cosine(&self, _at: &SurfacePoint<usize>, _wo: DVec3, _u: DVec2) -> Option<DVec3> {
-        None
-    }
-    fn mirror(&self, _at: &SurfacePoint<usize>, _wo: DVec3) -> Option<(DVec3, Spectrum<N>)> {
-        None
-    }
-}
+path_gather_only!(Furnace, usize, |scene| scene.element);
 
 /// A diffuse floor z = 0 (albedo `rho`, unbounded) under a square emitter
 /// [-s, s]² at height `h`, facing down with radiance `le`, black itself.
@@ -362,56 +386,4 @@ impl<const N: usize> GatherScene<N> for LitFloor {
     }
 }
 
-/// No links, no glossy part, flat shading: the path gather alone.
-impl<const N: usize> SolutionGather<N> for LitFloor {
-    fn element_size(&self, _at: &SurfacePoint<u8>) -> f64 {
-        0.1
-    }
-    fn shading_differs(&self, _at: &SurfacePoint<u8>) -> bool {
-        false
-    }
-    fn has_links(&self) -> bool {
-        false
-    }
-    fn has_glossy_faces(&self) -> bool {
-        false
-    }
-    fn diffuse_albedo(&self, _at: &SurfacePoint<u8>, _wo: DVec3) -> Spectrum<N> {
-        Spectrum::zero()
-    }
-    fn solution_irradiance(
-        &self,
-        _at: &SurfacePoint<u8>,
-        _wo: DVec3,
-        _visibility: LinkVisibility<'_>,
-        _cache: &mut LinkCache<N>,
-        _stats: &mut GatherStats,
-    ) -> Option<Spectrum<N>> {
-        None
-    }
-    fn near_correction(
-        &self,
-        _at: &SurfacePoint<u8>,
-        _wo: DVec3,
-        _coarse_near: &[FaceElement],
-        _cache: &mut LinkCache<N>,
-        _stats: &mut GatherStats,
-    ) -> Option<Spectrum<N>> {
-        None
-    }
-    fn is_glossy(&self, _at: &SurfacePoint<u8>, _wo: DVec3) -> bool {
-        false
-    }
-    fn glossy_cos(&self, _at: &SurfacePoint<u8>, _wi: DVec3, _wo: DVec3) -> Spectrum<N> {
-        Spectrum::zero()
-    }
-    fn reflected_glossy(&self, _from: &SurfacePoint<u8>, _to: &SurfacePoint<u8>) -> Spectrum<N> {
-        Spectrum::zero()
-    }
-    fn sample_cosine(&self, _at: &SurfacePoint<u8>, _wo: DVec3, _u: DVec2) -> Option<DVec3> {
-        None
-    }
-    fn mirror(&self, _at: &SurfacePoint<u8>, _wo: DVec3) -> Option<(DVec3, Spectrum<N>)> {
-        None
-    }
-}
+path_gather_only!(LitFloor, u8, |_scene| 0.1);
