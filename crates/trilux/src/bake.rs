@@ -87,14 +87,14 @@ pub fn run(args: &BakeArgs) -> Result<()> {
     outputs.write(&files)?;
     crate::warn(&outcome);
     let s = &baked.stats;
-    println!(
-        "wrote {} ({} bytes: {} vertices, {} triangles; baked in {:.2} s)",
+    crate::streams::print(&format!(
+        "wrote {} ({} bytes: {} vertices, {} triangles; baked in {:.2} s)\n",
         args.output.display(),
         s.bytes,
         s.vertices,
         s.triangles,
         s.seconds
-    );
+    ))?;
     if args.open {
         crate::serve::serve(&baked.glb, args.port.unwrap_or(0))?;
     }
