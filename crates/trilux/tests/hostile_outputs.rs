@@ -293,3 +293,43 @@ fn the_default_out_folder_is_made_only_when_something_is_written() {
     assert_ok(&run("sub-scene.xml"));
     assert!(dir.join("out/sub-scene.exr").is_file());
 }
+
+#[test]
+fn an_output_naming_a_folder_is_refused_before_any_work() {
+    let (dir, _scene) = setup("out-folder");
+    std::fs::create_dir(dir.join("sub")).unwrap();
+    let before = snapshot(&dir);
+    // The scene cannot load: an output error instead shows that the
+    // outputs were checked first, before any solve.
+    let m = dir.join("missing-mesh.xml");
+    let p = |name: &str| dir.join(name).to_string_lossy().into_owned();
+    for (command, flag, out) in [
+        ("solve", "-o", p("new/")),
+        ("solve", "-o", p("sub/")),
+        ("solve", "-o", p("sub")),
+        ("solve", "--stats", p("new/")),
+        ("render", "-o", p("new/")),
+        ("render", "--png", p("sub/")),
+        ("bake", "-o", p("sub/")),
+    ] {
+        let mut args = vec![command, s(&m), flag, &out];
+        if command == "solve" && flag != "-o" {
+            args.extend(["-o", "unused.sol"]);
+        }
+        let out_file = Path::new(&out);
+        let got = trilux(&args);
+        let what = if out.ends_with('/') {
+            "ends in '/'"
+        } else {
+            "it is a folder"
+        };
+        if command == "bake" {
+            // A bake names its .glb first: a folder is no .glb.
+            assert_refused(&got, "", "name the output .glb");
+        } else {
+            assert_refused(&got, &format!("{}", out_file.display()), what);
+        }
+        assert!(!dir.join("new").exists(), "{args:?} made a folder");
+    }
+    assert_eq!(snapshot(&dir), before);
+}
