@@ -481,3 +481,31 @@ fn a_far_clip_plane_cutting_the_scene_is_refused_at_the_sensor() {
     );
     assert!(exr.exists());
 }
+
+#[test]
+fn a_sample_count_above_the_maximum_is_located() {
+    use common::hostile::furnace;
+    let dir = folder("scene-spp");
+    // furnace()'s sampler is on line 5; its `<integer>` at column 33.
+    let text = furnace("0.5", "1.0", 1.0);
+    let too_many = text.replace(
+        r#"name="sample_count" value="4""#,
+        r#"name="sample_count" value="65537""#,
+    );
+    assert_ne!(too_many, text, "the sample count was replaced");
+    let scene = write(&dir, "spp.xml", too_many);
+    assert_refused_by_every_command(&scene, &format!("{}:5:", s(&scene)), "sample_count 65537");
+    // 65 536 = 2^16, the sequence's length, is still accepted.
+    let at_limit = text.replace(
+        r#"name="sample_count" value="4""#,
+        r#"name="sample_count" value="65536""#,
+    );
+    let scene = write(&dir, "spp-max.xml", at_limit);
+    let out = trilux(&["info", s(&scene)]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(String::from_utf8_lossy(&out.stdout).contains("65536 spp"));
+}
