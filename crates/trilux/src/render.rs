@@ -117,7 +117,8 @@ pub fn default_output(scene: &Path) -> PathBuf {
 }
 
 impl RenderArgs {
-    /// Every output planned (the default `out/` made when missing) and
+    /// Every output planned (the default `out/` made when missing, only
+    /// while planning and writing) and
     /// checked against the inputs, before any work: the EXR, then the PNG
     /// and the statistics when asked for.
     fn plan_outputs(&self) -> Result<Outputs> {

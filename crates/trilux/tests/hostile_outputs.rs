@@ -333,3 +333,55 @@ fn an_output_naming_a_folder_is_refused_before_any_work() {
     }
     assert_eq!(snapshot(&dir), before);
 }
+
+/// Bytes process `pid` has read so far (Linux's /proc: `rchar`).
+fn bytes_read(pid: u32) -> u64 {
+    let io = std::fs::read_to_string(format!("/proc/{pid}/io")).unwrap_or_default();
+    io.lines()
+        .find_map(|l| l.strip_prefix("rchar: "))
+        .and_then(|n| n.trim().parse().ok())
+        .unwrap_or(0)
+}
+
+#[test]
+fn a_render_interrupted_by_a_signal_leaves_no_out_folder() {
+    let (dir, scene) = setup("out-signal");
+    let sol = dir.join("x.sol");
+    solve(&scene, &sol);
+    for signal in ["INT", "TERM"] {
+        // A render far longer than the test waits: a megapixel at 4096
+        // samples a pixel.
+        let mut child = Command::new(env!("CARGO_BIN_EXE_trilux"))
+            .current_dir(&dir)
+            .args(["render", "scene.xml", "--quality", "draft", "--solution"])
+            .arg(&sol)
+            .args(["--width", "1024", "--height", "1024", "--spp", "4096"])
+            .args(["--threads", "2"])
+            .spawn()
+            .unwrap();
+        // The solution is read only after the outputs are planned: once
+        // the render has read as many bytes as it holds, it is at work (a
+        // minute's guard against a hang).
+        let sol_bytes = std::fs::metadata(&sol).unwrap().len();
+        let start = std::time::Instant::now();
+        while bytes_read(child.id()) < sol_bytes {
+            assert!(
+                child.try_wait().unwrap().is_none(),
+                "the render ended before it was interrupted"
+            );
+            assert!(
+                start.elapsed() < std::time::Duration::from_secs(60),
+                "the solution not read after a minute"
+            );
+            std::thread::sleep(std::time::Duration::from_millis(5));
+        }
+        let status = Command::new("kill")
+            .args([format!("-{signal}"), child.id().to_string()])
+            .status()
+            .unwrap();
+        assert!(status.success());
+        let status = child.wait().unwrap();
+        assert!(!status.success(), "SIG{signal} ended the render");
+        assert!(!dir.join("out").exists(), "SIG{signal} left out/ behind");
+    }
+}
