@@ -509,3 +509,31 @@ fn a_sample_count_above_the_maximum_is_located() {
     );
     assert!(String::from_utf8_lossy(&out.stdout).contains("65536 spp"));
 }
+
+#[test]
+fn a_grayscale_jpeg_texture_is_accepted() {
+    // Its texel values are checked in trilux-scene's tests/gltf.rs.
+    let dir = folder("scene-grey-jpeg");
+    let jpeg = Path::new(env!("CARGO_MANIFEST_DIR")).join("../trilux-scene/tests/data/grey192.jpg");
+    std::fs::copy(jpeg, dir.join("grey.jpg")).unwrap();
+    let texture = r#"<texture type="bitmap" name="reflectance"><string name="filename" value="grey.jpg"/></texture>"#;
+    let scene = write(
+        &dir,
+        "grey.xml",
+        format!(
+            "{HEAD}\n{SENSOR}\n<shape type=\"rectangle\"><bsdf type=\"diffuse\">{texture}</bsdf></shape>\n</scene>\n"
+        ),
+    );
+    let out = trilux(&["info", s(&scene)]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(String::from_utf8_lossy(&out.stdout).contains("1 texture"));
+    let exr = dir.join("grey.exr");
+    let out = trilux(&["render", s(&scene), "--quality", "draft", "-o", s(&exr)]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(exr.is_file());
+}
