@@ -71,6 +71,7 @@ pub fn run(args: &BakeArgs) -> Result<()> {
     inputs.extend(args.solution.as_deref());
     let outputs = Outputs::plan(&outputs, &inputs, None)?;
     let pending = trilux_scene::open_with_params(&args.scene, &args.params.define)?;
+    outputs.check_inputs(&pending.input_files())?;
     let bake = Product::Bake(BakeOptions {
         exposure: args.exposure,
         albedo_maps: !args.no_albedo_maps,

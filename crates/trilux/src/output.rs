@@ -95,6 +95,28 @@ impl Outputs {
         Ok(())
     }
 
+    /// Refuses an output that is one of the files the scene reads
+    /// (`trilux_scene::Pending::input_files`: meshes, textures, glTF
+    /// buffers, included files), compared as files (symbolic and hard
+    /// links seen through); called once the scene is opened, before any
+    /// of the work.
+    pub fn check_inputs(&self, inputs: &[PathBuf]) -> Result<()> {
+        for input in inputs {
+            let Ok(id) = FileIdentity::of(input) else {
+                continue; // missing: the loader says so
+            };
+            if let Some(out) = self.planned.iter().find(|o| *o.identity() == id) {
+                bail!(
+                    "{}: the {} would overwrite the input {}",
+                    out.path().display(),
+                    out.what(),
+                    input.display()
+                );
+            }
+        }
+        Ok(())
+    }
+
     /// Writes every output, `bytes` in the planned order, or none.
     pub fn write(&self, bytes: &[Vec<u8>]) -> Result<()> {
         if bytes.len() != self.planned.len() {

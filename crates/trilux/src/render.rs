@@ -169,6 +169,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let outputs = args.plan_outputs()?;
     let pending =
         trilux_scene::open_with_camera(&args.scene, args.camera.as_deref(), &args.params.define)?;
+    outputs.check_inputs(&pending.input_files())?;
     let camera = pending.scene().camera.as_ref().with_context(|| {
         let what = if trilux_scene::gltf::is_gltf(&args.scene) {
             "perspective camera"

@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 mod common;
-use common::hostile::{assert_ok, assert_refused, furnace, mkfifo, s};
+use common::hostile::{assert_ok, assert_refused, furnace, mkfifo, s, write};
 use common::{folder, trilux};
 
 /// The same scene with a mesh that does not exist: any error it gives
@@ -383,5 +383,133 @@ fn a_render_interrupted_by_a_signal_leaves_no_out_folder() {
         let status = child.wait().unwrap();
         assert!(!status.success(), "SIG{signal} ended the render");
         assert!(!dir.join("out").exists(), "SIG{signal} left out/ behind");
+    }
+}
+
+#[test]
+fn an_output_naming_any_input_of_the_scene_is_refused_before_any_work() {
+    let (dir, _) = setup("out-inputs");
+    let repo = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
+    // An XML scene with an included file, an OBJ mesh and a PNG texture.
+    write(
+        &dir,
+        "quad.obj",
+        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\n",
+    );
+    std::fs::copy(repo.join("textures/checker.png"), dir.join("checker.png")).unwrap();
+    std::os::unix::fs::symlink("quad.obj", dir.join("link.obj")).unwrap();
+    write(
+        &dir,
+        "part.xml",
+        r#"<scene version="3.0.0"><shape type="obj"><string name="filename" value="quad.obj"/><bsdf type="diffuse"><texture type="bitmap" name="reflectance"><string name="filename" value="checker.png"/></texture></bsdf></shape></scene>"#,
+    );
+    let sensor = r#"<sensor type="perspective"><transform name="to_world"><lookat origin="0.5,0.5,2" target="0.5,0.5,0" up="0,1,0"/></transform><film type="hdrfilm"><integer name="width" value="8"/><integer name="height" value="8"/></film></sensor>"#;
+    write(
+        &dir,
+        "main.xml",
+        format!(r#"<scene version="3.0.0">{sensor}<include filename="part.xml"/></scene>"#),
+    );
+    // A glTF scene with its .bin buffer and images beside it.
+    for f in ["textured-room.gltf", "textured-room.bin"] {
+        std::fs::copy(repo.join(f), dir.join(f)).unwrap();
+    }
+    let gltf_images: Vec<String> = {
+        let text = std::fs::read_to_string(dir.join("textured-room.gltf")).unwrap();
+        let json: serde_json::Value = serde_json::from_str(&text).unwrap();
+        json["images"]
+            .as_array()
+            .map(|a| {
+                a.iter()
+                    .filter_map(|i| i["uri"].as_str().map(String::from))
+                    .collect()
+            })
+            .unwrap_or_default()
+    };
+    for uri in &gltf_images {
+        let to = dir.join(uri);
+        std::fs::create_dir_all(to.parent().unwrap()).unwrap();
+        std::fs::copy(repo.join(uri), to).unwrap();
+    }
+    let before = snapshot(&dir);
+    let p = |name: &str| dir.join(name).to_string_lossy().into_owned();
+    let mut cases: Vec<(Vec<String>, &str)> = vec![
+        (
+            vec!["solve".into(), p("main.xml"), "-o".into(), p("quad.obj")],
+            "quad.obj",
+        ),
+        (
+            vec!["solve".into(), p("main.xml"), "-o".into(), p("link.obj")],
+            "quad.obj",
+        ),
+        (
+            vec![
+                "solve".into(),
+                p("main.xml"),
+                "-o".into(),
+                p("x.sol"),
+                "--stats".into(),
+                p("part.xml"),
+            ],
+            "part.xml",
+        ),
+        (
+            vec![
+                "render".into(),
+                p("main.xml"),
+                "--quality".into(),
+                "draft".into(),
+                "-o".into(),
+                p("y.exr"),
+                "--png".into(),
+                p("checker.png"),
+            ],
+            "checker.png",
+        ),
+        (
+            vec![
+                "bake".into(),
+                p("main.xml"),
+                "--quality".into(),
+                "draft".into(),
+                "-o".into(),
+                p("z.glb"),
+                "--stats".into(),
+                p("quad.obj"),
+            ],
+            "quad.obj",
+        ),
+        (
+            vec![
+                "solve".into(),
+                p("textured-room.gltf"),
+                "-o".into(),
+                p("textured-room.bin"),
+            ],
+            "textured-room.bin",
+        ),
+    ];
+    for uri in &gltf_images {
+        cases.push((
+            vec![
+                "render".into(),
+                p("textured-room.gltf"),
+                "--quality".into(),
+                "draft".into(),
+                "-o".into(),
+                p("w.exr"),
+                "--png".into(),
+                p(uri),
+            ],
+            "would overwrite the input",
+        ));
+    }
+    assert!(!gltf_images.is_empty(), "the glTF scene has image files");
+    for (args, what) in cases {
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let out = trilux(&args);
+        assert_refused(&out, "", "would overwrite the input");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(stderr.contains(what), "{args:?}: {stderr}");
+        assert_eq!(snapshot(&dir), before, "{args:?} changed a file");
     }
 }
