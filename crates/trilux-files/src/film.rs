@@ -7,6 +7,11 @@
 /// weights, the image, its encoded files), 4 GB at the limit.
 pub const MAX_FILM_EDGE: u32 = 32_768;
 
+/// Most camera samples per pixel (65 536): the render's low-discrepancy
+/// sequence has that many points per pixel. A scene's `sample_count` and
+/// `--spp` are both checked against it before any work.
+pub const MAX_SAMPLES_PER_PIXEL: u32 = 1 << 16;
+
 /// Most film pixels (see [`MAX_FILM_EDGE`]).
 pub const MAX_FILM_PIXELS: u64 = 1 << 26;
 

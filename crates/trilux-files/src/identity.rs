@@ -64,14 +64,35 @@ pub fn resolve(path: &Path) -> io::Result<Resolved> {
             });
         }
         let link = std::fs::read_link(&p)?;
-        p = match p.parent() {
+        let next = match p.parent() {
             Some(dir) if link.is_relative() => dir.join(link),
             _ => link,
         };
+        if let Some(magic) = magic_link(&p, &next) {
+            return Ok(magic);
+        }
+        p = next;
     }
     Err(io::Error::other(format!(
         "more than {MAX_LINKS} symbolic links to follow"
     )))
+}
+
+/// A link whose text names no path but the kernel follows all the same:
+/// `/dev/stdout` is `/proc/self/fd/1`, whose text is `pipe:[1234]` when
+/// stdout is a pipe. When `next` (the text followed) does not exist but
+/// `link` opens, `link` itself is the path to write through, with the
+/// metadata of what it opens (a pipe, a socket). A dangling link (nothing
+/// opens) is not one.
+fn magic_link(link: &Path, next: &Path) -> Option<Resolved> {
+    if std::fs::symlink_metadata(next).is_ok() {
+        return None;
+    }
+    let meta = std::fs::metadata(link).ok()?;
+    Some(Resolved {
+        path: link.to_path_buf(),
+        meta: Some(meta),
+    })
 }
 
 impl FileIdentity {

@@ -3,8 +3,8 @@
 //! - [`Output::plan`] resolves an output path before any work: symbolic
 //!   links are followed to the file they name (the link itself is never
 //!   replaced); the folder must exist and accept a new file (probed with a
-//!   temporary file made and removed at once); a folder, a block device or
-//!   a socket is refused; a FIFO or a character device (`/dev/null`,
+//!   temporary file made and removed at once); a folder (or a path ending
+//!   in `/`, which names one), a block device or a socket is refused; a FIFO or a character device (`/dev/null`,
 //!   `/dev/stdout`) is written through, never replaced by a file.
 //! - [`write_all`] stages every regular-file output in a temporary file of
 //!   its own folder, created exclusively under a name no other file has
@@ -93,6 +93,13 @@ impl Output {
             what: what.to_string(),
             source,
         };
+        // `out/` names a folder whether it exists or not: refused now,
+        // not at the final rename after the work.
+        if path.as_os_str().as_encoded_bytes().ends_with(b"/") {
+            return Err(refused(
+                "the path ends in '/', so it names a folder, not a file".into(),
+            ));
+        }
         let resolved = resolve(path).map_err(io_err)?;
         let through = match &resolved.meta {
             None => false,

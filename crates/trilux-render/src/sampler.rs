@@ -34,8 +34,9 @@ pub mod dims {
     pub const LINKS: u32 = GLOSSY_SENDERS + 6;
 }
 
-/// Largest number of samples per pixel the sequence supports.
-pub const MAX_SAMPLES: u32 = 1 << 16;
+/// Largest number of samples per pixel the sequence supports (the limit
+/// scene files are checked against too).
+pub const MAX_SAMPLES: u32 = trilux_files::film::MAX_SAMPLES_PER_PIXEL;
 
 /// Point `k` of the `n`-point Hammersley set in [0, 1)²: a fixed,
 /// well-stratified quadrature for the deterministic parts of the preview.

@@ -638,6 +638,13 @@ fn sampler(e: &Element) -> Result<u32> {
     let props = Props::new(e)?;
     props.no_objects()?;
     let n = positive_u32(&props, "sample_count", 4)?;
+    let max = crate::limits::MAX_SAMPLES_PER_PIXEL;
+    if n > max {
+        return Err(SceneError::at(
+            &props.loc("sample_count"),
+            format!("sample_count {n} is more than the {max} samples per pixel trilux renders"),
+        ));
+    }
     // Mitsuba's seed picks other random numbers (the noise, not the
     // image it converges to); trilux's sequences are its own (`--seed`).
     props.ignore(&["seed"]);

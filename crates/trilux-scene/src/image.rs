@@ -162,8 +162,16 @@ fn decode_jpeg(bytes: &[u8]) -> Result<Decoded, ImageError> {
     })?;
     let (width, height) = (width as u32, height as u32);
     check_size(width, height)?;
+    // RGB is asked for, but a one-component (grayscale) JPEG decodes to
+    // one channel (the decoder keeps Luma): read as Mitsuba reads it, a
+    // one-channel bitmap whose value stands for R = G = B (`decode`).
+    let channels = decoder
+        .get_output_colorspace()
+        .map_or(3, |c| c.num_components());
     let pixels = decoder.decode().map_err(err)?;
-    if pixels.len() as u64 != u64::from(width) * u64::from(height) * 3 {
+    if !matches!(channels, 1 | 3)
+        || pixels.len() as u64 != u64::from(width) * u64::from(height) * channels as u64
+    {
         return Err(ImageError::Decode {
             format: "JPEG",
             reason: "the decoded image has the wrong size".into(),
@@ -172,7 +180,7 @@ fn decode_jpeg(bytes: &[u8]) -> Result<Decoded, ImageError> {
     Ok((
         width,
         height,
-        3,
+        channels,
         pixels.into_iter().map(u16::from).collect(),
         255,
     ))

@@ -172,8 +172,9 @@ pub fn load_str_with_params(
 
 fn open_str(text: &str, path: &Path, params: &[(String, String)]) -> Result<Pending, SceneError> {
     let file: Arc<Path> = Arc::from(path);
-    let tree = xml::parse(text, &file, params)?;
+    let (tree, includes) = xml::parse(text, &file, params)?;
     let resolved = resolve::resolve(&tree)?;
-    let (scene, requests) = build::build(resolved, path)?;
+    let (scene, mut requests) = build::build(resolved, path)?;
+    requests.includes = includes;
     Ok(Pending::new(scene, requests))
 }

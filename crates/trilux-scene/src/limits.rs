@@ -54,7 +54,9 @@ pub const MAX_EXPANDED_BYTES: usize = 16 << 20;
 
 /// The film's limits, shared with the renderer (which checks a film given
 /// on the command line against them too).
-pub use trilux_files::film::{FILM_BYTES_PER_PIXEL, MAX_FILM_EDGE, MAX_FILM_PIXELS, check_film};
+pub use trilux_files::film::{
+    FILM_BYTES_PER_PIXEL, MAX_FILM_EDGE, MAX_FILM_PIXELS, MAX_SAMPLES_PER_PIXEL, check_film,
+};
 
 /// Largest emitted radiance (1e20 in any band).
 pub use trilux_color::MAX_RADIANCE;

@@ -11,7 +11,7 @@ use crate::error::{Result, SceneError};
 use crate::gltf::GltfMeshes;
 use crate::scene::Scene;
 use crate::shape::{MeshRequest, check_area};
-use crate::textures::{TextureCache, TextureRequest};
+use crate::textures::{ImageSource, TextureCache, TextureRequest};
 use trilux_geometry::ShapeKind;
 
 /// What a scene still has to read, by shape index.
@@ -23,6 +23,8 @@ pub(crate) struct Requests {
     pub textures: Vec<(usize, TextureRequest)>,
     /// The meshes of a glTF file (its buffers are read by `finish`).
     pub gltf: Option<GltfMeshes>,
+    /// The files the scene file `<include>`s (already read).
+    pub includes: Vec<std::path::PathBuf>,
 }
 
 /// A loaded scene whose meshes and textures are not read yet (module
@@ -52,6 +54,30 @@ impl Pending {
     /// The scene as the file states it; mesh shapes have empty meshes.
     pub fn scene(&self) -> &Scene {
         &self.scene
+    }
+
+    /// Every file the scene reads: the scene file, the files it includes,
+    /// its OBJ and PLY meshes, its texture images, a glTF file's external
+    /// buffers and images (relative names joined to the scene's folder).
+    /// A command compares its outputs with them, so that no output
+    /// overwrites an input.
+    pub fn input_files(&self) -> Vec<std::path::PathBuf> {
+        let mut files = vec![self.scene.path.clone()];
+        files.extend(self.requests.includes.iter().cloned());
+        files.extend(self.requests.meshes.iter().map(|(_, r)| r.path.clone()));
+        files.extend(
+            self.requests
+                .textures
+                .iter()
+                .filter_map(|(_, r)| match &r.source {
+                    ImageSource::File(p) => Some(p.clone()),
+                    _ => None,
+                }),
+        );
+        if let Some(gltf) = &self.requests.gltf {
+            files.extend(gltf.input_files());
+        }
+        files
     }
 
     /// Reads every mesh and texture; errors point at the place in the

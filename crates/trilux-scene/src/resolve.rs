@@ -241,7 +241,9 @@ mod tests {
         }
         text += "</scene>";
         let file: Arc<Path> = Arc::from(Path::new("chain.xml"));
-        crate::xml::parse(&text, &file, &[]).expect("the chain parses")
+        crate::xml::parse(&text, &file, &[])
+            .expect("the chain parses")
+            .0
     }
 
     fn walk(levels: usize) -> (Result<Extent>, usize) {

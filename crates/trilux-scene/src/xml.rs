@@ -20,7 +20,7 @@
 //! a stack overflow), the length of each substituted value and the bytes
 //! substitution produces over the whole file.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use crate::error::{Result, SceneError, SourceLocation};
@@ -99,15 +99,21 @@ impl Element {
 ///
 /// `params` are caller-given values for `$name` (they take precedence over
 /// `<default>`s, as Mitsuba's `load_file(path, name=value)` does).
-pub(crate) fn parse(text: &str, file: &Arc<Path>, params: &[(String, String)]) -> Result<Element> {
+pub(crate) fn parse(
+    text: &str,
+    file: &Arc<Path>,
+    params: &[(String, String)],
+) -> Result<(Element, Vec<PathBuf>)> {
     let mut shared = Shared {
         params: params.to_vec(),
         expanded: 0,
         chain: vec![file.clone()],
         included: 0,
         included_bytes: 0,
+        files: Vec::new(),
     };
-    parse_file(text, file, &mut shared)
+    let tree = parse_file(text, file, &mut shared)?;
+    Ok((tree, shared.files))
 }
 
 /// What the files of one scene share while they are parsed.
@@ -121,6 +127,8 @@ struct Shared {
     /// Files included so far, and their bytes.
     included: usize,
     included_bytes: u64,
+    /// Every file included (outputs may not overwrite them).
+    files: Vec<PathBuf>,
 }
 
 /// Parses one file of the scene (the scene file or an included one).
@@ -339,6 +347,7 @@ impl Context<'_, '_> {
             ))
         })?;
         self.shared.included_bytes += bytes.len() as u64;
+        self.shared.files.push(path.to_path_buf());
         let text = crate::text::decode(&bytes, &path)?;
         self.shared.chain.push(path.clone());
         let tree = parse_file(text, &path, self.shared)?;
@@ -416,7 +425,7 @@ mod tests {
             .iter()
             .map(|(a, b)| (a.to_string(), b.to_string()))
             .collect();
-        let tree = parse(text, &file(), &params)?;
+        let (tree, _) = parse(text, &file(), &params)?;
         Ok(tree.children[0].attrs[0].value.clone())
     }
 
@@ -445,7 +454,7 @@ mod tests {
     #[test]
     fn locations_are_one_based_line_and_column_of_values() {
         let t = "<scene version=\"3.0.0\">\n  <a\n     v=\"x\"/>\n</scene>";
-        let tree = parse(t, &file(), &[]).unwrap_or_else(|e| panic!("{e}"));
+        let (tree, _) = parse(t, &file(), &[]).unwrap_or_else(|e| panic!("{e}"));
         let a = &tree.children[0];
         assert_eq!((a.loc.line, a.loc.col), (2, 3));
         assert_eq!((a.attrs[0].loc.line, a.attrs[0].loc.col), (3, 9));
@@ -455,7 +464,7 @@ mod tests {
     #[test]
     fn comments_and_whitespace_are_dropped_text_is_refused() {
         let t = "<scene version=\"3.0.0\"> <!-- c --> <a/>\n</scene>";
-        let tree = parse(t, &file(), &[]).unwrap_or_else(|e| panic!("{e}"));
+        let (tree, _) = parse(t, &file(), &[]).unwrap_or_else(|e| panic!("{e}"));
         assert_eq!(tree.children.len(), 1);
         let e = parse("<scene version=\"3.0.0\">x</scene>", &file(), &[]).expect_err("text");
         assert!(

@@ -560,3 +560,49 @@ fn an_image_without_its_mime_type_is_located() {
     let err = load("image-mime", &j).unwrap_err().to_string();
     assert!(err.contains("/images/0"), "{err}");
 }
+
+/// A one-component (grayscale) JPEG is read as Mitsuba reads it: one
+/// channel standing for R = G = B. `tests/data/grey192.jpg` is 8 × 8 pixels
+/// of 192 (its README); a flat JPEG decodes to its value within 1/255, so
+/// every texel lies between the sRGB decodings of 191/255 and 193/255.
+#[test]
+fn a_grayscale_jpeg_texture_is_read_through_gltf_and_xml() {
+    let dir = folder("texture-grey-jpeg");
+    let jpeg = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/grey192.jpg");
+    std::fs::copy(jpeg, dir.join("grey.jpg")).unwrap();
+    let decode = |v: f64| ((v / 255.0 + 0.055) / 1.055).powf(2.4);
+    let (lo, hi) = (decode(191.0), decode(193.0));
+    let check = |texture: &trilux_brdf::Texture, how: &str| {
+        assert_eq!((texture.width(), texture.height()), (8, 8), "{how}");
+        let m = texture.mean();
+        assert!(m.iter().all(|&c| lo <= c && c <= hi), "{how}: {m:?}");
+        assert!(m[0] == m[1] && m[1] == m[2], "{how}: R = G = B: {m:?}");
+    };
+    // glTF: a base colour texture.
+    let m = json!({"pbrMetallicRoughness": {"baseColorFactor": [1.0, 1.0, 1.0, 1.0], "metallicFactor": 0.0,
+                   "baseColorTexture": {"index": 0}},
+                   "extensions": {"KHR_materials_specular": {"specularFactor": 0.0}}});
+    let mut j = with_material(Some(m));
+    j["images"] = json!([{"uri": "grey.jpg"}]);
+    j["textures"] = json!([{"source": 0}]);
+    let scene = load_in(&dir, &j).unwrap();
+    check(&scene.shapes[0].textures[0].texture, "glTF");
+    // Mitsuba XML: a bitmap reflectance.
+    let xml = dir.join("grey.xml");
+    std::fs::write(
+        &xml,
+        r#"<scene version="3.0.0">
+  <shape type="rectangle">
+    <bsdf type="diffuse">
+      <texture type="bitmap" name="reflectance"><string name="filename" value="grey.jpg"/></texture>
+    </bsdf>
+  </shape>
+</scene>
+"#,
+    )
+    .unwrap();
+    let scene = trilux_scene::load(&xml).unwrap();
+    let slot = &scene.shapes[0].textures[0];
+    assert_eq!(slot.kind, SlotKind::Reflectance);
+    check(&slot.texture, "XML");
+}

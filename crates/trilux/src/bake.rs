@@ -71,6 +71,7 @@ pub fn run(args: &BakeArgs) -> Result<()> {
     inputs.extend(args.solution.as_deref());
     let outputs = Outputs::plan(&outputs, &inputs, None)?;
     let pending = trilux_scene::open_with_params(&args.scene, &args.params.define)?;
+    outputs.check_inputs(&pending.input_files())?;
     let bake = Product::Bake(BakeOptions {
         exposure: args.exposure,
         albedo_maps: !args.no_albedo_maps,
@@ -87,14 +88,14 @@ pub fn run(args: &BakeArgs) -> Result<()> {
     outputs.write(&files)?;
     crate::warn(&outcome);
     let s = &baked.stats;
-    println!(
-        "wrote {} ({} bytes: {} vertices, {} triangles; baked in {:.2} s)",
+    crate::streams::print(&format!(
+        "wrote {} ({} bytes: {} vertices, {} triangles; baked in {:.2} s)\n",
         args.output.display(),
         s.bytes,
         s.vertices,
         s.triangles,
         s.seconds
-    );
+    ))?;
     if args.open {
         crate::serve::serve(&baked.glb, args.port.unwrap_or(0))?;
     }

@@ -1,6 +1,7 @@
 //! `trilux info SCENE [--json] [--mode rgb|spectral]`: what a scene loads to.
 
 use std::collections::BTreeMap;
+use std::fmt::Write;
 use std::path::PathBuf;
 
 use anyhow::Result;
@@ -85,46 +86,50 @@ pub fn run(args: &InfoArgs) -> Result<()> {
         }),
     };
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&info)?);
+        crate::streams::print(&format!("{}\n", serde_json::to_string_pretty(&info)?))
     } else {
-        print_text(&scene, &info);
+        crate::streams::print(&text(&scene, &info)?)
     }
-    Ok(())
 }
 
-fn print_text(scene: &Scene, info: &InfoJson) {
-    println!("scene          {}", scene.path.display());
-    println!(
+/// The text report of `info`, written whole at once (`streams::print`).
+fn text(scene: &Scene, info: &InfoJson) -> Result<String, std::fmt::Error> {
+    let mut out = String::new();
+    writeln!(out, "scene          {}", scene.path.display())?;
+    writeln!(
+        out,
         "mode           {} (the file is {})",
         info.mode,
         if scene.spectral { "spectral" } else { "rgb" }
-    );
-    println!("shapes         {}", info.shapes);
-    println!("input surfaces {}", info.input_surfaces);
-    println!("emitters       {}", info.emitters);
+    )?;
+    writeln!(out, "shapes         {}", info.shapes)?;
+    writeln!(out, "input surfaces {}", info.input_surfaces)?;
+    writeln!(out, "emitters       {}", info.emitters)?;
     let bsdfs: Vec<String> = info.bsdfs.iter().map(|(k, v)| format!("{k} {v}")).collect();
-    println!("bsdfs          {}", bsdfs.join(", "));
+    writeln!(out, "bsdfs          {}", bsdfs.join(", "))?;
     let power: Vec<String> = info
         .emitted_power
         .iter()
         .map(|p| format!("{p:.6}"))
         .collect();
-    println!("emitted power  [{}] W", power.join(", "));
+    writeln!(out, "emitted power  [{}] W", power.join(", "))?;
     if let Some(d) = scene.max_depth {
-        println!("max_depth      {d}");
+        writeln!(out, "max_depth      {d}")?;
     }
     match (&info.camera, &scene.camera) {
         (Some(c), Some(cam)) => {
-            println!(
+            writeln!(
+                out,
                 "camera         origin {:?} target {:?} up {:?}",
                 c.origin, c.target, c.up
-            );
-            println!(
+            )?;
+            writeln!(
+                out,
                 "               fov {} ({}), {}x{} px, {} spp, {:?} filter",
                 c.fov, c.fov_axis, c.width, c.height, cam.sample_count, cam.rfilter
-            );
+            )?;
         }
-        _ => println!("camera         none (the scene has no <sensor>)"),
+        _ => writeln!(out, "camera         none (the scene has no <sensor>)")?,
     }
     for (i, s) in scene.shapes.iter().enumerate() {
         let kind = match &s.shape.kind {
@@ -143,11 +148,13 @@ fn print_text(scene: &Scene, info: &InfoJson) {
             Some(p) => p.to_string(),
             None => format!("line {}", s.location.line),
         };
-        println!(
+        writeln!(
+            out,
             "  shape {i:3} {:16} {kind:24} area {:.6}{}{textures}  ({at})",
             s.id.as_deref().unwrap_or("-"),
             trilux_scene::surface_area(&s.shape),
             if s.emitter.is_some() { ", emitter" } else { "" },
-        );
+        )?;
     }
+    Ok(out)
 }

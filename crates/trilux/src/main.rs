@@ -9,7 +9,9 @@
 //! only once the camera and options are checked (`trilux_scene::open`). Number-list options whose values may begin
 //! with '-' (`--lookat -0.5,1,2,...`) need `#[arg(allow_hyphen_values =
 //! true)]` on the argument (`allow_negative_numbers` only covers plain
-//! numbers, not comma lists).
+//! numbers, not comma lists). Standard streams are written through
+//! `streams`, never `println!`: a closed pipe or a full disk on stdout or
+//! stderr is handled, not a panic.
 
 mod bake;
 mod info;
@@ -20,6 +22,7 @@ mod progress;
 mod render;
 mod serve;
 mod solve;
+mod streams;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -78,15 +81,15 @@ pub fn set_threads(threads: Option<u32>) {
 /// clamped reflectances) and the render's samples left out.
 pub fn warn(outcome: &trilux::Outcome) {
     for w in &outcome.solve.warnings {
-        eprintln!("warning: {w}");
+        streams::eprint_line(&format!("warning: {w}"));
     }
     if let Some(r) = &outcome.render
         && r.gather.dropped > 0
     {
-        eprintln!(
+        streams::eprint_line(&format!(
             "warning: {} camera samples had a value that is not finite and were left out of the image",
             r.gather.dropped
-        );
+        ));
     }
 }
 
@@ -106,8 +109,7 @@ fn render_default() -> anyhow::Result<()> {
         anyhow::bail!("the default render's arguments do not parse");
     };
     render::run(&args)?;
-    println!("wrote {} and {}", exr.display(), png.display());
-    Ok(())
+    streams::print(&format!("wrote {} and {}\n", exr.display(), png.display()))
 }
 
 fn run(cli: Cli) -> anyhow::Result<()> {
@@ -131,7 +133,7 @@ fn usage_error(e: clap::Error) -> ExitCode {
         e.exit();
     }
     for line in e.render().to_string().lines() {
-        eprintln!("{}", trilux_scene::error::elide(line, MAX_LINE_CHARS));
+        streams::eprint_line(&trilux_scene::error::elide(line, MAX_LINE_CHARS));
     }
     ExitCode::from(u8::try_from(e.exit_code()).unwrap_or(2))
 }
@@ -147,7 +149,7 @@ fn main() -> ExitCode {
         Err(e) => {
             let message = e.to_string().replace(['\n', '\r'], " ");
             let message = trilux_scene::error::elide(&message, MAX_LINE_CHARS);
-            eprintln!("error: {message}");
+            streams::eprint_line(&format!("error: {message}"));
             ExitCode::FAILURE
         }
     }

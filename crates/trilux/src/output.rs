@@ -11,8 +11,11 @@ use trilux_files::{FileIdentity, Output};
 /// The outputs of one command, in the order given to [`Outputs::plan`].
 pub struct Outputs {
     planned: Vec<Output>,
-    /// The default folder (`out/`) when this command made it: removed
-    /// again if it is still empty when the command ends (a failure).
+    /// The default folder (`out/`) when it did not exist: made to plan
+    /// the outputs in it and removed at once, made again only to write
+    /// them (so a command killed during its work, by SIGINT or SIGTERM,
+    /// which runs no destructor, leaves no empty folder behind), and
+    /// removed again if it is still empty when the command ends.
     made: Option<PathBuf>,
 }
 
@@ -28,7 +31,8 @@ impl Drop for Outputs {
 impl Outputs {
     /// Plans `outputs` (path and what it is) of a command reading
     /// `inputs`. `default_folder` is the folder of outputs the user did not
-    /// name, made when missing (and removed again if nothing is written).
+    /// name: when missing, made only while planning and while writing
+    /// (`made`).
     pub fn plan(
         outputs: &[(&Path, &str)],
         inputs: &[&Path],
@@ -50,6 +54,10 @@ impl Outputs {
             planned.planned.push(Output::plan(path, what)?);
         }
         planned.check_distinct(inputs)?;
+        if let Some(dir) = &planned.made {
+            // Planned (identities taken while it existed): nothing is in it.
+            let _ = std::fs::remove_dir(dir);
+        }
         Ok(planned)
     }
 
@@ -87,6 +95,28 @@ impl Outputs {
         Ok(())
     }
 
+    /// Refuses an output that is one of the files the scene reads
+    /// (`trilux_scene::Pending::input_files`: meshes, textures, glTF
+    /// buffers, included files), compared as files (symbolic and hard
+    /// links seen through); called once the scene is opened, before any
+    /// of the work.
+    pub fn check_inputs(&self, inputs: &[PathBuf]) -> Result<()> {
+        for input in inputs {
+            let Ok(id) = FileIdentity::of(input) else {
+                continue; // missing: the loader says so
+            };
+            if let Some(out) = self.planned.iter().find(|o| *o.identity() == id) {
+                bail!(
+                    "{}: the {} would overwrite the input {}",
+                    out.path().display(),
+                    out.what(),
+                    input.display()
+                );
+            }
+        }
+        Ok(())
+    }
+
     /// Writes every output, `bytes` in the planned order, or none.
     pub fn write(&self, bytes: &[Vec<u8>]) -> Result<()> {
         if bytes.len() != self.planned.len() {
@@ -95,6 +125,10 @@ impl Outputs {
                 self.planned.len(),
                 bytes.len()
             );
+        }
+        if let Some(dir) = &self.made {
+            std::fs::create_dir_all(dir)
+                .map_err(|e| anyhow::anyhow!("{}: cannot create the folder: {e}", dir.display()))?;
         }
         let items: Vec<(&Output, &[u8])> = self
             .planned

@@ -117,7 +117,8 @@ pub fn default_output(scene: &Path) -> PathBuf {
 }
 
 impl RenderArgs {
-    /// Every output planned (the default `out/` made when missing) and
+    /// Every output planned (the default `out/` made when missing, only
+    /// while planning and writing) and
     /// checked against the inputs, before any work: the EXR, then the PNG
     /// and the statistics when asked for.
     fn plan_outputs(&self) -> Result<Outputs> {
@@ -168,6 +169,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let outputs = args.plan_outputs()?;
     let pending =
         trilux_scene::open_with_camera(&args.scene, args.camera.as_deref(), &args.params.define)?;
+    outputs.check_inputs(&pending.input_files())?;
     let camera = pending.scene().camera.as_ref().with_context(|| {
         let what = if trilux_scene::gltf::is_gltf(&args.scene) {
             "perspective camera"

@@ -53,8 +53,9 @@ pub fn serve(glb: &[u8], port: u16) -> Result<()> {
     let listener = TcpListener::bind(("127.0.0.1", port))
         .with_context(|| format!("cannot listen on 127.0.0.1:{port}"))?;
     let port = listener.local_addr()?.port();
-    println!("viewer: http://127.0.0.1:{port}/index.html?file=/model.glb (Ctrl-C stops it)");
-    std::io::stdout().flush()?;
+    crate::streams::print(&format!(
+        "viewer: http://127.0.0.1:{port}/index.html?file=/model.glb (Ctrl-C stops it)\n"
+    ))?;
     // A failed connection (a closed tab) does not stop the server.
     for stream in listener.incoming().flatten() {
         let _ = answer(stream, glb);

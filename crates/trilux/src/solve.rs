@@ -35,6 +35,7 @@ pub fn run(args: &SolveArgs) -> Result<()> {
     outputs.extend(args.stats.as_deref().map(|p| (p, "statistics")));
     let outputs = Outputs::plan(&outputs, &[args.scene.as_path()], None)?;
     let pending = trilux_scene::open_with_params(&args.scene, &args.params.define)?;
+    outputs.check_inputs(&pending.input_files())?;
     let plan = args
         .options
         .plan(pending.scene(), None, Product::SolutionFile);

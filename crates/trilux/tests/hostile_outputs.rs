@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 mod common;
-use common::hostile::{assert_ok, assert_refused, furnace, mkfifo, s};
+use common::hostile::{assert_ok, assert_refused, furnace, mkfifo, s, write};
 use common::{folder, trilux};
 
 /// The same scene with a mesh that does not exist: any error it gives
@@ -292,4 +292,224 @@ fn the_default_out_folder_is_made_only_when_something_is_written() {
     assert!(!dir.join("out").exists());
     assert_ok(&run("sub-scene.xml"));
     assert!(dir.join("out/sub-scene.exr").is_file());
+}
+
+#[test]
+fn an_output_naming_a_folder_is_refused_before_any_work() {
+    let (dir, _scene) = setup("out-folder");
+    std::fs::create_dir(dir.join("sub")).unwrap();
+    let before = snapshot(&dir);
+    // The scene cannot load: an output error instead shows that the
+    // outputs were checked first, before any solve.
+    let m = dir.join("missing-mesh.xml");
+    let p = |name: &str| dir.join(name).to_string_lossy().into_owned();
+    for (command, flag, out) in [
+        ("solve", "-o", p("new/")),
+        ("solve", "-o", p("sub/")),
+        ("solve", "-o", p("sub")),
+        ("solve", "--stats", p("new/")),
+        ("render", "-o", p("new/")),
+        ("render", "--png", p("sub/")),
+        ("bake", "-o", p("sub/")),
+    ] {
+        let mut args = vec![command, s(&m), flag, &out];
+        if command == "solve" && flag != "-o" {
+            args.extend(["-o", "unused.sol"]);
+        }
+        let out_file = Path::new(&out);
+        let got = trilux(&args);
+        let what = if out.ends_with('/') {
+            "ends in '/'"
+        } else {
+            "it is a folder"
+        };
+        if command == "bake" {
+            // A bake names its .glb first: a folder is no .glb.
+            assert_refused(&got, "", "name the output .glb");
+        } else {
+            assert_refused(&got, &format!("{}", out_file.display()), what);
+        }
+        assert!(!dir.join("new").exists(), "{args:?} made a folder");
+    }
+    assert_eq!(snapshot(&dir), before);
+}
+
+/// Bytes process `pid` has read so far (Linux's /proc: `rchar`).
+fn bytes_read(pid: u32) -> u64 {
+    let io = std::fs::read_to_string(format!("/proc/{pid}/io")).unwrap_or_default();
+    io.lines()
+        .find_map(|l| l.strip_prefix("rchar: "))
+        .and_then(|n| n.trim().parse().ok())
+        .unwrap_or(0)
+}
+
+#[test]
+fn a_render_interrupted_by_a_signal_leaves_no_out_folder() {
+    let (dir, scene) = setup("out-signal");
+    let sol = dir.join("x.sol");
+    solve(&scene, &sol);
+    for signal in ["INT", "TERM"] {
+        // A render far longer than the test waits: a megapixel at 4096
+        // samples a pixel.
+        let mut child = Command::new(env!("CARGO_BIN_EXE_trilux"))
+            .current_dir(&dir)
+            .args(["render", "scene.xml", "--quality", "draft", "--solution"])
+            .arg(&sol)
+            .args(["--width", "1024", "--height", "1024", "--spp", "4096"])
+            .args(["--threads", "2"])
+            .spawn()
+            .unwrap();
+        // The solution is read only after the outputs are planned: once
+        // the render has read as many bytes as it holds, it is at work (a
+        // minute's guard against a hang).
+        let sol_bytes = std::fs::metadata(&sol).unwrap().len();
+        let start = std::time::Instant::now();
+        while bytes_read(child.id()) < sol_bytes {
+            assert!(
+                child.try_wait().unwrap().is_none(),
+                "the render ended before it was interrupted"
+            );
+            assert!(
+                start.elapsed() < std::time::Duration::from_secs(60),
+                "the solution not read after a minute"
+            );
+            std::thread::sleep(std::time::Duration::from_millis(5));
+        }
+        let status = Command::new("kill")
+            .args([format!("-{signal}"), child.id().to_string()])
+            .status()
+            .unwrap();
+        assert!(status.success());
+        let status = child.wait().unwrap();
+        assert!(!status.success(), "SIG{signal} ended the render");
+        assert!(!dir.join("out").exists(), "SIG{signal} left out/ behind");
+    }
+}
+
+#[test]
+fn an_output_naming_any_input_of_the_scene_is_refused_before_any_work() {
+    let (dir, _) = setup("out-inputs");
+    let repo = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
+    // An XML scene with an included file, an OBJ mesh and a PNG texture.
+    write(
+        &dir,
+        "quad.obj",
+        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\n",
+    );
+    std::fs::copy(repo.join("textures/checker.png"), dir.join("checker.png")).unwrap();
+    std::os::unix::fs::symlink("quad.obj", dir.join("link.obj")).unwrap();
+    write(
+        &dir,
+        "part.xml",
+        r#"<scene version="3.0.0"><shape type="obj"><string name="filename" value="quad.obj"/><bsdf type="diffuse"><texture type="bitmap" name="reflectance"><string name="filename" value="checker.png"/></texture></bsdf></shape></scene>"#,
+    );
+    let sensor = r#"<sensor type="perspective"><transform name="to_world"><lookat origin="0.5,0.5,2" target="0.5,0.5,0" up="0,1,0"/></transform><film type="hdrfilm"><integer name="width" value="8"/><integer name="height" value="8"/></film></sensor>"#;
+    write(
+        &dir,
+        "main.xml",
+        format!(r#"<scene version="3.0.0">{sensor}<include filename="part.xml"/></scene>"#),
+    );
+    // A glTF scene with its .bin buffer and images beside it.
+    for f in ["textured-room.gltf", "textured-room.bin"] {
+        std::fs::copy(repo.join(f), dir.join(f)).unwrap();
+    }
+    let gltf_images: Vec<String> = {
+        let text = std::fs::read_to_string(dir.join("textured-room.gltf")).unwrap();
+        let json: serde_json::Value = serde_json::from_str(&text).unwrap();
+        json["images"]
+            .as_array()
+            .map(|a| {
+                a.iter()
+                    .filter_map(|i| i["uri"].as_str().map(String::from))
+                    .collect()
+            })
+            .unwrap_or_default()
+    };
+    for uri in &gltf_images {
+        let to = dir.join(uri);
+        std::fs::create_dir_all(to.parent().unwrap()).unwrap();
+        std::fs::copy(repo.join(uri), to).unwrap();
+    }
+    let before = snapshot(&dir);
+    let p = |name: &str| dir.join(name).to_string_lossy().into_owned();
+    let mut cases: Vec<(Vec<String>, &str)> = vec![
+        (
+            vec!["solve".into(), p("main.xml"), "-o".into(), p("quad.obj")],
+            "quad.obj",
+        ),
+        (
+            vec!["solve".into(), p("main.xml"), "-o".into(), p("link.obj")],
+            "quad.obj",
+        ),
+        (
+            vec![
+                "solve".into(),
+                p("main.xml"),
+                "-o".into(),
+                p("x.sol"),
+                "--stats".into(),
+                p("part.xml"),
+            ],
+            "part.xml",
+        ),
+        (
+            vec![
+                "render".into(),
+                p("main.xml"),
+                "--quality".into(),
+                "draft".into(),
+                "-o".into(),
+                p("y.exr"),
+                "--png".into(),
+                p("checker.png"),
+            ],
+            "checker.png",
+        ),
+        (
+            vec![
+                "bake".into(),
+                p("main.xml"),
+                "--quality".into(),
+                "draft".into(),
+                "-o".into(),
+                p("z.glb"),
+                "--stats".into(),
+                p("quad.obj"),
+            ],
+            "quad.obj",
+        ),
+        (
+            vec![
+                "solve".into(),
+                p("textured-room.gltf"),
+                "-o".into(),
+                p("textured-room.bin"),
+            ],
+            "textured-room.bin",
+        ),
+    ];
+    for uri in &gltf_images {
+        cases.push((
+            vec![
+                "render".into(),
+                p("textured-room.gltf"),
+                "--quality".into(),
+                "draft".into(),
+                "-o".into(),
+                p("w.exr"),
+                "--png".into(),
+                p(uri),
+            ],
+            "would overwrite the input",
+        ));
+    }
+    assert!(!gltf_images.is_empty(), "the glTF scene has image files");
+    for (args, what) in cases {
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let out = trilux(&args);
+        assert_refused(&out, "", "would overwrite the input");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(stderr.contains(what), "{args:?}: {stderr}");
+        assert_eq!(snapshot(&dir), before, "{args:?} changed a file");
+    }
 }

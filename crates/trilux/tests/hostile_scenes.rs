@@ -481,3 +481,59 @@ fn a_far_clip_plane_cutting_the_scene_is_refused_at_the_sensor() {
     );
     assert!(exr.exists());
 }
+
+#[test]
+fn a_sample_count_above_the_maximum_is_located() {
+    use common::hostile::furnace;
+    let dir = folder("scene-spp");
+    // furnace()'s sampler is on line 5; its `<integer>` at column 33.
+    let text = furnace("0.5", "1.0", 1.0);
+    let too_many = text.replace(
+        r#"name="sample_count" value="4""#,
+        r#"name="sample_count" value="65537""#,
+    );
+    assert_ne!(too_many, text, "the sample count was replaced");
+    let scene = write(&dir, "spp.xml", too_many);
+    assert_refused_by_every_command(&scene, &format!("{}:5:", s(&scene)), "sample_count 65537");
+    // 65 536 = 2^16, the sequence's length, is still accepted.
+    let at_limit = text.replace(
+        r#"name="sample_count" value="4""#,
+        r#"name="sample_count" value="65536""#,
+    );
+    let scene = write(&dir, "spp-max.xml", at_limit);
+    let out = trilux(&["info", s(&scene)]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(String::from_utf8_lossy(&out.stdout).contains("65536 spp"));
+}
+
+#[test]
+fn a_grayscale_jpeg_texture_is_accepted() {
+    // Its texel values are checked in trilux-scene's tests/gltf.rs.
+    let dir = folder("scene-grey-jpeg");
+    let jpeg = Path::new(env!("CARGO_MANIFEST_DIR")).join("../trilux-scene/tests/data/grey192.jpg");
+    std::fs::copy(jpeg, dir.join("grey.jpg")).unwrap();
+    let texture = r#"<texture type="bitmap" name="reflectance"><string name="filename" value="grey.jpg"/></texture>"#;
+    let scene = write(
+        &dir,
+        "grey.xml",
+        format!(
+            "{HEAD}\n{SENSOR}\n<shape type=\"rectangle\"><bsdf type=\"diffuse\">{texture}</bsdf></shape>\n</scene>\n"
+        ),
+    );
+    let out = trilux(&["info", s(&scene)]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(String::from_utf8_lossy(&out.stdout).contains("1 texture"));
+    let exr = dir.join("grey.exr");
+    let out = trilux(&["render", s(&scene), "--quality", "draft", "-o", s(&exr)]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(exr.is_file());
+}

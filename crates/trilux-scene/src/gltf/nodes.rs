@@ -405,6 +405,25 @@ fn camera(file: &Arc<Path>, c: &CameraNode) -> Result<Camera> {
 }
 
 impl GltfMeshes {
+    /// The external files of the glTF: buffers and images named by a
+    /// `uri` that is not a `data:` URI.
+    pub fn input_files(&self) -> Vec<PathBuf> {
+        let folder = self.file.parent().unwrap_or(Path::new(""));
+        let buffers = self.document.buffers().filter_map(|b| match b.source() {
+            gltf::buffer::Source::Uri(uri) => Some(uri),
+            gltf::buffer::Source::Bin => None,
+        });
+        let images = self.document.images().filter_map(|i| match i.source() {
+            gltf::image::Source::Uri { uri, .. } => Some(uri),
+            gltf::image::Source::View { .. } => None,
+        });
+        buffers
+            .chain(images)
+            .filter(|uri| data_uri(uri).is_none())
+            .filter_map(|uri| relative_path(folder, uri).ok())
+            .collect()
+    }
+
     /// Reads every placed primitive's mesh into `scene` and returns the
     /// texture requests of their materials.
     pub fn finish(self, scene: &mut Scene) -> Result<Vec<(usize, TextureRequest)>> {

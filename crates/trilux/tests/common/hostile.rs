@@ -32,11 +32,23 @@ pub fn mkfifo(path: &Path) {
 /// Its output is read once it ends, so it is for commands that print
 /// little (a refusal's one line), not more than a pipe holds (64 KiB).
 pub fn trilux_or_hang(args: &[&str], limit: Duration) -> Output {
+    trilux_streams_or_hang(args, Stdio::piped(), Stdio::piped(), limit)
+}
+
+/// [`trilux_or_hang`] with the child's stdout and stderr as given (a
+/// full device, a pipe whose reader has gone); the output holds only
+/// what went to a `Stdio::piped()`.
+pub fn trilux_streams_or_hang(
+    args: &[&str],
+    stdout: Stdio,
+    stderr: Stdio,
+    limit: Duration,
+) -> Output {
     let mut child = Command::new(env!("CARGO_BIN_EXE_trilux"))
         .args(args)
         .stdin(Stdio::null())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
+        .stdout(stdout)
+        .stderr(stderr)
         .spawn()
         .expect("the trilux binary runs");
     let start = Instant::now();
