@@ -70,6 +70,11 @@ pub fn run(args: &BakeArgs) -> Result<()> {
     let mut inputs = vec![args.scene.as_path()];
     inputs.extend(args.solution.as_deref());
     let outputs = Outputs::plan(&outputs, &inputs, None)?;
+    // The viewer's port is taken before any work: one in use is refused now.
+    let listener = args
+        .open
+        .then(|| crate::serve::listen(args.port.unwrap_or(0)))
+        .transpose()?;
     let pending = trilux_scene::open_with_params(&args.scene, &args.params.define)?;
     outputs.check_inputs(&pending.input_files())?;
     let bake = Product::Bake(BakeOptions {
@@ -96,8 +101,8 @@ pub fn run(args: &BakeArgs) -> Result<()> {
         s.triangles,
         s.seconds
     ))?;
-    if args.open {
-        crate::serve::serve(&baked.glb, args.port.unwrap_or(0))?;
+    if let Some(listener) = listener {
+        crate::serve::serve(listener, &baked.glb)?;
     }
     Ok(())
 }

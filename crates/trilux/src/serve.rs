@@ -3,12 +3,18 @@
 //!
 //! The viewer's files are built into the binary (they are committed,
 //! three.js vendored), so an installed `trilux` needs no source tree. The
-//! server answers `GET` (and `HEAD`) for those files and `/model.glb`, one
-//! connection at a time, on 127.0.0.1 only: a walkthrough for the person
-//! at this machine, not a web server.
+//! server answers `GET` (and `HEAD`) for those files and `/model.glb` on
+//! 127.0.0.1 only: a walkthrough for the person at this machine, not a web
+//! server. Each connection is answered on its own thread, at most
+//! [`MAX_CONNECTIONS`] at once, each read bounded in time
+//! ([`READ_TIMEOUT`]) and size ([`MAX_REQUEST_BYTES`]), so one idle or
+//! half-sent request blocks nobody else. The port is bound before the
+//! solve ([`listen`]), so a port in use is refused before any work.
 
-use std::io::{BufRead, BufReader, Write};
+use std::io::{BufRead, BufReader, Read, Write};
 use std::net::{TcpListener, TcpStream};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::time::Duration;
 
 use anyhow::{Context, Result};
 
@@ -44,31 +50,56 @@ const VIEWER: [Served; 9] = viewer_files![
     ("vendor/three/examples/jsm/utils/SkeletonUtils.js", JS),
 ];
 
-/// Longest request head read.
-const MAX_REQUEST_BYTES: usize = 16 * 1024;
+/// Longest request head read, newlines or not.
+pub const MAX_REQUEST_BYTES: u64 = 16 * 1024;
 
-/// Serves the viewer with `glb` as `/model.glb` on 127.0.0.1 (`port` 0:
-/// any free one); prints the address; returns only on an error.
-pub fn serve(glb: &[u8], port: u16) -> Result<()> {
-    let listener = TcpListener::bind(("127.0.0.1", port))
-        .with_context(|| format!("cannot listen on 127.0.0.1:{port}"))?;
+/// Connections answered at once; more wait in the listener's backlog.
+pub const MAX_CONNECTIONS: usize = 16;
+
+/// How long a connection may stay silent while its request is read, and
+/// how long a reply may wait for the reader.
+pub const READ_TIMEOUT: Duration = Duration::from_secs(10);
+
+/// Binds 127.0.0.1:`port` (0: any free one), before any work.
+pub fn listen(port: u16) -> Result<TcpListener> {
+    TcpListener::bind(("127.0.0.1", port))
+        .with_context(|| format!("cannot listen on 127.0.0.1:{port}"))
+}
+
+/// Serves the viewer with `glb` as `/model.glb` on `listener`; prints the
+/// address; returns only on an error.
+pub fn serve(listener: TcpListener, glb: &[u8]) -> Result<()> {
     let port = listener.local_addr()?.port();
     crate::streams::print(&format!(
         "viewer: http://127.0.0.1:{port}/index.html?file=/model.glb (Ctrl-C stops it)\n"
     ))?;
-    // A failed connection (a closed tab) does not stop the server.
-    for stream in listener.incoming().flatten() {
-        let _ = answer(stream, glb);
-    }
+    let busy = AtomicUsize::new(0);
+    std::thread::scope(|scope| {
+        // A failed connection (a closed tab) does not stop the server.
+        for stream in listener.incoming().flatten() {
+            while busy.load(Ordering::Acquire) >= MAX_CONNECTIONS {
+                std::thread::sleep(Duration::from_millis(5));
+            }
+            busy.fetch_add(1, Ordering::AcqRel);
+            let busy = &busy;
+            scope.spawn(move || {
+                let _ = answer(stream, glb);
+                busy.fetch_sub(1, Ordering::AcqRel);
+            });
+        }
+    });
     Ok(())
 }
 
-/// Reads one request and answers it.
+/// Reads one request (at most [`MAX_REQUEST_BYTES`], each read within
+/// [`READ_TIMEOUT`]) and answers it.
 fn answer(stream: TcpStream, glb: &[u8]) -> std::io::Result<()> {
-    let mut reader = BufReader::new(stream.try_clone()?);
+    stream.set_read_timeout(Some(READ_TIMEOUT))?;
+    stream.set_write_timeout(Some(READ_TIMEOUT))?;
+    let mut reader = BufReader::new(stream.try_clone()?.take(MAX_REQUEST_BYTES));
     let mut head = String::new();
     let mut line = String::new();
-    while reader.read_line(&mut line)? > 0 && head.len() < MAX_REQUEST_BYTES {
+    while reader.read_line(&mut line)? > 0 {
         if line == "\r\n" || line == "\n" {
             break;
         }

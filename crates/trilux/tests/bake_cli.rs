@@ -533,6 +533,9 @@ fn a_bake_that_is_not_a_glb_is_refused() {
 fn http_get(port: u16, path: &str) -> (String, Vec<u8>) {
     use std::io::{Read, Write};
     let mut s = std::net::TcpStream::connect(("127.0.0.1", port)).unwrap();
+    // A server that never answers fails the test instead of hanging it.
+    s.set_read_timeout(Some(std::time::Duration::from_secs(60)))
+        .unwrap();
     write!(s, "GET {path} HTTP/1.1\r\nHost: localhost\r\n\r\n").unwrap();
     let mut all = Vec::new();
     s.read_to_end(&mut all).unwrap();
@@ -548,8 +551,27 @@ fn http_get(port: u16, path: &str) -> (String, Vec<u8>) {
 /// three.js, the file just written (byte for byte); 404 for anything else.
 #[test]
 fn open_serves_the_viewer_and_the_bake() {
-    use std::io::BufRead;
     let dir = folder("bake-open");
+    let glb = dir.join("furnace.glb");
+    let (mut child, port) = bake_and_serve(&dir);
+    let (status, page) = http_get(port, "/index.html?file=/model.glb");
+    assert!(status.contains("200"), "{status}");
+    assert!(String::from_utf8_lossy(&page).contains("importmap"));
+    let (status, three) = http_get(port, "/vendor/three/build/three.module.js");
+    assert!(status.contains("200") && three.len() > 1000, "{status}");
+    let (status, model) = http_get(port, "/model.glb");
+    assert!(status.contains("200"), "{status}");
+    assert_eq!(model, std::fs::read(&glb).unwrap());
+    let (status, _) = http_get(port, "/../Cargo.toml");
+    assert!(status.contains("404"), "{status}");
+    child.kill().unwrap();
+    child.wait().unwrap();
+}
+
+/// Starts `trilux bake --open` on the furnace and returns it with the
+/// port it serves on (read from its "viewer:" line).
+fn bake_and_serve(dir: &Path) -> (std::process::Child, u16) {
+    use std::io::BufRead;
     let glb = dir.join("furnace.glb");
     let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_trilux"))
         .args(["bake", repo("scenes/furnace.xml").to_str().unwrap()])
@@ -563,23 +585,76 @@ fn open_serves_the_viewer_and_the_bake() {
         .map(|l| l.unwrap())
         .find(|l| l.starts_with("viewer: "))
         .expect("the address is printed");
-    let port: u16 = url
+    let port = url
         .split("127.0.0.1:")
         .nth(1)
         .and_then(|r| r.split('/').next())
         .unwrap()
         .parse()
         .unwrap();
-    let (status, page) = http_get(port, "/index.html?file=/model.glb");
+    (child, port)
+}
+
+/// One idle connection and one that sends a request line far longer than
+/// the head limit without a newline do not stop the server answering a
+/// third client; the long one is answered (and closed) once the limit is
+/// read, not buffered without end.
+#[test]
+fn a_stalled_or_endless_request_blocks_no_other_client() {
+    use std::io::{Read, Write};
+    let dir = folder("bake-open-stalled");
+    let (mut child, port) = bake_and_serve(&dir);
+    let idle = std::net::TcpStream::connect(("127.0.0.1", port)).unwrap();
+    let mut endless = std::net::TcpStream::connect(("127.0.0.1", port)).unwrap();
+    // 64 KiB of one line: four times the head limit. The server stops
+    // reading at the limit, so the later writes may fail: that is the point.
+    let chunk = vec![b'A'; 4096];
+    for _ in 0..16 {
+        if endless.write_all(&chunk).is_err() {
+            break;
+        }
+    }
+    let (status, page) = http_get(port, "/index.html");
     assert!(status.contains("200"), "{status}");
     assert!(String::from_utf8_lossy(&page).contains("importmap"));
-    let (status, three) = http_get(port, "/vendor/three/build/three.module.js");
-    assert!(status.contains("200") && three.len() > 1000, "{status}");
-    let (status, model) = http_get(port, "/model.glb");
-    assert!(status.contains("200"), "{status}");
-    assert_eq!(model, std::fs::read(&glb).unwrap());
-    let (status, _) = http_get(port, "/../Cargo.toml");
-    assert!(status.contains("404"), "{status}");
+    // The endless request was answered (an error status) and closed once
+    // the limit was read; the close may reset the connection before the
+    // reply is read (the unread rest of the line), which is a close too.
+    // A server still reading it would time this read out.
+    endless
+        .set_read_timeout(Some(std::time::Duration::from_secs(50)))
+        .unwrap();
+    let mut reply = Vec::new();
+    match endless.read_to_end(&mut reply) {
+        Ok(_) => {
+            let reply = String::from_utf8_lossy(&reply);
+            assert!(reply.starts_with("HTTP/1.1 405"), "{reply}");
+        }
+        Err(e) => assert_eq!(e.kind(), std::io::ErrorKind::ConnectionReset, "{e}"),
+    }
+    drop(idle);
     child.kill().unwrap();
     child.wait().unwrap();
+}
+
+/// A port already in use is refused before the scene is solved or baked:
+/// one line, exit 1, no output written.
+#[test]
+fn a_port_in_use_is_refused_before_any_work() {
+    let dir = folder("bake-open-port");
+    let taken = std::net::TcpListener::bind(("127.0.0.1", 0)).unwrap();
+    let port = taken.local_addr().unwrap().port().to_string();
+    let glb = dir.join("furnace.glb");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_trilux"))
+        .args(["bake", repo("scenes/furnace.xml").to_str().unwrap()])
+        .args(["--open", "--port", &port, "-o", glb.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("cannot listen on 127.0.0.1"), "{stderr}");
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    assert!(!stderr.contains("solv"), "{stderr}");
+    assert!(!glb.exists());
+    drop(taken);
 }
