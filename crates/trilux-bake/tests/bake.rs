@@ -213,13 +213,15 @@ fn a_baked_closed_box_keeps_its_flux_and_is_valid_gltf() {
         }
     }
     assert_eq!(sides_seen, 12);
-    // The closed box's balance: ∫ L dA = Le A_e / (1 − ρ) = 8, to the
-    // solver's accuracy (1 %; its furnace test holds 0.5 %).
+    // The closed box's balance: ∫ L dA = Le A_e / (1 − ρ) = 8. Stopped at
+    // CR 0.999, the solve still holds 0.1 % of the emitted flux unshot,
+    // whose later reflections are missing: (1 − CR)·ρ = 0.05 % of the
+    // total. Tolerance 0.1 %, twice that (measured 0.054 %).
     let expected = LE * FACE_AREA / (1.0 - RHO);
     eprintln!("closed box: ∫ L dA over the file = {total_front} (expected {expected})");
     for c in 0..3 {
         assert!(
-            (total_front[c] - expected).abs() < 0.01 * expected,
+            (total_front[c] - expected).abs() < 1e-3 * expected,
             "∫ L dA = {total_front}, expected {expected}"
         );
     }
