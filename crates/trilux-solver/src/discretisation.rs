@@ -29,7 +29,17 @@ pub(crate) struct Discretisation {
 impl Discretisation {
     /// The discretisation of `geometry` under `settings`.
     pub fn new(geometry: &Arc<Geometry>, settings: &SolverSettings) -> Self {
-        let depths = depth_limits(geometry, settings);
+        Self::with_limits(geometry, Self::limits(geometry, settings))
+    }
+
+    /// The depth limits alone, cheap beside the trees: a solution file's
+    /// reader compares them with the file's before building anything.
+    pub fn limits(geometry: &Geometry, settings: &SolverSettings) -> Vec<u32> {
+        depth_limits(geometry, settings)
+    }
+
+    /// The trees for `depths`, which must be [`Discretisation::limits`]'s.
+    pub fn with_limits(geometry: &Arc<Geometry>, depths: Vec<u32>) -> Self {
         let forest = presubdivided(Arc::clone(geometry), &depths);
         Discretisation { depths, forest }
     }

@@ -298,17 +298,19 @@ impl<const N: usize> Solution<N> {
         // The file records the depth limits its elements were made with:
         // they must be this discretisation's, or the element indexes below
         // would mean other elements.
-        let discretisation = Discretisation::new(scene.geometry(), settings);
-        let depths = discretisation.depth_limits();
+        // Compared before the trees are built, so a file for another
+        // discretisation costs no subdivision.
+        let depths = Discretisation::limits(scene.geometry(), settings);
         let surfaces = r.u32()? as usize;
         if surfaces != depths.len() {
             return Err("surface count differs from the scene".into());
         }
-        for &d in depths {
+        for &d in &depths {
             if r.u32()? != d {
                 return Err("element depth limits differ from the scene's".into());
             }
         }
+        let discretisation = Discretisation::with_limits(scene.geometry(), depths);
         let forest = discretisation.forest();
         let elements = r.u64()?;
         if elements != forest.element_count() as u64 {
