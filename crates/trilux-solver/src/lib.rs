@@ -86,5 +86,5 @@ pub use prepared::{PrepareError, PreparedScene, SceneDescription};
 pub use settings::{Quality, SolverSettings, Transport};
 pub use solution::{FORMAT_VERSION, Solution, SurfaceSite, solve_hash};
 pub use solver::{Progress, Solver};
-pub use stats::SolveStats;
+pub use stats::{SolveStats, StopReason, TracePoint};
 pub use textures::ElementTextures;

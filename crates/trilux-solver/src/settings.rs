@@ -75,11 +75,22 @@ pub struct SolverSettings {
     /// tests that check the paper's algorithm alone.
     #[serde(default = "clustering_default")]
     pub clustering: bool,
+    /// Stop shooting once this many seconds have passed since the solve's
+    /// preparation began, with the best solution so far (progressive
+    /// refinement's promise). The final gather's links are still made
+    /// after the last shot. Not part of the solution's identity: it is
+    /// neither saved nor hashed, so a solution made within a budget loads
+    /// with any budget.
+    #[serde(skip)]
+    pub time_budget_seconds: Option<f64>,
 }
 
 fn clustering_default() -> bool {
     true
 }
+
+/// The longest time budget a solve accepts (a year, in seconds).
+pub const MAX_TIME_BUDGET_SECONDS: f64 = 365.0 * 24.0 * 3600.0;
 
 impl SolverSettings {
     /// The settings of a quality preset.
@@ -96,6 +107,7 @@ impl SolverSettings {
                 visibility_samples: 9,
                 transport: Transport::TwoPoint,
                 clustering: true,
+                time_budget_seconds: None,
             },
             Quality::Default => SolverSettings {
                 convergence: 0.999,
@@ -108,6 +120,7 @@ impl SolverSettings {
                 visibility_samples: 16,
                 transport: Transport::TwoPoint,
                 clustering: true,
+                time_budget_seconds: None,
             },
             Quality::High => SolverSettings {
                 convergence: 0.9999,
@@ -120,6 +133,7 @@ impl SolverSettings {
                 visibility_samples: 25,
                 transport: Transport::TwoPoint,
                 clustering: true,
+                time_budget_seconds: None,
             },
         }
     }
@@ -178,7 +192,22 @@ impl SolverSettings {
         if self.max_depth > 12 {
             return Err(format!("max_depth {} is above 12", self.max_depth));
         }
+        if let Some(seconds) = self.time_budget_seconds {
+            Self::validate_time_budget(seconds)?;
+        }
         Ok(())
+    }
+
+    /// A time budget must be a finite number of seconds, not negative, and
+    /// at most a year (a `Duration` holds it exactly).
+    pub fn validate_time_budget(seconds: f64) -> Result<(), String> {
+        if seconds.is_finite() && (0.0..=MAX_TIME_BUDGET_SECONDS).contains(&seconds) {
+            Ok(())
+        } else {
+            Err(format!(
+                "time budget must be in [0, {MAX_TIME_BUDGET_SECONDS}] seconds, got {seconds}"
+            ))
+        }
     }
 }
 

@@ -20,7 +20,7 @@
 //! `ShotState` (what the shots change: unshot radiance, hierarchies,
 //! ledger, statistics).
 
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use glam::DVec3;
 use trilux_color::Spectrum;
@@ -36,6 +36,7 @@ use crate::settings::SolverSettings;
 use crate::setup::Setup;
 use crate::solution::{FarRecord, Parts, Solution};
 use crate::state::ShotState;
+use crate::stats::{StopReason, TracePoint};
 
 use std::sync::Arc;
 
@@ -52,6 +53,11 @@ pub struct Progress {
     pub interactions: usize,
     /// Links alive during the last shot.
     pub live_links: usize,
+    /// Seconds since the solve's preparation began.
+    pub elapsed_seconds: f64,
+    /// The time budget, if the solve has one
+    /// ([`SolverSettings::time_budget_seconds`]).
+    pub time_budget_seconds: Option<f64>,
 }
 
 /// A light source for shooting.
@@ -70,6 +76,10 @@ pub(crate) enum Source {
 pub struct Solver<const N: usize> {
     pub(crate) setup: Setup<N>,
     pub(crate) state: ShotState<N>,
+    /// When preparation began: the time budget counts from here.
+    started: Instant,
+    /// Stop shooting once this much time has passed since `started`.
+    time_budget: Option<Duration>,
 }
 
 impl<const N: usize> Solver<N> {
@@ -79,9 +89,17 @@ impl<const N: usize> Solver<N> {
         scene: Arc<PreparedScene<N>>,
         settings: SolverSettings,
     ) -> Result<Self, SolverError> {
+        let started = Instant::now();
         let setup = Setup::new(scene, settings)?;
-        let state = ShotState::new(&setup);
-        Ok(Solver { setup, state })
+        let mut state = ShotState::new(&setup);
+        let budget = setup.settings.time_budget_seconds;
+        state.stats.time_budget_seconds = budget;
+        Ok(Solver {
+            setup,
+            state,
+            started,
+            time_budget: budget.map(Duration::from_secs_f64),
+        })
     }
 
     /// Prepares `desc` ([`PreparedScene::new`]) and a solve of it.
@@ -188,39 +206,101 @@ impl<const N: usize> Solver<N> {
             .sum()
     }
 
-    /// Runs shots until the target convergence ratio or the shot budget,
-    /// calling `progress` after each shot, then makes every hierarchy
-    /// consistent and returns the solution.
+    /// Runs shots until the target convergence ratio, the shot cap or the
+    /// time budget, calling `progress` after each shot, then makes every
+    /// hierarchy consistent and returns the solution.
     pub fn solve(mut self, mut progress: impl FnMut(&Progress)) -> Solution<N> {
         let start = Instant::now();
+        let reason = self.shoot_until_stopped(&mut progress);
+        self.state.stats.stop_reason = reason;
+        self.warn_if_short(reason);
+        self.finish(start.elapsed().as_secs_f64())
+    }
+
+    /// The shooting loop; returns why it stopped.
+    fn shoot_until_stopped(&mut self, progress: &mut impl FnMut(&Progress)) -> StopReason {
         let (target, max_shots) = (
             self.setup.settings.convergence,
             self.setup.settings.max_shots,
         );
-        while self.convergence_ratio() < target && self.state.stats.shots < u64::from(max_shots) {
+        let mut next_trace = 1u64;
+        loop {
+            if self.convergence_ratio() >= target {
+                return StopReason::Converged;
+            }
+            if self.state.stats.shots >= u64::from(max_shots) {
+                return StopReason::ShotCap;
+            }
+            if self
+                .time_budget
+                .is_some_and(|b| self.started.elapsed() >= b)
+            {
+                return StopReason::TimeBudget;
+            }
             let Some(source) = self.next_source() else {
-                break;
+                return StopReason::NothingUnshot;
             };
             let live = self.shoot(source);
             self.state.stats.shots += 1;
             let bytes = self.arena_bytes(live);
             self.state.stats.peak_memory_bytes = self.state.stats.peak_memory_bytes.max(bytes);
-            progress(&Progress {
+            let p = Progress {
                 shots: self.state.stats.shots,
                 convergence_ratio: self.convergence_ratio(),
                 target,
                 interactions: self.interaction_count(),
                 live_links: live,
+                elapsed_seconds: self.started.elapsed().as_secs_f64(),
+                time_budget_seconds: self.time_budget.map(|b| b.as_secs_f64()),
+            };
+            if p.shots == next_trace {
+                self.trace(&p);
+                next_trace *= 2;
+            }
+            progress(&p);
+        }
+    }
+
+    /// Appends a point to the convergence trace.
+    fn trace(&mut self, p: &Progress) {
+        self.state.stats.convergence_trace.push(TracePoint {
+            shots: p.shots,
+            seconds: p.elapsed_seconds,
+            convergence_ratio: p.convergence_ratio,
+        });
+    }
+
+    /// The last trace point, and a warning when the loop stopped short of
+    /// its target.
+    fn warn_if_short(&mut self, reason: StopReason) {
+        let cr = self.convergence_ratio();
+        let shots = self.state.stats.shots;
+        if self
+            .state
+            .stats
+            .convergence_trace
+            .last()
+            .is_none_or(|t| t.shots != shots)
+        {
+            let seconds = self.started.elapsed().as_secs_f64();
+            self.state.stats.convergence_trace.push(TracePoint {
+                shots,
+                seconds,
+                convergence_ratio: cr,
             });
         }
-        let cr = self.convergence_ratio();
-        if cr < target {
-            self.state.stats.warnings.push(format!(
-                "the solve stopped at its cap of {} shots with convergence ratio {cr:.4}, short of its target {} (surfaces that reflect nearly all light converge slowly: lower a reflectance, or ask for less with --convergence)",
-                self.state.stats.shots, target
-            ));
-        }
-        self.finish(start.elapsed().as_secs_f64())
+        let target = self.setup.settings.convergence;
+        let warning = match reason {
+            StopReason::Converged | StopReason::NothingUnshot => return,
+            StopReason::ShotCap => format!(
+                "the solve stopped at its cap of {shots} shots with convergence ratio {cr:.4}, short of its target {target} (surfaces that reflect nearly all light converge slowly: lower a reflectance, or ask for less with --convergence)"
+            ),
+            StopReason::TimeBudget => format!(
+                "the solve stopped at its time budget of {} s after {shots} shots with convergence ratio {cr:.4}, short of its target {target}: the solution is the best so far",
+                self.time_budget.map_or(0.0, |b| b.as_secs_f64())
+            ),
+        };
+        self.state.stats.warnings.push(warning);
     }
 
     /// Final push-pull of everything, statistics, and the solution.
@@ -283,7 +363,7 @@ impl<const N: usize> Solver<N> {
     /// The solution of the finished solve: its discretisation, radiance,
     /// hierarchies, far fields and gather links.
     fn into_solution(self, links: GatherLinks) -> Solution<N> {
-        let Solver { setup, state } = self;
+        let Solver { setup, state, .. } = self;
         let hierarchies: Vec<Hierarchy<N>> = state.hierarchies.into_iter().flatten().collect();
         let far = state
             .far

@@ -68,6 +68,43 @@ pub struct SolveStats {
     /// allocator).
     #[serde(default)]
     pub peak_memory_bytes: u64,
+    /// Why the shooting loop stopped.
+    #[serde(default)]
+    pub stop_reason: StopReason,
+    /// The time budget the solve was given (seconds from the start of its
+    /// preparation), if any.
+    #[serde(default)]
+    pub time_budget_seconds: Option<f64>,
+    /// The convergence over the solve: a point after shots 1, 2, 4, 8, …
+    /// and after the last shot.
+    #[serde(default)]
+    pub convergence_trace: Vec<TracePoint>,
     /// Warnings (e.g. a Lambertian reflectance above 1 clamped).
     pub warnings: Vec<String>,
+}
+
+/// Why a solve's shooting loop stopped.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum StopReason {
+    /// The convergence ratio reached its target.
+    #[default]
+    Converged,
+    /// No source had unshot light left (CR short of 1 only by rounding).
+    NothingUnshot,
+    /// The shot cap (`SolverSettings::max_shots`) was reached first.
+    ShotCap,
+    /// The time budget ran out first: the solution is the best so far.
+    TimeBudget,
+}
+
+/// One point of [`SolveStats::convergence_trace`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct TracePoint {
+    /// Shots so far.
+    pub shots: u64,
+    /// Seconds since the solve's preparation began.
+    pub seconds: f64,
+    /// The convergence ratio after those shots.
+    pub convergence_ratio: f64,
 }

@@ -27,6 +27,11 @@ pub struct SolveOptions {
     /// --quality: 0.95, 0.999, 0.9999).
     #[arg(long, value_parser = parse_unit)]
     pub convergence: Option<f64>,
+    /// Stop the solve after this many seconds (from the start of its
+    /// preparation) with the best solution so far; the stats say what it
+    /// reached.
+    #[arg(long, value_name = "SECONDS", value_parser = parse_budget, allow_hyphen_values = true)]
+    pub time_budget: Option<f64>,
     /// Override the scene's colour mode.
     #[arg(long, value_enum)]
     pub mode: Option<ModeArg>,
@@ -79,6 +84,7 @@ impl SolveOptions {
         if let Some(cr) = self.convergence {
             settings.convergence = cr;
         }
+        settings.time_budget_seconds = self.time_budget;
         settings
     }
 
@@ -145,6 +151,16 @@ fn parse_real(text: &str, ok: impl Fn(f64) -> bool, range: &str) -> Result<f64, 
 /// A number in [0, 1].
 fn parse_unit(text: &str) -> Result<f64, String> {
     parse_real(text, |v| (0.0..=1.0).contains(&v), "in [0, 1]")
+}
+
+/// A time budget: seconds, finite, not negative, at most a year.
+fn parse_budget(text: &str) -> Result<f64, String> {
+    let max = trilux_solver::settings::MAX_TIME_BUDGET_SECONDS;
+    parse_real(
+        text,
+        |v| (0.0..=max).contains(&v),
+        "a number of seconds in [0, 31536000] (a year)",
+    )
 }
 
 /// `text` quoted for a message, its middle elided when long (a value of

@@ -33,17 +33,24 @@ impl Bars {
         }
     }
 
-    /// Shows the solve's progress after a shot.
+    /// Shows the solve's progress after a shot: how far the unshot
+    /// remainder 1 − CR has fallen towards its target on a log scale (it
+    /// falls about geometrically with the shots, so this moves about evenly
+    /// in time), with the time left that its rate so far predicts.
     pub fn solve(&self, p: &Progress) {
         let Some(bar) = &self.solve else { return };
-        let frac = if p.target > 0.0 {
-            p.convergence_ratio / p.target
-        } else {
-            1.0
+        let frac = convergence_fraction(p.convergence_ratio, p.target);
+        bar.set_position((frac * 1000.0) as u64);
+        let left = match time_left(frac, p.elapsed_seconds) {
+            Some(s) => format!(", about {s:.0} s left"),
+            None => String::new(),
         };
-        bar.set_position((frac.clamp(0.0, 1.0) * 1000.0) as u64);
+        let budget = match p.time_budget_seconds {
+            Some(b) => format!(" (budget {b} s)"),
+            None => String::new(),
+        };
         bar.set_message(format!(
-            "CR {:.4}/{:.4}, shot {}, {} interactions, {} links",
+            "CR {:.4}/{:.4}{left}{budget}, shot {}, {} interactions, {} links",
             p.convergence_ratio, p.target, p.shots, p.interactions, p.live_links
         ));
     }
@@ -65,6 +72,32 @@ impl Bars {
             b.finish_and_clear();
         }
     }
+}
+
+/// How far the unshot remainder 1 − CR has come from 1 towards 1 − target,
+/// on a log scale, in [0, 1].
+fn convergence_fraction(cr: f64, target: f64) -> f64 {
+    let (gap, goal) = (1.0 - cr, 1.0 - target);
+    let frac = if !gap.is_finite() {
+        0.0
+    } else if goal <= 0.0 || goal >= 1.0 {
+        cr
+    } else if gap <= goal {
+        1.0
+    } else {
+        gap.max(f64::MIN_POSITIVE).ln() / goal.ln()
+    };
+    if frac.is_finite() {
+        frac.clamp(0.0, 1.0)
+    } else {
+        0.0
+    }
+}
+
+/// The seconds left if the fraction keeps growing at its rate so far
+/// (`None` before there is a rate to go by).
+fn time_left(frac: f64, elapsed: f64) -> Option<f64> {
+    (frac > 0.01 && frac < 1.0 && elapsed > 0.0).then(|| elapsed * (1.0 - frac) / frac)
 }
 
 /// Checks `plan` against the scene read so far, reads the rest of it
@@ -90,4 +123,29 @@ pub fn run_plan(
     );
     bars.finish();
     Ok(outcome?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_fraction_is_the_log_of_the_remainder_over_the_log_of_its_target() {
+        // 1 − CR from 1 to 0.001: 0.1 is a third of the way (log scale).
+        assert!((convergence_fraction(0.9, 0.999) - 1.0 / 3.0).abs() < 1e-12);
+        assert_eq!(convergence_fraction(0.0, 0.999), 0.0);
+        assert_eq!(convergence_fraction(0.9995, 0.999), 1.0);
+        assert_eq!(convergence_fraction(1.0, 0.999), 1.0);
+        // A target of 1 (or 0) has no log scale: CR itself.
+        assert_eq!(convergence_fraction(0.5, 1.0), 0.5);
+        assert_eq!(convergence_fraction(f64::NAN, 0.999), 0.0);
+    }
+
+    #[test]
+    fn the_time_left_extrapolates_the_rate_so_far() {
+        // A quarter of the way in 10 s: 30 s to go at that rate.
+        assert_eq!(time_left(0.25, 10.0), Some(30.0));
+        assert_eq!(time_left(0.0, 10.0), None);
+        assert_eq!(time_left(1.0, 10.0), None);
+    }
 }
