@@ -25,7 +25,7 @@ use trilux_geometry::{ElementId, FaceId};
 use crate::cluster_transport::{FarField, far_links};
 use crate::interaction::Hierarchy;
 use crate::link::{NodeLink, PairLink, PairShot, Sender, Sent};
-use crate::refine::{Incidence, RefineContext, TripleTask};
+use crate::refine::{Incidence, IncidenceMemo, RefineContext, TripleTask};
 use crate::solver::{Solver, Source};
 
 /// The most a stored interaction's shot is scaled up to carry its whole
@@ -396,6 +396,7 @@ fn stage_two<const N: usize>(
             groups_of_face.entry(l.face).or_default().push(g as u32);
         }
     }
+    let memo = IncidenceMemo::new();
     // The hierarchy sending this shot is out of its slot (unless it is a
     // face's interaction with itself, which receives).
     hierarchies
@@ -413,6 +414,7 @@ fn stage_two<const N: usize>(
                 group: 0,
                 lost: Spectrum::zero(),
                 out: Vec::new(),
+                memo: &memo,
             };
             for &g in &groups_of_face[&from] {
                 let l = &pair_links[g as usize];

@@ -46,7 +46,7 @@ const SHARDS: usize = 64;
 /// A hasher for the cache's u64 keys: a few multiplications instead of
 /// SipHash, which dominated the solve's profile.
 #[derive(Clone, Copy, Default)]
-struct KeyHasher(u64);
+pub(crate) struct KeyHasher(u64);
 
 impl std::hash::Hasher for KeyHasher {
     fn finish(&self) -> u64 {
@@ -70,7 +70,10 @@ impl std::hash::Hasher for KeyHasher {
     }
 }
 
-type KeyMap = HashMap<u64, Throughput, std::hash::BuildHasherDefault<KeyHasher>>;
+/// Builds [`KeyHasher`]s, for maps keyed by dense `u64` pair keys.
+pub(crate) type BuildKeyHasher = std::hash::BuildHasherDefault<KeyHasher>;
+
+type KeyMap = HashMap<u64, Throughput, BuildKeyHasher>;
 
 /// A bounded, thread-safe cache of throughputs keyed by ordered sided pairs.
 pub(crate) struct ThroughputCache {

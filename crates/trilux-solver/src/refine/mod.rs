@@ -24,14 +24,17 @@
 //! across the parallel tasks of one shot.
 //!
 //! Files, in reading order: `context` (what refinement reads, T through
-//! the cache), `pair` (stage 1), `triple` (stage 2), `narrow_lobe` (the
+//! the cache), `pair` (stage 1), `triple` (stage 2), `incidences` (stage 2's sub-pairs, once per
+//! shot), `narrow_lobe` (the
 //! sampled lobes stage 2 uses). The links and senders are in
 //! `crate::link`.
 
 mod context;
+mod incidences;
 mod narrow_lobe;
 mod pair;
 mod triple;
 
 pub(crate) use context::{RefineContext, visibility_samples_for};
+pub(crate) use incidences::IncidenceMemo;
 pub(crate) use triple::{Incidence, TripleTask};

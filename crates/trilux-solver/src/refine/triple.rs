@@ -17,6 +17,7 @@ use trilux_color::Spectrum;
 use trilux_geometry::{ElementId, FaceElement, FaceId};
 
 use super::context::RefineContext;
+use super::incidences::IncidenceMemo;
 use super::narrow_lobe::LobeHit;
 use crate::interaction::{Hierarchy, Node, Split};
 use crate::link::{NodeLink, Sender};
@@ -93,6 +94,8 @@ pub(crate) struct TripleTask<'t, const N: usize> {
     pub lost: Spectrum<N>,
     /// The links made.
     pub out: Vec<NodeLink<N>>,
+    /// The shot's sub-pair incidences, shared with its other tasks.
+    pub memo: &'t IncidenceMemo<N>,
 }
 
 impl<const N: usize> TripleTask<'_, N> {
@@ -298,11 +301,15 @@ impl<const N: usize> RefineContext<'_, N> {
         let known = match known {
             Some(k) => k,
             None => {
-                let Some(k) = self.incidence(task.sender, si.of(i), sj.of(j)) else {
+                let sender = task.sender;
+                let made = task
+                    .memo
+                    .get_or_make(i, sj.of(j), || self.incidence(sender, si.of(i), sj.of(j)));
+                let Some(k) = made else {
                     return;
                 };
                 owned = k;
-                &owned
+                &*owned
             }
         };
         let node = &task.h.nodes[n as usize];
@@ -735,6 +742,7 @@ mod tests {
         let incidence = ctx
             .incidence(&sender, ts::root(ctx.forest, e), ts::root(ctx.forest, r))
             .expect("light passes from E to R");
+        let memo = IncidenceMemo::new();
         let mut task = TripleTask {
             sender: &sender,
             si: e,
@@ -743,6 +751,7 @@ mod tests {
             group: 0,
             lost: Spectrum::zero(),
             out: Vec::new(),
+            memo: &memo,
         };
         f(&ctx, &mut task, &incidence);
         let out = std::mem::take(&mut task.out);
