@@ -44,9 +44,10 @@ rules for everything else (the nearest supported equivalent, or removal):
     mask                -> its nested BSDF, opaque (trilux has no cut-outs)
     bumpmap             -> its nested BSDF (trilux has no shading-normal maps)
     reflectance > 1     -> clamped to 1 (trilux refuses them)
-    sunsky, sky, envmap -> a sphere around the scene emitting inward with a
+    sunsky, sky, envmap -> a box just around the scene emitting inward with a
                            constant radiance (the sky's mean over the upper
-                           hemisphere; the sun is dropped)
+                           hemisphere, the sun dropped; the map's mean over
+                           all directions)
     point, spot, directional -> removed
     serialized meshes   -> PLY (Mitsuba's documented format, parsed here)
     maxSmoothAngle      -> face normals (Mitsuba 3 has no crease angle)
@@ -69,7 +70,7 @@ import zlib
 
 import numpy as np
 
-SCENES = ["staircase", "living-room-2", "sponza", "classroom", "dining-room", "bathroom"]
+SCENES = ["staircase", "living-room-2", "sponza", "classroom", "dining-room", "bathroom", "living-room"]
 FILM_MAX = 256
 MAX_TEXTURE = 1024
 MIN_ALPHA = 0.01
@@ -81,6 +82,14 @@ MIN_ALPHA = 0.01
 SKY_MEAN = {
     (3.0, (-0.866, 0.417, -0.277)): (0.07164, 0.09883, 0.12715),
     (3.0, (0.887, 0.289, 0.36)): (0.06813, 0.08758, 0.10120),
+}
+
+
+# Mean radiance (RGB) of an environment map over all directions (texels
+# weighted by the solid angle they cover, sin(theta)), read with Mitsuba
+# 3.9.1's Bitmap (numpy has no EXR reader). Keyed by the file's name.
+ENV_MEAN = {
+    "Sky 19.exr": (11.42488, 7.83410, 5.12506),
 }
 
 
@@ -612,8 +621,8 @@ def convert_scene(src_root, name, out_root):
     # emitters outside shapes
     for em in root.findall("emitter"):
         typ = em.get("type")
-        if typ in ("sunsky", "sky", "envmap", "constant"):
-            shapes_out.append(sky_sphere(em, bbox, notes))
+        if typ in ("sunsky", "sky", "envmap"):
+            shapes_out.append(sky_box(em, bbox, notes))
         else:
             notes.add("emitter", f"{typ}", "removed", "trilux reads area emitters on shapes only")
 
@@ -820,10 +829,16 @@ def convert_shape(sh, src_dir, out_dir, mats, notes, bsdf_cache, top_bsdfs, mesh
     return None
 
 
-def sky_sphere(em, bbox, notes):
+def sky_box(em, bbox, notes):
+    """A constant sky: a box just around the scene's bounds emitting inward.
+    Any closed emitter of constant radiance around the scene looks the same
+    from inside; a box keeps the scene's bounding box (trilux's MinArea is a
+    fraction of its diagonal) almost as it was, where a sphere or a distant
+    sun would enlarge it."""
     typ = em.get("type")
     c = 0.5 * (bbox[0] + bbox[1])
-    r = 10.0 * float(np.linalg.norm(bbox[1] - bbox[0]))
+    half = 0.5 * (bbox[1] - bbox[0])
+    half = half * 1.02 + 1e-3 * float(np.linalg.norm(bbox[1] - bbox[0]))
     if typ in ("sunsky", "sky"):
         t = fval(em, "turbidity", 3.0)
         d = prop(em, "sunDirection")
@@ -833,13 +848,24 @@ def sky_sphere(em, bbox, notes):
             raise ValueError(f"no sky mean for turbidity {t}, sun {dv}: add it to SKY_MEAN")
         s = fval(em, "skyScale", 1.0)
         L = [x * s for x in mean]
-        notes.add("emitter", f"{typ} (turbidity {t:g}, sunDirection {fmt(dv)}, skyScale {s:g}, sunScale {fval(em, 'sunScale', 1.0):g})",
-                  f"a sphere (centre {fmt(c)}, radius {r:.4g}) around the scene emitting inward a constant radiance {fmt(L)}; no sun",
-                  "trilux reads area emitters only: the sky's mean radiance over the upper hemisphere (Mitsuba 3's sunsky at the same turbidity and sun direction, times skyScale) stands for the sky; the room is lit by that uniform sky through its openings, without sunlit patches")
+        notes.add("emitter", f"{typ} (turbidity {t:g}, sunDirection {fmt(dv)}, skyScale {s:g}, sunScale {fval(em, 'sunScale', 1.0):g}, sunRadiusScale {fval(em, 'sunRadiusScale', 1.0):g})",
+                  f"a cube around the scene (centre {fmt(c)}, half-extents {fmt(half)}, 2 % beyond its bounds) emitting inward a constant radiance {fmt(L)}, black; no sun",
+                  "trilux reads area emitters only. The sky's mean radiance over the upper hemisphere (Mitsuba 3.9.1's sunsky at the same turbidity and sun direction, sun excluded, times skyScale) stands for the sky, from every direction (the ground below the horizon as bright as the sky). The sun is dropped: a distant disk would enlarge the scene's bounds (and trilux's MinArea with them) and a near one would shift its patches. The room is lit by that uniform sky through its openings only, without sunlit patches")
+    elif typ == "envmap":
+        fn = os.path.basename(sval(em, "filename"))
+        if fn not in ENV_MEAN:
+            raise ValueError(f"no mean radiance for the environment map {fn}: add it to ENV_MEAN")
+        s = fval(em, "scale", 1.0)
+        L = [x * s for x in ENV_MEAN[fn]]
+        notes.add("emitter", f"envmap `{fn}` (scale {s:g})",
+                  f"a cube around the scene (centre {fmt(c)}, half-extents {fmt(half)}, 2 % beyond its bounds) emitting inward a constant radiance {fmt(L)}, black",
+                  "trilux reads area emitters only. The map's mean radiance over all directions (its total power kept) stands for it, from every direction; the room is lit by that uniform sky through its openings")
     else:
         raise ValueError(f"{typ}: no constant radiance known")
-    return ('    <shape type="sphere">\n'
-            f'        <point name="center" value="{fmt(c)}"/>\n        <float name="radius" value="{r:.6g}"/>\n'
+    m = np.eye(4)
+    m[:3, :3] = np.diag(half)
+    m[:3, 3] = c
+    return ('    <shape type="cube">\n' + matrix_xml(m) +
             '        <boolean name="flip_normals" value="true"/>\n'
             '        <bsdf type="diffuse"><rgb name="reflectance" value="0, 0, 0"/></bsdf>\n'
             f'        <emitter type="area"><rgb name="radiance" value="{fmt(L)}"/></emitter>\n    </shape>')
