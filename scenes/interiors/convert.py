@@ -52,8 +52,10 @@ rules for everything else (the nearest supported equivalent, or removal):
     serialized meshes   -> PLY (Mitsuba's documented format, parsed here)
     maxSmoothAngle      -> face normals (Mitsuba 3 has no crease angle)
     zero-area triangles -> dropped; shapes of zero total area -> removed
-    a mesh or texture file missing from the checkout -> the shape removed /
-                           the texture replaced by a constant 0.5, listed
+    a mesh or texture file missing from the checkout, or in LEFT_OUT (absent
+                        from the snapshot the committed copies were made from)
+                        -> the shape removed / the texture replaced by a
+                           constant 0.5, listed
     integrator          -> path, max_depth as the source's when >= 64, else -1
                            (trilux's solve has no depth limit)
     film                -> at most FILM_MAX pixels on the longer side
@@ -71,6 +73,14 @@ import zlib
 import numpy as np
 
 SCENES = ["staircase", "living-room-2", "sponza", "classroom", "dining-room", "bathroom", "living-room"]
+# Files absent from the snapshot of dppm-scenes (commit 8fdb2dc) the
+# committed copies were made from. They are left out whatever the checkout
+# holds, so that every checkout gives the same files.
+LEFT_OUT = {
+    "living-room-2": {"models/Mesh130.obj"},
+    "bathroom": {"models/Mesh206.obj", "models/Mesh263.obj", "models/Mesh381.obj", "textures/rug.png"},
+}
+ABSENT = "absent from the snapshot the committed copies were made from (dppm-scenes 8fdb2dc); left out from every checkout so that all give the same files"
 FILM_MAX = 256
 MAX_TEXTURE = 1024
 MIN_ALPHA = 0.01
@@ -103,8 +113,10 @@ class Notes:
         key = (group, what, became, why)
         self.items[key] = self.items.get(key, 0) + 1
 
-    def markdown(self, name):
-        out = [f"# {name}: substitutions made by convert.py", ""]
+    def markdown(self, name, lit):
+        out = [f"# {name}: substitutions made by convert.py", "",
+               f"Source: dppm-scenes `scenes/{name}/scene.xml` (Mitsuba 0.6). Lit by: {lit}.",
+               "Each row is one change of meaning; `count` is how many times it was made.", ""]
         groups = {}
         for (g, what, became, why), n in self.items.items():
             groups.setdefault(g, []).append((what, became, why, n))
@@ -231,8 +243,9 @@ def matrix_xml(m, name="to_world", indent="        "):
 class MaterialBuilder:
     """Converts 0.6 BSDFs into Mitsuba 3 XML text trilux reads."""
 
-    def __init__(self, src_dir, out_dir, ids, notes):
+    def __init__(self, src_dir, out_dir, ids, notes, left_out):
         self.src_dir, self.out_dir, self.ids, self.notes = src_dir, out_dir, ids, notes
+        self.left_out = left_out
         self.textures = {}  # source file -> output name or None (missing)
 
     def resolve(self, e):
@@ -293,8 +306,9 @@ class MaterialBuilder:
             return self.textures[fn]
         src = os.path.join(self.src_dir, fn)
         base = os.path.basename(fn)
-        if not os.path.isfile(src):
-            self.notes.add("texture", f"`{fn}` (of `{label}`)", "constant 0.5", "the file is not in the checkout")
+        if fn in self.left_out or not os.path.isfile(src):
+            why = ABSENT if fn in self.left_out else "the file is not in the checkout"
+            self.notes.add("texture", f"`{fn}` (of `{label}`)", "constant 0.5", why)
             self.textures[fn] = None
             return None
         from PIL import Image
@@ -585,7 +599,7 @@ def convert_scene(src_root, name, out_root):
     root = ET.parse(os.path.join(src_dir, "scene.xml")).getroot()
     substitute_defaults(root)
     ids = {e.get("id"): e for e in root.iter() if e.get("id") and e.tag in ("bsdf", "texture")}
-    mats = MaterialBuilder(src_dir, out_dir, ids, notes)
+    mats = MaterialBuilder(src_dir, out_dir, ids, notes, LEFT_OUT.get(name, set()))
 
     out = ['<?xml version="1.0" encoding="utf-8"?>',
            f"<!-- {name}: converted from hchoi405/dppm-scenes scenes/{name}/scene.xml (Mitsuba 0.6)",
@@ -611,7 +625,7 @@ def convert_scene(src_root, name, out_root):
     shapes_out = []
     mesh_cache = {}  # (file, index, uv, normals, face) -> (ply name, triangles, P, T)
     bbox = [np.full(3, np.inf), np.full(3, -np.inf)]
-    stats = {"triangles": 0, "shapes": 0, "dropped_tris": 0}
+    stats = {"triangles": 0, "shapes": 0, "dropped_tris": 0, "emitters": 0, "sky": ""}
 
     for sh in root.findall("shape"):
         shape_out = convert_shape(sh, src_dir, out_dir, mats, notes, bsdf_cache, top_bsdfs, mesh_cache, bbox, stats)
@@ -623,6 +637,7 @@ def convert_scene(src_root, name, out_root):
         typ = em.get("type")
         if typ in ("sunsky", "sky", "envmap"):
             shapes_out.append(sky_box(em, bbox, notes))
+            stats["sky"] = typ + (" (without the sun)" if typ == "sunsky" else "")
         else:
             notes.add("emitter", f"{typ}", "removed", "trilux reads area emitters on shapes only")
 
@@ -638,7 +653,10 @@ def convert_scene(src_root, name, out_root):
     if stats["dropped_tris"]:
         notes.add("shape", f"{stats['dropped_tris']} triangles of zero area (over all meshes)", "dropped", "they are never hit; trilux would make elements of them")
     with open(os.path.join(out_dir, "SUBSTITUTIONS.md"), "w") as f:
-        f.write(notes.markdown(name))
+        lit = f"{stats['emitters']} area emitter(s) of the source" if stats["emitters"] else "no emitter of the source"
+        if stats["sky"]:
+            lit += " and the constant sky box standing for its " + stats["sky"]
+        f.write(notes.markdown(name, lit))
     print(f"{name}: {stats['shapes']} shapes, {stats['triangles']} triangles")
     return stats
 
@@ -736,6 +754,7 @@ def convert_shape(sh, src_dir, out_dir, mats, notes, bsdf_cache, top_bsdfs, mesh
                 em_xml = f'        <emitter type="area"><spectrum name="radiance" value="{r.get("value")}"/></emitter>\n'
             else:
                 em_xml = f'        <emitter type="area"><rgb name="radiance" value="{fmt(color_of(r))}"/></emitter>\n'
+            stats["emitters"] += 1
     flip = bval(sh, "flipNormals")
     extra = '        <boolean name="flip_normals" value="true"/>\n' if flip else ""
     if typ in ("obj", "serialized", "ply"):
@@ -747,8 +766,8 @@ def convert_shape(sh, src_dir, out_dir, mats, notes, bsdf_cache, top_bsdfs, mesh
             notes.add("shape", f"`{fn}`#{idx}: maxSmoothAngle {msa:g}", "face normals", "Mitsuba 3 has no crease angle")
             face = True
         path = os.path.join(src_dir, fn)
-        if not os.path.isfile(path):
-            notes.add("shape", f"`{fn}`", "removed", "the file is not in the checkout")
+        if fn in mats.left_out or not os.path.isfile(path):
+            notes.add("shape", f"`{fn}`", "removed", ABSENT if fn in mats.left_out else "the file is not in the checkout")
             return None
         key = (fn, idx, uv, face)
         if key not in mesh_cache:
