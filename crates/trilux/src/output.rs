@@ -25,7 +25,8 @@ pub enum Kind {
     Image,
     /// `render --png`: a PNG.
     Png,
-    /// `solve -o`: a solution file (any name but an image's or a glTF's).
+    /// `solve -o`: a solution file (any name but an image's, a glTF
+    /// file's or a JSON file's).
     Solution,
     /// `bake -o`: a glTF binary.
     Bake,
@@ -75,9 +76,9 @@ pub fn named(path: &Path, option: &str, kind: Kind) -> Result<Format, UsageError
         (Kind::Png, Some(_)) => Err(refuse(
             "this option writes a PNG; name it .png (-o names the EXR)",
         )),
-        (Kind::Solution, Some(e)) if image(e) || e == "glb" || e == "gltf" => Err(refuse(
-            "a solution file is neither an image nor a glTF file; name it .sol",
-        )),
+        (Kind::Solution, Some(e)) if image(e) || matches!(e, "glb" | "gltf" | "json") => Err(
+            refuse("a solution file is not an image, a glTF file or JSON; name it .sol"),
+        ),
         (Kind::Solution, _) => Ok(Format::Solution),
         (Kind::Bake, None | Some("glb")) => Ok(Format::Glb),
         (Kind::Bake, Some(_)) => Err(refuse("a bake is a glTF binary; name the output .glb")),

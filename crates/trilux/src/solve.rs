@@ -15,8 +15,8 @@ pub struct SolveArgs {
     pub scene: PathBuf,
     #[command(flatten)]
     pub params: crate::options::SceneParams,
-    /// Where to write the solution (any name but an image's or a glTF
-    /// file's). Default: out/<scene name>.sol (the folder is made when
+    /// Where to write the solution (any name but an image's, a glTF
+    /// file's or a JSON file's). Default: out/<scene name>.sol (the folder is made when
     /// missing).
     #[arg(short = 'o', long = "output")]
     pub output: Option<PathBuf>,

@@ -105,7 +105,7 @@ fn a_name_for_another_format_is_a_usage_error_before_any_work() {
     // The scene does not exist: a refusal that does not name it was made
     // before anything was read.
     let missing = s(&dir.join("missing.xml")).to_owned();
-    let cases: [(&[&str], &str, &str); 7] = [
+    let cases: [(&[&str], &str, &str); 8] = [
         (
             &["render", &missing, "-o", "out.jpg"],
             "-o out.jpg",
@@ -124,6 +124,7 @@ fn a_name_for_another_format_is_a_usage_error_before_any_work() {
         ),
         (&["solve", &missing, "-o", "x.exr"], "-o x.exr", ".sol"),
         (&["solve", &missing, "-o", "x.glb"], "-o x.glb", ".sol"),
+        (&["solve", &missing, "-o", "x.json"], "-o x.json", ".sol"),
         (&["bake", &missing, "-o", "x.gltf"], "-o x.gltf", ".glb"),
     ];
     for (args, start, what) in cases {
