@@ -98,7 +98,10 @@ impl Element {
 /// Parses scene text into the intermediate tree rooted at `<scene>`.
 ///
 /// `params` are caller-given values for `$name` (they take precedence over
-/// `<default>`s, as Mitsuba's `load_file(path, name=value)` does).
+/// `<default>`s, as Mitsuba's `load_file(path, name=value)` does); one that
+/// no `$name` of the scene (its included files too) uses is an error at the
+/// `<scene>` element, as Mitsuba 3 refuses it ("Found unused parameters"):
+/// a misspelt name must not be silently ignored.
 pub(crate) fn parse(
     text: &str,
     file: &Arc<Path>,
@@ -106,6 +109,7 @@ pub(crate) fn parse(
 ) -> Result<(Element, Vec<PathBuf>)> {
     let mut shared = Shared {
         params: params.to_vec(),
+        used: vec![false; params.len()],
         expanded: 0,
         chain: vec![file.clone()],
         included: 0,
@@ -113,6 +117,16 @@ pub(crate) fn parse(
         files: Vec::new(),
     };
     let tree = parse_file(text, file, &mut shared)?;
+    if let Some(k) = shared.used.iter().position(|u| !u) {
+        let (name, value) = &params[k];
+        return Err(SceneError::at(
+            &tree.loc,
+            format!(
+                "the parameter {name}={} is not used: the scene has no ${name} (Mitsuba refuses an unused parameter too)",
+                crate::error::elide(value, 60)
+            ),
+        ));
+    }
     Ok((tree, shared.files))
 }
 
@@ -120,6 +134,8 @@ pub(crate) fn parse(
 struct Shared {
     /// `$name` values: the caller's, then `<default>`s in document order.
     params: Vec<(String, String)>,
+    /// Whether each caller's value (the first of `params`) was used.
+    used: Vec<bool>,
     /// Bytes produced by `$name` substitution so far.
     expanded: usize,
     /// The files being parsed, the scene file first (include cycles).
@@ -373,8 +389,12 @@ impl Context<'_, '_> {
             if name.is_empty() {
                 return Err(SceneError::at(loc, "a lone '$' in an attribute value"));
             }
-            match self.shared.params.iter().find(|(n, _)| n == name) {
-                Some((_, v)) => {
+            match self.shared.params.iter().position(|(n, _)| n == name) {
+                Some(k) => {
+                    if let Some(used) = self.shared.used.get_mut(k) {
+                        *used = true;
+                    }
+                    let v = &self.shared.params[k].1;
                     if out.len() + v.len() > MAX_VALUE_BYTES {
                         return Err(SceneError::at(
                             loc,
@@ -439,6 +459,20 @@ mod tests {
         let e =
             attr_value(r#"<scene version="3.0.0"><a v="5$"/></scene>"#, &[]).expect_err("lone $");
         assert!(e.to_string().contains("lone '$'"), "{e}");
+    }
+
+    /// A caller's value that no `$name` uses is refused, as Mitsuba 3
+    /// does, even when a `<default>` names it; at the `<scene>` element.
+    #[test]
+    fn an_unused_caller_value_is_refused() {
+        let t = r#"<scene version="3.0.0"><default name="n" value="4"/><a v="$x"/></scene>"#;
+        assert_eq!(attr_value(t, &[("x", "1")]).ok().as_deref(), Some("1"));
+        for unused in ["n", "typo"] {
+            let e = attr_value(t, &[("x", "1"), (unused, "2")]).expect_err("unused");
+            let e = e.to_string();
+            assert!(e.starts_with("t.xml:1:1: "), "{e}");
+            assert!(e.contains(&format!("{unused}=2 is not used")), "{e}");
+        }
     }
 
     #[test]

@@ -1,13 +1,13 @@
-//! `trilux bake SCENE -o OUT.glb [--open]`: the solution's view-independent
+//! `trilux bake SCENE [-o OUT.glb] [--open]`: the solution's view-independent
 //! light as a glTF 2.0 binary, for walkthroughs in any glTF viewer
 //! (docs/bake.md; the file's layout is `trilux_bake`'s), and with `--open`
 //! in trilux's own viewer on localhost (`serve`).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use crate::options::{Product, SolveOptions, parse_exposure, parse_threads};
-use crate::output::{Outputs, bake_stats_json};
-use anyhow::{Context, Result, bail};
+use crate::output::{DEFAULT_FOLDER, Kind, Outputs, bake_stats_json, default_output, named};
+use anyhow::{Context, Result};
 use clap::Args;
 use trilux_bake::BakeOptions;
 
@@ -18,9 +18,10 @@ pub struct BakeArgs {
     pub scene: PathBuf,
     #[command(flatten)]
     pub params: crate::options::SceneParams,
-    /// Where to write the baked scene (a .glb file).
+    /// Where to write the baked scene (a .glb name). Default:
+    /// out/<scene name>.glb (the folder is made when missing).
     #[arg(short = 'o', long = "output")]
-    pub output: PathBuf,
+    pub output: Option<PathBuf>,
     /// Bake a saved solution instead of solving (`trilux solve`; it must
     /// have been made with the same --quality, --convergence and --mode).
     #[arg(long)]
@@ -54,22 +55,20 @@ pub struct BakeArgs {
 
 /// Runs `trilux bake`.
 pub fn run(args: &BakeArgs) -> Result<()> {
+    let output = match &args.output {
+        Some(path) => {
+            named(path, "-o", Kind::Bake)?;
+            path.clone()
+        }
+        None => default_output(&args.scene, "glb"),
+    };
     crate::set_threads(args.threads);
-    let glb = args
-        .output
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("glb"));
-    if !glb {
-        bail!(
-            "{}: a bake is a glTF binary; name the output .glb",
-            args.output.display()
-        );
-    }
-    let mut outputs = vec![(args.output.as_path(), "baked scene")];
+    let mut outputs = vec![(output.as_path(), "baked scene")];
     outputs.extend(args.stats.as_deref().map(|p| (p, "statistics")));
     let mut inputs = vec![args.scene.as_path()];
     inputs.extend(args.solution.as_deref());
-    let outputs = Outputs::plan(&outputs, &inputs, None)?;
+    let folder = args.output.is_none().then(|| Path::new(DEFAULT_FOLDER));
+    let outputs = Outputs::plan(&outputs, &inputs, folder)?;
     // The viewer's port is taken before any work: one in use is refused now.
     let listener = args
         .open
@@ -93,14 +92,10 @@ pub fn run(args: &BakeArgs) -> Result<()> {
     outputs.write(&files)?;
     crate::warn(&outcome);
     let s = &baked.stats;
-    crate::streams::print(&format!(
-        "wrote {} ({} bytes: {} vertices, {} triangles; baked in {:.2} s)\n",
-        args.output.display(),
-        s.bytes,
-        s.vertices,
-        s.triangles,
-        s.seconds
-    ))?;
+    outputs.report(Some(&format!(
+        "{} bytes: {} vertices, {} triangles; baked in {:.2} s",
+        s.bytes, s.vertices, s.triangles, s.seconds
+    )))?;
     if let Some(listener) = listener {
         crate::serve::serve(listener, &baked.glb)?;
     }

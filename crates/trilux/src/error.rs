@@ -23,6 +23,15 @@ pub enum PipelineError {
     /// The render's settings, camera or image failed.
     #[error(transparent)]
     Render(#[from] trilux_render::RenderError),
+    /// A plan did not make what it was asked for (a render without an
+    /// image): a defect of the pipeline, reported rather than panicking.
+    #[error("{}: the {what} was not made", path.display())]
+    NotMade {
+        /// The scene file.
+        path: PathBuf,
+        /// What is missing.
+        what: &'static str,
+    },
     /// The solution could not be baked.
     #[error(transparent)]
     Bake(#[from] trilux_bake::BakeError),

@@ -13,14 +13,22 @@
 //!   scene's own render settings.
 //! - [`pipeline`]: prepare a loaded scene in its mode, solve it or load a
 //!   saved solution, save it, bake it, render a view.
+//! - [`oneshot`]: the one-call API on top of the pipeline, from a scene
+//!   file to an image ([`render_file`]), a solution or a bake, with the
+//!   command's defaults (the examples and the Python module use it).
 //! - [`error`]: the error type, [`PipelineError`], wrapping each layer's.
 #![forbid(unsafe_code)]
 
 pub mod error;
+pub mod oneshot;
 pub mod pipeline;
 pub mod view;
 
 pub use error::PipelineError;
+pub use oneshot::{
+    SavedSolution, SolveOptions, ViewOptions, bake_scene, check_solution, load_file, render_file,
+    render_scene, solve_scene,
+};
 pub use pipeline::{
     Observer, Outcome, Plan, RenderPlan, SolutionSource, check, prepare, run, scene_camera,
 };

@@ -2,7 +2,9 @@
 //!
 //! Runtime errors print one line `error: ...` on stderr and exit with status
 //! 1; command-line usage errors (unknown options, malformed values) keep
-//! clap's message and exit with status 2, before any file is read.
+//! clap's message and exit with status 2, before any file is read, and so
+//! does an output named for a format trilux does not write (one line,
+//! `output::named`). Each file written is reported as `wrote PATH`.
 //! Subcommands live one per module; the work itself is
 //! the library's (`trilux::pipeline`). Every output is planned before any work and
 //! written all or none at the end (`output`); the scene's meshes are read
@@ -32,8 +34,9 @@ use clap::{Parser, Subcommand};
 /// Progressive hierarchical three-point light transport.
 ///
 /// With no command, renders the bundled Cornell box (scenes/cornell-box.xml)
-/// into out/cornell-box.exr, .png and .json; `trilux render` writes to
-/// out/<scene name>.exr unless told otherwise.
+/// into out/cornell-box.exr, .png and .json; without -o, `trilux render`
+/// writes out/<scene name>.exr (unless --png names its image), `solve`
+/// out/<scene name>.sol and `bake` out/<scene name>.glb.
 #[derive(Debug, Parser)]
 #[command(name = "trilux", version, about)]
 struct Cli {
@@ -93,14 +96,29 @@ pub fn warn(outcome: &trilux::Outcome) {
     }
 }
 
+/// Warns (one line on stderr) when `scene` has no emitter: its solution is
+/// zero everywhere and a render of it black. Not an error, for `render`
+/// as for `solve` and `bake`: the work on a dark scene is meaningless but
+/// harmless (and quick: there is no light to shoot), and a user who forgot
+/// the light is told so instead of being left with a black image.
+pub fn warn_if_dark(scene: &trilux_scene::Scene) {
+    if scene.shapes.iter().all(|s| s.emitter.is_none()) {
+        streams::eprint_line(&format!(
+            "warning: {}: the scene has no emitter: no light reaches any surface (an area emitter on a shape, or an emissive glTF material, lights it)",
+            scene.path.display()
+        ));
+    }
+}
+
 /// The main job: the bundled default scene rendered into out/.
 fn render_default() -> anyhow::Result<()> {
     let scene = default_scene();
-    let exr = render::default_output(&scene);
+    let exr = output::default_output(&scene, "exr");
     let png = exr.with_extension("png");
     let stats = exr.with_extension("json");
     let mut argv = vec!["trilux".into(), "render".into(), scene.into_os_string()];
-    argv.extend(["--png".into(), png.clone().into_os_string()]);
+    argv.extend(["-o".into(), exr.into_os_string()]);
+    argv.extend(["--png".into(), png.into_os_string()]);
     argv.extend(["--stats".into(), stats.into_os_string()]);
     let Cli {
         command: Some(Command::Render(args)),
@@ -108,8 +126,7 @@ fn render_default() -> anyhow::Result<()> {
     else {
         anyhow::bail!("the default render's arguments do not parse");
     };
-    render::run(&args)?;
-    streams::print(&format!("wrote {} and {}\n", exr.display(), png.display()))
+    render::run_into(&args, true)
 }
 
 fn run(cli: Cli) -> anyhow::Result<()> {
@@ -146,6 +163,10 @@ fn main() -> ExitCode {
     };
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
+        Err(e) if e.is::<output::UsageError>() => {
+            streams::eprint_line(&format!("error: {e}"));
+            ExitCode::from(2)
+        }
         Err(e) => {
             let message = e.to_string().replace(['\n', '\r'], " ");
             let message = trilux_scene::error::elide(&message, MAX_LINE_CHARS);

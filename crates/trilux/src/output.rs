@@ -1,12 +1,107 @@
-//! The command's outputs: every one planned and checked before any work
+//! The command's outputs: every one named for what it is ([`named`]: the
+//! format an image's name asks for, a bake's `.glb`, or a usage error,
+//! status 2, before anything is read), planned and checked before any work
 //! (`trilux_files::Output::plan`: folder, kind of file, symbolic links),
-//! none equal to an input or to another, and all written or none at the
-//! end (`trilux_files::write_all`).
+//! none equal to an input or to another, all written or none at the end
+//! (`trilux_files::write_all`), and each one written reported on its own
+//! line ([`Outputs::report`]).
 
 use std::path::{Path, PathBuf};
 
 use anyhow::{Result, bail};
 use trilux_files::{FileIdentity, Output};
+
+/// A command-line mistake found once the arguments are parsed (an output
+/// named for a format trilux does not write): one line `error: ...`, exit
+/// status 2 as clap's usage errors, before any file is read (`main.rs`).
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct UsageError(pub String);
+
+/// What a command-line output is, and so which names it takes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kind {
+    /// `render -o`: an EXR or a PNG, by the name's extension.
+    Image,
+    /// `render --png`: a PNG.
+    Png,
+    /// `solve -o`: a solution file (any name but an image's, a glTF
+    /// file's or a JSON file's).
+    Solution,
+    /// `bake -o`: a glTF binary.
+    Bake,
+}
+
+/// The format an output is written in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Format {
+    /// OpenEXR, linear sRGB radiance.
+    Exr,
+    /// PNG, sRGB-encoded, exposed and clamped.
+    Png,
+    /// trilux's solution file.
+    Solution,
+    /// glTF 2.0 binary.
+    Glb,
+}
+
+/// The format of `path`, an output of `kind` given with `option`, from
+/// its extension (case aside): `.exr` and `.png` for an image, `.png`
+/// for `--png`, `.glb` for a bake; a name without an extension (a device
+/// such as `/dev/stdout`, a FIFO, a folder the planning then refuses) is
+/// written in the kind's first format (EXR, PNG, solution, GLB). A name
+/// that asks for another format (`-o out.jpg`, `--png x.exr`, a solution
+/// named `.exr`) is a [`UsageError`]: trilux never writes one format under
+/// another's name. The one check `render`, `solve` and `bake` share.
+pub fn named(path: &Path, option: &str, kind: Kind) -> Result<Format, UsageError> {
+    let ext = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase());
+    let refuse = |why: &str| {
+        UsageError(format!(
+            "{option} {}: {why}",
+            shown(&path.display().to_string())
+        ))
+    };
+    let image = |e: &str| matches!(e, "exr" | "png" | "jpg" | "jpeg" | "tif" | "tiff" | "hdr");
+    match (kind, ext.as_deref()) {
+        (Kind::Image, None | Some("exr")) => Ok(Format::Exr),
+        (Kind::Image | Kind::Png, Some("png")) | (Kind::Png, None) => Ok(Format::Png),
+        (Kind::Image | Kind::Png, Some("jpg" | "jpeg")) => Err(refuse(
+            "trilux writes no JPEG; name the image .exr (linear radiance) or .png (sRGB)",
+        )),
+        (Kind::Image, Some(_)) => Err(refuse(
+            "an image is written as .exr (linear radiance) or .png (sRGB); name it so",
+        )),
+        (Kind::Png, Some(_)) => Err(refuse(
+            "this option writes a PNG; name it .png (-o names the EXR)",
+        )),
+        (Kind::Solution, Some(e)) if image(e) || matches!(e, "glb" | "gltf" | "json") => Err(
+            refuse("a solution file is not an image, a glTF file or JSON; name it .sol"),
+        ),
+        (Kind::Solution, _) => Ok(Format::Solution),
+        (Kind::Bake, None | Some("glb")) => Ok(Format::Glb),
+        (Kind::Bake, Some(_)) => Err(refuse("a bake is a glTF binary; name the output .glb")),
+    }
+}
+
+/// `text` as it goes into a usage error, its middle elided when long.
+fn shown(text: &str) -> String {
+    trilux_scene::error::elide(text, 200)
+}
+
+/// The output a command writes when `-o` is not given:
+/// `out/<scene's file stem>.<extension>` (the folder is made when
+/// missing, only while planning and writing: [`Outputs::plan`]).
+pub fn default_output(scene: &Path, extension: &str) -> PathBuf {
+    let stem = scene
+        .file_stem()
+        .map_or_else(|| "scene".into(), |s| s.to_string_lossy().into_owned());
+    PathBuf::from("out").join(format!("{stem}.{extension}"))
+}
+
+/// The folder of default outputs.
+pub const DEFAULT_FOLDER: &str = "out";
 
 /// The outputs of one command, in the order given to [`Outputs::plan`].
 pub struct Outputs {
@@ -138,6 +233,35 @@ impl Outputs {
             .collect();
         trilux_files::write_all(&items)?;
         Ok(())
+    }
+
+    /// Prints `wrote PATH` for every output, one line each, the first with
+    /// `first_detail` after it (a bake's size): on stdout, or on stderr
+    /// when an output is the standard output itself (`-o /dev/stdout`),
+    /// so that the report never mixes with an output's bytes. Called once
+    /// the files are written.
+    pub fn report(&self, first_detail: Option<&str>) -> Result<()> {
+        let mut text = String::new();
+        for (k, out) in self.planned.iter().enumerate() {
+            text.push_str(&format!("wrote {}", out.path().display()));
+            if let (0, Some(detail)) = (k, first_detail) {
+                text.push_str(&format!(" ({detail})"));
+            }
+            text.push('\n');
+        }
+        let stdout = FileIdentity::of(Path::new("/dev/stdout")).ok();
+        if self
+            .planned
+            .iter()
+            .any(|o| Some(o.identity()) == stdout.as_ref())
+        {
+            for line in text.lines() {
+                crate::streams::eprint_line(line);
+            }
+            Ok(())
+        } else {
+            crate::streams::print(&text)
+        }
     }
 }
 

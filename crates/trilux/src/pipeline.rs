@@ -30,6 +30,14 @@ pub enum SolutionSource<'p> {
     Solve,
     /// Load a solution saved for this scene, mode and settings.
     Load(&'p Path),
+    /// Read one from its file's bytes, already in memory (`name` is the
+    /// file they came from, for errors).
+    Bytes {
+        /// The solution file's bytes.
+        bytes: &'p [u8],
+        /// Where they came from.
+        name: &'p Path,
+    },
 }
 
 /// A view to render.
@@ -242,6 +250,16 @@ impl WithBands for Run<'_, '_> {
                 .solve(|p| (self.observer.solve)(p)),
             SolutionSource::Load(path) => {
                 let mut s = Solution::load(path, prepared, &self.plan.solver)?;
+                s.stats_mut().solve_seconds = 0.0;
+                s
+            }
+            SolutionSource::Bytes { bytes, name } => {
+                let mut s = Solution::from_bytes(bytes, prepared, &self.plan.solver).map_err(
+                    |message| SolverError::SolutionFile {
+                        path: name.display().to_string(),
+                        message,
+                    },
+                )?;
                 s.stats_mut().solve_seconds = 0.0;
                 s
             }

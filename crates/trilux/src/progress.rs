@@ -103,7 +103,10 @@ fn time_left(frac: f64, elapsed: f64) -> Option<f64> {
 /// Checks `plan` against the scene read so far, reads the rest of it
 /// (meshes, textures) and carries the plan out, with bars for its solve
 /// and, when it renders, its render (`pipeline::check`, then
-/// `pipeline::run`): what `solve`, `render` and `bake` share.
+/// `pipeline::run`, then a warning for a scene without an emitter: after
+/// the work, so that an error stays one line, and a dark scene's solve
+/// has no light to shoot and ends at once): what `solve`,
+/// `render` and `bake` share.
 pub fn run_plan(
     pending: trilux_scene::Pending,
     plan: &trilux::Plan<'_>,
@@ -122,7 +125,9 @@ pub fn run_plan(
         },
     );
     bars.finish();
-    Ok(outcome?)
+    let outcome = outcome?;
+    crate::warn_if_dark(&scene);
+    Ok(outcome)
 }
 
 #[cfg(test)]

@@ -13,7 +13,9 @@ use crate::options::{
     LookAt, Product, SolveOptions, parse_exposure, parse_film_edge, parse_fov, parse_lookat,
     parse_spp, parse_target_error, parse_threads,
 };
-use crate::output::{Outputs, stats_json};
+use crate::output::{
+    DEFAULT_FOLDER, Format, Kind, Outputs, UsageError, default_output, named, stats_json,
+};
 
 /// Where the gather continues one bounce before reading the solution.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -49,11 +51,14 @@ pub struct RenderArgs {
     /// default: the first camera of the scene).
     #[arg(long)]
     pub camera: Option<String>,
-    /// Output EXR (linear sRGB). Default: out/<scene name>.exr (the folder
-    /// is made when missing).
+    /// Output image, its format by its name: .exr (linear sRGB radiance) or
+    /// .png (sRGB-encoded, --exposure); another name is refused. Default:
+    /// out/<scene name>.exr unless --png names the image (the folder is
+    /// made when missing).
     #[arg(short = 'o', long = "output")]
     pub output: Option<PathBuf>,
-    /// Also write an sRGB-encoded PNG.
+    /// Write an sRGB-encoded PNG (a .png name), besides -o's image or
+    /// instead of the default EXR.
     #[arg(long)]
     pub png: Option<PathBuf>,
     /// The PNG's exposure in stops: values scaled by 2^stops before
@@ -108,28 +113,54 @@ pub struct RenderArgs {
     pub options: SolveOptions,
 }
 
-/// The default output path for a scene: out/<stem>.exr.
-pub fn default_output(scene: &Path) -> PathBuf {
-    let stem = scene
-        .file_stem()
-        .map_or_else(|| "render".into(), |s| s.to_string_lossy().into_owned());
-    PathBuf::from("out").join(format!("{stem}.exr"))
+/// The images a render writes: the one `-o` names (its format by its
+/// name), else `out/<scene>.exr` unless `--png` names one; and the PNG.
+struct Images {
+    /// `-o`'s image and its format, or the default EXR.
+    image: Option<(PathBuf, Format)>,
+    /// `--png`'s.
+    png: Option<PathBuf>,
+    /// True when `image` is the default (its folder `out/` made when
+    /// missing).
+    default: bool,
 }
 
 impl RenderArgs {
+    /// The images asked for, each name checked against its format
+    /// (`output::named`): a usage error before any file is read.
+    fn images(&self) -> Result<Images, UsageError> {
+        let png = match &self.png {
+            Some(p) => {
+                named(p, "--png", Kind::Png)?;
+                Some(p.clone())
+            }
+            None => None,
+        };
+        let image = match &self.output {
+            Some(p) => Some((p.clone(), named(p, "-o", Kind::Image)?)),
+            None if png.is_none() => Some((default_output(&self.scene, "exr"), Format::Exr)),
+            None => None,
+        };
+        Ok(Images {
+            image,
+            png,
+            default: self.output.is_none() && self.png.is_none(),
+        })
+    }
+
     /// Every output planned (the default `out/` made when missing, only
-    /// while planning and writing) and
-    /// checked against the inputs, before any work: the EXR, then the PNG
-    /// and the statistics when asked for.
-    fn plan_outputs(&self) -> Result<Outputs> {
-        let default = default_output(&self.scene);
-        let exr = self.output.as_deref().unwrap_or(&default);
-        let mut outputs = vec![(exr, "image")];
-        outputs.extend(self.png.as_deref().map(|p| (p, "PNG")));
+    /// while planning and writing) and checked against the inputs, before
+    /// any work: the image, then the PNG and the statistics when asked for.
+    /// `in_out`: the outputs are in `out/`, which is made when missing
+    /// (the default render's, `main.rs`).
+    fn plan_outputs(&self, images: &Images, in_out: bool) -> Result<Outputs> {
+        let mut outputs = Vec::new();
+        outputs.extend(images.image.as_ref().map(|(p, _)| (p.as_path(), "image")));
+        outputs.extend(images.png.as_deref().map(|p| (p, "PNG")));
         outputs.extend(self.stats.as_deref().map(|p| (p, "statistics")));
         let mut inputs = vec![self.scene.as_path()];
         inputs.extend(self.solution.as_deref());
-        let folder = self.output.is_none().then(|| Path::new("out"));
+        let folder = (images.default || in_out).then(|| Path::new(DEFAULT_FOLDER));
         Outputs::plan(&outputs, &inputs, folder)
     }
 
@@ -165,8 +196,16 @@ impl RenderArgs {
 
 /// Runs `trilux render`.
 pub fn run(args: &RenderArgs) -> Result<()> {
+    run_into(args, false)
+}
+
+/// Runs `trilux render`; with `in_out` its outputs are named in `out/`,
+/// made when missing as for a default output (the command without
+/// arguments: `main.rs`).
+pub fn run_into(args: &RenderArgs, in_out: bool) -> Result<()> {
+    let images = args.images()?;
     crate::set_threads(args.threads);
-    let outputs = args.plan_outputs()?;
+    let outputs = args.plan_outputs(&images, in_out)?;
     let pending =
         trilux_scene::open_with_camera(&args.scene, args.camera.as_deref(), &args.params.define)?;
     outputs.check_inputs(&pending.input_files())?;
@@ -190,8 +229,13 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         .image
         .as_ref()
         .context("the render produced no image")?;
-    let mut files = vec![image.exr_bytes()?];
-    if args.png.is_some() {
+    let mut files = Vec::new();
+    match &images.image {
+        Some((_, Format::Png)) => files.push(image.png_bytes(args.exposure)?),
+        Some(_) => files.push(image.exr_bytes()?),
+        None => {}
+    }
+    if images.png.is_some() {
         files.push(image.png_bytes(args.exposure)?);
     }
     if args.stats.is_some() {
@@ -200,5 +244,5 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     }
     outputs.write(&files)?;
     crate::warn(&outcome);
-    Ok(())
+    outputs.report(None)
 }

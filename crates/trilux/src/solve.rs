@@ -1,10 +1,10 @@
-//! `trilux solve SCENE -o FILE`: solve the light once and save it, so that
-//! any number of views can be rendered from it.
+//! `trilux solve SCENE [-o FILE]`: solve the light once and save it, so
+//! that any number of views can be rendered from it.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use crate::options::{Product, SolveOptions, parse_threads};
-use crate::output::{Outputs, stats_json};
+use crate::output::{DEFAULT_FOLDER, Kind, Outputs, default_output, named, stats_json};
 use anyhow::{Context, Result};
 use clap::Args;
 
@@ -15,9 +15,11 @@ pub struct SolveArgs {
     pub scene: PathBuf,
     #[command(flatten)]
     pub params: crate::options::SceneParams,
-    /// Where to write the solution.
+    /// Where to write the solution (any name but an image's, a glTF
+    /// file's or a JSON file's). Default: out/<scene name>.sol (the folder is made when
+    /// missing).
     #[arg(short = 'o', long = "output")]
-    pub output: PathBuf,
+    pub output: Option<PathBuf>,
     /// Write solve statistics as JSON.
     #[arg(long)]
     pub stats: Option<PathBuf>,
@@ -30,10 +32,18 @@ pub struct SolveArgs {
 
 /// Runs `trilux solve`.
 pub fn run(args: &SolveArgs) -> Result<()> {
+    let output = match &args.output {
+        Some(path) => {
+            named(path, "-o", Kind::Solution)?;
+            path.clone()
+        }
+        None => default_output(&args.scene, "sol"),
+    };
     crate::set_threads(args.threads);
-    let mut outputs = vec![(args.output.as_path(), "solution")];
+    let mut outputs = vec![(output.as_path(), "solution")];
     outputs.extend(args.stats.as_deref().map(|p| (p, "statistics")));
-    let outputs = Outputs::plan(&outputs, &[args.scene.as_path()], None)?;
+    let folder = args.output.is_none().then(|| Path::new(DEFAULT_FOLDER));
+    let outputs = Outputs::plan(&outputs, &[args.scene.as_path()], folder)?;
     let pending = trilux_scene::open_with_params(&args.scene, &args.params.define)?;
     outputs.check_inputs(&pending.input_files())?;
     let plan = args
@@ -50,5 +60,5 @@ pub fn run(args: &SolveArgs) -> Result<()> {
     }
     outputs.write(&files)?;
     crate::warn(&outcome);
-    Ok(())
+    outputs.report(None)
 }

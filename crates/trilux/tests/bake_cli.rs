@@ -511,7 +511,8 @@ fn spheres_and_disks_bake_to_their_solution() {
     assert_eq!(check_scene(&scene, "sphere-disk"), 0);
 }
 
-/// The output must be a .glb, said before any work.
+/// The output must be a .glb, said before any work: a usage error
+/// (status 2), as every output named for another format.
 #[test]
 fn a_bake_that_is_not_a_glb_is_refused() {
     let dir = folder("bake-not-glb");
@@ -522,7 +523,7 @@ fn a_bake_that_is_not_a_glb_is_refused() {
         "-o",
         out.to_str().unwrap(),
     ]);
-    assert_eq!(o.status.code(), Some(1));
+    assert_eq!(o.status.code(), Some(2));
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(err.contains("scene.gltf") && err.contains(".glb"), "{err}");
     assert_eq!(err.lines().count(), 1, "{err}");
