@@ -2,12 +2,13 @@
 //! the binary: a scene of 10 000 emitters (each element's line counted
 //! from the start of the file), 200 000 copies of one triangle (chart
 //! building and the BVH's passes quadratic, 8 GiB asked for), a polygon
-//! of 250 000 vertices (a fan of slivers: the BVH's passes quadratic),
+//! of 250 000 vertices (fanned into slivers: the BVH's passes quadratic;
+//! now cut in halves),
 //! and a glTF file placing one mesh 100 001 times (refused at the node
 //! that passes the shape limit). That the work is linear is tested where
 //! it is done, by counting it: `xml::tests` (bytes scanned),
-//! `chart::tests` (neighbours visited) and `bvh::ploc::tests` (nodes
-//! visited); here each case must finish, or be refused with one located
+//! `chart::tests` (neighbours visited), `bvh::ploc::tests` (nodes
+//! visited) and `obj::tests` (the triangles' summed extents); here each case must finish, or be refused with one located
 //! line, well inside a generous guard against a hang.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test may panic
 
