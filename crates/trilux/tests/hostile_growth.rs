@@ -3,13 +3,14 @@
 //! from the start of the file), 200 000 copies of one triangle (chart
 //! building and the BVH's passes quadratic, 8 GiB asked for), a polygon
 //! of 250 000 vertices (fanned into slivers: the BVH's passes quadratic;
-//! now cut in halves),
-//! and a glTF file placing one mesh 100 001 times (refused at the node
-//! that passes the shape limit). That the work is linear is tested where
-//! it is done, by counting it: `xml::tests` (bytes scanned),
-//! `chart::tests` (neighbours visited), `bvh::ploc::tests` (nodes
-//! visited) and `obj::tests` (the triangles' summed extents); here each case must finish, or be refused with one located
-//! line, well inside a generous guard against a hang.
+//! now cut in halves), and a glTF file placing one mesh 100 001 times and
+//! an XML scene of 100 001 shapes (refused at the node or shape that
+//! passes the shape limit). That the work is linear is tested where it is
+//! done, by counting it: `xml::tests` (bytes scanned), `chart::tests`
+//! (neighbours visited), `bvh::ploc::tests` (nodes visited) and
+//! `obj::tests` (the triangles' summed extents); here each case must
+//! finish, or be refused with one located line, well inside a generous
+//! guard against a hang.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test may panic
 
 use std::fmt::Write as _;
@@ -143,6 +144,21 @@ fn a_mesh_placed_by_too_many_nodes_is_refused_at_the_node() {
         &out,
         &format!("{}:/nodes/100000:", s(&file)),
         "more than 100000 mesh primitives (shapes), the limit",
+    );
+}
+
+#[test]
+fn a_scene_of_too_many_shapes_is_refused_at_the_shape() {
+    let dir = folder("growth-shapes");
+    let mut text = String::from("<scene version=\"3.0.0\">\n");
+    text += &"<shape type=\"rectangle\"/>\n".repeat(100_001);
+    text += "</scene>\n";
+    let scene = write(&dir, "shapes.xml", text);
+    let out = trilux_or_hang(&["info", s(&scene)], GUARD);
+    assert_refused(
+        &out,
+        &format!("{}:100002:1:", s(&scene)),
+        "more than 100000 shapes, the limit",
     );
 }
 
