@@ -9,7 +9,7 @@
 //! - cylinder: 4 curved quarter-turn pieces of an open tube, one analytic
 //!   primitive;
 //! - mesh: charts ([`crate::chart`]), every non-degenerate triangle a BVH
-//!   primitive.
+//!   primitive (a repeat of an earlier triangle counts as degenerate).
 //!
 //! Errors name the shape ([`GeometryError`]).
 
@@ -479,7 +479,8 @@ fn world_shading_normals(
 
 /// The mesh in world space with per-triangle normals and areas; triangles
 /// of area below 1e-14 of the mesh's squared diagonal count as degenerate
-/// (zero area, no chart). Refuses a mesh whose triangles are all
+/// (zero area, no chart), and so does a repeat of an earlier triangle
+/// ([`drop_repeats`]). Refuses a mesh whose triangles are all
 /// degenerate.
 fn world_mesh(mesh: &TriangleMesh, xf: &Affine, sign: f64) -> Result<MeshData, ShapeProblem> {
     let shading_normals = world_shading_normals(mesh, xf)?;
@@ -510,6 +511,7 @@ fn world_mesh(mesh: &TriangleMesh, xf: &Affine, sign: f64) -> Result<MeshData, S
             tri_normal.push(DVec3::ZERO);
         }
     }
+    drop_repeats(&positions, &mesh.triangles, &mut tri_area, &mut tri_normal);
     if tri_area.iter().all(|&a| a == 0.0) {
         return Err(ShapeProblem::ZeroArea);
     }
@@ -526,6 +528,44 @@ fn world_mesh(mesh: &TriangleMesh, xf: &Affine, sign: f64) -> Result<MeshData, S
             .clone()
             .filter(|t| t.len() == mesh.positions.len()),
     })
+}
+
+/// Leaves out (as degenerate: zero area, no chart, not traced) every
+/// triangle whose three corners, in either winding, are those of an
+/// earlier triangle of the mesh, and returns how many. A triangle already
+/// has both sides, so a repeat adds no surface: it would receive and
+/// reflect the surface's light a second time, and every ray through a
+/// stack of copies tests each of them (200 000 copies of one triangle
+/// made every ray test 200 000 triangles).
+fn drop_repeats(
+    positions: &[DVec3],
+    triangles: &[[u32; 3]],
+    area: &mut [f64],
+    normal: &mut [DVec3],
+) -> usize {
+    let mut weld: std::collections::HashMap<[u64; 3], u32> = Default::default();
+    let canon: Vec<u32> = positions
+        .iter()
+        .map(|p| {
+            let next = weld.len() as u32;
+            *weld.entry(p.to_array().map(f64::to_bits)).or_insert(next)
+        })
+        .collect();
+    let mut seen = std::collections::HashSet::with_capacity(triangles.len());
+    let mut dropped = 0;
+    for (t, tri) in triangles.iter().enumerate() {
+        if area[t] == 0.0 {
+            continue;
+        }
+        let mut key = tri.map(|v| canon[v as usize]);
+        key.sort_unstable();
+        if !seen.insert(key) {
+            area[t] = 0.0;
+            normal[t] = DVec3::ZERO;
+            dropped += 1;
+        }
+    }
+    dropped
 }
 
 /// Whether the front (back) side of a chart can see its own front (back)

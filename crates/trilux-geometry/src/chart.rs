@@ -9,7 +9,11 @@
 //!
 //! 1. Triangles are connected through shared edges. Vertices are welded by
 //!    exact position first, so a mesh whose loader duplicated vertices (for
-//!    normals or texture coordinates) is still connected.
+//!    normals or texture coordinates) is still connected. An edge shared by
+//!    more than [`CHART_MAX_EDGE_TRIANGLES`] (8) triangles connects none of them:
+//!    it is no surface (coincident copies of one triangle, pages of a book),
+//!    and its k triangles would make k² neighbour pairs (200 000 copies of
+//!    one triangle asked for 8 GiB); step 4 groups them instead.
 //! 2. A chart grows from the first unassigned triangle (in file order),
 //!    always adding the connected candidate whose centroid is closest to the
 //!    seed's centroid (so charts are compact, roughly round), as long as
@@ -56,6 +60,9 @@ use crate::ids::{ElementId, SurfaceId};
 pub const CHART_MAX_TRIANGLES: usize = 512;
 /// Half-angle, in degrees, of the normal cone of a chart around its seed.
 pub const CHART_CONE_DEG: f64 = 60.0;
+/// Most triangles an edge may have and still connect them (module docs):
+/// a closed surface has 2 on every edge, a T-shaped joint 3 or 4.
+pub const CHART_MAX_EDGE_TRIANGLES: usize = 8;
 
 /// A mesh in world space, with per-triangle data.
 #[derive(Clone, Debug)]
@@ -219,12 +226,20 @@ impl Piece {
 
 /// Groups the non-degenerate triangles of a mesh into charts (module docs).
 pub(crate) fn build_charts(mesh: &MeshData) -> Vec<Vec<u32>> {
+    build_charts_counted(mesh).0
+}
+
+/// [`build_charts`], and the number of neighbours it visited: the work of
+/// growing and merging charts, at most 3 × ([`CHART_MAX_EDGE_TRIANGLES`] − 1)
+/// for each time a triangle is added to a chart or tried for a merge.
+pub(crate) fn build_charts_counted(mesh: &MeshData) -> (Vec<Vec<u32>>, usize) {
     let adjacency = Adjacency::new(mesh);
     let cos_cone = CHART_CONE_DEG.to_radians().cos();
     let (mut charts, mut chart_of) = grow_charts(mesh, &adjacency, cos_cone);
     merge_small_charts(mesh, &adjacency, cos_cone, &mut charts, &mut chart_of);
     charts.retain(|c| !c.is_empty());
-    group_small_charts(mesh, charts, cos_cone)
+    let charts = group_small_charts(mesh, charts, cos_cone);
+    (charts, adjacency.visited.get())
 }
 
 /// Which triangles share an edge, after welding vertices by exact position
@@ -233,8 +248,11 @@ struct Adjacency<'m> {
     mesh: &'m MeshData,
     /// The welded index of every vertex.
     canon: Vec<u32>,
-    /// Welded edge (low, high) → the non-degenerate triangles that have it.
+    /// Welded edge (low, high) → the non-degenerate triangles that have it
+    /// (edges of more than [`CHART_MAX_EDGE_TRIANGLES`] left out).
     edges: HashMap<(u32, u32), Vec<u32>>,
+    /// Neighbours returned so far (the work, for the tests).
+    visited: std::cell::Cell<usize>,
 }
 
 impl<'m> Adjacency<'m> {
@@ -253,6 +271,7 @@ impl<'m> Adjacency<'m> {
             mesh,
             canon,
             edges: HashMap::new(),
+            visited: std::cell::Cell::new(0),
         };
         for (t, &area) in mesh.tri_area.iter().enumerate() {
             if area <= 0.0 {
@@ -263,6 +282,9 @@ impl<'m> Adjacency<'m> {
                 adjacency.edges.entry(edge).or_default().push(t as u32);
             }
         }
+        adjacency
+            .edges
+            .retain(|_, triangles| triangles.len() <= CHART_MAX_EDGE_TRIANGLES);
         adjacency
     }
 
@@ -284,6 +306,7 @@ impl<'m> Adjacency<'m> {
                 out.extend(list.iter().copied().filter(|&o| o != t));
             }
         }
+        self.visited.set(self.visited.get() + out.len());
         out
     }
 }
@@ -614,4 +637,142 @@ fn cluster_shape(
         planar = false;
     }
     (cone, best.1, planar)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A grid of `2 · side²` triangles in z = 0 (every inner edge shared
+    /// by two), then `copies` copies of one triangle, each with its own
+    /// three vertices at the same places (welded into one triangle).
+    fn grid_and_copies(side: u32, copies: u32) -> MeshData {
+        let mut positions = Vec::new();
+        for j in 0..=side {
+            for i in 0..=side {
+                positions.push(DVec3::new(f64::from(i), f64::from(j), 0.0));
+            }
+        }
+        let v = |i: u32, j: u32| j * (side + 1) + i;
+        let mut triangles = Vec::new();
+        for j in 0..side {
+            for i in 0..side {
+                triangles.push([v(i, j), v(i + 1, j), v(i + 1, j + 1)]);
+                triangles.push([v(i, j), v(i + 1, j + 1), v(i, j + 1)]);
+            }
+        }
+        for _ in 0..copies {
+            let first = positions.len() as u32;
+            positions.extend([DVec3::new(0.0, 0.0, 5.0), DVec3::X * 3.0, DVec3::Y * 3.0]);
+            triangles.push([first, first + 1, first + 2]);
+        }
+        let n = triangles.len();
+        let mut mesh = MeshData {
+            positions,
+            triangles,
+            shading_normals: None,
+            tri_normal: vec![DVec3::Z; n],
+            tri_area: vec![0.5; n],
+            tri_surface: vec![u32::MAX; n],
+            sign: 1.0,
+            texcoords: None,
+        };
+        for t in 0..n as u32 {
+            let [a, b, c] = mesh.vertices(t);
+            let cr = (b - a).cross(c - a);
+            mesh.tri_area[t as usize] = 0.5 * cr.length();
+            mesh.tri_normal[t as usize] = cr.normalize();
+        }
+        mesh
+    }
+
+    /// The charts of `mesh`, checked to partition its triangles within the
+    /// cap, and the work of making them.
+    fn charts(mesh: &MeshData) -> (usize, usize) {
+        let (charts, work) = build_charts_counted(mesh);
+        let mut seen = vec![false; mesh.triangles.len()];
+        for c in &charts {
+            let cap = CHART_MAX_TRIANGLES * 3 / 2; // merging allows 1.5×
+            assert!(!c.is_empty() && c.len() <= cap, "{}", c.len());
+            for &t in c {
+                assert!(!seen[t as usize], "triangle {t} in two charts");
+                seen[t as usize] = true;
+            }
+        }
+        assert!(seen.iter().all(|&s| s), "every triangle in a chart");
+        (charts.len(), work)
+    }
+
+    /// Coincident triangles cost work proportional to their number: 4 times
+    /// as many (with a grid 4 times as large beside them) visit about 4
+    /// times as many neighbours, at most 3 × 7 per triangle and pass. When
+    /// an edge connected all its triangles, each copy visited every other:
+    /// 200 000 copies asked for 8 GiB.
+    #[test]
+    fn coincident_triangles_cost_linear_work() {
+        let (charts_small, small) = charts(&grid_and_copies(32, 2_048));
+        let (charts_large, large) = charts(&grid_and_copies(64, 8_192));
+        eprintln!("{small} and {large} neighbours visited");
+        for (work, triangles) in [(small, 2 * 32 * 32 + 2_048), (large, 2 * 64 * 64 + 8_192)] {
+            assert!(work <= 2 * 3 * 7 * triangles, "{work} for {triangles}");
+        }
+        let ratio = large as f64 / small as f64;
+        assert!(
+            (3.5..4.5).contains(&ratio),
+            "work ×{ratio} for ×4 triangles"
+        );
+        // The copies fill charts of the cap (2 048 / 512 = 4), as any soup
+        // of separate triangles does; the grid makes at least 2 · side² /
+        // 512 more (4), and at most twice that.
+        assert!((4 + 4..=4 + 8).contains(&charts_small), "{charts_small}");
+        assert!(
+            (16 + 16..=16 + 32).contains(&charts_large),
+            "{charts_large}"
+        );
+    }
+
+    /// Up to the limit an edge still connects its triangles: a fan of 8
+    /// triangles around one edge, each tilted less than the cone from the
+    /// first, is one chart, where the same fan of 9 is 9 pieces grouped
+    /// again by position (here into one chart too, by the Morton pass).
+    #[test]
+    fn an_edge_connects_up_to_the_limit() {
+        let mesh = |k: usize| {
+            let mut positions = vec![DVec3::ZERO, DVec3::X];
+            let mut triangles = Vec::new();
+            for i in 0..k {
+                let a = (i as f64) * 0.05;
+                positions.push(DVec3::new(0.5, a.cos(), a.sin()));
+                triangles.push([0, 1, 2 + i as u32]);
+            }
+            let n = triangles.len();
+            let mut m = MeshData {
+                positions,
+                triangles,
+                shading_normals: None,
+                tri_normal: vec![DVec3::Z; n],
+                tri_area: vec![0.0; n],
+                tri_surface: vec![u32::MAX; n],
+                sign: 1.0,
+                texcoords: None,
+            };
+            for t in 0..n as u32 {
+                let [a, b, c] = m.vertices(t);
+                let cr = (b - a).cross(c - a);
+                m.tri_area[t as usize] = 0.5 * cr.length();
+                m.tri_normal[t as usize] = cr.normalize();
+            }
+            m
+        };
+        let (_, work) = build_charts_counted(&mesh(CHART_MAX_EDGE_TRIANGLES));
+        // Growing visits the 7 others from each of the 8, and so does the
+        // try to merge the small chart into another (there is none).
+        assert_eq!(
+            work,
+            2 * CHART_MAX_EDGE_TRIANGLES * (CHART_MAX_EDGE_TRIANGLES - 1)
+        );
+        let (charts, work) = build_charts_counted(&mesh(CHART_MAX_EDGE_TRIANGLES + 1));
+        assert_eq!(work, 0);
+        assert_eq!(charts.len(), 1);
+    }
 }

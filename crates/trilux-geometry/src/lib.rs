@@ -130,7 +130,7 @@ pub use bounds::Bounds;
 pub use burial::{BurialMap, BurialRequest};
 #[cfg(feature = "trace-stats")]
 pub use bvh::stats as trace_stats;
-pub use chart::{CHART_CONE_DEG, CHART_MAX_TRIANGLES, Piece};
+pub use chart::{CHART_CONE_DEG, CHART_MAX_EDGE_TRIANGLES, CHART_MAX_TRIANGLES, Piece};
 pub use crossing::LightFaces;
 pub use element::{Element, ElementDomain};
 pub use error::{GeometryError, ShapeProblem};

@@ -275,3 +275,29 @@ fn a_triangle_soup_becomes_a_handful_of_charts() {
     }
     assert!(seen.iter().all(|&n| n == 1));
 }
+
+/// Copies of one triangle (each with its own corners, in either winding)
+/// are one surface: a single BVH primitive and a single chart, so a ray
+/// through them tests one triangle, not one per copy (200 000 copies made
+/// every ray test 200 000), and the surface's area is the triangle's.
+#[test]
+fn repeated_triangles_are_one_surface() {
+    for copies in [2u32, 4_096] {
+        let mut p = Vec::new();
+        let mut t = Vec::new();
+        for k in 0..copies {
+            let first = p.len() as u32;
+            p.extend([DVec3::ZERO, DVec3::X, DVec3::Y]);
+            t.push(if k % 2 == 0 {
+                [first, first + 1, first + 2]
+            } else {
+                [first + 2, first + 1, first]
+            });
+        }
+        let g = common::forest(&[mesh(p, t, DMat4::IDENTITY)]).expect("valid mesh");
+        assert_eq!(g.geometry().primitive_count(), 1, "{copies} copies");
+        assert_eq!(g.geometry().surfaces().len(), 1, "{copies} copies");
+        let area = g.geometry().surfaces()[0].area();
+        assert!((area - 0.5).abs() < 1e-15, "{area}");
+    }
+}

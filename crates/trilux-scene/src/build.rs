@@ -12,6 +12,7 @@ use trilux_color::ColorParam;
 
 use crate::camera::{Camera, Crop, FovAxis, ReconstructionFilter, default_fov};
 use crate::error::{Result, SceneError};
+use crate::limits::MAX_SHAPES;
 use crate::material::{TextureCollector, build_bsdf, check_color};
 use crate::meshes::Requests;
 use crate::props::Props;
@@ -37,6 +38,14 @@ pub(crate) fn build(resolved: Resolved, path: &Path) -> Result<(Scene, Requests)
     for e in &scene_el.children {
         match e.tag.as_str() {
             "shape" => {
+                if shapes.len() == MAX_SHAPES {
+                    return Err(SceneError::at(
+                        &e.loc,
+                        format!(
+                            "the scene has more than {MAX_SHAPES} shapes, the limit (docs/limits.md)"
+                        ),
+                    ));
+                }
                 let (shape, request, textures) = scene_shape(e, folder)?;
                 requests.meshes.extend(request.map(|r| (shapes.len(), r)));
                 requests

@@ -84,6 +84,14 @@ pub const MAX_GLTF_TRIANGLES: usize = 8_000_000;
 /// Deepest glTF node hierarchy (the loader recurses once a level).
 pub const MAX_NODE_DEPTH: usize = 64;
 
+/// Most shapes of one scene: XML `<shape>`s, or mesh primitives placed by
+/// glTF nodes (a mesh placed by many nodes counts once for each). Every
+/// shape is at least one input surface, and loading takes about 2 KB a
+/// shape before its triangles (200 MB at the limit); the solver's setup
+/// costs more per input surface, and near pairs of them grow as their
+/// square. The largest scene solved in docs/results.md has 1 543.
+pub const MAX_SHAPES: usize = 100_000;
+
 /// Most node instances a glTF scene places (a node reached twice is
 /// refused: glTF's node graph is a set of disjoint trees).
 pub const MAX_GLTF_NODES: usize = 1_000_000;

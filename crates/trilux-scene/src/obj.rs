@@ -1,7 +1,9 @@
 //! Wavefront OBJ meshes (`<shape type="obj">`), read with `tobj`.
 //!
 //! Texture coordinates (`vt`) are kept when every vertex has them, with v
-//! flipped as Mitsuba's loader flips it. Polygons are triangulated as fans; vertices are shared when they share
+//! flipped as Mitsuba's loader flips it. Polygons of up to [`FAN_MAX`] vertices are
+//! triangulated as fans from their first vertex (as Mitsuba's and tobj's
+//! loaders do), larger ones by halving ([`triangulate`]); vertices are shared when they share
 //! position, texture and normal indices (as Mitsuba's own OBJ loader keys
 //! them). Materials (`mtllib`) are ignored, as Mitsuba ignores them.
 //!
@@ -109,12 +111,73 @@ pub fn parse_obj(
     merge_models(&models, path, face_normals, flip_tex_coords)
 }
 
-/// The OBJ's models as tobj reads them (triangulated, one index per
-/// vertex), refused beyond the mesh limits.
+/// Polygons of up to this many vertices are triangulated as fans from
+/// their first vertex; larger ones by halving ([`triangulate`]).
+pub const FAN_MAX: usize = 64;
+
+/// The triangles of faces of `arities` vertices each (all triangles when
+/// `arities` is empty, as tobj gives them), each face's indices in turn in
+/// `indices`. A face of up to [`FAN_MAX`] vertices is a fan from its first
+/// vertex. A larger one is cut by the chord from its first vertex to its
+/// middle one, and each part again (a triangle of the first, middle and
+/// last vertex of every arc): a fan of a polygon of a million vertices is
+/// a million slivers whose boxes all reach the first vertex, so every ray
+/// near it tests most of them, while the halves' triangles shrink with
+/// their depth (log₂ n levels). Both keep the polygon's winding and cover
+/// the same area when it is convex.
+pub fn triangulate(indices: &[u32], arities: &[u32], mut push: impl FnMut([u32; 3])) {
+    if arities.is_empty() {
+        for t in indices.chunks_exact(3) {
+            push([t[0], t[1], t[2]]);
+        }
+        return;
+    }
+    let mut start = 0;
+    for &k in arities {
+        let k = k as usize;
+        let Some(face) = indices.get(start..start + k) else {
+            return;
+        };
+        start += k;
+        if k < 3 {
+            continue;
+        }
+        if k <= FAN_MAX {
+            for i in 1..k - 1 {
+                push([face[0], face[i], face[i + 1]]);
+            }
+            continue;
+        }
+        let mut arcs = vec![(0, k - 1)];
+        while let Some((a, b)) = arcs.pop() {
+            if b - a >= 2 {
+                let m = (a + b) / 2;
+                push([face[a], face[m], face[b]]);
+                arcs.push((m, b));
+                arcs.push((a, m));
+            }
+        }
+    }
+}
+
+/// Triangles the faces make ([`triangulate`]).
+fn triangle_count(m: &tobj::Mesh) -> usize {
+    if m.face_arities.is_empty() {
+        m.indices.len() / 3
+    } else {
+        m.face_arities
+            .iter()
+            .map(|&k| (k as usize).saturating_sub(2))
+            .sum()
+    }
+}
+
+/// The OBJ's models as tobj reads them (faces with their arities, one
+/// index per vertex), refused beyond the mesh limits.
 fn load_models(bytes: &[u8], path: &Path) -> Result<Vec<tobj::Model>, ObjError> {
     let options = tobj::LoadOptions {
         single_index: true,
-        triangulate: true,
+        triangulate: false,
         ignore_points: true,
         ignore_lines: true,
     };
@@ -126,7 +189,7 @@ fn load_models(bytes: &[u8], path: &Path) -> Result<Vec<tobj::Model>, ObjError> 
         reason: e.to_string(),
     })?;
 
-    let triangles: usize = models.iter().map(|m| m.mesh.indices.len() / 3).sum();
+    let triangles: usize = models.iter().map(|m| triangle_count(&m.mesh)).sum();
     let vertices: usize = models.iter().map(|m| m.mesh.positions.len() / 3).sum();
     if triangles > crate::limits::MAX_MESH_TRIANGLES || vertices > crate::limits::MAX_MESH_VERTICES
     {
@@ -190,9 +253,9 @@ fn merge_models(
         } else {
             all_have_texcoords = false;
         }
-        for t in m.indices.chunks_exact(3) {
-            mesh.triangles.push([base + t[0], base + t[1], base + t[2]]);
-        }
+        triangulate(&m.indices, &m.face_arities, |t| {
+            mesh.triangles.push(t.map(|i| base + i));
+        });
     }
     if mesh.triangles.is_empty() {
         return Err(ObjError::Empty {
@@ -349,6 +412,92 @@ mod tests {
             assert_eq!(bad_face_index(text.as_bytes()), *bad, "{text:?}");
             let parsed = parse_obj(text.as_bytes(), Path::new("t.obj"), false, true);
             assert_eq!(parsed.is_err(), bad.is_some(), "{text:?}: {parsed:?}");
+        }
+    }
+
+    /// A polygon of `n` vertices on the unit circle, counter-clockwise.
+    fn circle(n: usize) -> String {
+        let mut t = String::new();
+        for i in 0..n {
+            let a = std::f64::consts::TAU * i as f64 / n as f64;
+            t += &format!("v {} {} 0\nvt {} {}\n", a.cos(), a.sin(), a.cos(), a.sin());
+        }
+        t
+    }
+
+    /// Faces up to [`FAN_MAX`] vertices give tobj's own fans, vertex for
+    /// vertex (triangles, quads, a pentagon, a 64-gon, with and without
+    /// texture indices).
+    #[test]
+    fn small_polygons_are_tobj_fans() {
+        let mut text = circle(FAN_MAX);
+        text += "f 1 2 3\nf 1/1 2/2 3/3 4/4\nf 5 6 7 8 9\nf 10 11 12 13\nf";
+        for i in 1..=FAN_MAX {
+            text += &format!(" {i}");
+        }
+        text += "\n";
+        let ours = parse_obj(text.as_bytes(), Path::new("t.obj"), true, true)
+            .unwrap_or_else(|e| panic!("{e}"));
+        let options = tobj::LoadOptions {
+            single_index: true,
+            triangulate: true,
+            ignore_points: true,
+            ignore_lines: true,
+        };
+        let (models, _) = tobj::load_obj_buf(&mut text.as_bytes(), &options, |_| {
+            Ok((Vec::new(), Default::default()))
+        })
+        .unwrap_or_else(|e| panic!("{e}"));
+        let theirs: Vec<[u32; 3]> = models[0]
+            .mesh
+            .indices
+            .chunks_exact(3)
+            .map(|t| [t[0], t[1], t[2]])
+            .collect();
+        assert_eq!(ours.triangles.len(), 1 + 2 + 3 + 2 + (FAN_MAX - 2));
+        assert_eq!(ours.triangles, theirs);
+        assert_eq!(ours.positions.len() * 3, models[0].mesh.positions.len());
+    }
+
+    /// A polygon of n > [`FAN_MAX`] vertices makes n − 2 triangles of its
+    /// winding covering its area, each corner of each triangle used, and
+    /// the triangles' boxes shrink by halves: their summed extents are
+    /// O(log n) times the polygon's, where a fan's are O(n) times.
+    #[test]
+    fn large_polygons_are_halved() {
+        for n in [FAN_MAX + 1, 1000, 4096] {
+            let mut text = circle(n);
+            text += "f";
+            for i in 1..=n {
+                text += &format!(" {i}");
+            }
+            text += "\n";
+            let mesh = parse_obj(text.as_bytes(), Path::new("t.obj"), true, true)
+                .unwrap_or_else(|e| panic!("{e}"));
+            assert_eq!(mesh.triangles.len(), n - 2);
+            let p = &mesh.positions;
+            let mut area = 0.0;
+            let mut extents = 0.0;
+            let mut used = vec![false; n];
+            for t in &mesh.triangles {
+                let [a, b, c] = t.map(|i| p[i as usize]);
+                let z = (b - a).cross(c - a).z;
+                assert!(z > 0.0, "counter-clockwise, as the polygon");
+                area += 0.5 * z;
+                extents += (a.max(b).max(c) - a.min(b).min(c)).length();
+                t.iter().for_each(|&i| used[i as usize] = true);
+            }
+            // The shoelace area of the polygon as read (tobj keeps f32).
+            let exact: f64 = (0..n)
+                .map(|i| 0.5 * p[i].truncate().perp_dot(p[(i + 1) % n].truncate()))
+                .sum();
+            assert!(
+                (area - exact).abs() < 1e-9 * exact,
+                "{area} against {exact}"
+            );
+            assert!(used.iter().all(|&u| u));
+            let levels = (n as f64).log2().ceil();
+            assert!(extents <= 8.0 * levels, "{n}: summed extents {extents}");
         }
     }
 }

@@ -7,7 +7,9 @@
 //! `s t`, `texture_u texture_v` or `texture_s texture_t`, kept as written:
 //! Mitsuba flips OBJ's `vt` but not PLY's); the `face` element's
 //! `vertex_indices` (or `vertex_index`) list gives polygons, triangulated as
-//! fans (Mitsuba 3.9 reads triangles only; a fan is what a polygon means).
+//! fans (Mitsuba 3.9 reads triangles only; a fan is what a polygon means),
+//! those of more than 64 vertices by halving as OBJ polygons are
+//! (`crate::obj::triangulate`).
 //! Other properties (colours) and other elements are read past. Normals
 //! follow the OBJ rules: the file's when it has them, otherwise smooth ones
 //! recomputed, none with `face_normals`.
@@ -22,7 +24,7 @@ use glam::{DVec2, DVec3};
 use trilux_geometry::TriangleMesh;
 
 use crate::limits::{MAX_MESH_BYTES, MAX_MESH_TRIANGLES, MAX_MESH_VERTICES};
-use crate::obj::vertex_normals;
+use crate::obj::{triangulate, vertex_normals};
 
 /// Why a PLY file could not be read (the caller adds the scene location).
 #[derive(Debug, thiserror::Error)]
@@ -544,7 +546,8 @@ impl RawMesh {
         }
     }
 
-    /// A polygon as a fan of triangles.
+    /// A polygon as triangles: a fan up to 64 vertices, halves beyond
+    /// ([`triangulate`]).
     fn add_face(&mut self, list: &[f64]) -> Result<(), String> {
         if list.len() < 3 {
             return Err(format!("a face with {} vertices (at least 3)", list.len()));
@@ -561,10 +564,9 @@ impl RawMesh {
             ));
         }
         // Integers within u32 (checked above): `as` is exact.
-        let id = |k: usize| list[k] as u32;
-        for k in 1..list.len() - 1 {
-            self.triangles.push([id(0), id(k), id(k + 1)]);
-        }
+        let ids: Vec<u32> = list.iter().map(|&i| i as u32).collect();
+        let triangles = &mut self.triangles;
+        triangulate(&ids, &[ids.len() as u32], |t| triangles.push(t));
         Ok(())
     }
 

@@ -27,6 +27,7 @@ use crate::error::{Result, SceneError, SourceLocation};
 use crate::limits::{
     MAX_DEPTH, MAX_EXPANDED_BYTES, MAX_INCLUDED_BYTES, MAX_INCLUDES, MAX_VALUE_BYTES, MAX_XML_NODES,
 };
+use crate::text::Locator;
 
 /// One attribute of an element, after substitution.
 #[derive(Clone, Debug)]
@@ -107,6 +108,16 @@ pub(crate) fn parse(
     file: &Arc<Path>,
     params: &[(String, String)],
 ) -> Result<(Element, Vec<PathBuf>)> {
+    let (tree, shared) = parse_shared(text, file, params)?;
+    Ok((tree, shared.files))
+}
+
+/// [`parse`], with what the files shared (the tests count its work).
+fn parse_shared(
+    text: &str,
+    file: &Arc<Path>,
+    params: &[(String, String)],
+) -> Result<(Element, Shared)> {
     let mut shared = Shared {
         params: params.to_vec(),
         used: vec![false; params.len()],
@@ -115,6 +126,7 @@ pub(crate) fn parse(
         included: 0,
         included_bytes: 0,
         files: Vec::new(),
+        located_bytes: 0,
     };
     let tree = parse_file(text, file, &mut shared)?;
     if let Some(k) = shared.used.iter().position(|u| !u) {
@@ -127,7 +139,7 @@ pub(crate) fn parse(
             ),
         ));
     }
-    Ok((tree, shared.files))
+    Ok((tree, shared))
 }
 
 /// What the files of one scene share while they are parsed.
@@ -145,6 +157,9 @@ struct Shared {
     included_bytes: u64,
     /// Every file included (outputs may not overwrite them).
     files: Vec<PathBuf>,
+    /// Bytes read to find the lines and columns of elements and
+    /// attributes, over every file: each file's length at most.
+    located_bytes: usize,
 }
 
 /// Parses one file of the scene (the scene file or an included one).
@@ -177,8 +192,8 @@ fn parse_file(text: &str, file: &Arc<Path>, shared: &mut Shared) -> Result<Eleme
         SceneError::at(&loc, format!("malformed XML: {message}"))
     })?;
     let mut ctx = Context {
-        doc: &doc,
         file: file.clone(),
+        locator: Locator::new(text),
         shared,
     };
     let root = doc.root_element();
@@ -196,6 +211,7 @@ fn parse_file(text: &str, file: &Arc<Path>, shared: &mut Shared) -> Result<Eleme
         .element(root, 1)?
         .pop()
         .ok_or_else(|| SceneError::at(&root_loc, "the root element must be <scene>"))?;
+    ctx.shared.located_bytes += ctx.locator.scanned;
     check_version(&tree)?;
     Ok(tree)
 }
@@ -238,18 +254,19 @@ fn check_version(scene: &Element) -> Result<()> {
 }
 
 struct Context<'a, 'input> {
-    doc: &'a roxmltree::Document<'input>,
     file: Arc<Path>,
+    /// Places in the file, asked in document order.
+    locator: Locator<'input>,
     shared: &'a mut Shared,
 }
 
 impl Context<'_, '_> {
-    fn loc(&self, byte: usize) -> SourceLocation {
-        let pos = self.doc.text_pos_at(byte);
+    fn loc(&mut self, byte: usize) -> SourceLocation {
+        let (line, col) = self.locator.at(byte);
         SourceLocation {
             file: self.file.clone(),
-            line: pos.row,
-            col: pos.col,
+            line,
+            col,
             pointer: None,
         }
     }
@@ -505,5 +522,72 @@ mod tests {
             e.to_string().starts_with("t.xml:1:24: unexpected text"),
             "{e}"
         );
+    }
+
+    /// Every element's and attribute's place is the one roxmltree's own
+    /// `text_pos_at` gives (counting from the start of the file), with
+    /// multi-byte characters, CR LF line ends and long lines.
+    #[test]
+    fn incremental_locations_match_counting_from_the_start() {
+        let mut t = String::from("<scene version=\"3.0.0\">\r\n");
+        for i in 0..40 {
+            t += &format!("  <a é=\"ü{i}\"  b=\"{}\">", "x".repeat(i * 7));
+            if i % 3 == 0 {
+                t += "\r\n<!-- ∑ -->\n";
+            }
+            t += "<c d=\"1\"/></a>\n";
+        }
+        t += "</scene>";
+        let doc = roxmltree::Document::parse(&t).unwrap_or_else(|e| panic!("{e}"));
+        let (tree, _) = parse(&t, &file(), &[]).unwrap_or_else(|e| panic!("{e}"));
+        let mut ours = Vec::new();
+        let mut stack = vec![&tree];
+        while let Some(e) = stack.pop() {
+            ours.push((e.loc.line, e.loc.col));
+            ours.extend(e.attrs.iter().map(|a| (a.loc.line, a.loc.col)));
+            stack.extend(e.children.iter().rev());
+        }
+        let mut theirs = Vec::new();
+        for n in doc.descendants().filter(|n| n.is_element()) {
+            let p = doc.text_pos_at(n.range().start);
+            theirs.push((p.row, p.col));
+            for a in n.attributes() {
+                let p = doc.text_pos_at(a.range_value().start);
+                theirs.push((p.row, p.col));
+            }
+        }
+        assert_eq!(ours.len(), 2 + 40 * 3 + 40 * 2);
+        assert_eq!(ours, theirs);
+    }
+
+    /// Locating every element reads each byte of the file once: the work
+    /// for 4n emitters is 4 times the work for n (it was quadratic: every
+    /// element's line counted from the start of the file).
+    #[test]
+    fn locating_elements_reads_the_file_once() {
+        let scene = |n: usize| {
+            let mut t = String::from("<scene version=\"3.0.0\">\n");
+            for i in 0..n {
+                t += &format!(
+                    "<shape type=\"rectangle\"><transform name=\"to_world\"><translate value=\"{i},0,0\"/></transform><emitter type=\"area\"><rgb name=\"radiance\" value=\"1\"/></emitter></shape>\n"
+                );
+            }
+            t + "</scene>"
+        };
+        let work = |n: usize| {
+            let t = scene(n);
+            let (tree, shared) = parse_shared(&t, &file(), &[]).unwrap_or_else(|e| panic!("{e}"));
+            assert_eq!(tree.children.len(), n);
+            assert!(
+                shared.located_bytes <= t.len(),
+                "{} > {}",
+                shared.located_bytes,
+                t.len()
+            );
+            shared.located_bytes as f64
+        };
+        let (small, large) = (work(2_500), work(10_000));
+        let ratio = large / small;
+        assert!((3.9..4.1).contains(&ratio), "work ×{ratio} for ×4 elements");
     }
 }

@@ -4,10 +4,11 @@
 //!
 //! One wide BVH ([`wide`]) over all primitives: mesh triangles, the two
 //! triangles of every planar quad, and one primitive per disk, sphere and
-//! cylinder. obvhs builds the binary tree (PLOC and reinsertion over the
-//! primitives' boxes, padded by 4·10⁻⁶ × the scene's extent); this module
-//! collapses it into nodes of eight children with f32 boxes, and leaves of
-//! up to four primitives stored as one [`Tri4`].
+//! cylinder. The binary tree is obvhs's PLOC with a bound on its work
+//! ([`ploc`]), then obvhs's reinsertion, over the primitives' boxes padded
+//! by 4·10⁻⁶ × the scene's extent; this module collapses it into nodes of
+//! eight children with f32 boxes, and leaves of up to four primitives
+//! stored as one [`Tri4`].
 //!
 //! A query ray is f64 (origin, non-unit direction, t in units of that
 //! direction). It is traversed as an f32 ray ([`traverse`]: nearest child
@@ -38,6 +39,7 @@
 //! [`PrimHit`] into a hit on an input surface.
 
 mod analytic;
+mod ploc;
 mod traverse;
 mod tri4;
 mod triangle;
@@ -79,7 +81,6 @@ pub(crate) use analytic::{Analytic, AnalyticKind};
 use glam::{DVec2, DVec3};
 use obvhs::aabb::Aabb;
 use obvhs::bvh2::reinsertion::ReinsertionOptimizer;
-use obvhs::ploc::{PlocBuilder, PlocSearchDistance, SortPrecision};
 use rayon::prelude::*;
 
 use crate::bounds::Bounds;
@@ -238,14 +239,14 @@ impl Bvh {
                 )
             })
             .collect();
-        let mut bvh2 = PlocBuilder::with_capacity(boxes.len()).build(
-            PlocSearchDistance::Low,
-            &boxes,
-            (0..boxes.len() as u32).collect(),
-            SortPrecision::U64,
-            2,
-        );
-        ReinsertionOptimizer::default().run(&mut bvh2, 0.02, None);
+        let (mut bvh2, visits) = ploc::build(&boxes);
+        // Reinsertion searches the tree from the top for each node it
+        // moves; on the boxes that exhausted PLOC's budget (coincident
+        // triangles, fans of slivers: boxes that all overlap) that search
+        // prunes nothing, so it is left out there.
+        if visits <= ploc::WORK_PER_PRIMITIVE * boxes.len() {
+            ReinsertionOptimizer::default().run(&mut bvh2, 0.02, None);
+        }
         // PLOC leaves hold one primitive each; anything else, and scenes
         // whose scale f32's range does not suit ([`tri4`]), fall back to
         // testing everything.

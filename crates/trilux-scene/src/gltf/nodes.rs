@@ -39,6 +39,7 @@ use crate::camera::{Camera, FovAxis, ReconstructionFilter};
 use crate::error::{Result, SceneError, SourceLocation};
 use crate::limits::{
     MAX_GLTF_NODES, MAX_GLTF_TRIANGLES, MAX_MESH_TRIANGLES, MAX_MESH_VERTICES, MAX_NODE_DEPTH,
+    MAX_SHAPES,
 };
 use crate::scene::{AreaEmitter, Scene, SceneShape};
 use crate::shape::check_area;
@@ -237,6 +238,14 @@ impl Walk<'_> {
                 "the primitive has no POSITION",
             )
         })?;
+        if self.shapes.len() == MAX_SHAPES {
+            return Err(self.at(
+                format!("/nodes/{}", node.index()),
+                format!(
+                    "the scene places more than {MAX_SHAPES} mesh primitives (shapes), the limit (docs/limits.md)"
+                ),
+            ));
+        }
         let corners = p.indices().map_or(positions.count(), |a| a.count());
         self.triangles += corners / 3;
         if self.triangles > MAX_GLTF_TRIANGLES {
