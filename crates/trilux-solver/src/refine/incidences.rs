@@ -15,7 +15,6 @@ use std::sync::{Arc, Mutex};
 
 use trilux_geometry::{ElementId, FaceElement};
 
-use super::triple::Incidence;
 use crate::throughput::BuildKeyHasher;
 
 /// Shards of the table: enough that two to a few dozen threads rarely
@@ -25,15 +24,15 @@ const SHARDS: usize = 32;
 /// One shard: incidences by i · 2³³ + j's key (2 × element + side;
 /// element ids stay far below 2³¹, whose forest would need hundreds of
 /// gigabytes), hashed as the throughput cache hashes its keys.
-type Table<const N: usize> = HashMap<u64, Option<Arc<Incidence<N>>>, BuildKeyHasher>;
+type Table<T> = HashMap<u64, Option<Arc<T>>, BuildKeyHasher>;
 
-/// One shot's incidences by (i, j and j's side); `None` records a sub-pair
-/// that carries no light.
-pub(crate) struct IncidenceMemo<const N: usize> {
-    shards: Vec<Mutex<Table<N>>>,
+/// One shot's incidences `T` (stage 2's `Incidence`) by (i, j and j's
+/// side); `None` records a sub-pair that carries no light.
+pub(crate) struct IncidenceMemo<T> {
+    shards: Vec<Mutex<Table<T>>>,
 }
 
-impl<const N: usize> IncidenceMemo<N> {
+impl<T> IncidenceMemo<T> {
     /// An empty table.
     pub fn new() -> Self {
         IncidenceMemo {
@@ -48,8 +47,8 @@ impl<const N: usize> IncidenceMemo<N> {
         &self,
         i: ElementId,
         j: FaceElement,
-        make: impl FnOnce() -> Option<Incidence<N>>,
-    ) -> Option<Arc<Incidence<N>>> {
+        make: impl FnOnce() -> Option<T>,
+    ) -> Option<Arc<T>> {
         let key = (u64::from(i.0) << 33) | j.key();
         let shard = &self.shards[(key.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 59) as usize % SHARDS];
         if let Some(found) = shard.lock().ok().and_then(|m| m.get(&key).cloned()) {

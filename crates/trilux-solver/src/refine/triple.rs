@@ -95,7 +95,7 @@ pub(crate) struct TripleTask<'t, const N: usize> {
     /// The links made.
     pub out: Vec<NodeLink<N>>,
     /// The shot's sub-pair incidences, shared with its other tasks.
-    pub memo: &'t IncidenceMemo<N>,
+    pub memo: &'t IncidenceMemo<Incidence<N>>,
 }
 
 impl<const N: usize> TripleTask<'_, N> {
