@@ -348,7 +348,13 @@ fn a_render_interrupted_by_a_signal_leaves_no_out_folder() {
     for signal in ["INT", "TERM"] {
         // A render far longer than the test waits: a megapixel at 4096
         // samples a pixel.
-        let mut child = Command::new(env!("CARGO_BIN_EXE_trilux"))
+        // Through coreutils' `env --default-signal`, which execs the render
+        // (same pid) with SIGINT and SIGTERM at their default action: a
+        // test runner started in the background of a non-interactive shell
+        // passes SIGINT on ignored, and the render would then never end.
+        let mut child = Command::new("env")
+            .arg("--default-signal=INT,TERM")
+            .arg(env!("CARGO_BIN_EXE_trilux"))
             .current_dir(&dir)
             .args(["render", "scene.xml", "--quality", "draft", "--solution"])
             .arg(&sol)
