@@ -231,7 +231,8 @@ fn interior_tests(dir: &Path) -> Result<()> {
     if !status.success() {
         bail!("cargo build --release -p trilux failed ({status})");
     }
-    let target = std::env::var_os("CARGO_TARGET_DIR").map_or_else(|| root().join("target"), PathBuf::from);
+    let target =
+        std::env::var_os("CARGO_TARGET_DIR").map_or_else(|| root().join("target"), PathBuf::from);
     let test = root().join("docs/viewer/test/interior.test.mjs");
     eprintln!("xtask: node --test {}", test.display());
     let status = Command::new("node")
@@ -240,7 +241,9 @@ fn interior_tests(dir: &Path) -> Result<()> {
         .env("TRILUX_BAKES", dir)
         .env("TRILUX", target.join("release/trilux"))
         .status()
-        .context("could not start node (docs/viewer/scripts/ci.sh installs what the viewer needs)")?;
+        .context(
+            "could not start node (docs/viewer/scripts/ci.sh installs what the viewer needs)",
+        )?;
     if !status.success() {
         bail!("the viewer's interior tests failed ({status})");
     }

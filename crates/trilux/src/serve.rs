@@ -77,7 +77,9 @@ pub fn serve(listener: TcpListener, glb: &[u8], open: bool) -> Result<()> {
     crate::streams::print(&format!("viewer: {url} (Ctrl-C stops it)\n"))?;
     if open {
         match open_browser(&url) {
-            Some(how) => crate::streams::print(&format!("viewer: opened in the browser ({how})\n"))?,
+            Some(how) => {
+                crate::streams::print(&format!("viewer: opened in the browser ({how})\n"))?
+            }
             None => crate::streams::eprint_line(&format!(
                 "warning: no browser to open ($BROWSER is not set and {OPENER} is not on PATH): open {url} yourself"
             )),

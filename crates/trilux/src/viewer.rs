@@ -76,9 +76,11 @@ pub fn check_glb(bytes: &[u8]) -> Result<(), String> {
     let json = usize::try_from(chunk)
         .ok()
         .and_then(|n| bytes.get(20..20usize.checked_add(n)?))
-        .ok_or_else(|| format!("byte 12: the JSON chunk's length {chunk} runs past the file's end"))?;
-    let doc: serde_json::Value = serde_json::from_slice(json)
-        .map_err(|e| format!("JSON chunk (byte 20 on): {e}"))?;
+        .ok_or_else(|| {
+            format!("byte 12: the JSON chunk's length {chunk} runs past the file's end")
+        })?;
+    let doc: serde_json::Value =
+        serde_json::from_slice(json).map_err(|e| format!("JSON chunk (byte 20 on): {e}"))?;
     match doc.pointer("/asset/version").and_then(|v| v.as_str()) {
         Some(v) if v.starts_with("2.") => Ok(()),
         Some(v) => Err(format!("JSON chunk: asset.version is \"{v}\", not 2.x")),

@@ -18,7 +18,7 @@ use common::{folder, trilux};
 /// to 4 bytes, its header's length `extra` bytes off the true one.
 fn glb(json: &str, extra: i64) -> Vec<u8> {
     let mut chunk = json.as_bytes().to_vec();
-    while chunk.len() % 4 != 0 {
+    while !chunk.len().is_multiple_of(4) {
         chunk.push(b' ');
     }
     let total = 12 + 8 + chunk.len();
@@ -65,8 +65,18 @@ fn a_missing_or_malformed_file_is_one_located_line() {
     v1[4] = 1;
     refused(&dir, "v1.glb", &v1, "version 1");
     refused(&dir, "cut.glb", &glb(ASSET, 8), "byte 8");
-    refused(&dir, "json.glb", &glb(r#"{"asset": {"version": "2.0""#, 0), "JSON chunk");
-    refused(&dir, "asset.glb", &glb(r#"{"scenes": []}"#, 0), "asset.version");
+    refused(
+        &dir,
+        "json.glb",
+        &glb(r#"{"asset": {"version": "2.0""#, 0),
+        "JSON chunk",
+    );
+    refused(
+        &dir,
+        "asset.glb",
+        &glb(r#"{"scenes": []}"#, 0),
+        "asset.version",
+    );
     let mut bin_first = glb(ASSET, 0);
     bin_first[16..20].copy_from_slice(b"BIN\0");
     refused(&dir, "bin.glb", &bin_first, "not JSON");
@@ -138,7 +148,10 @@ fn get(port: u16, path: &str) -> (String, Vec<u8>) {
     s.read_to_end(&mut all).unwrap();
     let split = all.windows(4).position(|w| w == b"\r\n\r\n").unwrap();
     let head = String::from_utf8_lossy(&all[..split]).into_owned();
-    (head.lines().next().unwrap().to_string(), all[split + 4..].to_vec())
+    (
+        head.lines().next().unwrap().to_string(),
+        all[split + 4..].to_vec(),
+    )
 }
 
 fn first_line(stderr: ChildStderr) -> String {
