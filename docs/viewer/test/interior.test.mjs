@@ -250,6 +250,7 @@ test('compact overlay: on a 360 × 640 screen the overlays cover under 5 %, the 
 		.reduce((sum, r) => sum + Math.max(0, Math.min(r.right, innerWidth) - Math.max(r.left, 0)) * Math.max(0, Math.min(r.bottom, innerHeight) - Math.max(r.top, 0)), 0)
 		/ (innerWidth * innerHeight));
 	const folded = await covered();
+	console.log(`the folded overlays cover ${(100 * folded).toFixed(2)} % of a 360 × 640 screen`);
 	assert.ok(folded < 0.05, `the folded overlays cover ${(100 * folded).toFixed(1)} % of the screen`);
 	await page.tap('#menu');
 	assert.equal(await page.isVisible('#exposure'), true);
