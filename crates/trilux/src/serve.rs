@@ -80,9 +80,15 @@ pub fn serve(listener: TcpListener, glb: &[u8], open: bool) -> Result<()> {
             Some(how) => {
                 crate::streams::print(&format!("viewer: opened in the browser ({how})\n"))?
             }
-            None => crate::streams::eprint_line(&format!(
-                "warning: no browser to open ($BROWSER is not set and {OPENER} is not on PATH): open {url} yourself"
-            )),
+            None => {
+                let listed = match std::env::var("BROWSER") {
+                    Ok(b) if !b.trim().is_empty() => "no command of $BROWSER started",
+                    _ => "$BROWSER is not set",
+                };
+                crate::streams::eprint_line(&format!(
+                    "warning: no browser to open ({listed} and {OPENER} is not on PATH): open {url} yourself"
+                ));
+            }
         }
     }
     let busy = AtomicUsize::new(0);
@@ -107,7 +113,7 @@ pub fn serve(listener: TcpListener, glb: &[u8], open: bool) -> Result<()> {
 const OPENER: &str = if cfg!(target_os = "macos") {
     "open"
 } else if cfg!(windows) {
-    "explorer"
+    "explorer.exe"
 } else {
     "xdg-open"
 };

@@ -233,3 +233,30 @@ fn open_without_a_browser_says_so_and_serves() {
     child.kill().unwrap();
     child.wait().unwrap();
 }
+
+/// A `$BROWSER` none of whose commands starts is the same: one line, and
+/// the server runs on.
+#[test]
+fn open_with_a_browser_that_does_not_start_says_so() {
+    let dir = folder("view-bad-browser");
+    let path = dir.join("model.glb");
+    std::fs::write(&path, glb(ASSET, 0)).unwrap();
+    let empty = dir.join("empty-path");
+    std::fs::create_dir_all(&empty).unwrap();
+    let missing = dir.join("no-such-browser");
+    let env = [
+        ("PATH", empty.to_str().unwrap()),
+        ("BROWSER", missing.to_str().unwrap()),
+    ];
+    let (mut child, lines, port) = serve(&path, true, &env, "viewer: ");
+    assert_eq!(lines.len(), 1, "{lines:?}");
+    let said = first_line(child.stderr.take().unwrap());
+    assert!(
+        said.starts_with("warning: no browser to open (no command of $BROWSER started"),
+        "{said}"
+    );
+    let (status, _) = get(port, "/index.html");
+    assert!(status.contains("200"), "{status}");
+    child.kill().unwrap();
+    child.wait().unwrap();
+}
