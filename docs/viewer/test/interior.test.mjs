@@ -116,6 +116,15 @@ test('an interior opens in walk mode, a scene seen from outside in orbit mode', 
 	await box.context.close();
 });
 
+test('?mode= overrides the default; an unknown mode is an error on the page', async () => {
+	const { page, context } = await open('crossing-room.glb', { query: { mode: 'orbit' } });
+	assert.equal(await page.evaluate(() => window.viewerInfo.mode), 'orbit');
+	await page.goto(page.url().replace('mode=orbit', 'mode=run'));
+	await page.waitForFunction(() => typeof window.viewerError === 'string', null, { timeout: 60_000 });
+	assert.equal(await page.evaluate(() => window.viewerError), 'mode=run is not walk, orbit or fly');
+	await context.close();
+});
+
 test('walk: W towards a wall stops the eye 0.25 m short of it, 1.6 m above the floor', async () => {
 	const { page, context } = await open('crossing-room.glb');
 	// From (3.6, ·, 3.7) towards the red wall at x = 0: nothing in between.
