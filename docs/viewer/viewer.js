@@ -4,7 +4,9 @@
 // materials get a default headlight; a file without a camera is framed).
 //
 // Query parameters: file=URL, exposure=STOPS, ui=0 (no overlays),
-// width=PX & height=PX (fixed canvas size instead of the window's).
+// width=PX & height=PX (fixed canvas size instead of the window's),
+// mode=walk|orbit|fly (else walk when the file's camera is enclosed by the
+// scene, orbit when not).
 // window.viewerReady becomes true once the first frame of a file is drawn;
 // window.viewerError holds the message of a failure (also shown on the page).
 
@@ -12,17 +14,21 @@ import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import { PointerLockControls } from 'three/addons/controls/PointerLockControls.js';
+import { Walker } from './walk.js';
 
 const params = new URLSearchParams(location.search);
 const $ = (id) => document.getElementById(id);
 const ui = {
 	stage: $('stage'), file: $('file'), exposure: $('exposure'), exposureText: $('exposure-text'),
 	sceneCamera: $('scene-camera'), navMode: $('nav-mode'), info: $('info'), error: $('error'),
+	menu: $('menu'), panel: $('panel'), notice: $('notice'), glossyList: $('glossy-list'),
 };
+const MODES = ['orbit', 'walk', 'fly'];
 
 window.viewerReady = false;
 window.viewerError = undefined;
 window.viewerInfo = undefined;
+window.viewerNotice = null;
 
 if (params.get('ui') === '0') document.body.classList.add('no-ui');
 
@@ -54,6 +60,8 @@ function positiveInt(name) {
 const fixedW = positiveInt('width');
 const fixedH = positiveInt('height');
 const fixedSize = fixedW !== null || fixedH !== null;
+const modeParam = params.get('mode');
+if (modeParam !== null && !['orbit', 'walk', 'fly'].includes(modeParam)) fail(`mode=${modeParam} is not walk, orbit or fly`);
 
 function viewSize() {
 	return {
@@ -116,9 +124,11 @@ const state = {
 	aspect: null, // the aspect whose full width must stay visible (the scene camera's)
 	near: 0.01,
 	mode: 'orbit',
+	inside: false, // the file's camera is enclosed by the scene (walk by default)
 	exposureFromUrl: params.has('exposure'),
 	exposureTouched: false,
 	loadSeq: 0,
+	glossy: [], // names of the materials whose glossy light the bake left out
 };
 
 // ---------------------------------------------------------------- exposure
@@ -154,29 +164,35 @@ fly.addEventListener('change', () => requestRender());
 fly.addEventListener('lock', () => requestRender());
 fly.addEventListener('unlock', () => requestRender());
 const keys = new Set();
+const walker = new Walker(camera, renderer.domElement, () => state.model, () => requestRender());
 
 function forward(out = new THREE.Vector3()) {
 	return out.set(0, 0, -1).applyQuaternion(camera.quaternion);
 }
 
 function setMode(mode) {
-	if (mode === state.mode) return;
+	if (!MODES.includes(mode)) return;
+	const was = state.mode;
 	state.mode = mode;
-	if (mode === 'fly') {
+	if (mode !== 'fly' && fly.isLocked) fly.unlock();
+	if (mode !== was) keys.clear();
+	if (mode === 'walk') walker.enable();
+	else walker.disable();
+	if (mode !== 'orbit') {
 		orbit.enabled = false;
-	} else {
-		if (fly.isLocked) fly.unlock();
-		keys.clear();
+	} else if (was !== 'orbit') {
 		const d = Math.max(camera.position.distanceTo(orbit.target), state.radius * 0.05);
 		orbit.target.copy(camera.position).addScaledVector(forward(), d);
 		orbit.enabled = true;
 		orbit.update();
 	}
-	ui.navMode.textContent = `mode: ${mode}`;
-	ui.navMode.setAttribute('aria-pressed', String(mode === 'fly'));
+	ui.navMode.textContent = mode;
+	ui.navMode.setAttribute('aria-pressed', String(mode !== 'orbit'));
+	if (window.viewerInfo) window.viewerInfo.mode = mode;
 	requestRender();
 }
-ui.navMode.addEventListener('click', () => setMode(state.mode === 'orbit' ? 'fly' : 'orbit'));
+const nextMode = () => MODES[(MODES.indexOf(state.mode) + 1) % MODES.length];
+ui.navMode.addEventListener('click', () => setMode(nextMode()));
 renderer.domElement.addEventListener('click', () => {
 	if (state.mode === 'fly' && !fly.isLocked) fly.lock();
 });
@@ -186,11 +202,12 @@ const FLY_KEYS = new Set(['KeyW', 'KeyA', 'KeyS', 'KeyD', 'KeyQ', 'KeyE', 'Arrow
 window.addEventListener('keydown', (e) => {
 	if (e.target instanceof HTMLInputElement) return;
 	if (e.ctrlKey || e.metaKey || e.altKey) return;
-	if (e.code === 'KeyV') setMode(state.mode === 'orbit' ? 'fly' : 'orbit');
+	if (e.code === 'KeyV') setMode(nextMode());
+	else if (e.code === 'KeyH') togglePanel();
 	else if (e.code === 'KeyC') goToSceneCamera();
 	else if (e.code === 'BracketLeft') setExposure(Math.round((state.stops - 0.5) * 2) / 2, true);
 	else if (e.code === 'BracketRight') setExposure(Math.round((state.stops + 0.5) * 2) / 2, true);
-	else if (state.mode === 'fly' && FLY_KEYS.has(e.code)) {
+	else if (state.mode !== 'orbit' && FLY_KEYS.has(e.code)) {
 		keys.add(e.code);
 		e.preventDefault();
 		requestRender();
@@ -201,12 +218,13 @@ window.addEventListener('blur', () => keys.clear());
 
 let lastTime = null;
 function flyStep(now) {
-	if (state.mode !== 'fly' || keys.size === 0) {
+	if (state.mode === 'orbit' || keys.size === 0) {
 		lastTime = null;
 		return false;
 	}
 	const dt = lastTime === null ? 1 / 60 : Math.min(0.1, (now - lastTime) / 1000);
 	lastTime = now;
+	if (state.mode === 'walk') return walker.keys(keys, dt);
 	const speed = state.radius * 0.6 * (keys.has('ShiftLeft') || keys.has('ShiftRight') ? 4 : 1);
 	const d = speed * dt;
 	const has = (...c) => c.some((k) => keys.has(k));
@@ -234,6 +252,7 @@ function frame(now) {
 	frameRequested = false;
 	const moving = flyStep(now);
 	drawNow();
+	updateNotice();
 	if (moving) requestRender();
 	const callbacks = afterFrame;
 	afterFrame = [];
@@ -260,6 +279,51 @@ function drawNow() {
 }
 window.addEventListener('resize', () => requestRender());
 
+// ---------------------------------------------------------------- overlay
+
+// The panel (file, exposure, what was loaded, help) is folded by default so
+// that a small screen keeps the view: only the bar and, where it applies,
+// the one-line notice show.
+function togglePanel(open = ui.panel.hidden) {
+	ui.panel.hidden = !open;
+	ui.menu.setAttribute('aria-expanded', String(open));
+}
+ui.menu.addEventListener('click', () => togglePanel());
+
+// A bake leaves out the glossy (view-dependent) light of the materials it
+// marks extras.trilux.glossy_left_out; such a surface under the mouse (or at
+// the centre of the view) says so instead of just looking dark.
+const GLOSSY_NOTICE = 'glossy reflections not baked here (trilux render shows them)';
+const probe = new THREE.Raycaster();
+
+function glossyLeftOut(material) {
+	const t = material && material.userData && material.userData.trilux;
+	return !!(t && t.glossy_left_out === true);
+}
+
+function materialAt(hit) {
+	const m = hit.object.material;
+	if (!Array.isArray(m)) return m;
+	return hit.face ? m[hit.face.materialIndex] : m[0];
+}
+
+function updateNotice() {
+	let text = null;
+	if (state.model && state.glossy.length > 0) {
+		const { w, h } = viewSize();
+		const at = walker.hover ?? { x: w / 2, y: h / 2 };
+		const rect = renderer.domElement.getBoundingClientRect();
+		const ndc = new THREE.Vector2(((at.x - rect.left) / w) * 2 - 1, -((at.y - rect.top) / h) * 2 + 1);
+		probe.setFromCamera(ndc, camera);
+		const hit = probe.intersectObject(state.model, true).find((x) => x.object.isMesh);
+		if (hit && glossyLeftOut(materialAt(hit))) text = GLOSSY_NOTICE;
+	}
+	if (text === window.viewerNotice) return;
+	window.viewerNotice = text;
+	ui.notice.textContent = text ?? '';
+	ui.notice.hidden = text === null;
+}
+
 // ---------------------------------------------------------------- views
 
 function goToSceneCamera() {
@@ -277,6 +341,7 @@ function goToSceneCamera() {
 	let t = state.center.clone().sub(v.position).dot(forward());
 	if (!(t > state.radius * 0.05)) t = state.radius;
 	orbit.target.copy(v.position).addScaledVector(forward(), t);
+	if (state.mode === 'walk') walker.enable();
 	requestRender();
 }
 ui.sceneCamera.addEventListener('click', () => goToSceneCamera());
@@ -421,6 +486,15 @@ async function openBuffer(buffer, name, basePath) {
 		}
 	});
 	const mats = [...materials.values()];
+	const glossy = new Set();
+	gltf.scene.traverse((obj) => {
+		if (!obj.isMesh) return;
+		for (const m of Array.isArray(obj.material) ? obj.material : [obj.material]) if (glossyLeftOut(m)) glossy.add(m.name || obj.name);
+	});
+	state.glossy = [...glossy].sort();
+	ui.glossyList.textContent = state.glossy.length
+		? `glossy reflections not baked on: ${state.glossy.join(', ')}` : '';
+	ui.glossyList.hidden = state.glossy.length === 0;
 	const lit = mats.some((m) => m.type !== 'MeshBasicMaterial');
 	lights.visible = lit;
 	headlight.visible = lit;
@@ -432,13 +506,16 @@ async function openBuffer(buffer, name, basePath) {
 	}
 
 	state.view = findSceneCamera(gltf) ?? frameBox();
+	state.inside = walker.encloses(state.view.position);
 	goToSceneCamera();
+	setMode(modeParam ?? (state.inside ? 'walk' : 'orbit'));
 
 	window.viewerInfo = {
 		name, meshes, triangles, vertices, materials: mats, lit, radianceAttributeMeshes: hdrMeshes,
-		camera: state.view.from, trilux,
+		camera: state.view.from, trilux, inside: state.inside, mode: state.mode, glossyLeftOut: state.glossy,
 		bbox: { min: bbox.min.toArray(), max: bbox.max.toArray() },
 	};
+	window.viewerNotice = undefined; // drawn afresh for this file
 	const unlitNote = lit ? 'lit materials (default headlight)' : 'unlit';
 	ui.info.textContent = `${name}: ${triangles.toLocaleString('en')} triangles, ${unlitNote}, view from ${state.view.from}`;
 
@@ -506,7 +583,7 @@ window.addEventListener('unhandledrejection', (e) => {
 });
 
 // Hooks for scripted use (tests, the console).
-window.viewer = { THREE, renderer, scene, camera, setExposure, goToSceneCamera, setMode, openUrl, state };
+window.viewer = { THREE, renderer, scene, camera, setExposure, goToSceneCamera, setMode, openUrl, state, walker, togglePanel, requestRender };
 
 const fileParam = params.get('file');
 if (window.viewerError) {

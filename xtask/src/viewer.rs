@@ -12,6 +12,11 @@
 //! [`MAX_MEAN_GAP`] of the preview's. Writes `target/viewer/NAME.glb`,
 //! `NAME-preview.png`, `NAME-viewer.png` and `report.md`.
 //!
+//! Then the viewer's interior tests (docs/viewer/test/interior.test.mjs:
+//! walk mode, touch, the glossy notice, the compact overlay, `trilux
+//! view`) run in headless Chromium on these bakes and the release
+//! `trilux` binary (built here if needed).
+//!
 //! `--solutions DIR` loads `DIR/NAME.sol` where it exists instead of
 //! solving (CI passes the solutions the golden step saved).
 //!
@@ -214,6 +219,37 @@ fn node(script: &str, args: &[String]) -> Result<()> {
     Ok(())
 }
 
+/// docs/viewer/test/interior.test.mjs on the bakes in `dir`, with the
+/// release `trilux` (built first: `cargo build` is quick when it is up to
+/// date).
+fn interior_tests(dir: &Path) -> Result<()> {
+    let status = Command::new("cargo")
+        .current_dir(root())
+        .args(["build", "--release", "-p", "trilux", "--bin", "trilux"])
+        .status()
+        .context("could not start cargo")?;
+    if !status.success() {
+        bail!("cargo build --release -p trilux failed ({status})");
+    }
+    let target =
+        std::env::var_os("CARGO_TARGET_DIR").map_or_else(|| root().join("target"), PathBuf::from);
+    let test = root().join("docs/viewer/test/interior.test.mjs");
+    eprintln!("xtask: node --test {}", test.display());
+    let status = Command::new("node")
+        .arg("--test")
+        .arg(&test)
+        .env("TRILUX_BAKES", dir)
+        .env("TRILUX", target.join("release/trilux"))
+        .status()
+        .context(
+            "could not start node (docs/viewer/scripts/ci.sh installs what the viewer needs)",
+        )?;
+    if !status.success() {
+        bail!("the viewer's interior tests failed ({status})");
+    }
+    Ok(())
+}
+
 /// The viewer's screenshot of `row`'s bake beside its preview.
 fn photograph(row: &mut Row, dir: &Path) -> Result<()> {
     let preview = dir.join(format!("{}-preview.png", row.scene));
@@ -271,6 +307,7 @@ pub fn main(args: &[String]) -> Result<()> {
     let report = report(&rows);
     print!("{report}");
     std::fs::write(dir.join("report.md"), &report)?;
+    interior_tests(&dir)?;
     let failed: Vec<&str> = rows
         .iter()
         .filter(|r| !passes(r))

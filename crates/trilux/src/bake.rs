@@ -40,7 +40,8 @@ pub struct BakeArgs {
     #[arg(long)]
     pub stats: Option<PathBuf>,
     /// Then serve the viewer (docs/viewer, built into trilux) with the
-    /// bake on 127.0.0.1 and print its address; runs until stopped.
+    /// bake on 127.0.0.1, print its address and open it in the system
+    /// browser ($BROWSER, else xdg-open); runs until stopped.
     #[arg(long)]
     pub open: bool,
     /// The port for --open (default: any free one).
@@ -97,7 +98,7 @@ pub fn run(args: &BakeArgs) -> Result<()> {
         s.bytes, s.vertices, s.triangles, s.seconds
     )))?;
     if let Some(listener) = listener {
-        crate::serve::serve(listener, &baked.glb)?;
+        crate::serve::serve(listener, &baked.glb, true)?;
     }
     Ok(())
 }

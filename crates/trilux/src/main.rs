@@ -25,6 +25,7 @@ mod render;
 mod serve;
 mod solve;
 mod streams;
+mod viewer;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -57,6 +58,9 @@ enum Command {
     /// Bake the solution's view-independent light into a glTF binary
     /// (.glb) for walkthroughs in any glTF viewer.
     Bake(bake::BakeArgs),
+    /// Serve an existing bake (.glb) in trilux's viewer on localhost,
+    /// without solving again.
+    View(viewer::ViewArgs),
 }
 
 /// The bundled default scene (the Cornell box): `scenes/cornell-box.xml`
@@ -135,6 +139,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         Some(Command::Solve(args)) => solve::run(&args),
         Some(Command::Render(args)) => render::run(&args),
         Some(Command::Bake(args)) => bake::run(&args),
+        Some(Command::View(args)) => viewer::run(&args),
         None => render_default(),
     }
 }

@@ -1,5 +1,6 @@
-//! `trilux bake --open`: the baked file in docs/viewer, served on
-//! localhost until the command is stopped.
+//! `trilux bake --open` and `trilux view`: a baked file in docs/viewer,
+//! served on localhost until the command is stopped, and opened in the
+//! system browser where there is one ([`open_browser`]).
 //!
 //! The viewer's files are built into the binary (they are committed,
 //! three.js vendored), so an installed `trilux` needs no source tree. The
@@ -35,9 +36,10 @@ macro_rules! viewer_files {
 const JS: &str = "text/javascript; charset=utf-8";
 
 /// The viewer's files.
-const VIEWER: [Served; 9] = viewer_files![
+const VIEWER: [Served; 10] = viewer_files![
     ("index.html", "text/html; charset=utf-8"),
     ("viewer.js", JS),
+    ("walk.js", JS),
     ("vendor/three/build/three.module.js", JS),
     ("vendor/three/build/three.core.js", JS),
     ("vendor/three/examples/jsm/controls/OrbitControls.js", JS),
@@ -67,12 +69,28 @@ pub fn listen(port: u16) -> Result<TcpListener> {
 }
 
 /// Serves the viewer with `glb` as `/model.glb` on `listener`; prints the
-/// address; returns only on an error.
-pub fn serve(listener: TcpListener, glb: &[u8]) -> Result<()> {
+/// address and, with `open`, opens it in the system browser; returns only
+/// on an error.
+pub fn serve(listener: TcpListener, glb: &[u8], open: bool) -> Result<()> {
     let port = listener.local_addr()?.port();
-    crate::streams::print(&format!(
-        "viewer: http://127.0.0.1:{port}/index.html?file=/model.glb (Ctrl-C stops it)\n"
-    ))?;
+    let url = format!("http://127.0.0.1:{port}/index.html?file=/model.glb");
+    crate::streams::print(&format!("viewer: {url} (Ctrl-C stops it)\n"))?;
+    if open {
+        match open_browser(&url) {
+            Some(how) => {
+                crate::streams::print(&format!("viewer: opened in the browser ({how})\n"))?
+            }
+            None => {
+                let listed = match std::env::var("BROWSER") {
+                    Ok(b) if !b.trim().is_empty() => "no command of $BROWSER started",
+                    _ => "$BROWSER is not set",
+                };
+                crate::streams::eprint_line(&format!(
+                    "warning: no browser to open ({listed} and {OPENER} is not on PATH): open {url} yourself"
+                ));
+            }
+        }
+    }
     let busy = AtomicUsize::new(0);
     std::thread::scope(|scope| {
         // A failed connection (a closed tab) does not stop the server.
@@ -89,6 +107,61 @@ pub fn serve(listener: TcpListener, glb: &[u8]) -> Result<()> {
         }
     });
     Ok(())
+}
+
+/// The platform's program that opens an address in the default browser.
+const OPENER: &str = if cfg!(target_os = "macos") {
+    "open"
+} else if cfg!(windows) {
+    "explorer.exe"
+} else {
+    "xdg-open"
+};
+
+/// Starts the system browser on `url`: each command of `$BROWSER` (a
+/// `:`-separated list, as `man` and Python's `webbrowser` read it; `%s`
+/// stands for the address, else it is appended) until one starts, else
+/// [`OPENER`] from `PATH`. Returns the command started, or `None` when
+/// there is none. The browser is not waited for (it may run for hours):
+/// a thread reaps it.
+pub fn open_browser(url: &str) -> Option<String> {
+    let listed = std::env::var("BROWSER").unwrap_or_default();
+    let mut commands: Vec<Vec<String>> = listed
+        .split(':')
+        .filter_map(|c| {
+            let words: Vec<String> = c.split_whitespace().map(str::to_string).collect();
+            (!words.is_empty()).then_some(words)
+        })
+        .map(|mut words| {
+            if words.iter().any(|w| w.contains("%s")) {
+                words.iter_mut().for_each(|w| *w = w.replace("%s", url));
+            } else {
+                words.push(url.to_string());
+            }
+            words
+        })
+        .collect();
+    if let Some(opener) = on_path(OPENER) {
+        commands.push(vec![opener.display().to_string(), url.to_string()]);
+    }
+    commands.into_iter().find_map(|words| {
+        let mut child = std::process::Command::new(&words[0])
+            .args(&words[1..])
+            .stdin(std::process::Stdio::null())
+            .stdout(std::process::Stdio::null())
+            .spawn()
+            .ok()?;
+        std::thread::spawn(move || child.wait());
+        Some(words[0].clone())
+    })
+}
+
+/// `program` in one of `PATH`'s folders.
+fn on_path(program: &str) -> Option<std::path::PathBuf> {
+    let path = std::env::var_os("PATH")?;
+    std::env::split_paths(&path)
+        .map(|dir| dir.join(program))
+        .find(|p| p.is_file())
 }
 
 /// Reads one request (at most [`MAX_REQUEST_BYTES`], each read within

@@ -577,6 +577,8 @@ fn bake_and_serve(dir: &Path) -> (std::process::Child, u16) {
     let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_trilux"))
         .args(["bake", repo("scenes/furnace.xml").to_str().unwrap()])
         .args(["--quality", "draft", "--open", "-o", glb.to_str().unwrap()])
+        // `--open` starts the browser: here one that does nothing.
+        .env("BROWSER", "true")
         .stdout(std::process::Stdio::piped())
         .spawn()
         .unwrap();
