@@ -14,6 +14,7 @@ mod rays;
 mod scale;
 mod scale_scenes;
 mod structure;
+mod surface;
 mod sweep;
 mod viewer;
 
@@ -126,6 +127,7 @@ fn main() -> Result<()> {
         Some("color") => color::color(),
         Some("structure") => structure::main(),
         Some("deps") => deps::main(),
+        Some("surface") => surface::main(&args[1..]),
         Some("golden") => golden::main(&args[1..]),
         Some("sweep") => sweep::main(&args[1..]),
         Some("rays") => rays::main(&args[1..]),
@@ -133,7 +135,7 @@ fn main() -> Result<()> {
         Some("viewer") => viewer::main(&args[1..]),
         _ => {
             eprintln!(
-                "usage: cargo xtask ci | structure | deps | color | golden | sweep | rays | scale | viewer"
+                "usage: cargo xtask ci | structure | deps | surface | color | golden | sweep | rays | scale | viewer"
             );
             std::process::exit(2);
         }

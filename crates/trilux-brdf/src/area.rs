@@ -23,7 +23,7 @@ use trilux_color::Spectrum;
 
 use crate::bsdf::Bsdf;
 use crate::frame::{Frame, reflect};
-use trilux_geometry::Side;
+use trilux_frame::Side;
 
 /// An element seen as points: what the BRDF variation estimate needs.
 #[derive(Clone, Copy, Debug)]

@@ -1,7 +1,8 @@
 //! # trilux-brdf — reflectance
 //!
-//! Layer: depends on `trilux-color` (spectra), `trilux-geometry` (only for
-//! [`Side`], the face of a surface) and `glam`; nothing here parses files or
+//! Layer: depends on `trilux-color` (spectra), `trilux-frame` (the side of
+//! a surface, [`Side`], and the tangent frame), `glam`, `serde` and
+//! `thiserror`, not on the geometry; nothing here parses files or
 //! knows about elements beyond points and normals (so it can be used
 //! without the solver). Every model is defined exactly as Mitsuba 3 defines it.
 //!
@@ -57,4 +58,4 @@ pub use frame::Frame;
 pub use params::{BsdfParams, Distribution, RoughConductorParams};
 pub use texture::{Filter, Texture, UvTransform, Wrap};
 pub use textured::{Branch, PointParts, Shading, SlotKind, SlotValues, TextureSlot, TexturedBsdf};
-pub use trilux_geometry::Side;
+pub use trilux_frame::Side;
