@@ -62,6 +62,9 @@ fn ci() -> Result<()> {
     // Every declared dependency used (a text check, see deps.rs for why
     // not cargo-machete).
     deps::main()?;
+    // The public-item count of every library crate is the one
+    // docs/architecture.md states (a change of surface is deliberate).
+    surface::main(&["--check".to_string()])?;
     run(
         "cargo",
         &[
@@ -100,6 +103,7 @@ fn ci() -> Result<()> {
     // debug assertions are on (the release pass below runs everything).
     run("cargo", &["test", "--workspace", "--lib", "--bins"])?;
     run("cargo", &["test", "--workspace", "--release"])?;
+    package()?;
     color::color()?;
     // Every bundled scene against its stored Mitsuba 3 reference (the
     // golden test: relative RMSE ≤ 0.05, mean within 1 %).
@@ -120,6 +124,27 @@ fn ci() -> Result<()> {
     Ok(())
 }
 
+/// Every publishable crate packaged as crates.io would receive it, and
+/// each package built on its own from its `.crate` (cargo's verification:
+/// a file outside the crate, a path dependency without a version or a
+/// missing README fails here). Sibling crates resolve from cargo's local
+/// overlay of the packages just made. trilux-py (a Python extension module,
+/// published as a wheel) and xtask are `publish = false`; `--workspace`
+/// would package them too, so they are excluded by name.
+fn package() -> Result<()> {
+    run(
+        "cargo",
+        &[
+            "package",
+            "--workspace",
+            "--exclude",
+            "trilux-py",
+            "--exclude",
+            "xtask",
+        ],
+    )
+}
+
 fn main() -> Result<()> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     match args.first().map(String::as_str) {
@@ -128,6 +153,7 @@ fn main() -> Result<()> {
         Some("structure") => structure::main(),
         Some("deps") => deps::main(),
         Some("surface") => surface::main(&args[1..]),
+        Some("package") => package(),
         Some("golden") => golden::main(&args[1..]),
         Some("sweep") => sweep::main(&args[1..]),
         Some("rays") => rays::main(&args[1..]),
@@ -135,7 +161,7 @@ fn main() -> Result<()> {
         Some("viewer") => viewer::main(&args[1..]),
         _ => {
             eprintln!(
-                "usage: cargo xtask ci | structure | deps | surface | color | golden | sweep | rays | scale | viewer"
+                "usage: cargo xtask ci | structure | deps | surface | package | color | golden | sweep | rays | scale | viewer"
             );
             std::process::exit(2);
         }

@@ -50,6 +50,7 @@ pub struct BakeInput<'a, const N: usize> {
 
 /// How to bake.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
 pub struct BakeOptions {
     /// `COLOR_0` is radiance × 2^exposure, clamped to [0, 1] (for viewers
     /// that show vertex colours as display values).
@@ -71,6 +72,7 @@ impl Default for BakeOptions {
 
 /// What a bake made.
 #[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
 pub struct BakeStats {
     /// Vertex positions written (each shared by both sides).
     pub vertices: usize,

@@ -18,8 +18,9 @@
 //!   `blendbsdf`.
 //! - [`microfacet`]: Mitsuba's Beckmann and GGX D, separable Smith G (its
 //!   rational G1 for Beckmann), and their sampling.
-//! - [`special`]: erf and its inverse (Beckmann visible-normal sampling).
-//! - [`fresnel`]: conductor Fresnel from η and k.
+//! - `special` (private): erf and its inverse (Beckmann visible-normal
+//!   sampling).
+//! - `fresnel` (private): conductor Fresnel from η and k.
 //! - [`albedo`]: [`AlbedoTable`], the directional albedo tabulated per
 //!   degree for frequent use.
 //! - [`texture`]: bitmap textures ([`Texture`]) with Mitsuba 3's
@@ -39,11 +40,11 @@ pub mod area;
 pub mod bsdf;
 pub mod error;
 pub mod frame;
-pub mod fresnel;
+mod fresnel;
 pub mod lobe;
 pub mod microfacet;
 pub mod params;
-pub mod special;
+mod special;
 pub mod texture;
 pub mod textured;
 
