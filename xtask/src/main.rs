@@ -130,13 +130,16 @@ fn ci() -> Result<()> {
 /// missing README fails here). Sibling crates resolve from cargo's local
 /// overlay of the packages just made. trilux-py (a Python extension module,
 /// published as a wheel) and xtask are `publish = false`; `--workspace`
-/// would package them too, so they are excluded by name.
+/// would package them too, so they are excluded by name. `--allow-dirty`:
+/// what is checked is the crates, not whether the work tree is committed
+/// (CI runs in a clean checkout; a local run may be mid-change).
 fn package() -> Result<()> {
     run(
         "cargo",
         &[
             "package",
             "--workspace",
+            "--allow-dirty",
             "--exclude",
             "trilux-py",
             "--exclude",

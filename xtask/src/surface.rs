@@ -201,10 +201,10 @@ fn collect_module(
     dir: &Path,
     path: Vec<String>,
     public: bool,
-    items: Vec<Item>,
+    mut items: Vec<Item>,
     out: &mut Vec<Module>,
 ) -> Result<()> {
-    for item in &items {
+    for item in &mut items {
         let Item::Mod(m) = item else { continue };
         if is_test(&m.attrs) {
             continue;
@@ -212,20 +212,15 @@ fn collect_module(
         let mut child = path.clone();
         child.push(m.ident.to_string());
         let child_public = public && is_pub(&m.vis);
-        if let Some((_, inline)) = &m.content {
-            collect_module(
-                &dir.join(m.ident.to_string()),
-                child,
-                child_public,
-                inline.clone(),
-                out,
-            )?;
+        let child_dir = dir.join(m.ident.to_string());
+        if let Some((_, inline)) = m.content.take() {
+            collect_module(&child_dir, child, child_public, inline, out)?;
         } else {
             let flat = dir.join(format!("{}.rs", m.ident));
             let file = if flat.is_file() {
                 flat
             } else {
-                dir.join(m.ident.to_string()).join("mod.rs")
+                child_dir.join("mod.rs")
             };
             read_module(&file, child, child_public, out)?;
         }
@@ -384,7 +379,7 @@ fn public_item(item: &Item) -> Option<(&'static str, String, &[Attribute])> {
         Item::Const(i) => ("constants", &i.vis, &i.ident, &i.attrs),
         Item::Static(i) => ("constants", &i.vis, &i.ident, &i.attrs),
         Item::Macro(i) if has_attr(&i.attrs, "macro_export") => {
-            return Some(("functions", i.ident.as_ref()?.to_string(), &i.attrs));
+            return Some(("functions", i.ident.as_ref()?.to_string(), i.attrs.as_slice()));
         }
         _ => return None,
     };

@@ -127,7 +127,7 @@ pub fn bake<const N: usize>(
     if let Some(camera) = input.camera {
         write_camera(&mut doc, input.solution, &camera);
     }
-    let glb = doc.to_glb(asset(options), &["KHR_materials_unlit"])?;
+    let glb = doc.into_glb(asset(options), &["KHR_materials_unlit"])?;
     let stats = BakeStats {
         vertices,
         triangles,

@@ -126,7 +126,7 @@ impl Document {
 
     /// The whole file: `asset` and `extensionsUsed` as given, one scene of
     /// every node.
-    pub(crate) fn to_glb(self, asset: Value, extensions: &[&str]) -> Result<Vec<u8>, BakeError> {
+    pub(crate) fn into_glb(self, asset: Value, extensions: &[&str]) -> Result<Vec<u8>, BakeError> {
         let nodes: Vec<usize> = (0..self.nodes.len()).collect();
         let mut root = json!({
             "asset": asset,

@@ -285,7 +285,7 @@ impl<const N: usize> Lobe<N> {
         }
     }
 
-    /// The density of [`Lobe::sample_dir`] per unit solid angle of wi.
+    /// The density of `Lobe::sample_dir` per unit solid angle of wi.
     pub fn pdf(&self, wo: DVec3, wi: DVec3) -> f64 {
         match self {
             Lobe::Diffuse { .. } => {
