@@ -379,7 +379,11 @@ fn public_item(item: &Item) -> Option<(&'static str, String, &[Attribute])> {
         Item::Const(i) => ("constants", &i.vis, &i.ident, &i.attrs),
         Item::Static(i) => ("constants", &i.vis, &i.ident, &i.attrs),
         Item::Macro(i) if has_attr(&i.attrs, "macro_export") => {
-            return Some(("functions", i.ident.as_ref()?.to_string(), i.attrs.as_slice()));
+            return Some((
+                "functions",
+                i.ident.as_ref()?.to_string(),
+                i.attrs.as_slice(),
+            ));
         }
         _ => return None,
     };

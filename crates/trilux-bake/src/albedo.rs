@@ -46,7 +46,10 @@ pub(crate) struct AlbedoMap {
 /// `KHR_texture_transform`): the map is laid over the surface's own unit
 /// square in the image's resolution, which a tiled, shifted or rotated
 /// texture does not fit. Such a side is baked as vertex colours.
-pub(crate) fn albedo_map<const N: usize>(textured: &TexturedBsdf<N>, side: Side) -> Option<AlbedoMap> {
+pub(crate) fn albedo_map<const N: usize>(
+    textured: &TexturedBsdf<N>,
+    side: Side,
+) -> Option<AlbedoMap> {
     let slots = textured.slots();
     if slots.iter().any(|s| s.to_uv != UvTransform::IDENTITY) {
         return None;
