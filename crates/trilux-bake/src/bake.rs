@@ -140,7 +140,11 @@ pub fn bake<const N: usize>(
 
 /// A leaf's exitant radiance (reflected and emitted) on `side`, averaged
 /// over its area with buried parts black, in linear sRGB.
-pub fn leaf_value<const N: usize>(solution: &Solution<N>, side: Side, leaf: ElementId) -> [f64; 3] {
+pub(crate) fn leaf_value<const N: usize>(
+    solution: &Solution<N>,
+    side: Side,
+    leaf: ElementId,
+) -> [f64; 3] {
     let element = solution.forest().element(leaf);
     let face = FaceId::new(element.surface, side);
     let exposed = if element.area > 0.0 {
