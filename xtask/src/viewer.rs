@@ -156,10 +156,9 @@ fn bake_scene(path: &Path, dir: &Path, solutions: Option<&Path>) -> Result<Vec<R
         plan.source = SolutionSource::Load(&solution);
         plan.save = None;
         plan.render = None;
-        plan.bake = Some(trilux_bake::BakeOptions {
-            albedo_maps: false,
-            ..Default::default()
-        });
+        let mut vertex_only = trilux_bake::BakeOptions::default();
+        vertex_only.albedo_maps = false;
+        plan.bake = Some(vertex_only);
         let outcome = Observer::quiet(|o| trilux::pipeline::run(&scene, &plan, o))?;
         let baked = outcome.baked.context("the plan bakes")?;
         rows.push(row(format!("{name}-vertex"), false, baked)?);

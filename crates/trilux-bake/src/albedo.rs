@@ -23,11 +23,11 @@ use trilux_color::srgb::linear_srgb_to_u8;
 use trilux_geometry::Side;
 
 /// Largest albedo map edge, in texels.
-pub const MAX_MAP_EDGE: u32 = 2048;
+pub(crate) const MAX_MAP_EDGE: u32 = 2048;
 
 /// A side's diffuse albedo sampled at texel centres, row 0 at v = 0.
 #[derive(Clone, Debug, PartialEq)]
-pub struct AlbedoMap {
+pub(crate) struct AlbedoMap {
     /// Width in texels.
     pub width: u32,
     /// Height in texels.
@@ -46,7 +46,10 @@ pub struct AlbedoMap {
 /// `KHR_texture_transform`): the map is laid over the surface's own unit
 /// square in the image's resolution, which a tiled, shifted or rotated
 /// texture does not fit. Such a side is baked as vertex colours.
-pub fn albedo_map<const N: usize>(textured: &TexturedBsdf<N>, side: Side) -> Option<AlbedoMap> {
+pub(crate) fn albedo_map<const N: usize>(
+    textured: &TexturedBsdf<N>,
+    side: Side,
+) -> Option<AlbedoMap> {
     let slots = textured.slots();
     if slots.iter().any(|s| s.to_uv != UvTransform::IDENTITY) {
         return None;

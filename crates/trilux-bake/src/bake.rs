@@ -50,6 +50,7 @@ pub struct BakeInput<'a, const N: usize> {
 
 /// How to bake.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
 pub struct BakeOptions {
     /// `COLOR_0` is radiance × 2^exposure, clamped to [0, 1] (for viewers
     /// that show vertex colours as display values).
@@ -71,6 +72,7 @@ impl Default for BakeOptions {
 
 /// What a bake made.
 #[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
 pub struct BakeStats {
     /// Vertex positions written (each shared by both sides).
     pub vertices: usize,
@@ -125,7 +127,7 @@ pub fn bake<const N: usize>(
     if let Some(camera) = input.camera {
         write_camera(&mut doc, input.solution, &camera);
     }
-    let glb = doc.to_glb(asset(options), &["KHR_materials_unlit"])?;
+    let glb = doc.into_glb(asset(options), &["KHR_materials_unlit"])?;
     let stats = BakeStats {
         vertices,
         triangles,
@@ -138,7 +140,11 @@ pub fn bake<const N: usize>(
 
 /// A leaf's exitant radiance (reflected and emitted) on `side`, averaged
 /// over its area with buried parts black, in linear sRGB.
-pub fn leaf_value<const N: usize>(solution: &Solution<N>, side: Side, leaf: ElementId) -> [f64; 3] {
+pub(crate) fn leaf_value<const N: usize>(
+    solution: &Solution<N>,
+    side: Side,
+    leaf: ElementId,
+) -> [f64; 3] {
     let element = solution.forest().element(leaf);
     let face = FaceId::new(element.surface, side);
     let exposed = if element.area > 0.0 {

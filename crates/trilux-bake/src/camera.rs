@@ -35,7 +35,7 @@ impl BakeCamera {
 
     /// The glTF camera object, with clip planes for a scene of `extent`
     /// (its bounding box's size) seen from `distance` at most.
-    pub fn gltf_camera(&self, extent: f64, distance: f64) -> Value {
+    pub(crate) fn gltf_camera(&self, extent: f64, distance: f64) -> Value {
         let znear = (1e-3 * extent).max(1e-6);
         let zfar = (2.0 * (extent + distance)).max(10.0 * znear);
         json!({

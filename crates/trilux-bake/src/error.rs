@@ -4,6 +4,7 @@ use thiserror::Error;
 
 /// A bake that cannot be written.
 #[derive(Debug, Error)]
+#[non_exhaustive]
 pub enum BakeError {
     /// The scene's light has no finite value somewhere.
     #[error("shape {shape}: its baked radiance is not finite")]

@@ -112,7 +112,7 @@ impl Document {
 
     /// A PNG image in the buffer with its sampler, as a texture. Returns
     /// the texture's index.
-    pub fn png_texture(&mut self, png: &[u8], sampler: Value) -> usize {
+    pub(crate) fn png_texture(&mut self, png: &[u8], sampler: Value) -> usize {
         let view = self.view(png, None);
         self.images
             .push(json!({ "bufferView": view, "mimeType": "image/png" }));
@@ -126,7 +126,7 @@ impl Document {
 
     /// The whole file: `asset` and `extensionsUsed` as given, one scene of
     /// every node.
-    pub fn to_glb(self, asset: Value, extensions: &[&str]) -> Result<Vec<u8>, BakeError> {
+    pub(crate) fn into_glb(self, asset: Value, extensions: &[&str]) -> Result<Vec<u8>, BakeError> {
         let nodes: Vec<usize> = (0..self.nodes.len()).collect();
         let mut root = json!({
             "asset": asset,

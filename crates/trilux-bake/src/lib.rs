@@ -12,24 +12,25 @@
 //! (`KHR_materials_unlit`). docs/bake.md is the user's account.
 //!
 //! Contents, in the order a bake runs:
-//! - [`tessellate`]: every shape's leaves as welded triangles, each owned
-//!   by one leaf; T-junctions split so that neighbours share vertices.
+//! - `tessellate` (private, as are `albedo`, `camera` and `glb`): every
+//!   shape's leaves as welded triangles ([`ShapeMesh`]), each owned by one leaf;
+//!   T-junctions split so that neighbours share vertices.
 //! - [`reconstruct`]: vertex colours from the leaves' radiance by
 //!   flux-conserving averaging (the rule and its error bound are there).
-//! - [`albedo`]: textured materials as an albedo map times the light.
-//! - [`camera`]: the scene's camera as a glTF camera node.
-//! - [`glb`]: the glTF JSON and the binary container.
+//! - `albedo`: textured materials as an albedo map times the light.
+//! - `camera`: the scene's camera ([`BakeCamera`]) as a glTF camera node.
+//! - `glb`: the glTF JSON and the binary container.
 //! - [`bake()`](bake()): the whole, with its [`BakeStats`].
 //! - [`mod@error`]: the error type, [`BakeError`].
 #![forbid(unsafe_code)]
 
-pub mod albedo;
+mod albedo;
 pub mod bake;
-pub mod camera;
+mod camera;
 pub mod error;
-pub mod glb;
+mod glb;
 pub mod reconstruct;
-pub mod tessellate;
+mod tessellate;
 
 pub use bake::{BakeInput, BakeOptions, BakeStats, Baked, bake};
 pub use camera::BakeCamera;

@@ -36,7 +36,7 @@ use crate::tessellate::ShapeMesh;
 /// E/π times an albedo map, the leaf's mean albedo ρ̄, so that
 /// Σ_T A_T ρ̄_T (v_a + v_b + v_c)/3 is again the leaves' flux. A vertex no
 /// triangle uses gets zero.
-pub fn vertex_values(
+pub(crate) fn vertex_values(
     mesh: &ShapeMesh,
     value: impl Fn(ElementId) -> [f64; 3],
     weight: impl Fn(ElementId) -> [f64; 3],
@@ -76,9 +76,9 @@ pub fn vertex_values(
 
 /// The flux Σ_T A_T w_T mean(v_T) (without the factor π) of the triangles
 /// of `mesh`, with vertex values `values` and the weights of
-/// [`vertex_values`], summed by `key` of each triangle's leaf (its input
+/// `vertex_values`, summed by `key` of each triangle's leaf (its input
 /// surface, say), in one pass.
-pub fn baked_flux<K: Ord>(
+pub(crate) fn baked_flux<K: Ord>(
     mesh: &ShapeMesh,
     values: &[[f64; 3]],
     weight: impl Fn(ElementId) -> [f64; 3],

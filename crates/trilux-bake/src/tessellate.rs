@@ -5,7 +5,7 @@
 //! - A parametric leaf (a (u, v) rectangle) is cut into m_u × m_v display
 //!   cells, m powers of two, doubled along whichever direction brings the
 //!   tessellated area closer to the leaf's exact area, until they are
-//!   within [`AREA_TOLERANCE`] or the leaf has [`MAX_CELLS`] cells. A planar
+//!   within `AREA_TOLERANCE` or the leaf has `MAX_CELLS` cells. A planar
 //!   quad stays one cell; curved pieces and disks get as many as their
 //!   curvature needs, so the baked flux is the solution's within that
 //!   tolerance. A leaf cut at all is cut in both directions, so that its
@@ -20,7 +20,7 @@
 //!   sub-triangles of them. A piece with another piece's corner on an edge,
 //!   and the piece of a one-piece leaf, becomes a fan from its centroid.
 //! - Vertices are welded per input surface by position (rounded to f32)
-//!   when their normals are within [`CREASE_DEG`] and their texture
+//!   when their normals are within `CREASE_DEG` and their texture
 //!   coordinates agree (a mesh's texture seams keep their two vertices). Each surface keeps its
 //!   own vertices, so that each keeps its own flux (`reconstruct`); where
 //!   surfaces meet, their vertices take one position, the first computed,
@@ -36,12 +36,12 @@ use trilux_geometry::{
 };
 
 /// Largest relative gap between a parametric leaf's tessellated area and
-/// its exact area (unless [`MAX_CELLS`] stops the refinement first).
-pub const AREA_TOLERANCE: f64 = 2e-3;
+/// its exact area (unless `MAX_CELLS` stops the refinement first).
+pub(crate) const AREA_TOLERANCE: f64 = 2e-3;
 /// Most display cells per parametric leaf.
-pub const MAX_CELLS: u32 = 1024;
+pub(crate) const MAX_CELLS: u32 = 1024;
 /// Normals further apart than this keep separate vertices at one position.
-pub const CREASE_DEG: f64 = 30.0;
+pub(crate) const CREASE_DEG: f64 = 30.0;
 /// Deepest halving of an edge when looking for a neighbour's corners.
 const MAX_SPLIT_DEPTH: u32 = 30;
 
@@ -74,7 +74,7 @@ impl ShapeMesh {
 /// The display meshes of every shape of `forest`'s geometry (empty meshes
 /// for shapes without surfaces), in shape order; the shapes for which
 /// `textured` holds keep texture coordinates.
-pub fn tessellate(forest: &ElementForest, textured: impl Fn(u32) -> bool) -> Vec<ShapeMesh> {
+pub(crate) fn tessellate(forest: &ElementForest, textured: impl Fn(u32) -> bool) -> Vec<ShapeMesh> {
     let geometry = forest.geometry();
     let shapes = geometry
         .surfaces()

@@ -11,7 +11,7 @@ use glam::DVec3;
 use trilux_color::Spectrum;
 
 use crate::bsdf::Bsdf;
-use trilux_geometry::Side;
+use trilux_frame::Side;
 
 /// Samples per side: θ = 0°, 1°, …, 90° (the last one evaluated at 89.95°).
 const STEPS: usize = 91;

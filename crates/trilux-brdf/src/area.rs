@@ -23,7 +23,7 @@ use trilux_color::Spectrum;
 
 use crate::bsdf::Bsdf;
 use crate::frame::{Frame, reflect};
-use trilux_geometry::Side;
+use trilux_frame::Side;
 
 /// An element seen as points: what the BRDF variation estimate needs.
 #[derive(Clone, Copy, Debug)]
@@ -55,7 +55,7 @@ impl<const N: usize> AreaReflectance<N> {
 
 /// The reflecting side of J for light from `to_i` towards `to_k` (world
 /// directions from J), or `None` if they are on opposite sides.
-pub fn reflecting_side(j_normal: DVec3, to_i: DVec3, to_k: DVec3) -> Option<Side> {
+pub(crate) fn reflecting_side(j_normal: DVec3, to_i: DVec3, to_k: DVec3) -> Option<Side> {
     let (a, b) = (to_i.dot(j_normal), to_k.dot(j_normal));
     if a > 0.0 && b > 0.0 {
         Some(Side::Front)

@@ -10,7 +10,7 @@
 
 use glam::{DVec2, DVec3};
 use trilux_color::{ColorParam, Spectrum};
-use trilux_geometry::Side;
+use trilux_frame::Side;
 
 use crate::error::BrdfError;
 use crate::lobe::{Conductor, Lobe};

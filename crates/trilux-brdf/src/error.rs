@@ -4,6 +4,7 @@ use thiserror::Error;
 
 /// What is wrong with a material.
 #[derive(Clone, Debug, Error, PartialEq)]
+#[non_exhaustive]
 pub enum BrdfError {
     /// A colour parameter could not be converted.
     #[error("{what}: {source}")]

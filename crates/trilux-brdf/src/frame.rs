@@ -19,10 +19,10 @@ pub struct Frame {
 
 impl Frame {
     /// A frame around the unit normal `n`: its tangents are
-    /// [`trilux_geometry::coordinate_system`]'s (Duff et al. 2017,
+    /// [`trilux_frame::coordinate_system`]'s (Duff et al. 2017,
     /// branchless and continuous except across n.z = 0's sign change).
     pub fn from_normal(n: DVec3) -> Frame {
-        let (s, t) = trilux_geometry::coordinate_system(n);
+        let (s, t) = trilux_frame::coordinate_system(n);
         Frame { s, t, n }
     }
 

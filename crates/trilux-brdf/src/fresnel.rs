@@ -4,7 +4,7 @@
 //! implements `material="none"`.
 
 /// F(cosθ_i) for a conductor with index `eta` + i `k`.
-pub fn fresnel_conductor(cos_theta_i: f64, eta: f64, k: f64) -> f64 {
+pub(crate) fn fresnel_conductor(cos_theta_i: f64, eta: f64, k: f64) -> f64 {
     let c2 = cos_theta_i * cos_theta_i;
     let s2 = 1.0 - c2;
     let s4 = s2 * s2;

@@ -1,7 +1,8 @@
 //! # trilux-brdf — reflectance
 //!
-//! Layer: depends on `trilux-color` (spectra), `trilux-geometry` (only for
-//! [`Side`], the face of a surface) and `glam`; nothing here parses files or
+//! Layer: depends on `trilux-color` (spectra), `trilux-frame` (the side of
+//! a surface, [`Side`], and the tangent frame), `glam`, `serde` and
+//! `thiserror`, not on the geometry; nothing here parses files or
 //! knows about elements beyond points and normals (so it can be used
 //! without the solver). Every model is defined exactly as Mitsuba 3 defines it.
 //!
@@ -17,8 +18,9 @@
 //!   `blendbsdf`.
 //! - [`microfacet`]: Mitsuba's Beckmann and GGX D, separable Smith G (its
 //!   rational G1 for Beckmann), and their sampling.
-//! - [`special`]: erf and its inverse (Beckmann visible-normal sampling).
-//! - [`fresnel`]: conductor Fresnel from η and k.
+//! - `special` (private): erf and its inverse (Beckmann visible-normal
+//!   sampling).
+//! - `fresnel` (private): conductor Fresnel from η and k.
 //! - [`albedo`]: [`AlbedoTable`], the directional albedo tabulated per
 //!   degree for frequent use.
 //! - [`texture`]: bitmap textures ([`Texture`]) with Mitsuba 3's
@@ -38,11 +40,11 @@ pub mod area;
 pub mod bsdf;
 pub mod error;
 pub mod frame;
-pub mod fresnel;
+mod fresnel;
 pub mod lobe;
 pub mod microfacet;
 pub mod params;
-pub mod special;
+mod special;
 pub mod texture;
 pub mod textured;
 
@@ -57,4 +59,4 @@ pub use frame::Frame;
 pub use params::{BsdfParams, Distribution, RoughConductorParams};
 pub use texture::{Filter, Texture, UvTransform, Wrap};
 pub use textured::{Branch, PointParts, Shading, SlotKind, SlotValues, TextureSlot, TexturedBsdf};
-pub use trilux_geometry::Side;
+pub use trilux_frame::Side;

@@ -259,7 +259,7 @@ impl<const N: usize> Lobe<N> {
     }
 
     /// Samples wi (without pdf or weight; see [`Lobe::pdf`]).
-    pub fn sample_dir(&self, wo: DVec3, u: DVec2) -> Option<DVec3> {
+    pub(crate) fn sample_dir(&self, wo: DVec3, u: DVec2) -> Option<DVec3> {
         match self {
             Lobe::Diffuse { .. } => {
                 let wi = square_to_cosine_hemisphere(u);
@@ -285,7 +285,7 @@ impl<const N: usize> Lobe<N> {
         }
     }
 
-    /// The density of [`Lobe::sample_dir`] per unit solid angle of wi.
+    /// The density of `Lobe::sample_dir` per unit solid angle of wi.
     pub fn pdf(&self, wo: DVec3, wi: DVec3) -> f64 {
         match self {
             Lobe::Diffuse { .. } => {

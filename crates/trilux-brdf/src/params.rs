@@ -8,6 +8,7 @@ use trilux_color::ColorParam;
 
 /// Microfacet normal distribution of `roughconductor`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[non_exhaustive]
 pub enum Distribution {
     /// Beckmann (Mitsuba's default).
     Beckmann,

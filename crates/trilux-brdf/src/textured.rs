@@ -30,7 +30,7 @@ use std::sync::Arc;
 use glam::{DVec2, DVec3};
 use serde::Serialize;
 use trilux_color::{ColorParam, Role, Spectrum, luminance};
-use trilux_geometry::{Side, Sided};
+use trilux_frame::{Side, Sided};
 
 use crate::bsdf::{Bsdf, BsdfSample};
 use crate::error::BrdfError;

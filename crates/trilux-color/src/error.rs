@@ -4,6 +4,7 @@ use thiserror::Error;
 
 /// What is wrong with a colour value.
 #[derive(Clone, Debug, Error, PartialEq)]
+#[non_exhaustive]
 pub enum ColorError {
     /// A sampled spectrum needs at least two wavelength:value pairs.
     #[error("a sampled spectrum needs at least two wavelength:value pairs, got {0}")]

@@ -16,6 +16,7 @@ use crate::human_bytes;
 
 /// Why a file could not be read (the caller names the file and its role).
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum ReadError {
     /// The operating system refused (missing file, no permission, ...).
     #[error("{0}")]
@@ -37,7 +38,7 @@ pub enum ReadError {
 }
 
 /// What kind of non-regular file `meta` describes, for messages.
-pub fn kind_of(meta: &Metadata) -> &'static str {
+pub(crate) fn kind_of(meta: &Metadata) -> &'static str {
     let t = meta.file_type();
     if t.is_dir() {
         return "a folder";

@@ -23,6 +23,7 @@ use crate::read::kind_of;
 
 /// Why an output could not be planned or written.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum WriteError {
     /// The output cannot be written as asked (missing folder, a folder in
     /// its place, a kind of file trilux does not write to).

@@ -12,7 +12,7 @@
 //!
 //! **Crossed faces.** Face A of a planar parametric surface is crossed
 //! when some planar parametric surface B of another shape has A's corners
-//! on both sides of its plane, each at least [`MIN_CROSSING`] of A's size
+//! on both sides of its plane, each at least `MIN_CROSSING` of A's size
 //! away from it, B's bounds meet A's bounds, and B's corners lie on both
 //! sides of A's plane in the same sense: the two pass through each other.
 //! A wall ending on the floor does not cross it, nor does a box resting on
@@ -25,9 +25,9 @@
 //! nothing.
 //!
 //! **Cut off.** A point p of a crossed face is *lit* when
-//! 1. a segment from p to one of [`EMITTER_SAMPLES`] points of some
+//! 1. a segment from p to one of `EMITTER_SAMPLES` points of some
 //!    emitter's front face is unoccluded (both facing), or
-//! 2. one of [`REACH_RAYS`] rays from p into its hemisphere meets a face
+//! 2. one of `REACH_RAYS` rays from p into its hemisphere meets a face
 //!    that sends light (`senders`) at a point that is lit by test 1, or
 //!    that lies on a face that is not crossed (whose every point counts as
 //!    reached);
@@ -47,12 +47,12 @@ use crate::surface::SurfaceCoord;
 /// which a face must reach past the crossing plane on both sides for the
 /// crossing to count (the modelling slivers of the Cornell box, a few
 /// tenths of a per cent, do not).
-pub const MIN_CROSSING: f64 = 0.05;
+pub(crate) const MIN_CROSSING: f64 = 0.05;
 
 /// Segments to each emitter per probe point.
-pub const EMITTER_SAMPLES: u32 = 4;
+pub(crate) const EMITTER_SAMPLES: u32 = 4;
 /// Reach rays per probe point.
-pub const REACH_RAYS: u32 = 16;
+pub(crate) const REACH_RAYS: u32 = 16;
 
 /// What the crossing probe needs to know of the light: which faces emit,
 /// and which send light at all (emit or reflect).
@@ -90,7 +90,7 @@ pub fn is_crossed(geom: &Geometry, a: SurfaceId) -> bool {
     let sa = geom.surface(a);
     let tol = 1e-6 * geom.extent();
     let bounds = sa.bounds.padded(tol);
-    // A sliver thinner than [`MIN_CROSSING`] of the face's size is below
+    // A sliver thinner than `MIN_CROSSING` of the face's size is below
     // the element resolution: not a crossing.
     let reach = (MIN_CROSSING * sa.area().sqrt()).max(tol);
     let a_plane = sa
@@ -165,7 +165,7 @@ impl Reach<'_> {
 
     /// True when point `p` of a crossed face (normal `n` on its sending
     /// side) is lit (module docs).
-    pub fn is_lit(&self, p: DVec3, n: DVec3) -> bool {
+    pub(crate) fn is_lit(&self, p: DVec3, n: DVec3) -> bool {
         if self.sees_emitter(p, n) {
             return true;
         }

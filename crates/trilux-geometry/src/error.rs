@@ -18,6 +18,7 @@ pub struct GeometryError {
 
 /// What is wrong with a shape.
 #[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
 pub enum ShapeProblem {
     /// The transform has a NaN or infinite entry.
     #[error("the transform world_from_object has a non-finite entry")]

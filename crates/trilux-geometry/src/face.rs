@@ -5,70 +5,17 @@
 //! `twosided` makes the back reflect too. Every layer therefore speaks of
 //! *faces*: (input surface, [`Side`]). This module is the one place that
 //! says how a face is named ([`FaceId`]), how per-face data is stored
-//! ([`PerFace`]), how per-side data of one element is stored ([`Sided`])
-//! and how an element is seen from one of its sides ([`FaceElement`]).
+//! ([`PerFace`]) and how an element is seen from one of its sides
+//! ([`FaceElement`]). [`Side`] and per-side storage ([`Sided`]) are
+//! `trilux-frame`'s, shared with the reflectance models (`trilux-brdf`).
 
 use std::ops::{Index, IndexMut};
 
-use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
+pub use trilux_frame::{Side, Sided};
+
 use crate::ids::{ElementId, SurfaceId};
-
-/// Which side of a surface or element light leaves or arrives on.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
-pub enum Side {
-    /// The side the (geometric, after `flip_normals`) normal points to.
-    Front,
-    /// The other side.
-    Back,
-}
-
-impl Side {
-    /// Both sides, front first.
-    pub const BOTH: [Side; 2] = [Side::Front, Side::Back];
-
-    /// +1 for the front, −1 for the back: turns the front normal into this
-    /// side's.
-    #[inline]
-    pub fn sign(self) -> f64 {
-        match self {
-            Side::Front => 1.0,
-            Side::Back => -1.0,
-        }
-    }
-
-    /// True for the back.
-    #[inline]
-    pub fn is_back(self) -> bool {
-        self == Side::Back
-    }
-
-    /// The back when `back` is true.
-    #[inline]
-    pub fn from_back(back: bool) -> Side {
-        if back { Side::Back } else { Side::Front }
-    }
-
-    /// The side a direction in a local frame (z = front normal) lies on;
-    /// `None` exactly in the tangent plane.
-    #[inline]
-    pub fn of_local(w: DVec3) -> Option<Side> {
-        if w.z > 0.0 {
-            Some(Side::Front)
-        } else if w.z < 0.0 {
-            Some(Side::Back)
-        } else {
-            None
-        }
-    }
-
-    /// 0 for the front, 1 for the back (for two-slot storage).
-    #[inline]
-    fn slot(self) -> usize {
-        usize::from(self.is_back())
-    }
-}
 
 /// One face of an input surface, as a dense index: 2 × surface + (back).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
@@ -78,7 +25,7 @@ impl FaceId {
     /// The face `side` of `surface`.
     #[inline]
     pub fn new(surface: SurfaceId, side: Side) -> FaceId {
-        FaceId(2 * surface.0 + side.slot() as u32)
+        FaceId(2 * surface.0 + u32::from(side.is_back()))
     }
 
     /// Its input surface.
@@ -174,52 +121,6 @@ impl<T> IndexMut<FaceId> for PerFace<T> {
     }
 }
 
-/// A pair of values, one per side (for example one per-element array for
-/// each side of every element).
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct Sided<T> {
-    /// The front's value.
-    pub front: T,
-    /// The back's value.
-    pub back: T,
-}
-
-impl<T> Sided<T> {
-    /// Both values made by `f`.
-    pub fn from_fn(mut f: impl FnMut(Side) -> T) -> Self {
-        Sided {
-            front: f(Side::Front),
-            back: f(Side::Back),
-        }
-    }
-
-    /// Both values with their sides, front first.
-    pub fn iter(&self) -> impl Iterator<Item = (Side, &T)> {
-        [(Side::Front, &self.front), (Side::Back, &self.back)].into_iter()
-    }
-}
-
-impl<T> Index<Side> for Sided<T> {
-    type Output = T;
-    #[inline]
-    fn index(&self, side: Side) -> &T {
-        match side {
-            Side::Front => &self.front,
-            Side::Back => &self.back,
-        }
-    }
-}
-
-impl<T> IndexMut<Side> for Sided<T> {
-    #[inline]
-    fn index_mut(&mut self, side: Side) -> &mut T {
-        match side {
-            Side::Front => &mut self.front,
-            Side::Back => &mut self.back,
-        }
-    }
-}
-
 impl<T> Index<FaceElement> for Sided<Vec<T>> {
     type Output = T;
     #[inline]
@@ -267,7 +168,7 @@ impl FaceElement {
     /// A dense key: 2 × element + (back).
     #[inline]
     pub fn key(self) -> u64 {
-        (u64::from(self.element.0) << 1) | self.side.slot() as u64
+        (u64::from(self.element.0) << 1) | u64::from(self.side.is_back())
     }
 }
 

@@ -1,8 +1,10 @@
 //! # trilux-geometry — surfaces, elements, visibility, form factors
 //!
-//! Layer: the lowest geometric layer. Depends only on `glam`, `obvhs`,
-//! `rayon`, `serde`, `thiserror` and `sobol_burley` (no other trilux crate),
-//! so that it can be taken alone as a BVH + form-factor library. All public
+//! Layer: the lowest geometric layer. Depends only on `trilux-frame` (the
+//! two sides of a surface and the tangent frame, shared with
+//! `trilux-brdf`), `glam`, `obvhs`, `rdst`, `rayon`, `serde`, `thiserror`
+//! and `sobol_burley`, so that it can be taken alone as a BVH +
+//! form-factor library. All public
 //! geometry is f64 (`glam::DVec3`).
 //!
 //! ## In brief
@@ -63,9 +65,9 @@
 //!   scale and shear are supported exactly for every shape (ellipsoids,
 //!   elliptic tubes and disks): shapes are evaluated in object space and
 //!   mapped by the affine transform.
-//! - [`face`]: the two sides of a surface ([`Side`]), faces ([`FaceId`],
-//!   [`PerFace`]), per-side storage ([`Sided`]) and an element seen from
-//!   one side ([`FaceElement`]).
+//! - [`face`]: faces ([`FaceId`], [`PerFace`]) and an element seen from
+//!   one side ([`FaceElement`]); the two sides of a surface ([`Side`]) and
+//!   per-side storage ([`Sided`]) are `trilux-frame`'s, re-exported.
 //! - [`chart`]: triangle meshes as charts (≤ 512 triangles, 60° normal cone,
 //!   grown compactly over shared edges), chart elements as clusters of
 //!   triangle pieces (the rules are documented there).
@@ -89,9 +91,9 @@
 //!   burial map.
 //! - [`visibility`]: visible fractions from stratified shadow segments
 //!   ([`Visibility`], which takes the burial map explicitly).
-//! - [`basis`]: the orthonormal basis around a unit vector
-//!   ([`coordinate_system`], Duff et al.), the one tangent frame every
-//!   crate builds on.
+//! - [`coordinate_system`]: the orthonormal basis around a unit vector
+//!   (Duff et al.), the one tangent frame every crate builds on
+//!   (`trilux-frame`'s, re-exported).
 //! - [`sensor`]: the camera's plain data shared by the scene loader and
 //!   the renderer: Mitsuba's `look_at` ([`look_at`]), the field of view's
 //!   axis ([`FovAxis`]) and the film's reconstruction filters
@@ -100,7 +102,6 @@
 //!   seeded Sobol points and affine maps.
 #![forbid(unsafe_code)]
 
-pub mod basis;
 pub mod bounds;
 pub mod build;
 pub mod burial;
@@ -125,7 +126,6 @@ pub mod surface;
 mod transform;
 pub mod visibility;
 
-pub use basis::coordinate_system;
 pub use bounds::Bounds;
 pub use burial::{BurialMap, BurialRequest};
 #[cfg(feature = "trace-stats")]
@@ -147,4 +147,5 @@ pub use sampling::SurfaceSample;
 pub use sensor::{FovAxis, LookAtError, ReconstructionFilter, look_at};
 pub use shape::{Shape, ShapeKind, TriangleMesh};
 pub use surface::{InputSurface, SurfaceCoord, SurfaceKind, SurfacePoint};
+pub use trilux_frame::coordinate_system;
 pub use visibility::Visibility;

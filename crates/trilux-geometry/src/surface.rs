@@ -9,6 +9,7 @@ use crate::patch::Patch;
 
 /// What kind of input surface this is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[non_exhaustive]
 pub enum SurfaceKind {
     /// A planar piece: a rectangle, a cube face, a disk. Children are
     /// coplanar.

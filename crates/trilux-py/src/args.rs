@@ -68,11 +68,11 @@ pub fn solve_options(
             )));
         }
     };
-    Ok(SolveOptions {
-        quality,
-        convergence,
-        mode,
-    })
+    let mut options = SolveOptions::default();
+    options.quality = quality;
+    options.convergence = convergence;
+    options.mode = mode;
+    Ok(options)
 }
 
 /// `value` (when given) as an integer in `1..=max`, else a `ValueError`
@@ -101,12 +101,12 @@ pub fn view_options(
     let seed = u32::try_from(seed).map_err(|_| {
         PyValueError::new_err(format!("seed must lie in 0..={}, not {seed}", u32::MAX))
     })?;
-    Ok(ViewOptions {
-        spp: in_range(spp, trilux_render::sampler::MAX_SAMPLES, "spp")?,
-        width: in_range(width, MAX_FILM_EDGE, "width")?,
-        height: in_range(height, MAX_FILM_EDGE, "height")?,
-        seed,
-    })
+    let mut options = ViewOptions::default();
+    options.spp = in_range(spp, trilux_render::sampler::MAX_SAMPLES, "spp")?;
+    options.width = in_range(width, MAX_FILM_EDGE, "width")?;
+    options.height = in_range(height, MAX_FILM_EDGE, "height")?;
+    options.seed = seed;
+    Ok(options)
 }
 
 /// The bake's options; `output` must be a .glb name (as `trilux bake -o`)
@@ -130,8 +130,8 @@ pub fn bake_options(
             "exposure must lie within ±64 stops, not {exposure}"
         )));
     }
-    Ok(trilux_bake::BakeOptions {
-        exposure,
-        albedo_maps,
-    })
+    let mut options = trilux_bake::BakeOptions::default();
+    options.exposure = exposure;
+    options.albedo_maps = albedo_maps;
+    Ok(options)
 }

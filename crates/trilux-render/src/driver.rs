@@ -28,6 +28,7 @@ use crate::solved::SolvedScene;
 
 /// How a camera sample reads the solution.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum Estimator {
     /// The solution's gather links at the primary hit (Lambertian parts
     /// without Monte Carlo noise but in penumbrae), a gather ray for glossy
@@ -89,6 +90,7 @@ impl Default for RenderSettings {
 
 /// What a render did.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[non_exhaustive]
 pub struct RenderStats {
     /// Ray and sample counters.
     pub gather: GatherStats,

@@ -4,6 +4,7 @@ use std::path::PathBuf;
 
 /// What can go wrong while setting up a render or writing an image.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum RenderError {
     /// A camera parameter is out of range (fov, film size, transform).
     #[error("invalid camera: {0}")]

@@ -49,15 +49,16 @@ use trilux_color::Spectrum;
 /// solution there (`FinalGather::gather`; a roughconductor lobe of
 /// roughness α subtends about 4πα², so this is α below about 0.056;
 /// docs/rendering.md, "Near-specular surfaces").
-pub const NEAR_SPECULAR_SR: f64 = 0.04;
+pub(crate) const NEAR_SPECULAR_SR: f64 = 0.04;
 
 /// The most gather levels a path continues through near-specular hits
 /// (a closed mirror box reflects a path until it meets the light; after
 /// this many levels the solution is read).
-pub const MAX_SPECULAR_LEVELS: u32 = 48;
+pub(crate) const MAX_SPECULAR_LEVELS: u32 = 48;
 
 /// When to continue a gather path one bounce before reading the solution.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[non_exhaustive]
 pub enum ExtraBounce {
     /// Always read the solution at the first gather hit (the paper's §4.5).
     Never,

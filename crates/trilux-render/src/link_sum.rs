@@ -5,7 +5,7 @@
 //! 1. **Links of a leaf.** The links of x's leaf and of its ancestors cover
 //!    every sender once. They are gathered once per leaf and kept
 //!    ([`LinkField`]): a sender is *near* when it is closer to the leaf than
-//!    [`NEAR_FIELD`] × (its size + the leaf's size), else *far*.
+//!    `NEAR_FIELD` × (its size + the leaf's size), else *far*.
 //! 2. **Far field.** Over a leaf, far senders' contributions L_i F(x → i)
 //!    vary smoothly (their distance exceeds both sizes), so the sum of the
 //!    fully visible ones is computed exactly at the leaf's four corners and
@@ -17,7 +17,7 @@
 //!    factor computed exactly. Its radiance is its element's average: where
 //!    a child's radiance differs from it by δ, the error is at most about
 //!    δ · F(x → i), and the sender is refined into its children where that
-//!    bound exceeds [`NEAR_FIELD_TOLERANCE`] of the whole sum (a cut chosen
+//!    bound exceeds `NEAR_FIELD_TOLERANCE` of the whole sum (a cut chosen
 //!    per point, as lightcuts do: Walter et al. 2005). Curved senders near
 //!    x are refined too: their point form factor comes from a fixed rule,
 //!    accurate only from afar. The senders left at their average near x are
@@ -33,7 +33,7 @@
 //!    shadows are what a viewer sees first. The *traced* links (partly
 //!    visible ones and those from emitters) are either taken with the
 //!    visible fraction v_k the solve measured (`Cached`) or corrected by
-//!    [`PARTIAL_RAYS`] shadow rays (`Traced`): each picks a traced sender
+//!    `PARTIAL_RAYS` shadow rays (`Traced`): each picks a traced sender
 //!    k with probability p_k ∝ a weight w_k (its contribution, at the
 //!    corners for far senders) and a point y on it with area density p(y),
 //!    so that L_k G(x, y) (V(x, y) − v_k) / (p(y) p_k), G = cos θ_x cos θ_y
@@ -56,14 +56,14 @@ use crate::solution::RadianceSolution;
 
 /// A sender closer to a receiving leaf than this many times their sizes is
 /// evaluated at the point, and may be refined into its children.
-pub const NEAR_FIELD: f64 = 1.0;
+pub(crate) const NEAR_FIELD: f64 = 1.0;
 
 /// The error bound (relative to the whole sum) above which a near sender
 /// is refined.
-pub const NEAR_FIELD_TOLERANCE: f64 = 0.002;
+pub(crate) const NEAR_FIELD_TOLERANCE: f64 = 0.002;
 
 /// Shadow rays per link sum for its traced links (step 5).
-pub const PARTIAL_RAYS: u32 = 2;
+pub(crate) const PARTIAL_RAYS: u32 = 2;
 
 /// The point a link sum is evaluated at.
 pub struct Receiver {

@@ -73,6 +73,7 @@ pub enum LinkVisibility<'a> {
 
 /// Counters of one render.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[non_exhaustive]
 pub struct GatherStats {
     /// Camera rays traced.
     pub camera_rays: u64,

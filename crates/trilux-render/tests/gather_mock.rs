@@ -103,6 +103,7 @@ fn furnace_renders_two_at_64_spp() {
                         && stats.gather.extra_bounces < stats.gather.camera_rays
                 )
             }
+            other => panic!("no expectation for {other:?}"),
         }
     }
 }

@@ -91,6 +91,6 @@ impl Camera {
 
 /// Mitsuba's default field of view (50 mm lens, 36 × 24 mm film), along the
 /// diagonal, in degrees.
-pub fn default_fov() -> f64 {
+pub(crate) fn default_fov() -> f64 {
     (2.0 * ((36f64 * 36.0 + 24.0 * 24.0).sqrt() / 100.0).atan()).to_degrees()
 }

@@ -45,6 +45,7 @@ impl fmt::Display for SourceLocation {
 
 /// Why a scene could not be loaded.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum SceneError {
     /// Something is wrong at a known place of the scene file.
     #[error("{location}: {message}")]
@@ -89,7 +90,7 @@ impl SceneError {
 
 /// The longest message an error carries; longer ones (a quoted value of
 /// megabytes) lose their middle.
-pub const MAX_MESSAGE_CHARS: usize = 400;
+pub(crate) const MAX_MESSAGE_CHARS: usize = 400;
 
 /// `text` cut to at most `max` characters by replacing its middle with
 /// "…(N characters)…", so that both its start and its end stay readable.

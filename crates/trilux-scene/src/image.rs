@@ -30,6 +30,7 @@ pub struct Sampling {
 
 /// Why an image could not be decoded (the caller names the file).
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum ImageError {
     /// Neither PNG nor JPEG.
     #[error("not a PNG or JPEG image (the first bytes are neither signature)")]
@@ -58,7 +59,7 @@ pub enum ImageError {
 }
 
 /// The sRGB transfer function's inverse: encoded value in [0, 1] → linear.
-pub fn srgb_to_linear(v: f64) -> f64 {
+pub(crate) fn srgb_to_linear(v: f64) -> f64 {
     if v <= 0.04045 {
         v / 12.92
     } else {

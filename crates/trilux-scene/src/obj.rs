@@ -1,7 +1,7 @@
 //! Wavefront OBJ meshes (`<shape type="obj">`), read with `tobj`.
 //!
 //! Texture coordinates (`vt`) are kept when every vertex has them, with v
-//! flipped as Mitsuba's loader flips it. Polygons of up to [`FAN_MAX`] vertices are
+//! flipped as Mitsuba's loader flips it. Polygons of up to `FAN_MAX` vertices are
 //! triangulated as fans from their first vertex (as Mitsuba's and tobj's
 //! loaders do), larger ones by halving ([`triangulate`]); vertices are shared when they share
 //! position, texture and normal indices (as Mitsuba's own OBJ loader keys
@@ -26,6 +26,7 @@ use trilux_geometry::TriangleMesh;
 
 /// Why an OBJ file could not be read (the caller adds the scene location).
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum ObjError {
     /// The file could not be read (missing, not a regular file, too
     /// large).
@@ -71,7 +72,7 @@ pub enum ObjError {
 
 /// Reads an OBJ file into one triangle mesh (all its objects merged);
 /// `flip_tex_coords` is Mitsuba's parameter (true by default: v ↦ 1 − v).
-pub fn load_obj(
+pub(crate) fn load_obj(
     path: &Path,
     face_normals: bool,
     flip_tex_coords: bool,
@@ -84,7 +85,7 @@ pub fn load_obj(
     parse_obj(&bytes, path, face_normals, flip_tex_coords)
 }
 
-/// [`load_obj`] on the bytes of an OBJ file; `path` names it in errors.
+/// `load_obj` on the bytes of an OBJ file; `path` names it in errors.
 pub fn parse_obj(
     bytes: &[u8],
     path: &Path,
@@ -113,11 +114,11 @@ pub fn parse_obj(
 
 /// Polygons of up to this many vertices are triangulated as fans from
 /// their first vertex; larger ones by halving ([`triangulate`]).
-pub const FAN_MAX: usize = 64;
+pub(crate) const FAN_MAX: usize = 64;
 
 /// The triangles of faces of `arities` vertices each (all triangles when
 /// `arities` is empty, as tobj gives them), each face's indices in turn in
-/// `indices`. A face of up to [`FAN_MAX`] vertices is a fan from its first
+/// `indices`. A face of up to `FAN_MAX` vertices is a fan from its first
 /// vertex. A larger one is cut by the chord from its first vertex to its
 /// middle one, and each part again (a triangle of the first, middle and
 /// last vertex of every arc): a fan of a polygon of a million vertices is
@@ -362,7 +363,7 @@ fn bad_face_index(bytes: &[u8]) -> Option<i64> {
 
 /// Angle-weighted smooth vertex normals (Mitsuba's `recompute_vertex_normals`).
 /// A vertex that only touches degenerate triangles gets +z, never NaN.
-pub fn vertex_normals(positions: &[DVec3], triangles: &[[u32; 3]]) -> Vec<DVec3> {
+pub(crate) fn vertex_normals(positions: &[DVec3], triangles: &[[u32; 3]]) -> Vec<DVec3> {
     let mut acc = vec![DVec3::ZERO; positions.len()];
     for t in triangles {
         let v = t.map(|i| positions[i as usize]);
@@ -425,7 +426,7 @@ mod tests {
         t
     }
 
-    /// Faces up to [`FAN_MAX`] vertices give tobj's own fans, vertex for
+    /// Faces up to `FAN_MAX` vertices give tobj's own fans, vertex for
     /// vertex (triangles, quads, a pentagon, a 64-gon, with and without
     /// texture indices).
     #[test]
@@ -459,7 +460,7 @@ mod tests {
         assert_eq!(ours.positions.len() * 3, models[0].mesh.positions.len());
     }
 
-    /// A polygon of n > [`FAN_MAX`] vertices makes n − 2 triangles of its
+    /// A polygon of n > `FAN_MAX` vertices makes n − 2 triangles of its
     /// winding covering its area, each corner of each triangle used, and
     /// the triangles' boxes shrink by halves: their summed extents are
     /// O(log n) times the polygon's, where a fan's are O(n) times.

@@ -28,6 +28,7 @@ use crate::obj::{triangulate, vertex_normals};
 
 /// Why a PLY file could not be read (the caller adds the scene location).
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum PlyError {
     /// The file could not be read (missing, not a regular file, too
     /// large).
@@ -76,7 +77,7 @@ pub enum PlyError {
 
 /// Reads a PLY file into one triangle mesh; `flip_tex_coords` (false by
 /// default in Mitsuba for PLY) maps v ↦ 1 − v.
-pub fn load_ply(
+pub(crate) fn load_ply(
     path: &Path,
     face_normals: bool,
     flip_tex_coords: bool,
@@ -89,7 +90,7 @@ pub fn load_ply(
     parse_ply(&bytes, path, face_normals, flip_tex_coords)
 }
 
-/// [`load_ply`] on the bytes of a PLY file; `path` names it in errors.
+/// `load_ply` on the bytes of a PLY file; `path` names it in errors.
 pub fn parse_ply(
     bytes: &[u8],
     path: &Path,

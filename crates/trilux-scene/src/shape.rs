@@ -117,7 +117,7 @@ impl MeshFormat {
 
     /// Mitsuba's default `flip_tex_coords`: OBJ's v runs up, PLY's is
     /// taken as written.
-    pub fn flips_by_default(self) -> bool {
+    pub(crate) fn flips_by_default(self) -> bool {
         self == MeshFormat::Obj
     }
 }

@@ -18,6 +18,7 @@ pub fn no_finite_solution(band: usize, bands: usize) -> String {
 
 /// What can go wrong when preparing, running, saving or loading a solve.
 #[derive(Debug, Error)]
+#[non_exhaustive]
 pub enum SolverError {
     /// The scene description could not be prepared.
     #[error(transparent)]

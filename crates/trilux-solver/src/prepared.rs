@@ -29,6 +29,7 @@ pub struct SceneDescription<'a> {
 
 /// What is wrong with a scene description.
 #[derive(Debug, Error)]
+#[non_exhaustive]
 pub enum PrepareError {
     /// A shape's geometry could not be built.
     #[error(transparent)]
@@ -57,7 +58,7 @@ pub enum PrepareError {
         /// Index of the shape.
         shape: usize,
     },
-    /// An emitter's radiance is beyond [`MAX_BAND_RADIANCE`] in these
+    /// An emitter's radiance is beyond `MAX_BAND_RADIANCE` in these
     /// bands, or its flux π·A·Le overflows.
     #[error(
         "shape {shape}: emitted radiance beyond 1e30 in some band, or a flux that overflows (docs/limits.md)"
@@ -210,7 +211,7 @@ impl<const N: usize> PreparedScene<N> {
     }
 
     /// True when some material has textures.
-    pub fn has_textures(&self) -> bool {
+    pub(crate) fn has_textures(&self) -> bool {
         self.textured.iter().any(Option::is_some)
     }
 
@@ -302,11 +303,11 @@ fn emitted<const N: usize>(
 /// conversion to bands can scale a few times; this is the solver's own
 /// guard, far enough below the 32-bit floats of the solution file (3.4e38)
 /// for the sums of many reflections.
-pub const MAX_BAND_RADIANCE: f64 = 1e30;
+pub(crate) const MAX_BAND_RADIANCE: f64 = 1e30;
 
 /// Refuses an emitter whose flux π·A·Le overflows in some band (it would
 /// make an infinite solution, which no renderer can use), and one whose
-/// radiance is beyond [`MAX_BAND_RADIANCE`].
+/// radiance is beyond `MAX_BAND_RADIANCE`.
 fn check_flux<const N: usize>(
     geometry: &Geometry,
     emission: &[Spectrum<N>],

@@ -5,6 +5,7 @@ use serde::{Deserialize, Serialize};
 
 /// How light leaving Lambertian surfaces is represented.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[non_exhaustive]
 pub enum Transport {
     /// Lambertian parts keep one outgoing radiance per element (two-point,
     /// like hierarchical radiosity); interactions are stored only for glossy
@@ -18,6 +19,7 @@ pub enum Transport {
 
 /// Quality presets for the command line.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[non_exhaustive]
 pub enum Quality {
     /// Fast previews: CR 0.95, coarse elements.
     Draft,
@@ -43,6 +45,7 @@ impl std::str::FromStr for Quality {
 
 /// Everything that steers a solve. Part of the solution's hash.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[non_exhaustive]
 pub struct SolverSettings {
     /// Stop when the convergence ratio CR = (IF − RF)/IF reaches this
     /// (paper §6).
@@ -200,7 +203,7 @@ impl SolverSettings {
 
     /// A time budget must be a finite number of seconds, not negative, and
     /// at most a year (a `Duration` holds it exactly).
-    pub fn validate_time_budget(seconds: f64) -> Result<(), String> {
+    pub(crate) fn validate_time_budget(seconds: f64) -> Result<(), String> {
         if seconds.is_finite() && (0.0..=MAX_TIME_BUDGET_SECONDS).contains(&seconds) {
             Ok(())
         } else {

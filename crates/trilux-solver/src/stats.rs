@@ -4,6 +4,7 @@ use serde::{Deserialize, Serialize};
 
 /// What a solve did and where the energy went.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[non_exhaustive]
 pub struct SolveStats {
     /// Input surfaces of the scene.
     pub input_surfaces: usize,
@@ -86,6 +87,7 @@ pub struct SolveStats {
 /// Why a solve's shooting loop stopped.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
+#[non_exhaustive]
 pub enum StopReason {
     /// The convergence ratio reached its target.
     #[default]

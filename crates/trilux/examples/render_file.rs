@@ -19,10 +19,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         || std::env::temp_dir().join("render_file.exr"),
         PathBuf::from,
     );
-    let view = ViewOptions {
-        spp: args.get(2).map(|s| s.parse()).transpose()?,
-        ..ViewOptions::default()
-    };
+    let mut view = ViewOptions::default();
+    view.spp = args.get(2).map(|s| s.parse()).transpose()?;
     let image = trilux::render_file(&scene, &[], &SolveOptions::default(), &view)?;
     image.write_exr(&out)?;
     println!(

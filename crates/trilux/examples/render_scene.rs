@@ -1,5 +1,10 @@
 //! Solves a scene file and renders it by final gathering.
 //!
+//! The short way is the one-call API (`trilux::render_file`, example
+//! `render_file`); this example assembles the `Plan` itself to reach what
+//! that API keeps at the command's defaults (single solver settings from
+//! the environment, the extra bounce) and to print the render's counters.
+//!
 //! Run: `cargo run --release -p trilux --example render_scene -- SCENE.xml OUT.exr [SIZE] [SPP] [draft|default|high] [never|auto|always]`
 //!
 //! Prints the solve and render times and the image mean. Spectral scenes

@@ -77,10 +77,10 @@ pub fn run(args: &BakeArgs) -> Result<()> {
         .transpose()?;
     let pending = trilux_scene::open_with_params(&args.scene, &args.params.define)?;
     outputs.check_inputs(&pending.input_files())?;
-    let bake = Product::Bake(BakeOptions {
-        exposure: args.exposure,
-        albedo_maps: !args.no_albedo_maps,
-    });
+    let mut options = BakeOptions::default();
+    options.exposure = args.exposure;
+    options.albedo_maps = !args.no_albedo_maps;
+    let bake = Product::Bake(options);
     let plan = args
         .options
         .plan(pending.scene(), args.solution.as_deref(), bake);

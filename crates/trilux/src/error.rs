@@ -5,6 +5,7 @@ use std::path::PathBuf;
 
 /// What can go wrong while carrying out a plan.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum PipelineError {
     /// The scene cannot be prepared as written (a material or emitter that
     /// does not convert, a shape the geometry refuses, a camera it does not

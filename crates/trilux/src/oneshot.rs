@@ -24,6 +24,7 @@ use crate::view::{ViewOverrides, render_settings};
 /// How the light is solved: the command's `--quality`, `--convergence`
 /// and `--mode`. A saved solution must have been made with the same.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
 pub struct SolveOptions {
     /// The preset: error bounds, depth limit, default convergence.
     pub quality: Quality,
@@ -62,6 +63,7 @@ impl SolveOptions {
 /// A view to render: the command's `--spp`, `--width`, `--height` and
 /// `--seed` (the scene's own values where `None`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[non_exhaustive]
 pub struct ViewOptions {
     /// Camera samples per pixel.
     pub spp: Option<u32>,
@@ -183,11 +185,13 @@ pub fn render_scene(
 /// FILE -D ... --spp ... --seed ...` without the files.
 ///
 /// ```no_run
+/// let mut view = trilux::ViewOptions::default();
+/// view.spp = Some(16);
 /// let image = trilux::render_file(
 ///     "scenes/cornell-box.xml",
 ///     &[],
 ///     &trilux::SolveOptions::default(),
-///     &trilux::ViewOptions { spp: Some(16), ..Default::default() },
+///     &view,
 /// )?;
 /// println!("{} × {}, mean {:?}", image.width(), image.height(), image.mean());
 /// # Ok::<(), trilux::PipelineError>(())

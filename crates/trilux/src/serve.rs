@@ -22,13 +22,14 @@ use anyhow::{Context, Result};
 /// A file the server sends: path, content type, bytes.
 type Served = (&'static str, &'static str, &'static [u8]);
 
-/// Builds the table of the viewer's files from paths below docs/viewer.
+/// Builds the table of the viewer's files from paths below docs/viewer
+/// (through the link viewer/, so that the package holds them).
 macro_rules! viewer_files {
     ($(($path:literal, $kind:expr)),* $(,)?) => {
         [$((
             concat!("/", $path),
             $kind,
-            include_bytes!(concat!("../../../docs/viewer/", $path)).as_slice(),
+            include_bytes!(concat!("../viewer/", $path)).as_slice(),
         )),*]
     };
 }

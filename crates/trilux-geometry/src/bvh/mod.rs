@@ -145,6 +145,7 @@ pub(crate) struct PrimHit {
 
 /// Size and build time of a scene's BVH.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
 pub struct BvhStats {
     /// Inner nodes (eight children each).
     pub nodes: usize,

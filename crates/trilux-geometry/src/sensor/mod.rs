@@ -55,6 +55,7 @@ impl FovAxis {
 
 /// Why [`look_at`] refuses a placement.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
 pub enum LookAtError {
     /// The origin and the target are the same point, or the direction
     /// between them is not finite, or the origin is not finite.

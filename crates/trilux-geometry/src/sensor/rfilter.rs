@@ -26,6 +26,7 @@ use serde::Serialize;
 /// A separable reconstruction filter.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 #[serde(rename_all = "lowercase")]
+#[non_exhaustive]
 pub enum ReconstructionFilter {
     /// Mitsuba's `gaussian` with standard deviation `stddev` (default 0.5)
     /// and radius 4·stddev.

@@ -46,7 +46,7 @@ use crate::image::Sampling;
 
 /// The smallest GGX α a glTF roughness maps to (roughness 0.1): smoother
 /// surfaces are mirrors that no element-based solve can resolve.
-pub const MIN_ALPHA: f64 = 0.01;
+pub(crate) const MIN_ALPHA: f64 = 0.01;
 
 /// A texture of a mapped material, its image not read yet.
 #[derive(Clone, Debug)]

@@ -34,7 +34,7 @@ pub(crate) use nodes::GltfMeshes;
 /// Extensions a file may require (others in `extensionsRequired` are
 /// refused; others only used are ignored, as the glTF specification
 /// allows).
-pub const SUPPORTED_EXTENSIONS: [&str; 3] = [
+pub(crate) const SUPPORTED_EXTENSIONS: [&str; 3] = [
     "KHR_materials_specular",
     "KHR_materials_emissive_strength",
     "KHR_texture_transform",
