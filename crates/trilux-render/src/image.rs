@@ -125,18 +125,42 @@ impl Image {
 
     /// The OpenEXR file of this image (linear float RGB, ZIP).
     pub fn exr_bytes(&self) -> Result<Vec<u8>, RenderError> {
+        self.exr_bytes_with(&[])
+    }
+
+    /// The OpenEXR file of this image with `attributes` (name, text) as
+    /// string attributes of its header, so that a file carries how it was
+    /// made; `software` sets the standard attribute of that name. Texts
+    /// must be Latin-1 (the header's strings are bytes), names shorter
+    /// than 32 bytes (longer ones need OpenEXR's long-names flag).
+    pub fn exr_bytes_with(&self, attributes: &[(&str, &str)]) -> Result<Vec<u8>, RenderError> {
         use exr::prelude::{Encoding, Image as ExrImage, SpecificChannels, Vec2, WritableImage};
+        use exr::prelude::{AttributeValue, Text};
         self.check_finite()?;
         let w = self.width as usize;
         let channels = SpecificChannels::rgb(|Vec2(x, y): Vec2<usize>| {
             let p = self.pixels[y * w + x];
             (p[0], p[1], p[2])
         });
-        let image = ExrImage::from_encoded_channels(
+        let mut image = ExrImage::from_encoded_channels(
             (w, self.height as usize),
             Encoding::SMALL_LOSSLESS,
             channels,
         );
+        let encode = |what: &str| RenderError::Encode {
+            format: "EXR",
+            reason: format!("the header attribute {what} is not Latin-1 text"),
+        };
+        let header = &mut image.layer_data.attributes;
+        for (name, text) in attributes {
+            let value = Text::new_or_none(text).ok_or_else(|| encode(name))?;
+            if *name == "software" {
+                header.software_name = Some(value);
+            } else {
+                let key = Text::new_or_none(name).ok_or_else(|| encode(name))?;
+                header.other.insert(key, AttributeValue::Text(value));
+            }
+        }
         let mut bytes = Cursor::new(Vec::new());
         image
             .write()
