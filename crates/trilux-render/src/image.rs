@@ -134,8 +134,8 @@ impl Image {
     /// must be Latin-1 (the header's strings are bytes), names shorter
     /// than 32 bytes (longer ones need OpenEXR's long-names flag).
     pub fn exr_bytes_with(&self, attributes: &[(&str, &str)]) -> Result<Vec<u8>, RenderError> {
-        use exr::prelude::{Encoding, Image as ExrImage, SpecificChannels, Vec2, WritableImage};
         use exr::prelude::{AttributeValue, Text};
+        use exr::prelude::{Encoding, Image as ExrImage, SpecificChannels, Vec2, WritableImage};
         self.check_finite()?;
         let w = self.width as usize;
         let channels = SpecificChannels::rgb(|Vec2(x, y): Vec2<usize>| {

@@ -258,7 +258,10 @@ pub fn run_into(args: &RenderArgs, in_out: bool) -> Result<()> {
 
 /// The EXR file of `image` with `record` in its header
 /// (`Record::exr_attributes`).
-fn exr_with_record(image: &trilux_render::Image, record: &crate::record::Record) -> Result<Vec<u8>> {
+fn exr_with_record(
+    image: &trilux_render::Image,
+    record: &crate::record::Record,
+) -> Result<Vec<u8>> {
     let attributes = record.exr_attributes()?;
     let pairs: Vec<(&str, &str)> = attributes.iter().map(|(k, v)| (*k, v.as_str())).collect();
     Ok(image.exr_bytes_with(&pairs)?)

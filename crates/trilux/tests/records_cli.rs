@@ -73,7 +73,10 @@ fn check_record(stats: &Value, args: &[&str], seen_seconds: f64) -> Value {
     let sum: f64 = phases.iter().map(|k| p[*k].as_f64().unwrap()).sum();
     assert!(phases.iter().all(|k| p[*k].as_f64().unwrap() >= 0.0), "{p}");
     let wall = p["wall_seconds"].as_f64().unwrap();
-    assert!(sum <= wall && wall <= seen_seconds, "{p}, seen {seen_seconds}");
+    assert!(
+        sum <= wall && wall <= seen_seconds,
+        "{p}, seen {seen_seconds}"
+    );
     let memory = r["peak_resident_bytes"].as_u64().unwrap();
     assert!(memory > 1 << 20 && memory < mem_total(), "{memory}");
     assert_eq!(r["convergence_trace"], stats["convergence_trace"]);
@@ -180,7 +183,10 @@ fn a_render_writes_its_record_into_the_exr_header_and_the_stats() {
     let render = &r["settings"]["render"];
     assert_eq!(render["spp"], 3);
     assert_eq!(render["seed"], 7);
-    assert_eq!((&render["view"]["width"], &render["view"]["height"]), (&10.into(), &6.into()));
+    assert_eq!(
+        (&render["view"]["width"], &render["view"]["height"]),
+        (&10.into(), &6.into())
+    );
     assert_eq!(render["estimator"], "links");
     assert_eq!(render["extra_bounce"], "never");
     assert_eq!(r["settings"]["png_exposure"], -1.5);
@@ -266,7 +272,10 @@ fn info_json_lists_every_shape_as_the_text_does() {
     assert_eq!(list.len(), shapes.len());
     assert_eq!(v["shapes"], shapes.len());
     for (i, (s, (kind, id))) in list.iter().zip(&shapes).enumerate() {
-        assert_eq!((&s["index"], &s["kind"], &s["id"]), (&i.into(), &kind.as_str().into(), &id.as_str().into()));
+        assert_eq!(
+            (&s["index"], &s["kind"], &s["id"]),
+            (&i.into(), &kind.as_str().into(), &id.as_str().into())
+        );
         assert_eq!(s["emitter"], id == "light", "{s}");
     }
     // The text lists the same shapes, one line each.
@@ -308,7 +317,10 @@ fn info_names_the_gltf_cameras() {
     let line = format!("cameras        {}", listed.join(", "));
     assert!(text.lines().any(|l| l == line), "{text}");
     // An XML scene has one sensor and no named cameras.
-    assert_eq!(info_json(&scenes().join("cornell-box.xml"))["cameras"], serde_json::json!([]));
+    assert_eq!(
+        info_json(&scenes().join("cornell-box.xml"))["cameras"],
+        serde_json::json!([])
+    );
 }
 
 /// The screen a terminal shows after `bytes`: a minimal emulator of what
@@ -396,10 +408,17 @@ fn the_progress_bar_estimates_the_time_left_and_leaves_no_line_behind() {
         .args(["-qec", &command, "/dev/null"])
         .output()
         .expect("script (util-linux) runs");
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let shown = String::from_utf8_lossy(&out.stdout);
     // The solve's bar, with its estimate from the convergence.
-    assert!(shown.contains("solve [") && shown.contains(" s left, CR "), "{shown:?}");
+    assert!(
+        shown.contains("solve [") && shown.contains(" s left, CR "),
+        "{shown:?}"
+    );
     // Once done, the terminal shows the report and nothing else: no bar,
     // no empty line.
     assert_eq!(screen(&out.stdout), ["wrote a.exr"], "{shown:?}");

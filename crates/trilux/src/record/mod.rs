@@ -120,7 +120,10 @@ impl Record {
                 "trilux.commandLine",
                 json(serde_json::to_value(&self.command_line)?),
             ),
-            ("trilux.settings", json(Value::Object(self.settings.clone()))),
+            (
+                "trilux.settings",
+                json(Value::Object(self.settings.clone())),
+            ),
             ("trilux.phases", json(serde_json::to_value(self.phases)?)),
             (
                 "trilux.peakResidentBytes",
