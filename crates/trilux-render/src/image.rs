@@ -292,6 +292,28 @@ mod tests {
     }
 
     #[test]
+    fn header_attributes_read_back_and_leave_the_pixels_alone() {
+        use exr::meta::attribute::{AttributeValue, Text};
+        let img = Image::from_pixels(3, 2, vec![[0.5, 1.0, 2.0]; 6]).unwrap();
+        let bytes = img
+            .exr_bytes_with(&[("software", "trilux x"), ("trilux.a", "[1,2]")])
+            .unwrap();
+        let meta = exr::meta::MetaData::read_from_buffered(Cursor::new(&bytes), false).unwrap();
+        let own = &meta.headers[0].own_attributes;
+        assert_eq!(own.software_name, Some(Text::from("trilux x")));
+        assert_eq!(
+            own.other.get(&Text::from("trilux.a")),
+            Some(&AttributeValue::Text(Text::from("[1,2]")))
+        );
+        let d = tmpdir("attributes");
+        std::fs::write(d.join("a.exr"), &bytes).unwrap();
+        assert_eq!(Image::read_exr(&d.join("a.exr")).unwrap(), img);
+        std::fs::remove_dir_all(&d).unwrap();
+        // Text beyond Latin-1 has no bytes in a header: refused, not mangled.
+        assert!(img.exr_bytes_with(&[("trilux.b", "日本")]).is_err());
+    }
+
+    #[test]
     fn a_non_finite_pixel_is_never_written() {
         let d = tmpdir("non-finite");
         for bad in [f32::INFINITY, f32::NAN, f32::NEG_INFINITY] {
