@@ -323,9 +323,13 @@ fn info_names_the_gltf_cameras() {
     );
 }
 
-/// The screen a terminal shows after `bytes`: a minimal emulator of what
-/// progress bars send (carriage return, newline, erase line, cursor up,
-/// erase below), enough to see a line left behind.
+/// Columns of the test's terminal.
+const COLUMNS: usize = 80;
+
+/// The screen a terminal of [`COLUMNS`] shows after `bytes`: a minimal
+/// emulator of what progress bars send (carriage return, newline, erase
+/// line, cursor up and down, erase below, and a long line wrapping onto
+/// the next), enough to see a line left behind.
 fn screen(bytes: &[u8]) -> Vec<String> {
     let text = String::from_utf8_lossy(bytes);
     let mut lines = vec![String::new()];
@@ -356,6 +360,10 @@ fn screen(bytes: &[u8]) -> Vec<String> {
                 match end {
                     'K' => lines[row].clear(),
                     'A' => row = row.saturating_sub(n),
+                    'B' => {
+                        row += n;
+                        lines.resize(lines.len().max(row + 1), String::new());
+                    }
                     'J' => {
                         lines[row].truncate(col);
                         lines.truncate(row + 1);
@@ -364,6 +372,11 @@ fn screen(bytes: &[u8]) -> Vec<String> {
                 }
             }
             c => {
+                if col == COLUMNS {
+                    row += 1;
+                    col = 0;
+                    lines.resize(lines.len().max(row + 1), String::new());
+                }
                 let mut line: Vec<char> = lines[row].chars().collect();
                 line.resize(line.len().max(col), ' ');
                 if col < line.len() {
@@ -389,17 +402,26 @@ fn the_emulated_screen_sees_a_stale_line() {
     assert_eq!(screen(b"bar\r\x1b[2Kdone\n"), ["done"]);
     assert_eq!(screen(b"bar\n\x1b[2Kdone\n"), ["bar", "done"]);
     assert_eq!(screen(b"bar\r\x1b[2K\ndone\n"), ["", "done"]);
+    // A line longer than the terminal wraps: erasing the last row leaves
+    // the first.
+    let long = format!("{}tail\r\x1b[2Kdone\n", "x".repeat(COLUMNS));
+    assert_eq!(
+        screen(long.as_bytes()),
+        ["x".repeat(COLUMNS), "done".into()]
+    );
 }
 
 #[test]
 fn the_progress_bar_estimates_the_time_left_and_leaves_no_line_behind() {
     // A terminal for the binary: util-linux's `script` (Debian's
-    // essential bsdutils), which runs the command on a pseudo-terminal and
-    // copies what it shows.
+    // essential bsdutils), which runs the command on a pseudo-terminal of
+    // COLUMNS columns and copies what it shows. (trilux 0.1.0 before this
+    // test drew a bar for the solve and one for the render at once and
+    // let the solve's message wrap: lines of both stayed on the screen.)
     let dir = folder("record-progress");
     let scene = scenes().join("cornell-box.xml");
     let command = format!(
-        "'{}' render '{}' --quality draft --spp 2 --width 64 --height 48 -o a.exr",
+        "stty cols {COLUMNS} rows 24; '{}' render '{}' --quality draft --spp 2 --width 64 --height 48 -o a.exr",
         env!("CARGO_BIN_EXE_trilux"),
         scene.display()
     );
