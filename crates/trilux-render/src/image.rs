@@ -125,6 +125,16 @@ impl Image {
 
     /// The OpenEXR file of this image (linear float RGB, ZIP).
     pub fn exr_bytes(&self) -> Result<Vec<u8>, RenderError> {
+        self.exr_bytes_with(&[])
+    }
+
+    /// The OpenEXR file of this image with `attributes` (name, text) as
+    /// string attributes of its header, so that a file carries how it was
+    /// made; `software` sets the standard attribute of that name. Texts
+    /// must be Latin-1 (the header's strings are bytes), names shorter
+    /// than 32 bytes (longer ones need OpenEXR's long-names flag).
+    pub fn exr_bytes_with(&self, attributes: &[(&str, &str)]) -> Result<Vec<u8>, RenderError> {
+        use exr::prelude::{AttributeValue, Text};
         use exr::prelude::{Encoding, Image as ExrImage, SpecificChannels, Vec2, WritableImage};
         self.check_finite()?;
         let w = self.width as usize;
@@ -132,11 +142,25 @@ impl Image {
             let p = self.pixels[y * w + x];
             (p[0], p[1], p[2])
         });
-        let image = ExrImage::from_encoded_channels(
+        let mut image = ExrImage::from_encoded_channels(
             (w, self.height as usize),
             Encoding::SMALL_LOSSLESS,
             channels,
         );
+        let encode = |what: &str| RenderError::Encode {
+            format: "EXR",
+            reason: format!("the header attribute {what} is not Latin-1 text"),
+        };
+        let header = &mut image.layer_data.attributes;
+        for (name, text) in attributes {
+            let value = Text::new_or_none(text).ok_or_else(|| encode(name))?;
+            if *name == "software" {
+                header.software_name = Some(value);
+            } else {
+                let key = Text::new_or_none(name).ok_or_else(|| encode(name))?;
+                header.other.insert(key, AttributeValue::Text(value));
+            }
+        }
         let mut bytes = Cursor::new(Vec::new());
         image
             .write()
@@ -265,6 +289,28 @@ mod tests {
             meta.headers[0].compression,
             exr::compression::Compression::ZIP16
         );
+    }
+
+    #[test]
+    fn header_attributes_read_back_and_leave_the_pixels_alone() {
+        use exr::meta::attribute::{AttributeValue, Text};
+        let img = Image::from_pixels(3, 2, vec![[0.5, 1.0, 2.0]; 6]).unwrap();
+        let bytes = img
+            .exr_bytes_with(&[("software", "trilux x"), ("trilux.a", "[1,2]")])
+            .unwrap();
+        let meta = exr::meta::MetaData::read_from_buffered(Cursor::new(&bytes), false).unwrap();
+        let own = &meta.headers[0].own_attributes;
+        assert_eq!(own.software_name, Some(Text::from("trilux x")));
+        assert_eq!(
+            own.other.get(&Text::from("trilux.a")),
+            Some(&AttributeValue::Text(Text::from("[1,2]")))
+        );
+        let d = tmpdir("attributes");
+        std::fs::write(d.join("a.exr"), &bytes).unwrap();
+        assert_eq!(Image::read_exr(&d.join("a.exr")).unwrap(), img);
+        std::fs::remove_dir_all(&d).unwrap();
+        // Text beyond Latin-1 has no bytes in a header: refused, not mangled.
+        assert!(img.exr_bytes_with(&[("trilux.b", "日本")]).is_err());
     }
 
     #[test]

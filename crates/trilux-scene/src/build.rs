@@ -118,6 +118,7 @@ pub(crate) fn build(resolved: Resolved, path: &Path) -> Result<(Scene, Requests)
         max_depth,
         spectral,
         bsdf_counts: resolved.bsdf_counts,
+        camera_names: Vec::new(),
     };
     Ok((scene, requests))
 }

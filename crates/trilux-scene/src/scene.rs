@@ -62,6 +62,11 @@ pub struct Scene {
     /// Number of `<bsdf>` elements of each type written in the file (nested
     /// ones included; a referenced BSDF counts once).
     pub bsdf_counts: BTreeMap<String, usize>,
+    /// A glTF file's cameras in the order its nodes are walked (the first
+    /// is the default; `--camera` takes either name), each by its
+    /// camera's name, else its node's, `None` when neither is named.
+    /// Empty for an XML scene (its one `<sensor>` is `camera`).
+    pub camera_names: Vec<Option<String>>,
 }
 
 impl Scene {

@@ -84,11 +84,14 @@ pub fn run(args: &BakeArgs) -> Result<()> {
     let plan = args
         .options
         .plan(pending.scene(), args.solution.as_deref(), bake);
-    let mut outcome = crate::progress::run_plan(pending, &plan)?;
+    let crate::plan::Finished {
+        mut outcome,
+        record,
+    } = crate::plan::run_plan(pending, &plan)?;
     let baked = outcome.baked.take().context("the bake produced no file")?;
     let mut files = vec![baked.glb.clone()];
     if args.stats.is_some() {
-        files.push(bake_stats_json(&outcome.solve, &baked.stats)?);
+        files.push(bake_stats_json(&outcome.solve, &baked.stats, &record)?);
     }
     outputs.write(&files)?;
     crate::warn(&outcome);

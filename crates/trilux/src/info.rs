@@ -45,6 +45,31 @@ struct InfoJson {
     mode: &'static str,
     /// `null` when the scene has no sensor.
     camera: Option<CameraJson>,
+    /// A glTF file's cameras by name (`Scene::camera_names`).
+    cameras: Vec<Option<String>>,
+    /// Every shape, in file order: what the text lists line by line.
+    shape_list: Vec<ShapeJson>,
+}
+
+/// One shape of `info`.
+#[derive(Debug, Serialize)]
+struct ShapeJson {
+    /// Its index (the solver's shape index).
+    index: usize,
+    /// Its `id` (XML) or node name (glTF), if any.
+    id: Option<String>,
+    /// `rectangle`, `cube`, `disk`, `sphere`, `cylinder` or `mesh`.
+    kind: &'static str,
+    /// A mesh's triangles (`null` for the other kinds).
+    triangles: Option<usize>,
+    /// Surface area in scene units².
+    area: f64,
+    /// True when it carries an area emitter.
+    emitter: bool,
+    /// Textures it uses.
+    textures: usize,
+    /// Where it is written: `line N` (XML) or a JSON pointer (glTF).
+    at: String,
 }
 
 #[derive(Debug, Serialize)]
@@ -84,6 +109,8 @@ pub fn run(args: &InfoArgs) -> Result<()> {
             width: c.width,
             height: c.height,
         }),
+        cameras: scene.camera_names.clone(),
+        shape_list: scene.shapes.iter().enumerate().map(shape_json).collect(),
     };
     if args.json {
         crate::streams::print(&format!("{}\n", serde_json::to_string_pretty(&info)?))
@@ -131,30 +158,57 @@ fn text(scene: &Scene, info: &InfoJson) -> Result<String, std::fmt::Error> {
         }
         _ => writeln!(out, "camera         none (the scene has no <sensor>)")?,
     }
-    for (i, s) in scene.shapes.iter().enumerate() {
-        let kind = match &s.shape.kind {
-            ShapeKind::Rectangle => "rectangle".to_string(),
-            ShapeKind::Cube => "cube".to_string(),
-            ShapeKind::Disk => "disk".to_string(),
-            ShapeKind::Sphere { .. } => "sphere".to_string(),
-            ShapeKind::Cylinder { .. } => "cylinder".to_string(),
-            ShapeKind::Mesh(m) => format!("mesh ({} triangles)", m.triangles.len()),
+    if !info.cameras.is_empty() {
+        let names: Vec<&str> = info
+            .cameras
+            .iter()
+            .map(|n| n.as_deref().unwrap_or("(unnamed)"))
+            .collect();
+        writeln!(out, "cameras        {}", names.join(", "))?;
+    }
+    for s in &info.shape_list {
+        let kind = match s.triangles {
+            Some(n) => format!("mesh ({n} triangles)"),
+            None => s.kind.to_string(),
         };
-        let textures = match s.textures.len() {
+        let textures = match s.textures {
             0 => String::new(),
             n => format!(", {n} texture{}", if n == 1 { "" } else { "s" }),
         };
-        let at = match &s.location.pointer {
-            Some(p) => p.to_string(),
-            None => format!("line {}", s.location.line),
-        };
         writeln!(
             out,
-            "  shape {i:3} {:16} {kind:24} area {:.6}{}{textures}  ({at})",
+            "  shape {:3} {:16} {kind:24} area {:.6}{}{textures}  ({})",
+            s.index,
             s.id.as_deref().unwrap_or("-"),
-            trilux_scene::surface_area(&s.shape),
-            if s.emitter.is_some() { ", emitter" } else { "" },
+            s.area,
+            if s.emitter { ", emitter" } else { "" },
+            s.at,
         )?;
     }
     Ok(out)
+}
+
+/// Shape `index` of the scene as `info` shows it.
+fn shape_json((index, s): (usize, &trilux_scene::SceneShape)) -> ShapeJson {
+    let (kind, triangles) = match &s.shape.kind {
+        ShapeKind::Rectangle => ("rectangle", None),
+        ShapeKind::Cube => ("cube", None),
+        ShapeKind::Disk => ("disk", None),
+        ShapeKind::Sphere { .. } => ("sphere", None),
+        ShapeKind::Cylinder { .. } => ("cylinder", None),
+        ShapeKind::Mesh(m) => ("mesh", Some(m.triangles.len())),
+    };
+    ShapeJson {
+        index,
+        id: s.id.clone(),
+        kind,
+        triangles,
+        area: trilux_scene::surface_area(&s.shape),
+        emitter: s.emitter.is_some(),
+        textures: s.textures.len(),
+        at: match &s.location.pointer {
+            Some(p) => p.to_string(),
+            None => format!("line {}", s.location.line),
+        },
+    }
 }

@@ -19,8 +19,10 @@ mod bake;
 mod info;
 mod options;
 mod output;
+mod plan;
 mod power;
 mod progress;
+mod record;
 mod render;
 mod serve;
 mod solve;
@@ -161,6 +163,7 @@ fn usage_error(e: clap::Error) -> ExitCode {
 }
 
 fn main() -> ExitCode {
+    record::start();
     // Usage errors exit here with clap's message and status 2.
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,

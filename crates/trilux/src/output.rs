@@ -265,16 +265,18 @@ impl Outputs {
     }
 }
 
-/// The statistics JSON: the solver's figures plus the render time and
-/// what the render left out.
+/// The statistics JSON: the solver's figures plus the render time, what
+/// the render left out and the run's record.
 pub fn stats_json(
     stats: &trilux_solver::SolveStats,
     render: Option<&trilux_render::RenderStats>,
     render_seconds: f64,
+    record: &crate::record::Record,
 ) -> Result<Vec<u8>> {
     let mut value = serde_json::to_value(stats)?;
     if let Some(map) = value.as_object_mut() {
         map.insert("render_seconds".into(), serde_json::json!(render_seconds));
+        map.insert("record".into(), serde_json::to_value(record)?);
         if let Some(r) = render {
             map.insert(
                 "dropped_samples".into(),
@@ -290,13 +292,16 @@ pub fn stats_json(
 }
 
 /// The statistics JSON of a bake: the solver's figures plus the file's
-/// (`bake`: bytes, vertices, triangles, seconds, max_flux_error).
+/// (`bake`: bytes, vertices, triangles, seconds, max_flux_error) and the
+/// run's record.
 pub fn bake_stats_json(
     stats: &trilux_solver::SolveStats,
     bake: &trilux_bake::BakeStats,
+    record: &crate::record::Record,
 ) -> Result<Vec<u8>> {
     let mut value = serde_json::to_value(stats)?;
     if let Some(map) = value.as_object_mut() {
+        map.insert("record".into(), serde_json::to_value(record)?);
         map.insert(
             "bake".into(),
             serde_json::json!({

@@ -1,35 +1,42 @@
-//! Progress bars on a terminal, nothing otherwise (CI stays quiet).
+//! The progress bar of `solve`, `render` and `bake` on a terminal, nothing
+//! otherwise (CI stays quiet).
 
 use std::io::IsTerminal;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use indicatif::{ProgressBar, ProgressStyle};
 use trilux_solver::Progress;
 
-/// A progress bar labelled `what` on a terminal, `None` otherwise.
-fn bar(len: u64, what: &str) -> Option<ProgressBar> {
+/// The one bar of a command, `None` when stderr is not a terminal. The
+/// message is `{wide_msg}`: cut to the terminal's width, so that the bar
+/// stays one line and clearing it leaves nothing behind.
+fn bar() -> Option<ProgressBar> {
     if !std::io::stderr().is_terminal() {
         return None;
     }
-    let bar = ProgressBar::new(len);
-    if let Ok(style) = ProgressStyle::with_template("{prefix} [{bar:40}] {msg} ({elapsed})") {
+    let bar = ProgressBar::new(1000);
+    if let Ok(style) = ProgressStyle::with_template("{prefix} [{bar:30}] {elapsed} {wide_msg}") {
         bar.set_style(style.progress_chars("=> "));
     }
-    bar.set_prefix(what.to_string());
+    bar.set_prefix("solve");
     Some(bar)
 }
 
-/// The bars of one command: the solve's convergence and the render's tiles.
+/// The progress of one command (`solve`, `render`, `bake`): one bar,
+/// the solve's convergence and then the render's tiles, each with the time
+/// left that its rate so far predicts ([`time_left`]).
 pub struct Bars {
-    solve: Option<ProgressBar>,
-    render: Option<ProgressBar>,
+    bar: Option<ProgressBar>,
+    /// Set by the first tile: the bar then shows the render.
+    rendering: AtomicBool,
 }
 
 impl Bars {
-    /// Bars for a solve and, with `render`, a render.
-    pub fn new(render: bool) -> Self {
+    /// The bar of a command (on a terminal).
+    pub fn new() -> Self {
         Bars {
-            solve: bar(1000, "solve"),
-            render: if render { bar(1, "render") } else { None },
+            bar: bar(),
+            rendering: AtomicBool::new(false),
         }
     }
 
@@ -38,39 +45,63 @@ impl Bars {
     /// falls about geometrically with the shots, so this moves about evenly
     /// in time), with the time left that its rate so far predicts.
     pub fn solve(&self, p: &Progress) {
-        let Some(bar) = &self.solve else { return };
+        let Some(bar) = &self.bar else { return };
         let frac = convergence_fraction(p.convergence_ratio, p.target);
         bar.set_position((frac * 1000.0) as u64);
-        let left = match time_left(frac, p.elapsed_seconds) {
-            Some(s) => format!(", about {s:.0} s left"),
-            None => String::new(),
-        };
         let budget = match p.time_budget_seconds {
             Some(b) => format!(" (budget {b} s)"),
             None => String::new(),
         };
         bar.set_message(format!(
-            "CR {:.4}/{:.4}{left}{budget}, shot {}, {} interactions, {} links",
-            p.convergence_ratio, p.target, p.shots, p.interactions, p.live_links
+            "{}CR {:.4}/{:.4}{budget}, shot {}, {} interactions, {} links",
+            left(time_left(frac, p.elapsed_seconds)),
+            p.convergence_ratio,
+            p.target,
+            p.shots,
+            p.interactions,
+            p.live_links
         ));
     }
 
-    /// Shows the render's progress after a tile.
+    /// Shows the render's progress after a tile (from worker threads); the
+    /// first tile turns the bar into the render's, its clock restarted.
     pub fn render(&self, done: usize, total: usize) {
-        if let Some(s) = &self.solve {
-            s.finish_and_clear();
+        let Some(bar) = &self.bar else { return };
+        if !self.rendering.swap(true, Ordering::AcqRel) {
+            bar.set_prefix("render");
+            bar.set_message("");
+            bar.reset();
         }
-        let Some(bar) = &self.render else { return };
-        bar.set_length(total as u64);
+        bar.set_length(total.max(1) as u64);
         bar.set_position(done as u64);
-        bar.set_message(format!("{done}/{total} tiles"));
+        let frac = done as f64 / total.max(1) as f64;
+        let seconds = bar.elapsed().as_secs_f64();
+        bar.set_message(format!(
+            "{}{done}/{total} tiles",
+            left(time_left(frac, seconds))
+        ));
     }
 
-    /// Clears every bar.
+    /// Clears the bar: the terminal is left as it was before.
     pub fn finish(&self) {
-        for b in [&self.solve, &self.render].into_iter().flatten() {
-            b.finish_and_clear();
+        if let Some(bar) = &self.bar {
+            bar.finish_and_clear();
         }
+    }
+}
+
+impl Default for Bars {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// "about N s left, " when there is an estimate, else nothing.
+fn left(seconds: Option<f64>) -> String {
+    match seconds {
+        Some(s) if s < 10.0 => format!("about {s:.1} s left, "),
+        Some(s) => format!("about {s:.0} s left, "),
+        None => String::new(),
     }
 }
 
@@ -98,36 +129,6 @@ fn convergence_fraction(cr: f64, target: f64) -> f64 {
 /// (`None` before there is a rate to go by).
 fn time_left(frac: f64, elapsed: f64) -> Option<f64> {
     (frac > 0.01 && frac < 1.0 && elapsed > 0.0).then(|| elapsed * (1.0 - frac) / frac)
-}
-
-/// Checks `plan` against the scene read so far, reads the rest of it
-/// (meshes, textures) and carries the plan out, with bars for its solve
-/// and, when it renders, its render (`pipeline::check`, then
-/// `pipeline::run`, then a warning for a scene without an emitter: after
-/// the work, so that an error stays one line, and a dark scene's solve
-/// has no light to shoot and ends at once): what `solve`,
-/// `render` and `bake` share.
-pub fn run_plan(
-    pending: trilux_scene::Pending,
-    plan: &trilux::Plan<'_>,
-) -> anyhow::Result<trilux::Outcome> {
-    trilux::pipeline::check(pending.scene(), plan)?;
-    let scene = pending.finish()?;
-    let bars = Bars::new(plan.render.is_some());
-    let mut on_shot = |p: &Progress| bars.solve(p);
-    let on_tile = |done: usize, total: usize| bars.render(done, total);
-    let outcome = trilux::pipeline::run(
-        &scene,
-        plan,
-        trilux::Observer {
-            solve: &mut on_shot,
-            render: &on_tile,
-        },
-    );
-    bars.finish();
-    let outcome = outcome?;
-    crate::warn_if_dark(&scene);
-    Ok(outcome)
 }
 
 #[cfg(test)]

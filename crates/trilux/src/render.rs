@@ -224,7 +224,11 @@ pub fn run_into(args: &RenderArgs, in_out: bool) -> Result<()> {
     let plan = args
         .options
         .plan(pending.scene(), args.solution.as_deref(), render);
-    let outcome = crate::progress::run_plan(pending, &plan)?;
+    let crate::plan::Finished {
+        outcome,
+        mut record,
+    } = crate::plan::run_plan(pending, &plan)?;
+    record.set("png_exposure", serde_json::json!(args.exposure));
     let image = outcome
         .image
         .as_ref()
@@ -232,7 +236,7 @@ pub fn run_into(args: &RenderArgs, in_out: bool) -> Result<()> {
     let mut files = Vec::new();
     match &images.image {
         Some((_, Format::Png)) => files.push(image.png_bytes(args.exposure)?),
-        Some(_) => files.push(image.exr_bytes()?),
+        Some(_) => files.push(exr_with_record(image, &record)?),
         None => {}
     }
     if images.png.is_some() {
@@ -240,9 +244,25 @@ pub fn run_into(args: &RenderArgs, in_out: bool) -> Result<()> {
     }
     if args.stats.is_some() {
         let render = outcome.render.as_ref();
-        files.push(stats_json(&outcome.solve, render, outcome.render_seconds)?);
+        files.push(stats_json(
+            &outcome.solve,
+            render,
+            outcome.render_seconds,
+            &record,
+        )?);
     }
     outputs.write(&files)?;
     crate::warn(&outcome);
     outputs.report(None)
+}
+
+/// The EXR file of `image` with `record` in its header
+/// (`Record::exr_attributes`).
+fn exr_with_record(
+    image: &trilux_render::Image,
+    record: &crate::record::Record,
+) -> Result<Vec<u8>> {
+    let attributes = record.exr_attributes()?;
+    let pairs: Vec<(&str, &str)> = attributes.iter().map(|(k, v)| (*k, v.as_str())).collect();
+    Ok(image.exr_bytes_with(&pairs)?)
 }

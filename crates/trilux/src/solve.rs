@@ -49,14 +49,17 @@ pub fn run(args: &SolveArgs) -> Result<()> {
     let plan = args
         .options
         .plan(pending.scene(), None, Product::SolutionFile);
-    let mut outcome = crate::progress::run_plan(pending, &plan)?;
+    let crate::plan::Finished {
+        mut outcome,
+        record,
+    } = crate::plan::run_plan(pending, &plan)?;
     let solution = outcome
         .solution_file
         .take()
         .context("the solve produced no solution file")?;
     let mut files = vec![solution];
     if args.stats.is_some() {
-        files.push(stats_json(&outcome.solve, None, 0.0)?);
+        files.push(stats_json(&outcome.solve, None, 0.0, &record)?);
     }
     outputs.write(&files)?;
     crate::warn(&outcome);

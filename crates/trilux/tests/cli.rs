@@ -247,10 +247,12 @@ fn info_json_has_exactly_the_design_keys() {
         [
             "bsdfs",
             "camera",
+            "cameras",
             "emitted_power",
             "emitters",
             "input_surfaces",
             "mode",
+            "shape_list",
             "shapes"
         ]
     );

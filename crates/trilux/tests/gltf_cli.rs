@@ -335,3 +335,34 @@ fn camera_by_name() {
         "{stderr}"
     );
 }
+
+/// `info` names every camera: by the camera's name, else its node's, else
+/// `null` (JSON) or `(unnamed)` (text), in the order of the nodes.
+#[test]
+fn info_names_every_camera() {
+    let json = triangle(|j| {
+        j["scenes"][0]["nodes"] = serde_json::json!([0, 1, 2, 3]);
+        j["cameras"][0]["name"] = "wide".into();
+        let lens = serde_json::json!({"yfov": 0.5, "znear": 0.01});
+        let nodes = j["nodes"].as_array_mut().unwrap();
+        nodes
+            .push(serde_json::json!({"name": "side", "camera": 1, "translation": [2.0, 0.2, 0.2]}));
+        nodes.push(serde_json::json!({"camera": 2, "translation": [0.2, 2.0, 0.2]}));
+        let cameras = j["cameras"].as_array_mut().unwrap();
+        for _ in 0..2 {
+            cameras.push(serde_json::json!({"type": "perspective", "perspective": lens}));
+        }
+    });
+    let dir = folder("gltf-camera-names");
+    let path = dir.join("cameras.gltf");
+    std::fs::write(&path, serde_json::to_vec(&json).unwrap()).unwrap();
+    let v = info_json(&path, &[]);
+    assert_eq!(v["cameras"], serde_json::json!(["wide", "side", null]));
+    let out = trilux(&["info", path.to_str().unwrap()]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.lines()
+            .any(|l| l == "cameras        wide, side, (unnamed)"),
+        "{text}"
+    );
+}

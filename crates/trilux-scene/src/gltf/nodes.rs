@@ -101,6 +101,11 @@ pub(crate) fn build(
         walk.node(&node, DMat4::IDENTITY, 1)?;
     }
     let camera = choose_camera(file, &walk.cameras, camera)?;
+    let camera_names = walk
+        .cameras
+        .iter()
+        .map(|c| c.names.iter().flatten().next().cloned())
+        .collect();
     let scene = Scene {
         path: file.to_path_buf(),
         shapes: walk.shapes,
@@ -108,6 +113,7 @@ pub(crate) fn build(
         max_depth: None,
         spectral: false,
         bsdf_counts: walk.bsdf_counts,
+        camera_names,
     };
     let meshes = GltfMeshes {
         file: Arc::clone(file),
