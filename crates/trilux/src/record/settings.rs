@@ -55,11 +55,14 @@ fn render(scene: &trilux_scene::Scene, plan: &RenderPlan) -> Result<Value> {
         Estimator::Paths => "paths",
         Estimator::Links => "links",
         Estimator::Preview => "preview",
+        // A kind added later: its Debug name until it is named here.
+        other => &format!("{other:?}"),
     };
     let extra_bounce = match s.extra_bounce {
         ExtraBounce::Always => json!("always"),
         ExtraBounce::Never => json!("never"),
         ExtraBounce::Auto { close_factor } => json!({ "auto": { "close_factor": close_factor } }),
+        other => json!(format!("{other:?}")),
     };
     let v = &plan.view;
     let lookat = v.lookat.map(|(eye, target, up)| {
