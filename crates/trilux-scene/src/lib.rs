@@ -57,6 +57,7 @@ mod resolve;
 /// sensor's plain data in `trilux_geometry::sensor`).
 pub use trilux_geometry::sensor::rfilter;
 pub mod scene;
+pub mod serialized;
 pub mod shape;
 mod text;
 mod textures;
