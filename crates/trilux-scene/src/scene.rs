@@ -62,6 +62,10 @@ pub struct Scene {
     /// Number of `<bsdf>` elements of each type written in the file (nested
     /// ones included; a referenced BSDF counts once).
     pub bsdf_counts: BTreeMap<String, usize>,
+    /// What loading left out, one line each with its place (zero-area
+    /// triangles and meshes): the command prints them as warnings.
+    #[serde(skip)]
+    pub warnings: Vec<String>,
 }
 
 impl Scene {

@@ -195,7 +195,7 @@ fn references_to_top_level_bsdfs() {
     );
     assert!(
         err(r#"<shape type="rectangle" id="a"/><shape type="cube"><ref id="a"/></shape>"#)
-            .contains("only <bsdf> elements can be referenced")
+            .contains("only <bsdf> and <texture> elements can be referenced")
     );
     assert!(
         err(r#"<bsdf type="diffuse" id="a"/><bsdf type="diffuse" id="a"/>"#)
@@ -904,7 +904,7 @@ fn clip_planes() {
 
 #[test]
 fn unknown_things_are_refused() {
-    assert!(err(r#"<shape type="serialized"/>"#).contains("unknown shape plugin \"serialized\""));
+    assert!(err(r#"<shape type="heightfield"/>"#).contains("unknown shape plugin \"heightfield\""));
     assert!(
         err(r#"<shape type="rectangle"><float name="size" value="2"/></shape>"#)
             .contains("unknown parameter \"size\" for <shape type=\"rectangle\">")

@@ -113,6 +113,7 @@ pub fn run_plan(
 ) -> anyhow::Result<trilux::Outcome> {
     trilux::pipeline::check(pending.scene(), plan)?;
     let scene = pending.finish()?;
+    crate::warn_loading(&scene);
     let bars = Bars::new(plan.render.is_some());
     let mut on_shot = |p: &Progress| bars.solve(p);
     let on_tile = |done: usize, total: usize| bars.render(done, total);

@@ -71,10 +71,10 @@ fn malformed_xml() {
 fn unknown_plugin() {
     assert_scene_error(
         "plugin",
-        &format!("{HEAD}  <shape type=\"serialized\"/>\n</scene>\n"),
+        &format!("{HEAD}  <shape type=\"heightfield\"/>\n</scene>\n"),
         2,
-        "serialized",
-        "unknown shape plugin \"serialized\"",
+        "heightfield",
+        "unknown shape plugin \"heightfield\"",
     );
     assert_scene_error(
         "bsdf-plugin",

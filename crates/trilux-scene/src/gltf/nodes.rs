@@ -108,6 +108,7 @@ pub(crate) fn build(
         max_depth: None,
         spectral: false,
         bsdf_counts: walk.bsdf_counts,
+        warnings: Vec::new(),
     };
     let meshes = GltfMeshes {
         file: Arc::clone(file),
