@@ -314,3 +314,143 @@ fn read_mesh(s: &mut Inflate<'_>, version: u16, face_normals: bool) -> Result<Tr
         texcoords,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use std::io::Write;
+
+    use super::*;
+
+    /// A mesh's stream as Mitsuba 0.6 writes it: `flags`, the name
+    /// (version 4), the counts, then `arrays` of floats and the indices.
+    fn stream(version: u16, flags: u32, nv: u64, arrays: &[&[f64]], tris: &[u32]) -> Vec<u8> {
+        let mut d = flags.to_le_bytes().to_vec();
+        if version == 4 {
+            d.extend(b"a mesh\0");
+        }
+        d.extend(nv.to_le_bytes());
+        d.extend((tris.len() as u64 / 3).to_le_bytes());
+        for &x in arrays.iter().copied().flatten() {
+            if flags & 0x2000 != 0 {
+                d.extend(x.to_le_bytes());
+            } else {
+                d.extend((x as f32).to_le_bytes());
+            }
+        }
+        tris.iter().for_each(|i| d.extend(i.to_le_bytes()));
+        d
+    }
+
+    fn compress(data: &[u8]) -> Vec<u8> {
+        let mut z = flate2::write::ZlibEncoder::new(Vec::new(), flate2::Compression::default());
+        z.write_all(data).unwrap();
+        z.finish().unwrap()
+    }
+
+    /// The meshes' streams, each behind its header, and the dictionary
+    /// (offsets `u64` in version 4, `u32` in version 3).
+    fn file(version: u16, streams: &[Vec<u8>]) -> Vec<u8> {
+        let mut out = Vec::new();
+        let mut offsets = Vec::new();
+        for s in streams {
+            offsets.push(out.len() as u64);
+            out.extend(MAGIC.to_le_bytes());
+            out.extend(version.to_le_bytes());
+            out.extend(compress(s));
+        }
+        for o in offsets {
+            if version == 4 {
+                out.extend(o.to_le_bytes());
+            } else {
+                out.extend((o as u32).to_le_bytes());
+            }
+        }
+        out.extend((streams.len() as u32).to_le_bytes());
+        out
+    }
+
+    fn parse(bytes: &[u8], index: u32, face_normals: bool) -> Result<TriangleMesh, String> {
+        parse_serialized(bytes, Path::new("m.serialized"), index, face_normals)
+            .map_err(|e| e.to_string())
+    }
+
+    const P: [f64; 9] = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
+
+    /// Every part of both versions, in single and double precision, is
+    /// where the layout puts it: normals and texture coordinates as
+    /// written, colours read past (the indices after them still right),
+    /// each mesh of a file reached through the dictionary.
+    #[test]
+    fn both_versions_read_every_part_of_every_mesh() {
+        let n = [0.0, 0.0, 1.0, 0.0, 0.5, 0.75, 0.0, 0.0, 1.0];
+        let uv = [0.0, 0.0, 0.25, 0.0, 0.0, 0.75];
+        let colours = [9.0; 9];
+        for version in [3, 4] {
+            for precision in [0x1000, 0x2000] {
+                let first = stream(version, precision | 0x0B, 3, &[&P, &n, &uv, &colours], &[0, 1, 2]);
+                let second = stream(version, precision, 4, &[&P, &[5.0, 5.0, 5.0]], &[2, 1, 0, 3, 1, 2]);
+                let bytes = file(version, &[first, second]);
+                let m = parse(&bytes, 0, false).unwrap();
+                assert_eq!(m.positions[1], DVec3::X);
+                assert_eq!(m.normals.as_ref().unwrap()[1], DVec3::new(0.0, 0.5, 0.75));
+                assert_eq!(m.texcoords.as_ref().unwrap()[2], DVec2::new(0.0, 0.75));
+                assert_eq!(m.triangles, [[0, 1, 2]]);
+                assert!(parse(&bytes, 0, true).unwrap().normals.is_none());
+                let m = parse(&bytes, 1, false).unwrap();
+                assert_eq!(m.positions[3], DVec3::splat(5.0));
+                assert_eq!(m.triangles, [[2, 1, 0], [3, 1, 2]]);
+                assert!(m.texcoords.is_none());
+                // Without normals in the file: recomputed smooth ones
+                // (the first triangle faces −z).
+                assert_eq!(m.normals.unwrap()[0], -DVec3::Z);
+            }
+        }
+    }
+
+    /// A name that never ends is refused after [`MAX_NAME_BYTES`], however
+    /// far its stream would expand; a value that is not finite is refused.
+    #[test]
+    fn endless_names_and_non_finite_values_are_refused() {
+        let mut name = 0x1000u32.to_le_bytes().to_vec();
+        name.extend(vec![b'a'; 8 << 20]);
+        let e = parse(&file(4, &[name]), 0, false).unwrap_err();
+        assert!(e.contains("name") && e.contains("longer than 65536 bytes"), "{e}");
+        let mut p = P;
+        p[4] = f64::NAN;
+        let e = parse(&file(4, &[stream(4, 0x2000, 3, &[&p], &[0, 1, 2])]), 0, false)
+            .unwrap_err();
+        assert!(e.contains("positions") && e.contains("not a finite number"), "{e}");
+        let e = parse(&file(4, &[stream(4, 0x1000, 3, &[&P], &[])]), 0, false).unwrap_err();
+        assert!(e.contains("no triangles"), "{e}");
+    }
+
+    /// The dictionary is checked: a count beyond it, an offset beyond the
+    /// file, a mesh of another version there.
+    #[test]
+    fn a_bad_dictionary_is_refused() {
+        let one = file(4, &[stream(4, 0x1000, 3, &[&P], &[0, 1, 2])]);
+        let e = parse(&one, 1, false).unwrap_err();
+        assert!(e.contains("shape_index 1 is out of range: the file holds 1 meshes"), "{e}");
+        let mut far = one.clone();
+        let n = far.len();
+        far[n - 12..n - 4].copy_from_slice(&u64::MAX.to_le_bytes());
+        far[n - 4..].copy_from_slice(&2u32.to_le_bytes());
+        let e = parse(&far, 1, false).unwrap_err();
+        assert!(e.contains("beyond the file"), "{e}");
+        let e = parse(&[0x1C, 0x04, 4, 0, 2, 0, 0, 0], 1, false).unwrap_err();
+        assert!(e.contains("too short"), "{e}");
+        let mut mixed = file(4, &[stream(4, 0x1000, 3, &[&P], &[0, 1, 2])]);
+        let at = mixed.len() - 12;
+        mixed.truncate(at);
+        let second = mixed.len() as u64;
+        mixed.extend(MAGIC.to_le_bytes());
+        mixed.extend(3u16.to_le_bytes());
+        mixed.extend(compress(&stream(3, 0x1000, 3, &[&P], &[0, 1, 2])));
+        mixed.extend(0u64.to_le_bytes());
+        mixed.extend(second.to_le_bytes());
+        mixed.extend(2u32.to_le_bytes());
+        assert!(parse(&mixed, 0, false).is_ok());
+        let e = parse(&mixed, 1, false).unwrap_err();
+        assert!(e.contains("version 3, but the file's first mesh is version 4"), "{e}");
+    }
+}

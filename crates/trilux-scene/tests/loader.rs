@@ -201,6 +201,13 @@ fn references_to_top_level_bsdfs() {
         err(r#"<bsdf type="diffuse" id="a"/><bsdf type="diffuse" id="a"/>"#)
             .contains("already used")
     );
+    // A texture's <ref> gives the parameter's name; without one the copy
+    // has none, and a definition needs an id.
+    let e = err(
+        r#"<texture type="checkerboard" id="t"/><shape type="rectangle"><bsdf type="diffuse"><ref id="t"/></bsdf></shape>"#,
+    );
+    assert!(e.contains("name"), "{e}");
+    assert!(err(r#"<texture type="checkerboard"/>"#).contains("unsupported element <texture>"));
 }
 
 // ---- sensor, film, sampler, integrator ---------------------------------
