@@ -169,7 +169,11 @@ fn drop_zero_area(mesh: &mut TriangleMesh, world_from_object: &DMat4) -> (usize,
         // The readers check every index against the vertices.
         let [a, b, c] = t.map(|i| placed.get(i as usize).copied().unwrap_or(DVec3::NAN));
         let area = 0.5 * (b - a).cross(c - a).length();
-        !(area <= 1e-14 * diagonal)
+        // Kept unless comparably small (NaN compares to nothing).
+        !matches!(
+            area.partial_cmp(&(1e-14 * diagonal)),
+            Some(std::cmp::Ordering::Less | std::cmp::Ordering::Equal)
+        )
     });
     (total, total - mesh.triangles.len())
 }

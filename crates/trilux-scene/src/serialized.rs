@@ -165,7 +165,9 @@ fn mesh_offset(bytes: &[u8], version: u16, index: u32) -> Result<usize, String> 
     usize::try_from(offset)
         .ok()
         .filter(|&o| o < len)
-        .ok_or_else(|| format!("mesh {index} starts at byte {offset}, beyond the file's {len} bytes"))
+        .ok_or_else(|| {
+            format!("mesh {index} starts at byte {offset}, beyond the file's {len} bytes")
+        })
 }
 
 /// The decompressed stream of one mesh, counting the bytes read.
@@ -212,7 +214,8 @@ impl<'a> Inflate<'a> {
         if double {
             self.bytes::<8>(part).map(f64::from_le_bytes)
         } else {
-            self.bytes::<4>(part).map(|b| f64::from(f32::from_le_bytes(b)))
+            self.bytes::<4>(part)
+                .map(|b| f64::from(f32::from_le_bytes(b)))
         }
     }
 
@@ -240,7 +243,11 @@ impl<'a> Inflate<'a> {
 }
 
 /// The mesh in `s` (its stream after the header).
-fn read_mesh(s: &mut Inflate<'_>, version: u16, face_normals: bool) -> Result<TriangleMesh, Failure> {
+fn read_mesh(
+    s: &mut Inflate<'_>,
+    version: u16,
+    face_normals: bool,
+) -> Result<TriangleMesh, Failure> {
     let flags = s.u32("flags")?;
     if version == 4 {
         let mut name = 0;
@@ -289,7 +296,11 @@ fn read_mesh(s: &mut Inflate<'_>, version: u16, face_normals: bool) -> Result<Tr
     }
     let mut tris = Vec::with_capacity(nt.min(1 << 16));
     for _ in 0..nt {
-        let t = [s.u32("triangles")?, s.u32("triangles")?, s.u32("triangles")?];
+        let t = [
+            s.u32("triangles")?,
+            s.u32("triangles")?,
+            s.u32("triangles")?,
+        ];
         if let Some(&i) = t.iter().find(|&&i| i as usize >= nv) {
             return Err((
                 "triangles",
@@ -387,8 +398,20 @@ mod tests {
         let colours = [9.0; 9];
         for version in [3, 4] {
             for precision in [0x1000, 0x2000] {
-                let first = stream(version, precision | 0x0B, 3, &[&P, &n, &uv, &colours], &[0, 1, 2]);
-                let second = stream(version, precision, 4, &[&P, &[5.0, 5.0, 5.0]], &[2, 1, 0, 3, 1, 2]);
+                let first = stream(
+                    version,
+                    precision | 0x0B,
+                    3,
+                    &[&P, &n, &uv, &colours],
+                    &[0, 1, 2],
+                );
+                let second = stream(
+                    version,
+                    precision,
+                    4,
+                    &[&P, &[5.0, 5.0, 5.0]],
+                    &[2, 1, 0, 3, 1, 2],
+                );
                 let bytes = file(version, &[first, second]);
                 let m = parse(&bytes, 0, false).unwrap();
                 assert_eq!(m.positions[1], DVec3::X);
@@ -414,12 +437,22 @@ mod tests {
         let mut name = 0x1000u32.to_le_bytes().to_vec();
         name.extend(vec![b'a'; 8 << 20]);
         let e = parse(&file(4, &[name]), 0, false).unwrap_err();
-        assert!(e.contains("name") && e.contains("longer than 65536 bytes"), "{e}");
+        assert!(
+            e.contains("name") && e.contains("longer than 65536 bytes"),
+            "{e}"
+        );
         let mut p = P;
         p[4] = f64::NAN;
-        let e = parse(&file(4, &[stream(4, 0x2000, 3, &[&p], &[0, 1, 2])]), 0, false)
-            .unwrap_err();
-        assert!(e.contains("positions") && e.contains("not a finite number"), "{e}");
+        let e = parse(
+            &file(4, &[stream(4, 0x2000, 3, &[&p], &[0, 1, 2])]),
+            0,
+            false,
+        )
+        .unwrap_err();
+        assert!(
+            e.contains("positions") && e.contains("not a finite number"),
+            "{e}"
+        );
         let e = parse(&file(4, &[stream(4, 0x1000, 3, &[&P], &[])]), 0, false).unwrap_err();
         assert!(e.contains("no triangles"), "{e}");
     }
@@ -430,7 +463,10 @@ mod tests {
     fn a_bad_dictionary_is_refused() {
         let one = file(4, &[stream(4, 0x1000, 3, &[&P], &[0, 1, 2])]);
         let e = parse(&one, 1, false).unwrap_err();
-        assert!(e.contains("shape_index 1 is out of range: the file holds 1 meshes"), "{e}");
+        assert!(
+            e.contains("shape_index 1 is out of range: the file holds 1 meshes"),
+            "{e}"
+        );
         let mut far = one.clone();
         let n = far.len();
         far[n - 12..n - 4].copy_from_slice(&u64::MAX.to_le_bytes());
@@ -451,6 +487,9 @@ mod tests {
         mixed.extend(2u32.to_le_bytes());
         assert!(parse(&mixed, 0, false).is_ok());
         let e = parse(&mixed, 1, false).unwrap_err();
-        assert!(e.contains("version 3, but the file's first mesh is version 4"), "{e}");
+        assert!(
+            e.contains("version 3, but the file's first mesh is version 4"),
+            "{e}"
+        );
     }
 }

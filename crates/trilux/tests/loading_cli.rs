@@ -23,7 +23,12 @@ const TRIANGLE: Mesh<'static> = Mesh {
 
 /// A 2 × 3 rectangle, in doubles, with texture coordinates.
 const QUAD: Mesh<'static> = Mesh {
-    positions: &[[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [2.0, 3.0, 0.0], [0.0, 3.0, 0.0]],
+    positions: &[
+        [0.0, 0.0, 0.0],
+        [2.0, 0.0, 0.0],
+        [2.0, 3.0, 0.0],
+        [0.0, 3.0, 0.0],
+    ],
     triangles: &[[0, 1, 2], [0, 2, 3]],
     texcoords: Some(&[[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]),
     double: true,
@@ -57,7 +62,10 @@ fn serialized_meshes_emit_from_their_analytic_areas() {
     let cases = [
         (filename("two.serialized"), 0.5),
         (
-            format!("{}\n    <integer name=\"shape_index\" value=\"1\"/>", filename("two.serialized")),
+            format!(
+                "{}\n    <integer name=\"shape_index\" value=\"1\"/>",
+                filename("two.serialized")
+            ),
             6.0,
         ),
         // Scaled by 2: four times the area; the checkerboard needs the
@@ -107,10 +115,28 @@ fn bad_serialized_files_are_refused_in_one_located_line() {
         ("version", version, "", 3, "version 5"),
         ("truncated", truncated, "", 3, "the data ends early"),
         ("bomb", bomb, "", 3, "the limits are 4000000 triangles"),
-        ("index", index, "", 3, "refers to vertex 3, but the mesh has 3 vertices"),
+        (
+            "index",
+            index,
+            "",
+            3,
+            "refers to vertex 3, but the mesh has 3 vertices",
+        ),
         ("corrupt", corrupt, "", 3, "corrupt"),
-        ("range", good.clone(), "2", 3, "shape_index 2 is out of range: the file holds 2 meshes"),
-        ("negative", good, "-1", 4, "shape_index must be a mesh index"),
+        (
+            "range",
+            good.clone(),
+            "2",
+            3,
+            "shape_index 2 is out of range: the file holds 2 meshes",
+        ),
+        (
+            "negative",
+            good,
+            "-1",
+            4,
+            "shape_index must be a mesh index",
+        ),
     ];
     for (name, bytes, index, line, what) in cases {
         let mesh = write(&dir, &format!("{name}.serialized"), bytes);
@@ -124,7 +150,11 @@ fn bad_serialized_files_are_refused_in_one_located_line() {
     }
     let path = write(&dir, "missing.xml", scene(&filename("none.serialized")));
     let out = trilux(&["info", s(&path)]);
-    assert_refused(&out, &format!("{}:3:5: ", s(&path)), "cannot read serialized file");
+    assert_refused(
+        &out,
+        &format!("{}:3:5: ", s(&path)),
+        "cannot read serialized file",
+    );
 }
 
 /// A mesh with a triangle of zero area and a mesh of zero area: the scene
@@ -162,7 +192,11 @@ fn zero_area_parts_load_with_a_warning_line() {
     );
     let path = write(&dir, "lit.xml", lit);
     let out = trilux(&["info", s(&path)]);
-    assert_refused(&out, &format!("{}:8:5: ", s(&path)), "no surface to emit from");
+    assert_refused(
+        &out,
+        &format!("{}:8:5: ", s(&path)),
+        "no surface to emit from",
+    );
 }
 
 /// The furnace (a closed box of ρ = 0.5 emitting Le = 1: L = 2 everywhere)
@@ -197,7 +231,10 @@ fn zero_area_parts_leave_a_furnace_unchanged() {
     assert!(stderr.contains("1 of the 13 triangles"), "{stderr}");
     assert_eq!(stderr.matches("warning: ").count(), 2, "{stderr}");
     let mean = image_mean(&exr);
-    assert!(mean.iter().all(|m| (m / 2.0 - 1.0).abs() < 0.03), "{mean:?}");
+    assert!(
+        mean.iter().all(|m| (m / 2.0 - 1.0).abs() < 0.03),
+        "{mean:?}"
+    );
 }
 
 fn image_mean(exr: &Path) -> [f64; 3] {
@@ -210,6 +247,8 @@ fn image_mean(exr: &Path) -> [f64; 3] {
 fn the_test_writer_makes_rfc_1950_streams() {
     assert_eq!(
         zlib_stored(&[]),
-        [0x78, 0x01, 0x01, 0x00, 0x00, 0xFF, 0xFF, 0x00, 0x00, 0x00, 0x01]
+        [
+            0x78, 0x01, 0x01, 0x00, 0x00, 0xFF, 0xFF, 0x00, 0x00, 0x00, 0x01
+        ]
     );
 }
