@@ -227,7 +227,7 @@ impl<'a> Inflate<'a> {
         part: &'static str,
     ) -> Result<Vec<[f64; N]>, Failure> {
         // Grows with the data, not with the declared count (module docs).
-        let mut out = Vec::with_capacity(count.min(1 << 16));
+        let mut out = Vec::with_capacity(count.min(1 << 10));
         for _ in 0..count {
             let mut v = [0.0; N];
             for x in &mut v {
@@ -294,7 +294,7 @@ fn read_mesh(
     if flags & 0x0008 != 0 {
         s.vectors::<3>(nv, double, "colours")?;
     }
-    let mut tris = Vec::with_capacity(nt.min(1 << 16));
+    let mut tris = Vec::with_capacity(nt.min(1 << 10));
     for _ in 0..nt {
         let t = [
             s.u32("triangles")?,
