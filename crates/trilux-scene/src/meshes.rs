@@ -1,6 +1,8 @@
-//! Stage 5 of loading: the files a scene names — OBJ and PLY meshes, glTF
-//! buffers, texture images — read only once the whole scene file is
-//! checked.
+//! Stage 5 of loading: the files a scene names — OBJ, PLY and serialized
+//! meshes, glTF buffers, texture images — read only once the whole scene
+//! file is checked. Zero-area triangles are left out here, each shape's
+//! count a line of [`Scene::warnings`], and so are meshes of zero area (an
+//! emitting one is refused, as Mitsuba refuses it).
 //!
 //! A [`Pending`] scene is everything the scene file says, its meshes still
 //! empty and its textures unread: a command checks its camera, film and

@@ -8,10 +8,12 @@
 //! Refused, each at the place that causes it: a singular `to_world` (a zero
 //! scale), zero radius or length, a sphere scaled non-uniformly, a cylinder
 //! whose cross-section is not a circle after `to_world` (Mitsuba only warns;
-//! the exact analytic intersection needs a circle), a zero total area, and a
-//! missing or malformed OBJ file. An OBJ file is only named here
-//! (`MeshRequest`); it is read once the whole scene file is checked
-//! (`crate::meshes`).
+//! the exact analytic intersection needs a circle), a zero total area of an
+//! analytic shape, and a missing or malformed mesh file. A mesh file (OBJ,
+//! PLY, serialized) is only named here (`MeshRequest`); it is read once the
+//! whole scene file is checked (`crate::meshes`), where its zero-area
+//! triangles, or the whole mesh if they all are, are left out with a
+//! warning as Mitsuba loads them and never hits them.
 
 use std::path::Path;
 
