@@ -116,7 +116,10 @@ fn a_polygon_of_a_quarter_million_vertices_loads() {
         assert!(stderr.contains("of the 249998 triangles"), "{stderr}");
     }
     let kept = 249_998 - dropped;
-    assert!(stdout.contains(&format!("({kept} triangles)")), "{stdout}\n{stderr}");
+    assert!(
+        stdout.contains(&format!("({kept} triangles)")),
+        "{stdout}\n{stderr}"
+    );
 }
 
 #[test]
