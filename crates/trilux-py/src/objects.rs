@@ -99,6 +99,13 @@ impl Scene {
         self.inner.path.clone()
     }
 
+    /// What loading left out (zero-area triangles and meshes), one line
+    /// each with its place: the command line prints them as warnings.
+    #[getter]
+    fn warnings(&self) -> Vec<String> {
+        self.inner.warnings.clone()
+    }
+
     /// The number of shapes.
     #[getter]
     fn shapes(&self) -> usize {

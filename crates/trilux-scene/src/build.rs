@@ -58,6 +58,9 @@ pub(crate) fn build(resolved: Resolved, path: &Path) -> Result<(Scene, Requests)
                 // definitions are reported too.
                 build_bsdf(e, &mut TextureCollector::new(folder))?;
             }
+            // A texture definition, checked where a <ref> places it (it
+            // needs the name the <ref> gives it).
+            "texture" if e.attr("id").is_some() => {}
             "sensor" => {
                 if let Some((_, first)) = &camera {
                     return Err(SceneError::at(
@@ -98,7 +101,7 @@ pub(crate) fn build(resolved: Resolved, path: &Path) -> Result<(Scene, Requests)
                 return Err(SceneError::at(
                     &e.loc,
                     format!(
-                        "unsupported element <{other}> in <scene> (supported: shape, bsdf, sensor, integrator, default, include)"
+                        "unsupported element <{other}> in <scene> (supported: shape, bsdf, texture with an id, sensor, integrator, default, include)"
                     ),
                 ));
             }
@@ -119,6 +122,7 @@ pub(crate) fn build(resolved: Resolved, path: &Path) -> Result<(Scene, Requests)
         spectral,
         bsdf_counts: resolved.bsdf_counts,
         camera_names: Vec::new(),
+        warnings: Vec::new(),
     };
     Ok((scene, requests))
 }

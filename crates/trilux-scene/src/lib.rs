@@ -21,8 +21,8 @@
 //!    numbers read by `numbers`) → the
 //!    model: shapes ([`shape`]), materials (`material`), area lights and the
 //!    camera ([`camera`], its film's filter in [`rfilter`]).
-//! 4. [`meshes`]: the OBJ and PLY files the shapes name ([`obj`],
-//!    [`ply`]) and the
+//! 4. [`meshes`]: the OBJ, PLY and serialized files the shapes name
+//!    ([`obj`], [`ply`], [`serialized`]) and the
 //!    textures' images, read last, so that a command can check the camera
 //!    and its options against the [`Pending`] scene first ([`open`]).
 //!
@@ -57,6 +57,7 @@ mod resolve;
 /// sensor's plain data in `trilux_geometry::sensor`).
 pub use trilux_geometry::sensor::rfilter;
 pub mod scene;
+pub mod serialized;
 pub mod shape;
 mod text;
 mod textures;

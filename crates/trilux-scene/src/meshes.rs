@@ -1,6 +1,8 @@
-//! Stage 5 of loading: the files a scene names — OBJ and PLY meshes, glTF
-//! buffers, texture images — read only once the whole scene file is
-//! checked.
+//! Stage 5 of loading: the files a scene names — OBJ, PLY and serialized
+//! meshes, glTF buffers, texture images — read only once the whole scene
+//! file is checked. Zero-area triangles are left out here, each shape's
+//! count a line of [`Scene::warnings`], and so are meshes of zero area (an
+//! emitting one is refused, as Mitsuba refuses it).
 //!
 //! A [`Pending`] scene is everything the scene file says, its meshes still
 //! empty and its textures unread: a command checks its camera, film and
@@ -12,7 +14,8 @@ use crate::gltf::GltfMeshes;
 use crate::scene::Scene;
 use crate::shape::{MeshRequest, check_area};
 use crate::textures::{ImageSource, TextureCache, TextureRequest};
-use trilux_geometry::ShapeKind;
+use glam::{DMat4, DVec3};
+use trilux_geometry::{ShapeKind, TriangleMesh};
 
 /// What a scene still has to read, by shape index.
 #[derive(Debug, Default)]
@@ -83,14 +86,40 @@ impl Pending {
     /// Reads every mesh and texture; errors point at the place in the
     /// scene that names the file.
     pub fn finish(mut self) -> Result<Scene> {
+        let mut flat = Vec::new();
         for (index, request) in self.requests.meshes {
-            let mesh = request
+            let mut mesh = request
                 .format
                 .load(&request.path, request.face_normals, request.flip_tex_coords)
                 .map_err(|e| SceneError::at(&request.filename, e))?;
-            let shape = &mut self.scene.shapes[index].shape;
+            let scene_shape = &mut self.scene.shapes[index];
+            let shape = &mut scene_shape.shape;
+            let (total, dropped) = drop_zero_area(&mut mesh, &shape.world_from_object);
             shape.kind = ShapeKind::Mesh(mesh);
-            check_area(shape, &request.shape, request.format.element())?;
+            let element = request.format.element();
+            if let (true, Some(emitter)) = (dropped == total, &scene_shape.emitter) {
+                return Err(SceneError::at(
+                    &emitter.location,
+                    format!(
+                        "every triangle of this {element} has zero area: it has no surface to emit from (Mitsuba refuses it too)"
+                    ),
+                ));
+            }
+            if dropped == total {
+                self.scene.warnings.push(format!(
+                    "{}: every triangle of this {element} has zero area: it is left out (Mitsuba loads it and never hits it)",
+                    request.shape
+                ));
+                flat.push(index);
+                continue;
+            }
+            if dropped > 0 {
+                self.scene.warnings.push(format!(
+                    "{}: {dropped} of the {total} triangles of this {element} have zero area and are left out",
+                    request.shape
+                ));
+            }
+            check_area(shape, &request.shape, element)?;
         }
         let mut cache = TextureCache::default();
         let mut textures = self.requests.textures;
@@ -110,6 +139,43 @@ impl Pending {
             }
             shape.textures.push(slot);
         }
+        // Last, so that the indices of the requests above stay valid.
+        let mut index = 0;
+        self.scene.shapes.retain(|_| {
+            index += 1;
+            !flat.contains(&(index - 1))
+        });
         Ok(self.scene)
     }
+}
+
+/// Leaves out the triangles of `mesh` that have zero area once
+/// `world_from_object` places them, by the geometry layer's rule (area at
+/// most 1e-14 of the squared diagonal of the placed vertices: it makes no
+/// surface of them) and returns how many triangles there were and how
+/// many are left out. Non-finite areas are kept, for the geometry layer to
+/// refuse.
+fn drop_zero_area(mesh: &mut TriangleMesh, world_from_object: &DMat4) -> (usize, usize) {
+    let placed: Vec<DVec3> = mesh
+        .positions
+        .iter()
+        .map(|p| world_from_object.transform_point3(*p))
+        .collect();
+    let (lo, hi) = placed.iter().fold(
+        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+        |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+    );
+    let diagonal = (hi - lo).length_squared();
+    let total = mesh.triangles.len();
+    mesh.triangles.retain(|t| {
+        // The readers check every index against the vertices.
+        let [a, b, c] = t.map(|i| placed.get(i as usize).copied().unwrap_or(DVec3::NAN));
+        let area = 0.5 * (b - a).cross(c - a).length();
+        // Kept unless comparably small (NaN compares to nothing).
+        !matches!(
+            area.partial_cmp(&(1e-14 * diagonal)),
+            Some(std::cmp::Ordering::Less | std::cmp::Ordering::Equal)
+        )
+    });
+    (total, total - mesh.triangles.len())
 }

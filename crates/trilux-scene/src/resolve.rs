@@ -1,9 +1,13 @@
 //! Stage 3 of loading: resolve `<ref id>` against the objects that carry an
-//! `id` (top-level `<bsdf id>` in practice), and count `<bsdf>` elements.
+//! `id` (top-level `<bsdf id>` and `<texture id>` in practice), and count
+//! `<bsdf>` elements.
 //!
 //! After this pass the tree has no `<ref>` left: each reference is replaced
-//! by a copy of the element it names (BSDF parameters are plain data, so a
-//! copy is as good as sharing). Only BSDFs can be referenced.
+//! by a copy of the element it names (BSDF parameters are plain data, and
+//! the texture cache reads an image once however many copies name it, so a
+//! copy is as good as sharing). Only BSDFs and textures can be referenced;
+//! a texture's copy takes the `name` of its `<ref>` (the parameter it
+//! gives, as in Mitsuba).
 //!
 //! A reference to a BSDF that is being expanded is a cycle, refused as
 //! one; the expanded tree is bounded in depth and in size
@@ -186,11 +190,11 @@ fn target<'a>(
     let (name, target) = ids.get_key_value(&id.value).ok_or_else(|| {
         SceneError::at(&id.loc, format!("reference to unknown id \"{}\"", id.value))
     })?;
-    if target.tag != "bsdf" {
+    if target.tag != "bsdf" && target.tag != "texture" {
         return Err(SceneError::at(
             &id.loc,
             format!(
-                "\"{}\" names a {}; only <bsdf> elements can be referenced",
+                "\"{}\" names a {}; only <bsdf> and <texture> elements can be referenced",
                 id.value,
                 target.describe()
             ),
@@ -208,7 +212,17 @@ fn copy(ids: &HashMap<String, &Element>, e: &Element) -> Result<Element> {
     let mut children = Vec::with_capacity(e.children.len());
     for child in &e.children {
         children.push(if child.tag == "ref" {
-            copy(ids, target(ids, child)?.1)?
+            let (_, named) = target(ids, child)?;
+            let mut c = copy(ids, named)?;
+            if named.tag == "texture" {
+                // Placed where the <ref> is: errors of its use point there.
+                c.loc = child.loc.clone();
+                if let Some(name) = child.attr("name") {
+                    c.attrs.retain(|a| a.name != "name");
+                    c.attrs.push(name.clone());
+                }
+            }
+            c
         } else {
             copy(ids, child)?
         });

@@ -67,6 +67,10 @@ pub struct Scene {
     /// camera's name, else its node's, `None` when neither is named.
     /// Empty for an XML scene (its one `<sensor>` is `camera`).
     pub camera_names: Vec<Option<String>>,
+    /// What loading left out, one line each with its place (zero-area
+    /// triangles and meshes): the command prints them as warnings.
+    #[serde(skip)]
+    pub warnings: Vec<String>,
 }
 
 impl Scene {

@@ -8,10 +8,12 @@
 //! Refused, each at the place that causes it: a singular `to_world` (a zero
 //! scale), zero radius or length, a sphere scaled non-uniformly, a cylinder
 //! whose cross-section is not a circle after `to_world` (Mitsuba only warns;
-//! the exact analytic intersection needs a circle), a zero total area, and a
-//! missing or malformed OBJ file. An OBJ file is only named here
-//! (`MeshRequest`); it is read once the whole scene file is checked
-//! (`crate::meshes`).
+//! the exact analytic intersection needs a circle), a zero total area of an
+//! analytic shape, and a missing or malformed mesh file. A mesh file (OBJ,
+//! PLY, serialized) is only named here (`MeshRequest`); it is read once the
+//! whole scene file is checked (`crate::meshes`), where its zero-area
+//! triangles, or the whole mesh if they all are, are left out with a
+//! warning as Mitsuba loads them and never hits them.
 
 use std::path::Path;
 
@@ -87,6 +89,12 @@ pub(crate) enum MeshFormat {
     Obj,
     /// Stanford PLY (`crate::ply`).
     Ply,
+    /// Mesh `shape_index` of a Mitsuba serialized file
+    /// (`crate::serialized`).
+    Serialized {
+        /// Which mesh of the file.
+        shape_index: u32,
+    },
 }
 
 impl MeshFormat {
@@ -104,6 +112,10 @@ impl MeshFormat {
             MeshFormat::Ply => {
                 crate::ply::load_ply(path, face_normals, flip_tex_coords).map_err(|e| e.to_string())
             }
+            MeshFormat::Serialized { shape_index } => {
+                crate::serialized::load_serialized(path, shape_index, face_normals)
+                    .map_err(|e| e.to_string())
+            }
         }
     }
 
@@ -112,6 +124,7 @@ impl MeshFormat {
         match self {
             MeshFormat::Obj => "<shape type=\"obj\">",
             MeshFormat::Ply => "<shape type=\"ply\">",
+            MeshFormat::Serialized { .. } => "<shape type=\"serialized\">",
         }
     }
 
@@ -162,7 +175,7 @@ pub(crate) fn build_shape(
         "disk" => ShapeKind::Disk,
         "sphere" => sphere(props, &l)?,
         "cylinder" => cylinder(props, &l)?,
-        "obj" | "ply" => {
+        "obj" | "ply" | "serialized" => {
             let (kind, mesh) = mesh(props, plugin, folder)?;
             request = Some(mesh);
             kind
@@ -171,7 +184,7 @@ pub(crate) fn build_shape(
             return Err(SceneError::at(
                 &e.required("type")?.loc,
                 format!(
-                    "unknown shape plugin \"{other}\" (supported: rectangle, cube, disk, sphere, cylinder, obj, ply)"
+                    "unknown shape plugin \"{other}\" (supported: rectangle, cube, disk, sphere, cylinder, obj, ply, serialized)"
                 ),
             ));
         }
@@ -267,7 +280,7 @@ fn cylinder(props: &Props<'_>, l: &DMat3) -> Result<ShapeKind> {
     Ok(ShapeKind::Cylinder { p0, p1, radius })
 }
 
-/// An `obj` or `ply` shape: an empty mesh (with its `face_normals` choice)
+/// An `obj`, `ply` or `serialized` shape: an empty mesh (with its `face_normals` choice)
 /// and the request to read its file, relative to `folder`.
 fn mesh(props: &Props<'_>, plugin: &str, folder: &Path) -> Result<(ShapeKind, MeshRequest)> {
     let e = props.owner();
@@ -280,11 +293,18 @@ fn mesh(props: &Props<'_>, plugin: &str, folder: &Path) -> Result<(ShapeKind, Me
     let face_normals = props.boolean("face_normals")?.unwrap_or(false);
     let format = match plugin {
         "obj" => MeshFormat::Obj,
-        _ => MeshFormat::Ply,
+        "ply" => MeshFormat::Ply,
+        _ => MeshFormat::Serialized {
+            shape_index: shape_index(props)?,
+        },
     };
-    let flip_tex_coords = props
-        .boolean("flip_tex_coords")?
-        .unwrap_or(format.flips_by_default());
+    // Mitsuba's serialized plugin has no `flip_tex_coords`: it keeps them.
+    let flip_tex_coords = match format {
+        MeshFormat::Serialized { .. } => false,
+        _ => props
+            .boolean("flip_tex_coords")?
+            .unwrap_or(format.flips_by_default()),
+    };
     let request = MeshRequest {
         format,
         path: folder.join(&name),
@@ -298,6 +318,19 @@ fn mesh(props: &Props<'_>, plugin: &str, folder: &Path) -> Result<(ShapeKind, Me
         ..Default::default()
     });
     Ok((kind, request))
+}
+
+/// A serialized shape's `shape_index` (Mitsuba's default 0), which must
+/// not be negative; whether the file holds that many meshes is checked
+/// when it is read.
+fn shape_index(props: &Props<'_>) -> Result<u32> {
+    let index = props.integer("shape_index")?.unwrap_or(0);
+    u32::try_from(index).map_err(|_| {
+        SceneError::at(
+            &props.loc("shape_index"),
+            format!("shape_index must be a mesh index (0, 1, ...), found {index}"),
+        )
+    })
 }
 
 /// Refuses a shape of zero (or non-finite) area, at `loc`.

@@ -1,11 +1,14 @@
-//! Mutated OBJ and PLY meshes and scene files: 12 000
+//! Mutated OBJ, PLY and serialized meshes and scene files: 12 000
 //! corruptions of real OBJ files, 6 000 of ASCII and binary PLY files — bytes, tokens such as `1e30`, `nan`, `-7`, `99999999`
-//! and whole lines of them — each parsed and, when it parses, built into
+//! and whole lines of them —, 4 000 of Mitsuba serialized files (bytes and
+//! counts of the decompressed stream, or of the compressed file), each
+//! parsed and, when it parses, built into
 //! geometry and a BVH; and 10 000 of the bundled Cornell box, loaded. None
 //! panics; every refusal is one line; no case makes the loader hold more
 //! than its stated bound (a counting allocator measures every case and
 //! refuses any single request above 256 MiB outright):
-//! - OBJ and PLY: 256 KiB + 256 bytes per byte of the file, through
+//! - OBJ, PLY and serialized: 256 KiB + 256 bytes per byte of the file
+//!   (serialized: of its decompressed stream), through
 //!   `Geometry::build` (the worst case measured: 34 bytes per byte);
 //! - scene: 1 MiB + 64 bytes per byte of the file (measured: 12).
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test may panic
@@ -20,6 +23,7 @@ use glam::DMat4;
 use trilux_geometry::{Geometry, Shape, ShapeKind};
 use trilux_scene::obj::parse_obj;
 use trilux_scene::ply::parse_ply;
+use trilux_scene::serialized::parse_serialized;
 
 #[global_allocator]
 static ALLOCATOR: Capped = Capped;
@@ -27,6 +31,7 @@ static ALLOCATOR: Capped = Capped;
 const OBJ_CASES: usize = 12_000;
 const PLY_CASES: usize = 6_000;
 const XML_CASES: usize = 10_000;
+const SERIALIZED_CASES: usize = 4_000;
 
 /// Valid seeds: a cube of quads with texture coordinates and normals,
 /// negative (relative) indices, several objects, fans.
@@ -211,6 +216,112 @@ fn fuzz_ply(rng: &mut Rng) -> usize {
     built
 }
 
+/// A mesh stream of a serialized file: a pyramid of four triangles with
+/// the parts `flags` asks for (0x1 normals, 0x2 texture coordinates, 0x8
+/// colours, 0x2000 doubles), a name when `version` is 4.
+fn serialized_stream(version: u16, flags: u32) -> Vec<u8> {
+    let p = [
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.5, 0.5, 0.7],
+    ];
+    let mut d = flags.to_le_bytes().to_vec();
+    if version == 4 {
+        d.extend(b"pyramid\0");
+    }
+    d.extend(5u64.to_le_bytes());
+    d.extend(4u64.to_le_bytes());
+    let parts = [(0, 3), (0x1, 3), (0x2, 2), (0x8, 3)];
+    for (flag, n) in parts {
+        if flag == 0 || flags & flag != 0 {
+            for v in &p {
+                for &x in &v[..n] {
+                    if flags & 0x2000 != 0 {
+                        d.extend(f64::to_le_bytes(x));
+                    } else {
+                        d.extend((x as f32).to_le_bytes());
+                    }
+                }
+            }
+        }
+    }
+    for i in [0u32, 1, 4, 1, 2, 4, 2, 3, 4, 3, 0, 4] {
+        d.extend(i.to_le_bytes());
+    }
+    d
+}
+
+/// A one-mesh file of `stream`, with its dictionary.
+fn serialized_file(version: u16, stream: &[u8]) -> Vec<u8> {
+    use std::io::Write;
+    let mut z = flate2::write::ZlibEncoder::new(Vec::new(), flate2::Compression::fast());
+    z.write_all(stream).unwrap();
+    let mut out = 0x041Cu16.to_le_bytes().to_vec();
+    out.extend(version.to_le_bytes());
+    out.extend(z.finish().unwrap());
+    if version == 4 {
+        out.extend(0u64.to_le_bytes());
+    } else {
+        out.extend(0u32.to_le_bytes());
+    }
+    out.extend(1u32.to_le_bytes());
+    out
+}
+
+/// One random change of binary `b`: a byte, a 64-bit count written over
+/// any 8 bytes (extreme or at the limits), a cut, or a repeated range.
+fn mutate_binary(rng: &mut Rng, b: &mut Vec<u8>) {
+    if b.is_empty() {
+        return;
+    }
+    let at = rng.below(b.len());
+    match rng.below(4) {
+        0 => b[at] = rng.next() as u8,
+        1 => {
+            let counts = [u64::MAX, 1 << 40, 12_000_000, 4_000_001, 0, 6, 1 << 32];
+            let v = counts[rng.below(counts.len())].to_le_bytes();
+            let end = (at + 8).min(b.len());
+            b[at..end].copy_from_slice(&v[..end - at]);
+        }
+        2 => b.truncate(at),
+        _ => {
+            let end = (at + 1 + rng.below(64)).min(b.len());
+            let piece = b[at..end].to_vec();
+            b.splice(at..at, piece);
+        }
+    }
+}
+
+/// The serialized loop; how many cases became geometry.
+fn fuzz_serialized(rng: &mut Rng) -> usize {
+    let mut built = 0;
+    for case in 0..SERIALIZED_CASES {
+        let version = [3, 4][case % 2];
+        let flags = [0x1000, 0x100B, 0x2003, 0x2008][(case / 2) % 4];
+        let mut stream = serialized_stream(version, flags);
+        let compressed_too = rng.below(8) == 0;
+        for _ in 0..1 + rng.below(3) {
+            mutate_binary(rng, &mut stream);
+        }
+        let mut bytes = serialized_file(version, &stream);
+        if compressed_too {
+            mutate_binary(rng, &mut bytes);
+        }
+        let face_normals = rng.below(2) == 0;
+        let path = Path::new("fuzz.serialized");
+        let (used, ok) = mesh_case(|| parse_serialized(&bytes, path, 0, face_normals));
+        let bound = (256 << 10) + 256 * stream.len().max(bytes.len());
+        assert!(
+            used <= bound,
+            "serialized case {case}: {used} bytes, bound {bound}: {stream:?}"
+        );
+        built += usize::from(ok);
+    }
+    built
+}
+
 const SCENE: &str = include_str!("../../../scenes/cornell-box.xml");
 
 /// Pieces a mutation inserts into a scene: markup, references, defaults.
@@ -275,8 +386,14 @@ fn mutated_meshes_and_scenes_never_panic_nor_exceed_their_memory_bounds() {
         let mesh = parse_ply(seed, Path::new("seed.ply"), false, false);
         assert!(mesh.is_ok(), "{:?}", mesh.err());
     }
+    for (version, flags) in [(3, 0x1000), (4, 0x100B), (4, 0x2003), (3, 0x2008)] {
+        let bytes = serialized_file(version, &serialized_stream(version, flags));
+        let mesh = parse_serialized(&bytes, Path::new("seed.serialized"), 0, false);
+        assert!(mesh.is_ok(), "{:?}", mesh.err());
+    }
     let built = fuzz_obj(&mut rng);
     let built_ply = fuzz_ply(&mut rng);
+    let built_serialized = fuzz_serialized(&mut rng);
     let loaded = fuzz_xml(&mut rng);
     eprintln!(
         "{OBJ_CASES} OBJ cases ({built} built), {PLY_CASES} PLY cases ({built_ply} built), {XML_CASES} scene cases ({loaded} loaded)"
@@ -288,4 +405,9 @@ fn mutated_meshes_and_scenes_never_panic_nor_exceed_their_memory_bounds() {
         "{built_ply}"
     );
     assert!(loaded > XML_CASES / 10 && loaded < XML_CASES, "{loaded}");
+    eprintln!("{SERIALIZED_CASES} serialized cases ({built_serialized} built)");
+    assert!(
+        built_serialized > SERIALIZED_CASES / 10 && built_serialized < SERIALIZED_CASES,
+        "{built_serialized}"
+    );
 }

@@ -195,12 +195,19 @@ fn references_to_top_level_bsdfs() {
     );
     assert!(
         err(r#"<shape type="rectangle" id="a"/><shape type="cube"><ref id="a"/></shape>"#)
-            .contains("only <bsdf> elements can be referenced")
+            .contains("only <bsdf> and <texture> elements can be referenced")
     );
     assert!(
         err(r#"<bsdf type="diffuse" id="a"/><bsdf type="diffuse" id="a"/>"#)
             .contains("already used")
     );
+    // A texture's <ref> gives the parameter's name; without one the copy
+    // has none, and a definition needs an id.
+    let e = err(
+        r#"<texture type="checkerboard" id="t"/><shape type="rectangle"><bsdf type="diffuse"><ref id="t"/></bsdf></shape>"#,
+    );
+    assert!(e.contains("name"), "{e}");
+    assert!(err(r#"<texture type="checkerboard"/>"#).contains("unsupported element <texture>"));
 }
 
 // ---- sensor, film, sampler, integrator ---------------------------------
@@ -904,7 +911,7 @@ fn clip_planes() {
 
 #[test]
 fn unknown_things_are_refused() {
-    assert!(err(r#"<shape type="serialized"/>"#).contains("unknown shape plugin \"serialized\""));
+    assert!(err(r#"<shape type="heightfield"/>"#).contains("unknown shape plugin \"heightfield\""));
     assert!(
         err(r#"<shape type="rectangle"><float name="size" value="2"/></shape>"#)
             .contains("unknown parameter \"size\" for <shape type=\"rectangle\">")

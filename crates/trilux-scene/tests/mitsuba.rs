@@ -224,15 +224,23 @@ fn rays_hit_what_mitsuba_hits() {
 /// Textures with `to_uv` (scale, translation, rotation, their composition)
 /// and `checkerboard`: the diffuse reflectance at fixed texture
 /// coordinates, against Mitsuba's `eval_diffuse_reflectance`. Tolerance
-/// 1e-5: Mitsuba interpolates and decodes sRGB in single precision.
+/// 1e-5: Mitsuba interpolates and decodes sRGB in single precision. Each
+/// texture is given inside its BSDF and, as a top-level definition, by a
+/// `<ref>` that names its parameter.
 #[test]
 fn texture_lookups_match_mitsuba() {
     let exp = expected();
-    for case in exp["textures"].as_array().expect("textures") {
+    let cases = exp["textures"].as_array().expect("textures");
+    for (case, by_ref) in cases.iter().flat_map(|c| [(c, false), (c, true)]) {
         let xml = case["xml"].as_str().expect("xml");
-        let scene = load(&format!(
-            "<shape type=\"rectangle\"><bsdf type=\"diffuse\">{xml}</bsdf></shape>"
-        ));
+        let scene = load(&if by_ref {
+            let definition = xml.replacen("name=\"reflectance\"", "id=\"t\"", 1);
+            format!(
+                "{definition}<shape type=\"rectangle\"><bsdf type=\"diffuse\"><ref name=\"reflectance\" id=\"t\"/></bsdf></shape>"
+            )
+        } else {
+            format!("<shape type=\"rectangle\"><bsdf type=\"diffuse\">{xml}</bsdf></shape>")
+        });
         let slot = scene.shapes[0].textures.first().expect("a texture slot");
         for v in case["values"].as_array().expect("values") {
             let uv = glam::DVec2::new(

@@ -88,6 +88,7 @@ pub fn run(args: &InfoArgs) -> Result<()> {
     let scene =
         trilux_scene::open_with_camera(&args.scene, args.camera.as_deref(), &args.params.define)?
             .finish()?;
+    crate::warn_loading(&scene);
     let mode = match args.mode {
         Some(ModeArg::Rgb) => Mode::Rgb,
         Some(ModeArg::Spectral) => Mode::Spectral,

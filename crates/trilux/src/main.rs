@@ -102,6 +102,14 @@ pub fn warn(outcome: &trilux::Outcome) {
     }
 }
 
+/// Prints what loading `scene` left out (zero-area triangles and meshes),
+/// one warning line each.
+pub fn warn_loading(scene: &trilux_scene::Scene) {
+    for w in &scene.warnings {
+        streams::eprint_line(&format!("warning: {w}"));
+    }
+}
+
 /// Warns (one line on stderr) when `scene` has no emitter: its solution is
 /// zero everywhere and a render of it black. Not an error, for `render`
 /// as for `solve` and `bake`: the work on a dark scene is meaningless but

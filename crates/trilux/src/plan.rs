@@ -24,6 +24,7 @@ pub fn run_plan(
 ) -> anyhow::Result<Finished> {
     trilux::pipeline::check(pending.scene(), plan)?;
     let scene = pending.finish()?;
+    crate::warn_loading(&scene);
     let bars = Bars::new();
     let mut on_shot = |p: &Progress| bars.solve(p);
     let on_tile = |done: usize, total: usize| bars.render(done, total);

@@ -304,13 +304,16 @@ fn every_scene_error_from_every_command_is_located() {
     let ply =
         |f: &str| format!("<shape type=\"ply\"><string name=\"filename\" value=\"{f}\"/></shape>");
     let closed = "<shape type=\"cube\"><boolean name=\"flip_normals\" value=\"true\"/><bsdf type=\"diffuse\"><float name=\"reflectance\" value=\"1\"/></bsdf><emitter type=\"area\"/></shape>";
+    // A flat mesh loads (left out, as Mitsuba never hits it); an emitting
+    // one is refused, as in Mitsuba.
+    let lit = |body: String| body.replace("</shape>", "<emitter type=\"area\"/></shape>");
     let cases: Vec<(String, bool)> = vec![
-        (obj("flat.obj"), true),
+        (lit(obj("flat.obj")), true),
         (obj("far.obj"), true),
         (obj("index.obj"), true),
         (obj("nan.obj"), true),
         (obj("missing.obj"), true),
-        (ply("flat.ply"), true),
+        (lit(ply("flat.ply")), true),
         (ply("index.ply"), true),
         (ply("short.ply"), true),
         (ply("missing.ply"), true),

@@ -114,6 +114,7 @@ pub(crate) fn build(
         spectral: false,
         bsdf_counts: walk.bsdf_counts,
         camera_names,
+        warnings: Vec::new(),
     };
     let meshes = GltfMeshes {
         file: Arc::clone(file),

@@ -2,6 +2,7 @@
 #![allow(dead_code)] // each test binary uses some of them
 
 pub mod hostile;
+pub mod serialized;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
