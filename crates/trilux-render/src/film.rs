@@ -69,6 +69,15 @@ impl Film {
     /// Splats one sample of linear RGB `value` taken at film position
     /// (`px`, `py`) in pixels. Pixels outside this buffer are skipped.
     pub fn splat(&mut self, px: f64, py: f64, value: [f64; 3]) {
+        self.splat_weighted(px, py, value, 1.0);
+    }
+
+    /// [`Film::splat`] with the filter weights scaled by `weight`: adaptive
+    /// sampling gives each sample of a pixel that took n samples weight 1/n,
+    /// so a pixel's neighbours see its samples as one unit of weight however
+    /// many it took (an unevenly sampled neighbour would otherwise pull a
+    /// pixel toward its own value).
+    pub fn splat_weighted(&mut self, px: f64, py: f64, value: [f64; 3], weight: f64) {
         let r = self.filter.radius();
         // Continuous position relative to pixel centres at integer indices.
         let cx = px - 0.5;
@@ -95,7 +104,7 @@ impl Film {
             *w = self.filter.eval((lo_x + k as i64) as f64 - cx);
         }
         for j in lo_y..=hi_y {
-            let wy = self.filter.eval(j as f64 - cy);
+            let wy = self.filter.eval(j as f64 - cy) * weight;
             if wy == 0.0 {
                 continue;
             }
