@@ -75,13 +75,10 @@ pub fn allot(pilots: &[Pilot], width: usize, target: f64, cap: u32) -> Vec<u32> 
         // not prove the pixel noiseless.
         let finite: Vec<f64> = noise.iter().map(|&(_, r)| r).filter(|r| r.is_finite()).collect();
         let even = DEFENSIVE * finite.iter().sum::<f64>() / finite.len().max(1) as f64;
-        for (_, r) in &mut noise {
-            *r += even;
-        }
         let r: Vec<f64> = noise.iter().map(|&(_, r)| r).collect();
-        let c = neyman_constant(&r, target, cap);
+        let c = neyman_constant(&r, even, target, cap);
         for (i, r) in noise {
-            counts[i] = samples(c, r, cap);
+            counts[i] = samples(c, r + even, cap);
         }
     }
     counts
@@ -145,13 +142,14 @@ fn samples(c: f64, r: f64, cap: u32) -> u32 {
     }
 }
 
-/// The smallest c whose allotment predicts a mean r²/n ≤ `target²` over
-/// the pixels below the cap (a pixel at the cap has done what it may).
-fn neyman_constant(r: &[f64], target: f64, cap: u32) -> f64 {
+/// The smallest c whose allotment n = c · (r + `even`) predicts a mean
+/// r²/n ≤ `target²` over the pixels below the cap (a pixel at the cap has
+/// done what it may).
+fn neyman_constant(r: &[f64], even: f64, target: f64, cap: u32) -> f64 {
     let meets = |c: f64| -> bool {
         let (mut sum, mut k) = (0.0, 0.0);
         for &r in r {
-            let n = samples(c, r, cap);
+            let n = samples(c, r + even, cap);
             if n < cap {
                 sum += r * r / f64::from(n);
                 k += 1.0;
@@ -161,7 +159,7 @@ fn neyman_constant(r: &[f64], target: f64, cap: u32) -> f64 {
     };
     let smallest = r
         .iter()
-        .copied()
+        .map(|&r| r + even)
         .filter(|&r| r > 0.0)
         .fold(f64::INFINITY, f64::min);
     if !smallest.is_finite() {
@@ -204,9 +202,13 @@ mod tests {
                 .sum();
             assert!(err <= target * target * 4.0 * (1.0 + 1e-9), "{err}");
         }
-        // Away from the step: σ = 1 and 3, counts in ratio 3 (±1 for ceil).
+        // Neyman with the defensive share: n ∝ r + ½ mean r (±1 for ceil).
+        let r: Vec<f64> = (0..8).map(|x| relative_noise(&p, 8, 1, x, 0, 1.0)).collect();
+        let even = DEFENSIVE * (r[1] + r[3] + r[5] + r[7]) / 4.0;
+        let expected = (r[7] + even) / (r[1] + even);
         let ratio = f64::from(n[7]) / f64::from(n[1]);
-        assert!((ratio - 3.0).abs() < 0.02, "{n:?}");
+        assert!((ratio / expected - 1.0).abs() < 0.01, "{n:?}, {ratio} vs {expected}");
+        assert!(r[7] > 2.5 * r[1], "{r:?}");
     }
 
     #[test]
