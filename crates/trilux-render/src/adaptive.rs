@@ -62,18 +62,27 @@ pub fn allot(pilots: &[Pilot], width: usize, target: f64, cap: u32) -> Vec<u32> 
         // the scale).
         let (sum, k) = (0..pilots.len())
             .filter(|&i| other(i % width, i / width))
-            .fold((0.0, 0.0), |(s, k), i| (s + f64::from(pilots[i].mean).max(0.0), k + 1.0));
+            .fold((0.0, 0.0), |(s, k), i| {
+                (s + f64::from(pilots[i].mean).max(0.0), k + 1.0)
+            });
         let floor = if k > 0.0 { sum / k } else { 0.0 };
         let mut noise = Vec::new();
         for y in 0..height {
             for x in (0..width).filter(|&x| !other(x, y)) {
-                noise.push((y * width + x, relative_noise(pilots, width, height, x, y, floor)));
+                noise.push((
+                    y * width + x,
+                    relative_noise(pilots, width, height, x, y, floor),
+                ));
             }
         }
         // Defensive: a share of the budget spread evenly, because a pilot
         // that saw no noise (every sample missed a rare bright path) does
         // not prove the pixel noiseless.
-        let finite: Vec<f64> = noise.iter().map(|&(_, r)| r).filter(|r| r.is_finite()).collect();
+        let finite: Vec<f64> = noise
+            .iter()
+            .map(|&(_, r)| r)
+            .filter(|r| r.is_finite())
+            .collect();
         let even = DEFENSIVE * finite.iter().sum::<f64>() / finite.len().max(1) as f64;
         let r: Vec<f64> = noise.iter().map(|&(_, r)| r).collect();
         let c = neyman_constant(&r, even, target, cap);
@@ -122,10 +131,19 @@ fn relative_noise(
     let near = &near[..k];
     let n0 = f64::from(PILOT_SPP);
     let mean = near.iter().map(|p| f64::from(p.mean)).sum::<f64>() / k as f64;
-    let within: f64 = near.iter().map(|p| (n0 - 1.0) * f64::from(p.var).max(0.0)).sum();
-    let between: f64 = near.iter().map(|p| n0 * (f64::from(p.mean) - mean).powi(2)).sum();
+    let within: f64 = near
+        .iter()
+        .map(|p| (n0 - 1.0) * f64::from(p.var).max(0.0))
+        .sum();
+    let between: f64 = near
+        .iter()
+        .map(|p| n0 * (f64::from(p.mean) - mean).powi(2))
+        .sum();
     let sigma = ((within + between) / (n0 * k as f64 - 1.0)).sqrt();
-    let least = near.iter().map(|p| f64::from(p.mean)).fold(f64::INFINITY, f64::min);
+    let least = near
+        .iter()
+        .map(|p| f64::from(p.mean))
+        .fold(f64::INFINITY, f64::min);
     let scale = least.max(floor);
     if sigma == 0.0 { 0.0 } else { sigma / scale }
 }
@@ -203,11 +221,16 @@ mod tests {
             assert!(err <= target * target * 4.0 * (1.0 + 1e-9), "{err}");
         }
         // Neyman with the defensive share: n ∝ r + ½ mean r (±1 for ceil).
-        let r: Vec<f64> = (0..8).map(|x| relative_noise(&p, 8, 1, x, 0, 1.0)).collect();
+        let r: Vec<f64> = (0..8)
+            .map(|x| relative_noise(&p, 8, 1, x, 0, 1.0))
+            .collect();
         let even = DEFENSIVE * (r[1] + r[3] + r[5] + r[7]) / 4.0;
         let expected = (r[7] + even) / (r[1] + even);
         let ratio = f64::from(n[7]) / f64::from(n[1]);
-        assert!((ratio / expected - 1.0).abs() < 0.01, "{n:?}, {ratio} vs {expected}");
+        assert!(
+            (ratio / expected - 1.0).abs() < 0.01,
+            "{n:?}, {ratio} vs {expected}"
+        );
         assert!(r[7] > 2.5 * r[1], "{r:?}");
     }
 
@@ -216,8 +239,14 @@ mod tests {
         // Changing pixel (1, 1)'s own pilot changes no count of its colour.
         let base = pilots(&[1.0; 16]);
         let mut changed = base.clone();
-        changed[5] = Pilot { mean: 0.1, var: 50.0 };
-        let (a, b) = (allot(&base, 4, 0.05, 1 << 16), allot(&changed, 4, 0.05, 1 << 16));
+        changed[5] = Pilot {
+            mean: 0.1,
+            var: 50.0,
+        };
+        let (a, b) = (
+            allot(&base, 4, 0.05, 1 << 16),
+            allot(&changed, 4, 0.05, 1 << 16),
+        );
         for i in 0..16 {
             if (i % 4 + i / 4) % 2 == 0 {
                 assert_eq!(a[i], b[i], "pixel {i}");
@@ -232,8 +261,18 @@ mod tests {
         // No noise: the pilot's count. A black image cannot meet a relative
         // target: the cap. A lone pixel has no neighbours to measure: the
         // cap.
-        assert!(allot(&pilots(&[0.0; 6]), 3, 0.01, 64).iter().all(|&n| n == PILOT_SPP));
-        let black = vec![Pilot { mean: 0.0, var: 1.0 }; 6];
+        assert!(
+            allot(&pilots(&[0.0; 6]), 3, 0.01, 64)
+                .iter()
+                .all(|&n| n == PILOT_SPP)
+        );
+        let black = vec![
+            Pilot {
+                mean: 0.0,
+                var: 1.0
+            };
+            6
+        ];
         assert!(allot(&black, 3, 0.01, 64).iter().all(|&n| n == 64));
         assert_eq!(allot(&pilots(&[1.0]), 1, 0.01, 64), vec![64]);
     }

@@ -114,7 +114,7 @@ impl RenderSettings {
             }
             if self.spp < MIN_ADAPTIVE_SPP {
                 return Err(RenderError::Settings(format!(
-                    "adaptive sampling needs at least {MIN_ADAPTIVE_SPP} samples per pixel, not {}",
+                    "adaptive sampling (--target-error) needs at least {MIN_ADAPTIVE_SPP} samples per pixel (--spp), not {}",
                     self.spp
                 )));
             }
@@ -320,7 +320,11 @@ impl<S, F> TileJob<'_, S, F> {
     {
         caches.pixel.clear();
         caches.scratch.clear();
-        let weight = if self.counts.is_some() { 1.0 / f64::from(n) } else { 1.0 };
+        let weight = if self.counts.is_some() {
+            1.0 / f64::from(n)
+        } else {
+            1.0
+        };
         let mut sampler = PixelSampler::new(self.settings.seed, x, y);
         for k in 0..n {
             let (film_pos, rgb) = self.sample(x, y, k, &mut sampler, caches, stats);

@@ -46,11 +46,7 @@ fn adaptive_sampling_is_unbiased_and_beats_uniform_at_equal_samples() {
         Observer::quiet(|o| trilux::pipeline::run(&scene, &plan, o)).unwrap()
     };
     // The reference, solving once and keeping the solution.
-    let uniform = |spp, seed| RenderSettings {
-        spp,
-        seed,
-        ..base
-    };
+    let uniform = |spp, seed| RenderSettings { spp, seed, ..base };
     let outcome = render(SolutionSource::Solve, uniform(2048, 7), true);
     let reference = outcome.image.unwrap();
     let bytes = outcome.solution_file.unwrap();
@@ -83,7 +79,10 @@ fn adaptive_sampling_is_unbiased_and_beats_uniform_at_equal_samples() {
             c.rel_rmse, c.rel_rmse_all, c.mean_ratio, c.mean_ratio_all
         )
     };
-    println!("adaptive: {samples} samples, {}, lamp {lamp_ratio:.4}", show(&a));
+    println!(
+        "adaptive: {samples} samples, {}, lamp {lamp_ratio:.4}",
+        show(&a)
+    );
     println!("uniform at {spp} spp: {}", show(&u));
     // Unbiased: the mean within 0.5 %, over the unmasked pixels, all
     // pixels, and the lamp with its edge.
@@ -97,8 +96,18 @@ fn adaptive_sampling_is_unbiased_and_beats_uniform_at_equal_samples() {
     // It spends fewer samples than its cap, and errs no more than the
     // uniform render with as many samples.
     assert!(spp < 256, "{spp} spp: adaptive sampling did not adapt");
-    assert!(a.rel_rmse <= u.rel_rmse, "unmasked: {} vs {}", show(&a), show(&u));
-    assert!(a.rel_rmse_all <= u.rel_rmse_all, "all: {} vs {}", show(&a), show(&u));
+    assert!(
+        a.rel_rmse <= u.rel_rmse,
+        "unmasked: {} vs {}",
+        show(&a),
+        show(&u)
+    );
+    assert!(
+        a.rel_rmse_all <= u.rel_rmse_all,
+        "all: {} vs {}",
+        show(&a),
+        show(&u)
+    );
 }
 
 /// 1 where the lamp is seen: the reference's luminance above 1 (the walls
