@@ -58,10 +58,11 @@ pub struct RenderSettings {
     pub estimator: Estimator,
     /// When the path gather continues one bounce ([`ExtraBounce`]).
     pub extra_bounce: ExtraBounce,
-    /// Adaptive sampling: the relative RMSE of the image (the golden
-    /// comparisons' measure) the samples are allotted for, pixels sampled in
-    /// proportion to their noise ([`crate::adaptive`]); `spp` stays the
-    /// most a pixel takes. `None`: every pixel takes `spp`.
+    /// Adaptive sampling: the predicted RMS relative error a pixel (against
+    /// the larger of its mean and the image's) the samples are allotted
+    /// for, in proportion to each pixel's noise ([`crate::adaptive`]);
+    /// `spp` stays the most a pixel takes (at least [`MIN_ADAPTIVE_SPP`]).
+    /// `None`: every pixel takes `spp`.
     pub target_error: Option<f64>,
     /// Tile edge in pixels.
     pub tile_size: u32,
