@@ -216,6 +216,22 @@ mod tests {
     }
 
     #[test]
+    fn weighted_samples_count_as_units() {
+        let f = ReconstructionFilter::default();
+        let mut film = Film::new(0, 0, 8, 8, f).unwrap();
+        film.splat_weighted(3.5, 3.5, [1.0; 3], 0.25);
+        assert!((film.weights[3 * 8 + 3] - 0.25 * f.eval(0.0).powi(2)).abs() < 1e-15);
+        // Pixel 0 took one sample of 1, pixel 2 four of 3, each weighted
+        // 1/n: pixel 1, as far from both, sees two equal units, mean 2.
+        let mut row = Film::new(0, 0, 3, 1, f).unwrap();
+        row.splat_weighted(0.5, 0.5, [1.0; 3], 1.0);
+        for _ in 0..4 {
+            row.splat_weighted(2.5, 0.5, [3.0; 3], 0.25);
+        }
+        assert!((row.develop().pixels()[1][0] - 2.0).abs() < 1e-6);
+    }
+
+    #[test]
     fn tiles_merge_to_the_whole() {
         let f = ReconstructionFilter::default();
         let mut whole = Film::new(0, 0, 6, 6, f).unwrap();
