@@ -13,6 +13,7 @@ use glam::DVec2;
 use rayon::prelude::*;
 use trilux_color::Spectrum;
 
+use crate::adaptive::{PILOT_SPP, Pilot, allot};
 use crate::camera::Camera;
 use crate::error::RenderError;
 use crate::film::Film;
@@ -58,21 +59,19 @@ pub struct RenderSettings {
     pub estimator: Estimator,
     /// When the path gather continues one bounce ([`ExtraBounce`]).
     pub extra_bounce: ExtraBounce,
-    /// Adaptive sampling: a pixel stops once the standard error of its mean
-    /// luminance is below this fraction of the mean (of a floor, for dark
-    /// pixels), after [`MIN_ADAPTIVE_SPP`] samples; `spp` stays the most.
+    /// Adaptive sampling: the predicted RMS relative error a pixel (against
+    /// the larger of its mean and the image's) the samples are allotted
+    /// for, in proportion to each pixel's noise ([`crate::adaptive`]);
+    /// `spp` stays the most a pixel takes (at least [`MIN_ADAPTIVE_SPP`]).
     /// `None`: every pixel takes `spp`.
     pub target_error: Option<f64>,
     /// Tile edge in pixels.
     pub tile_size: u32,
 }
 
-/// Samples every pixel takes before adaptive sampling may stop it.
-pub const MIN_ADAPTIVE_SPP: u32 = 4;
-
-/// Dark pixels are held to the target against this fraction of the
-/// image's mean luminance (a pilot estimate) rather than their own mean.
-const DARK_FLOOR: f64 = 0.05;
+/// Samples every pixel takes under adaptive sampling: its pilot's, which
+/// it takes again when rendered.
+pub const MIN_ADAPTIVE_SPP: u32 = PILOT_SPP;
 
 impl Default for RenderSettings {
     fn default() -> Self {
@@ -110,12 +109,18 @@ impl RenderSettings {
         if self.tile_size == 0 {
             return Err(RenderError::Settings("tile size must be at least 1".into()));
         }
-        if let Some(t) = self.target_error
-            && !(t.is_finite() && t > 0.0)
-        {
-            return Err(RenderError::Settings(format!(
-                "target error {t} must be finite and positive"
-            )));
+        if let Some(t) = self.target_error {
+            if !(t.is_finite() && t > 0.0) {
+                return Err(RenderError::Settings(format!(
+                    "target error {t} must be finite and positive"
+                )));
+            }
+            if self.spp < MIN_ADAPTIVE_SPP {
+                return Err(RenderError::Settings(format!(
+                    "adaptive sampling (--target-error) needs at least {MIN_ADAPTIVE_SPP} samples per pixel (--spp), not {}",
+                    self.spp
+                )));
+            }
         }
         if let ExtraBounce::Auto { close_factor } = self.extra_bounce
             && !(close_factor.is_finite() && close_factor >= 0.0)
@@ -179,28 +184,6 @@ impl<'a, S> Estimators<'a, S> {
     }
 }
 
-/// When a pixel has enough samples.
-#[derive(Clone, Copy, Debug)]
-struct StopRule {
-    spp: u32,
-    /// (target relative error, absolute floor of the mean) when adaptive.
-    adaptive: Option<(f64, f64)>,
-}
-
-impl StopRule {
-    /// True after `n` samples of mean `m` and sample variance `v` (of the
-    /// luminance).
-    fn done(&self, n: u32, m: f64, v: f64) -> bool {
-        match self.adaptive {
-            _ if n >= self.spp => true,
-            Some((target, floor)) if n >= MIN_ADAPTIVE_SPP => {
-                (v / f64::from(n)).sqrt() <= target * m.max(floor)
-            }
-            _ => false,
-        }
-    }
-}
-
 /// Renders `scene` through `camera`. `to_rgb` turns the N-band radiance of
 /// one sample into linear sRGB (identity for N = 3); `progress(done, total)`
 /// is called after each tile (from worker threads).
@@ -228,13 +211,31 @@ where
     // The whole film first: a film too large for memory fails before work.
     let mut image = Film::new(0, 0, w as usize, h as usize, settings.filter)?;
     let mut stats = RenderStats::default();
-    let rule = StopRule {
-        spp: settings.spp,
-        adaptive: settings.target_error.map(|t| {
-            let (mean, pilot) = pilot_mean(&estimators, camera, settings.seed, &to_rgb);
-            stats.gather.add(&pilot);
-            (t, DARK_FLOOR * mean)
-        }),
+    let job = TileJob {
+        estimators: &estimators,
+        camera,
+        settings,
+        counts: None,
+        to_rgb: &to_rgb,
+    };
+    // Adaptive: each pixel's samples, allotted from the pilot of the other
+    // checkerboard colour (rows collected in order: the same whatever the
+    // number of threads).
+    let counts = match settings.target_error {
+        Some(target) => {
+            let rows: Vec<_> = (0..h).into_par_iter().map(|y| job.pilot_row(y)).collect();
+            let mut pilots = Vec::with_capacity(w as usize * h as usize);
+            for (row, s) in rows {
+                pilots.extend(row);
+                stats.gather.add(&s);
+            }
+            Some(allot(&pilots, w as usize, target, settings.spp))
+        }
+        None => None,
+    };
+    let job = TileJob {
+        counts: counts.as_deref(),
+        ..job
     };
     let tiles: Vec<Result<(Film, GatherStats), RenderError>> = (0..total)
         .into_par_iter()
@@ -242,13 +243,6 @@ where
             let tx = (t as u32 % tiles_x) * ts;
             let ty = (t as u32 / tiles_x) * ts;
             let tile = (tx, ty, ts.min(w - tx), ts.min(h - ty));
-            let job = TileJob {
-                estimators: &estimators,
-                camera,
-                settings,
-                rule,
-                to_rgb: &to_rgb,
-            };
             let out = job.render(tile);
             progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);
             out
@@ -263,43 +257,6 @@ where
     Ok((image.develop(), stats))
 }
 
-/// The image's mean luminance from a 32 × 32 pilot at one sample a pixel
-/// (the floor adaptive sampling holds dark pixels to), with what the
-/// pilot traced.
-fn pilot_mean<S: SolutionGather<N>, const N: usize>(
-    estimators: &Estimators<'_, S>,
-    camera: &Camera,
-    seed: u32,
-    to_rgb: &(impl Fn(&Spectrum<N>) -> [f64; 3] + Sync),
-) -> (f64, GatherStats) {
-    const P: u32 = 32;
-    let (w, h) = (f64::from(camera.width()), f64::from(camera.height()));
-    // Collected, then summed in order: the floor is the same bit for bit
-    // whatever the number of threads.
-    let samples: Vec<(f64, GatherStats)> = (0..P * P)
-        .into_par_iter()
-        .map(|k| {
-            let (i, j) = (k % P, k / P);
-            let sampler = PixelSampler::new(seed ^ 0x5eed, i, j);
-            let pos = DVec2::new(
-                (f64::from(i) + 0.5) * w / f64::from(P),
-                (f64::from(j) + 0.5) * h / f64::from(P),
-            );
-            let mut caches = Caches::<N>::default();
-            let mut stats = GatherStats::default();
-            let l = estimators.sample(camera, pos, &sampler, &mut caches, &mut stats);
-            (luminance(to_rgb(&l)), stats)
-        })
-        .collect();
-    let mut stats = GatherStats::default();
-    let mut sum = 0.0;
-    for (y, s) in &samples {
-        sum += y;
-        stats.add(s);
-    }
-    ((sum / f64::from(P * P)).max(0.0), stats)
-}
-
 /// The luminance of linear sRGB ([`trilux_color::luminance`]), 0 for a
 /// non-finite value: a dropped sample must not poison the running variance.
 fn luminance(rgb: [f64; 3]) -> f64 {
@@ -307,12 +264,13 @@ fn luminance(rgb: [f64; 3]) -> f64 {
     if y.is_finite() { y } else { 0.0 }
 }
 
-/// What rendering one tile needs.
+/// What rendering one tile (or the adaptive pilot) needs.
 struct TileJob<'a, S, F> {
     estimators: &'a Estimators<'a, S>,
     camera: &'a Camera,
     settings: &'a RenderSettings,
-    rule: StopRule,
+    /// Samples of each pixel (row-major) when adaptive.
+    counts: Option<&'a [u32]>,
     to_rgb: &'a F,
 }
 
@@ -337,21 +295,25 @@ impl<S, F> TileJob<'_, S, F> {
         )?;
         let mut stats = GatherStats::default();
         let mut caches = Caches::<N>::default();
+        let width = self.camera.width() as usize;
         for y in ty..ty + th {
             for x in tx..tx + tw {
-                caches.pixel.clear();
-                caches.scratch.clear();
-                self.pixel(x, y, &mut film, &mut caches, &mut stats);
+                let n = self
+                    .counts
+                    .map_or(self.settings.spp, |c| c[y as usize * width + x as usize]);
+                self.pixel(x, y, n, &mut film, &mut caches, &mut stats);
             }
         }
         Ok((film, stats))
     }
 
-    /// One pixel's samples, until the stop rule is met.
+    /// Samples 0..n of pixel (x, y) into the film, each weighted 1/n when
+    /// adaptive (so its neighbours see it as one unit of weight).
     fn pixel<const N: usize>(
         &self,
         x: u32,
         y: u32,
+        n: u32,
         film: &mut Film,
         caches: &mut Caches<N>,
         stats: &mut GatherStats,
@@ -359,30 +321,76 @@ impl<S, F> TileJob<'_, S, F> {
         S: SolutionGather<N>,
         F: Fn(&Spectrum<N>) -> [f64; 3] + Sync,
     {
+        caches.pixel.clear();
+        caches.scratch.clear();
+        let weight = if self.counts.is_some() {
+            1.0 / f64::from(n)
+        } else {
+            1.0
+        };
         let mut sampler = PixelSampler::new(self.settings.seed, x, y);
-        let (mut n, mut mean, mut m2) = (0u32, 0.0f64, 0.0f64);
-        while !self
-            .rule
-            .done(n, mean, if n > 1 { m2 / f64::from(n - 1) } else { 0.0 })
-        {
-            sampler.start_sample(n);
-            let film_pos = DVec2::new(x as f64, y as f64) + sampler.get2(dims::FILM);
-            let l = self
-                .estimators
-                .sample(self.camera, film_pos, &sampler, caches, stats);
-            let rgb = (self.to_rgb)(&l);
+        for k in 0..n {
+            let (film_pos, rgb) = self.sample(x, y, k, &mut sampler, caches, stats);
             if rgb.iter().all(|v| v.is_finite()) {
-                film.splat(film_pos.x, film_pos.y, rgb);
+                film.splat_weighted(film_pos.x, film_pos.y, rgb, weight);
             } else {
                 stats.dropped += 1;
             }
-            // Welford's running mean and variance of the luminance.
-            n += 1;
-            let y_l = luminance(rgb);
-            let delta = y_l - mean;
-            mean += delta / f64::from(n);
-            m2 += delta * (y_l - mean);
         }
+    }
+
+    /// Camera sample `k` of pixel (x, y) from `sampler`: its film position
+    /// and linear sRGB value.
+    fn sample<const N: usize>(
+        &self,
+        x: u32,
+        y: u32,
+        k: u32,
+        sampler: &mut PixelSampler,
+        caches: &mut Caches<N>,
+        stats: &mut GatherStats,
+    ) -> (DVec2, [f64; 3])
+    where
+        S: SolutionGather<N>,
+        F: Fn(&Spectrum<N>) -> [f64; 3] + Sync,
+    {
+        sampler.start_sample(k);
+        let film_pos = DVec2::new(x as f64, y as f64) + sampler.get2(dims::FILM);
+        let l = self
+            .estimators
+            .sample(self.camera, film_pos, sampler, caches, stats);
+        (film_pos, (self.to_rgb)(&l))
+    }
+
+    /// The adaptive pilot of row `y`: the luminance statistics of the first
+    /// [`PILOT_SPP`] samples of each pixel.
+    fn pilot_row<const N: usize>(&self, y: u32) -> (Vec<Pilot>, GatherStats)
+    where
+        S: SolutionGather<N>,
+        F: Fn(&Spectrum<N>) -> [f64; 3] + Sync,
+    {
+        let mut caches = Caches::<N>::default();
+        let mut stats = GatherStats::default();
+        let mut row = Vec::with_capacity(self.camera.width() as usize);
+        for x in 0..self.camera.width() {
+            caches.pixel.clear();
+            caches.scratch.clear();
+            let mut sampler = PixelSampler::new(self.settings.seed, x, y);
+            // Welford's running mean and variance of the luminance.
+            let (mut mean, mut m2) = (0.0f64, 0.0f64);
+            for k in 0..PILOT_SPP {
+                let (_, rgb) = self.sample(x, y, k, &mut sampler, &mut caches, &mut stats);
+                let y_l = luminance(rgb);
+                let delta = y_l - mean;
+                mean += delta / f64::from(k + 1);
+                m2 += delta * (y_l - mean);
+            }
+            row.push(Pilot {
+                mean: mean as f32,
+                var: (m2 / f64::from(PILOT_SPP - 1)) as f32,
+            });
+        }
+        (row, stats)
     }
 }
 

@@ -69,6 +69,15 @@ impl Film {
     /// Splats one sample of linear RGB `value` taken at film position
     /// (`px`, `py`) in pixels. Pixels outside this buffer are skipped.
     pub fn splat(&mut self, px: f64, py: f64, value: [f64; 3]) {
+        self.splat_weighted(px, py, value, 1.0);
+    }
+
+    /// [`Film::splat`] with the filter weights scaled by `weight`: adaptive
+    /// sampling gives each sample of a pixel that took n samples weight 1/n,
+    /// so a pixel's neighbours see its samples as one unit of weight however
+    /// many it took (an unevenly sampled neighbour would otherwise pull a
+    /// pixel toward its own value).
+    pub fn splat_weighted(&mut self, px: f64, py: f64, value: [f64; 3], weight: f64) {
         let r = self.filter.radius();
         // Continuous position relative to pixel centres at integer indices.
         let cx = px - 0.5;
@@ -95,7 +104,7 @@ impl Film {
             *w = self.filter.eval((lo_x + k as i64) as f64 - cx);
         }
         for j in lo_y..=hi_y {
-            let wy = self.filter.eval(j as f64 - cy);
+            let wy = self.filter.eval(j as f64 - cy) * weight;
             if wy == 0.0 {
                 continue;
             }
@@ -204,6 +213,22 @@ mod tests {
         assert!((film.weights[3 * 8 + 3] - f.eval(0.0).powi(2)).abs() < 1e-15);
         assert!((film.weights[3 * 8 + 4] - f.eval(0.0) * f.eval(1.0)).abs() < 1e-15);
         assert_eq!(film.weights[3 * 8 + 5], 0.0); // d = 2: weight exactly zero
+    }
+
+    #[test]
+    fn weighted_samples_count_as_units() {
+        let f = ReconstructionFilter::default();
+        let mut film = Film::new(0, 0, 8, 8, f).unwrap();
+        film.splat_weighted(3.5, 3.5, [1.0; 3], 0.25);
+        assert!((film.weights[3 * 8 + 3] - 0.25 * f.eval(0.0).powi(2)).abs() < 1e-15);
+        // Pixel 0 took one sample of 1, pixel 2 four of 3, each weighted
+        // 1/n: pixel 1, as far from both, sees two equal units, mean 2.
+        let mut row = Film::new(0, 0, 3, 1, f).unwrap();
+        row.splat_weighted(0.5, 0.5, [1.0; 3], 1.0);
+        for _ in 0..4 {
+            row.splat_weighted(2.5, 0.5, [3.0; 3], 0.25);
+        }
+        assert!((row.develop().pixels()[1][0] - 2.0).abs() < 1e-6);
     }
 
     #[test]

@@ -37,6 +37,8 @@
 //!   geometry, BRDFs and a solution ([`SolvedScene`]).
 //! - [`filter`]: reconstruction filters (Mitsuba's Gaussian, box, ...).
 //! - [`film`]: splatting samples through the filter, per-pixel normalisation.
+//! - [`adaptive`]: how many samples each pixel takes under adaptive
+//!   sampling (two streams, each allotted from the other's pilot).
 //! - [`driver`]: tiles rendered in parallel (rayon), merged deterministically.
 //! - [`image`]: the finished [`Image`], its EXR (ZIP) and PNG files (never
 //!   with a non-finite pixel; written through `trilux-files`).
@@ -45,6 +47,7 @@
 //! - [`error`]: the error type, [`RenderError`].
 #![forbid(unsafe_code)]
 
+pub mod adaptive;
 pub mod analytic;
 pub mod camera;
 pub mod compare;

@@ -101,8 +101,9 @@ pub struct RenderArgs {
     /// own visibility, no random rays (one sample a pixel unless --spp).
     #[arg(long, conflicts_with_all = ["gather", "target_error"])]
     pub preview: bool,
-    /// Adaptive sampling: a pixel stops once its estimated relative error
-    /// is below this (e.g. 0.02); --spp is then the most a pixel takes.
+    /// Adaptive sampling: samples go where the pilot saw noise, for about
+    /// this RMS relative error a pixel (e.g. 0.02; docs/rendering.md);
+    /// --spp is then the most a pixel takes (at least 4).
     #[arg(long, value_parser = parse_target_error)]
     pub target_error: Option<f64>,
     /// Where the path gather continues one bounce before reading the

@@ -132,6 +132,24 @@ fn unwritable_output_and_missing_scene_fail_cleanly() {
         s(&dir.join("m.sol")),
     ]);
     assert_one_error_line(&out, "missing scene (solve)");
+    // Adaptive sampling's pilot takes 4 samples a pixel: fewer is refused
+    // before any work, with what to change.
+    let out = trilux(&[
+        "render",
+        &furnace[..],
+        "-o",
+        s(&dir.join("a.exr")),
+        "--spp",
+        "2",
+        "--target-error",
+        "0.1",
+    ]);
+    assert_one_error_line(&out, "adaptive with 2 spp");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("--spp") && stderr.contains("at least 4"),
+        "{stderr}"
+    );
 }
 
 #[test]
