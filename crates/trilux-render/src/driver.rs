@@ -61,7 +61,7 @@ pub struct RenderSettings {
     pub extra_bounce: ExtraBounce,
     /// Adaptive sampling: the predicted RMS relative error a pixel (against
     /// the larger of its mean and the image's) the samples are allotted
-    /// for, in proportion to each pixel's noise ([`crate::adaptive`]);
+    /// for, in proportion to each pixel's noise (docs/rendering.md, "Adaptive sampling");
     /// `spp` stays the most a pixel takes (at least [`MIN_ADAPTIVE_SPP`]).
     /// `None`: every pixel takes `spp`.
     pub target_error: Option<f64>,

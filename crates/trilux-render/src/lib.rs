@@ -37,8 +37,9 @@
 //!   geometry, BRDFs and a solution ([`SolvedScene`]).
 //! - [`filter`]: reconstruction filters (Mitsuba's Gaussian, box, ...).
 //! - [`film`]: splatting samples through the filter, per-pixel normalisation.
-//! - [`adaptive`]: how many samples each pixel takes under adaptive
-//!   sampling (two streams, each allotted from the other's pilot).
+//! - `adaptive` (private): how many samples each pixel takes under
+//!   adaptive sampling (allotted from the pilots of the other colour of a
+//!   checkerboard, so that no pixel's count depends on its own samples).
 //! - [`driver`]: tiles rendered in parallel (rayon), merged deterministically.
 //! - [`image`]: the finished [`Image`], its EXR (ZIP) and PNG files (never
 //!   with a non-finite pixel; written through `trilux-files`).
@@ -47,7 +48,7 @@
 //! - [`error`]: the error type, [`RenderError`].
 #![forbid(unsafe_code)]
 
-pub mod adaptive;
+mod adaptive;
 pub mod analytic;
 pub mod camera;
 pub mod compare;
