@@ -417,10 +417,7 @@ impl<S, F> TileJob<'_, S, F> {
         F: Fn(&Spectrum<N>) -> [f64; 3] + Sync,
     {
         let (w, h) = (self.camera.width(), self.camera.height());
-        let rows: Vec<_> = (0..h)
-            .into_par_iter()
-            .map(|y| self.pilot_row(y))
-            .collect();
+        let rows: Vec<_> = (0..h).into_par_iter().map(|y| self.pilot_row(y)).collect();
         let mut pilots = Vec::with_capacity(w as usize * h as usize);
         let mut kept = Vec::with_capacity(h as usize);
         let mut stats = GatherStats::default();
@@ -535,7 +532,10 @@ mod tests {
         let (kept, kept_stats) = run(true);
         let (again, again_stats) = run(false);
         let pixels = u64::from(w * h);
-        let (k, a) = (kept_stats.gather.camera_rays, again_stats.gather.camera_rays);
+        let (k, a) = (
+            kept_stats.gather.camera_rays,
+            again_stats.gather.camera_rays,
+        );
         assert_eq!(a - k, u64::from(PILOT_SPP) * pixels);
         // The counts adapted: between the pilot's and the cap.
         assert!(k > 2 * pixels && k < (64 - 4) * pixels, "{k} samples");
