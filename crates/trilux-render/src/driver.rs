@@ -291,6 +291,10 @@ struct KeptSample {
 /// [`PILOT_SPP`] samples (pixel x's at x · [`PILOT_SPP`]..), the counters.
 type PilotRow = (Vec<Pilot>, Vec<KeptSample>, GatherStats);
 
+/// The whole adaptive pilot: each pixel's count, the kept samples a row
+/// each, the counters.
+type PilotPass = (Vec<u32>, Vec<Vec<KeptSample>>, GatherStats);
+
 /// What rendering one tile (or the adaptive pilot) needs.
 struct TileJob<'a, S, F> {
     estimators: &'a Estimators<'a, S>,
@@ -411,7 +415,7 @@ impl<S, F> TileJob<'_, S, F> {
     fn pilot<const N: usize>(
         &self,
         target: f64,
-    ) -> Result<(Vec<u32>, Vec<Vec<KeptSample>>, GatherStats), RenderError>
+    ) -> Result<PilotPass, RenderError>
     where
         S: SolutionGather<N>,
         F: Fn(&Spectrum<N>) -> [f64; 3] + Sync,
