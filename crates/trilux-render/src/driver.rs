@@ -412,10 +412,7 @@ impl<S, F> TileJob<'_, S, F> {
     /// The adaptive pilot: each pixel's count for `target`, the pilot's
     /// samples a row each, and the pilot's counters (rows collected in
     /// order: the same whatever the number of threads).
-    fn pilot<const N: usize>(
-        &self,
-        target: f64,
-    ) -> Result<PilotPass, RenderError>
+    fn pilot<const N: usize>(&self, target: f64) -> Result<PilotPass, RenderError>
     where
         S: SolutionGather<N>,
         F: Fn(&Spectrum<N>) -> [f64; 3] + Sync,
