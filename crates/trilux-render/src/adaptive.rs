@@ -10,9 +10,11 @@
 //! - the pixels are coloured like a checkerboard, and a pixel's count is a
 //!   function of the other colour's pilot only: its noise from its four
 //!   edge neighbours, the image-wide constants from the other colour;
-//! - the pixel then takes its count from the start of its sequence (the
-//!   pilot samples again, and kept), each sample splatted with weight
-//!   1/count ([`crate::film::Film::splat_weighted`]).
+//! - the pixel then takes its count from the start of its sequence, the
+//!   pilot's samples kept (not taken again: at about 50 samples a pixel
+//!   retaking them made the error 4 % worse than uniform sampling's), each
+//!   sample splatted with weight 1/count
+//!   ([`crate::film::Film::splat_weighted`]).
 //!
 //! Given its count, a pixel's samples are as in a uniform render: its mean
 //! is unbiased. (One Sobol sequence a pixel, as in the uniform render:
@@ -28,8 +30,8 @@
 //! the image), brighter ones (lamps) to a relative one, so a lamp's noisy
 //! edge cannot take the whole budget.
 
-/// Pilot samples of every pixel (taken again, and kept, when the pixel is
-/// rendered): the fewest a pixel takes.
+/// Pilot samples of every pixel (kept for the pixel's render): the fewest
+/// a pixel takes.
 pub const PILOT_SPP: u32 = 4;
 
 /// The evenly spread share of the noise allotment: each pixel's relative

@@ -70,7 +70,7 @@ pub struct RenderSettings {
 }
 
 /// Samples every pixel takes under adaptive sampling: its pilot's, which
-/// it takes again when rendered.
+/// its render keeps.
 pub const MIN_ADAPTIVE_SPP: u32 = PILOT_SPP;
 
 impl Default for RenderSettings {
@@ -197,6 +197,22 @@ pub fn render_image<S, const N: usize>(
 where
     S: SolutionGather<N>,
 {
+    render_tiles(scene, camera, settings, to_rgb, progress, true)
+}
+
+/// [`render_image`]; with `keep_pilot` false an adaptive render takes its
+/// pilot samples again instead of keeping them (the tests' reference).
+fn render_tiles<S, const N: usize>(
+    scene: &S,
+    camera: &Camera,
+    settings: &RenderSettings,
+    to_rgb: impl Fn(&Spectrum<N>) -> [f64; 3] + Sync,
+    progress: impl Fn(usize, usize) + Sync,
+    keep_pilot: bool,
+) -> Result<(Image, RenderStats), RenderError>
+where
+    S: SolutionGather<N>,
+{
     settings.validate()?;
     let start = Instant::now();
     let (w, h) = (camera.width(), camera.height());
@@ -216,25 +232,22 @@ where
         camera,
         settings,
         counts: None,
+        kept: None,
         to_rgb: &to_rgb,
     };
     // Adaptive: each pixel's samples, allotted from the pilot of the other
-    // checkerboard colour (rows collected in order: the same whatever the
-    // number of threads).
-    let counts = match settings.target_error {
+    // checkerboard colour, and the pilot's samples kept.
+    let (counts, kept) = match settings.target_error {
         Some(target) => {
-            let rows: Vec<_> = (0..h).into_par_iter().map(|y| job.pilot_row(y)).collect();
-            let mut pilots = Vec::with_capacity(w as usize * h as usize);
-            for (row, s) in rows {
-                pilots.extend(row);
-                stats.gather.add(&s);
-            }
-            Some(allot(&pilots, w as usize, target, settings.spp))
+            let (counts, kept, s) = job.pilot(target)?;
+            stats.gather.add(&s);
+            (Some(counts), keep_pilot.then_some(kept))
         }
-        None => None,
+        None => (None, None),
     };
     let job = TileJob {
         counts: counts.as_deref(),
+        kept: kept.as_deref(),
         ..job
     };
     let tiles: Vec<Result<(Film, GatherStats), RenderError>> = (0..total)
@@ -264,6 +277,24 @@ fn luminance(rgb: [f64; 3]) -> f64 {
     if y.is_finite() { y } else { 0.0 }
 }
 
+/// A pilot sample kept for its pixel's render: where on the film it fell
+/// (the offset within the pixel; exact in f32, as Sobol's values are) and
+/// its linear sRGB value, so the render splats it instead of taking it
+/// again.
+#[derive(Clone, Copy, Debug, Default)]
+struct KeptSample {
+    offset: [f32; 2],
+    rgb: [f64; 3],
+}
+
+/// One row of the adaptive pilot: each pixel's statistics, its
+/// [`PILOT_SPP`] samples (pixel x's at x · [`PILOT_SPP`]..), the counters.
+type PilotRow = (Vec<Pilot>, Vec<KeptSample>, GatherStats);
+
+/// The whole adaptive pilot: each pixel's count, the kept samples a row
+/// each, the counters.
+type PilotPass = (Vec<u32>, Vec<Vec<KeptSample>>, GatherStats);
+
 /// What rendering one tile (or the adaptive pilot) needs.
 struct TileJob<'a, S, F> {
     estimators: &'a Estimators<'a, S>,
@@ -271,6 +302,9 @@ struct TileJob<'a, S, F> {
     settings: &'a RenderSettings,
     /// Samples of each pixel (row-major) when adaptive.
     counts: Option<&'a [u32]>,
+    /// The pilot's samples, a row each, when adaptive (`None`: the render
+    /// takes them again).
+    kept: Option<&'a [Vec<KeptSample>]>,
     to_rgb: &'a F,
 }
 
@@ -301,19 +335,24 @@ impl<S, F> TileJob<'_, S, F> {
                 let n = self
                     .counts
                     .map_or(self.settings.spp, |c| c[y as usize * width + x as usize]);
-                self.pixel(x, y, n, &mut film, &mut caches, &mut stats);
+                let start = x as usize * PILOT_SPP as usize;
+                let kept = self
+                    .kept
+                    .map(|rows| &rows[y as usize][start..start + PILOT_SPP as usize]);
+                self.pixel(x, y, (n, kept), &mut film, &mut caches, &mut stats);
             }
         }
         Ok((film, stats))
     }
 
     /// Samples 0..n of pixel (x, y) into the film, each weighted 1/n when
-    /// adaptive (so its neighbours see it as one unit of weight).
+    /// adaptive (so its neighbours see it as one unit of weight); the first
+    /// ones from `kept` (the pilot's) when given, the rest taken.
     fn pixel<const N: usize>(
         &self,
         x: u32,
         y: u32,
-        n: u32,
+        (n, kept): (u32, Option<&[KeptSample]>),
         film: &mut Film,
         caches: &mut Caches<N>,
         stats: &mut GatherStats,
@@ -328,14 +367,22 @@ impl<S, F> TileJob<'_, S, F> {
         } else {
             1.0
         };
-        let mut sampler = PixelSampler::new(self.settings.seed, x, y);
-        for k in 0..n {
-            let (film_pos, rgb) = self.sample(x, y, k, &mut sampler, caches, stats);
+        let mut splat = |film_pos: DVec2, rgb: [f64; 3], stats: &mut GatherStats| {
             if rgb.iter().all(|v| v.is_finite()) {
                 film.splat_weighted(film_pos.x, film_pos.y, rgb, weight);
             } else {
                 stats.dropped += 1;
             }
+        };
+        let kept = kept.unwrap_or_default();
+        for s in kept {
+            let offset = DVec2::new(f64::from(s.offset[0]), f64::from(s.offset[1]));
+            splat(DVec2::new(x as f64, y as f64) + offset, s.rgb, stats);
+        }
+        let mut sampler = PixelSampler::new(self.settings.seed, x, y);
+        for k in kept.len() as u32..n {
+            let (film_pos, rgb) = self.sample(x, y, k, &mut sampler, caches, stats);
+            splat(film_pos, rgb, stats);
         }
     }
 
@@ -362,17 +409,50 @@ impl<S, F> TileJob<'_, S, F> {
         (film_pos, (self.to_rgb)(&l))
     }
 
+    /// The adaptive pilot: each pixel's count for `target`, the pilot's
+    /// samples a row each, and the pilot's counters (rows collected in
+    /// order: the same whatever the number of threads).
+    fn pilot<const N: usize>(&self, target: f64) -> Result<PilotPass, RenderError>
+    where
+        S: SolutionGather<N>,
+        F: Fn(&Spectrum<N>) -> [f64; 3] + Sync,
+    {
+        let (w, h) = (self.camera.width(), self.camera.height());
+        let rows: Vec<_> = (0..h).into_par_iter().map(|y| self.pilot_row(y)).collect();
+        let mut pilots = Vec::with_capacity(w as usize * h as usize);
+        let mut kept = Vec::with_capacity(h as usize);
+        let mut stats = GatherStats::default();
+        for row in rows {
+            let (row, samples, s) = row?;
+            pilots.extend(row);
+            kept.push(samples);
+            stats.add(&s);
+        }
+        let counts = allot(&pilots, w as usize, target, self.settings.spp);
+        Ok((counts, kept, stats))
+    }
+
     /// The adaptive pilot of row `y`: the luminance statistics of the first
-    /// [`PILOT_SPP`] samples of each pixel.
-    fn pilot_row<const N: usize>(&self, y: u32) -> (Vec<Pilot>, GatherStats)
+    /// [`PILOT_SPP`] samples of each pixel, and the samples, kept; an error,
+    /// not an abort, when their memory cannot be had.
+    fn pilot_row<const N: usize>(&self, y: u32) -> Result<PilotRow, RenderError>
     where
         S: SolutionGather<N>,
         F: Fn(&Spectrum<N>) -> [f64; 3] + Sync,
     {
         let mut caches = Caches::<N>::default();
         let mut stats = GatherStats::default();
-        let mut row = Vec::with_capacity(self.camera.width() as usize);
-        for x in 0..self.camera.width() {
+        let width = self.camera.width();
+        let mut row = Vec::with_capacity(width as usize);
+        let mut kept = Vec::new();
+        kept.try_reserve_exact(width as usize * PILOT_SPP as usize)
+            .map_err(|_| {
+                RenderError::Settings(format!(
+                    "not enough memory for the adaptive pilot of a {width} × {} film (docs/limits.md)",
+                    self.camera.height()
+                ))
+            })?;
+        for x in 0..width {
             caches.pixel.clear();
             caches.scratch.clear();
             let mut sampler = PixelSampler::new(self.settings.seed, x, y);
@@ -380,6 +460,12 @@ impl<S, F> TileJob<'_, S, F> {
             let (mut mean, mut m2) = (0.0f64, 0.0f64);
             for k in 0..PILOT_SPP {
                 let (_, rgb) = self.sample(x, y, k, &mut sampler, &mut caches, &mut stats);
+                // The film offset again (`sample` drew it): f64 of an f32.
+                let offset = sampler.get2(dims::FILM);
+                kept.push(KeptSample {
+                    offset: [offset.x as f32, offset.y as f32],
+                    rgb,
+                });
                 let y_l = luminance(rgb);
                 let delta = y_l - mean;
                 mean += delta / f64::from(k + 1);
@@ -390,7 +476,7 @@ impl<S, F> TileJob<'_, S, F> {
                 var: (m2 / f64::from(PILOT_SPP - 1)) as f32,
             });
         }
-        (row, stats)
+        Ok((row, kept, stats))
     }
 }
 
@@ -405,4 +491,63 @@ pub fn render<const N: usize, S: RadianceSolution<N>>(
 ) -> Result<(Image, RenderStats), RenderError> {
     let solved = SolvedScene::new(solution);
     render_image::<_, N>(&solved, camera, settings, |l| l.to_linear_srgb(), progress)
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::DVec3;
+
+    use super::*;
+    use crate::analytic::LitFloor;
+    use crate::camera::{FovAxis, look_at};
+
+    #[test]
+    fn the_kept_pilot_is_the_pilot_taken_again() {
+        // A floor under a square lamp, the lamp in view: the counts vary.
+        // Keeping the pilot's samples must give the image of taking them
+        // again (same samples, same weights, same order) with PILOT_SPP
+        // fewer camera samples a pixel.
+        let scene = LitFloor {
+            rho: 0.8,
+            s: 0.5,
+            h: 1.0,
+            le: 5.0,
+        };
+        let m = look_at(
+            DVec3::new(-2.5, -2.5, 0.5),
+            DVec3::new(0.0, 0.0, 0.6),
+            DVec3::Z,
+        )
+        .unwrap();
+        let (w, h) = (20u32, 14u32);
+        let camera = Camera::new(m, 60.0, FovAxis::X, w, h).unwrap();
+        let settings = RenderSettings {
+            spp: 64,
+            target_error: Some(0.05),
+            tile_size: 6,
+            ..Default::default()
+        };
+        let run = |keep| {
+            render_tiles::<_, 3>(&scene, &camera, &settings, |l| l.0, |_, _| {}, keep).unwrap()
+        };
+        let (kept, kept_stats) = run(true);
+        let (again, again_stats) = run(false);
+        let pixels = u64::from(w * h);
+        let (k, a) = (
+            kept_stats.gather.camera_rays,
+            again_stats.gather.camera_rays,
+        );
+        assert_eq!(a - k, u64::from(PILOT_SPP) * pixels);
+        // The counts adapted: between the pilot's and the cap.
+        assert!(k > 2 * pixels && k < (64 - 4) * pixels, "{k} samples");
+        assert_eq!(kept_stats.gather.dropped, again_stats.gather.dropped);
+        let lit = kept.pixels().iter().filter(|p| p[0] > 0.01).count();
+        assert!(lit > 20, "{lit} lit pixels");
+        for (i, (p, q)) in kept.pixels().iter().zip(again.pixels()).enumerate() {
+            for c in 0..3 {
+                let tol = 1e-6 * p[c].abs().max(q[c].abs()) + 1e-9;
+                assert!((p[c] - q[c]).abs() <= tol, "pixel {i}: {p:?} vs {q:?}");
+            }
+        }
+    }
 }
