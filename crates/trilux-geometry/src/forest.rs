@@ -17,7 +17,7 @@ use crate::chart::{Piece, cluster_element, split_cluster};
 use crate::element::{Element, ElementDomain, rect_element};
 use crate::geometry::Geometry;
 use crate::ids::{ElementId, SurfaceId};
-use crate::sampling::{SurfaceSample, sample_cluster, sample_rect};
+use crate::sampling::{SurfaceSample, piece_ends, sample_cluster, sample_rect};
 use crate::surface::{SurfaceCoord, SurfaceGeom};
 
 /// The element trees of a scene (see the module docs).
@@ -26,6 +26,9 @@ pub struct ElementForest {
     geometry: Arc<Geometry>,
     elements: Vec<Element>,
     pieces: Vec<Piece>,
+    /// Per piece, the running sum of its element's piece areas up to it
+    /// (`sampling::piece_ends`), for sampling in O(log n).
+    piece_ends: Vec<f64>,
     /// Per mesh, per triangle: the deepest element holding the whole
     /// triangle (a shortcut for `locate`).
     tri_element: Vec<Vec<u32>>,
@@ -43,6 +46,7 @@ impl ElementForest {
             geometry,
             elements: Vec::new(),
             pieces: Vec::new(),
+            piece_ends: Vec::new(),
         };
         for s in 0..forest.geometry.surfaces().len() as u32 {
             let root = forest.make_root(SurfaceId(s));
@@ -101,6 +105,16 @@ impl ElementForest {
         }
     }
 
+    /// The running sums of a chart element's piece areas.
+    fn element_piece_ends(&self, id: ElementId) -> &[f64] {
+        match self.elements[id.index()].domain {
+            ElementDomain::Cluster { first, count } => {
+                &self.piece_ends[first as usize..(first + count) as usize]
+            }
+            ElementDomain::Rect { .. } => &[],
+        }
+    }
+
     /// The leaves under `id` (itself when it has no children), depth first.
     pub fn leaves(&self, id: ElementId) -> Vec<ElementId> {
         let mut out = Vec::new();
@@ -131,6 +145,7 @@ impl ElementForest {
         for p in pieces.iter().filter(|p| p.is_whole()) {
             self.tri_element[mesh as usize][p.triangle as usize] = id;
         }
+        self.piece_ends.extend(piece_ends(m, &pieces));
         self.pieces.extend(pieces);
         element
     }
@@ -381,6 +396,7 @@ impl ElementForest {
             (ElementDomain::Cluster { .. }, SurfaceGeom::Chart { mesh, .. }) => sample_cluster(
                 &self.geometry.meshes[*mesh as usize],
                 self.element_pieces(id),
+                self.element_piece_ends(id),
                 e.area,
                 u,
             ),

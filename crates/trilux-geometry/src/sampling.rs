@@ -104,22 +104,72 @@ pub(crate) fn sample_rect(
     }
 }
 
-/// Samples a cluster of `pieces` (of total area `area`) of a mesh: `u.x`
-/// picks a piece by its area and is rescaled within it, then the
-/// square-root map gives a uniform point of the piece.
-pub(crate) fn sample_cluster(m: &MeshData, pieces: &[Piece], area: f64, u: DVec2) -> SurfaceSample {
-    let target = u.x * area;
+/// The running sums Σ_{i≤k} A_i of the pieces' areas, added in order.
+pub(crate) fn piece_ends(m: &MeshData, pieces: &[Piece]) -> Vec<f64> {
     let mut acc = 0.0;
-    let mut chosen = (pieces.len() - 1, 0.0, 1.0);
-    for (k, p) in pieces.iter().enumerate() {
-        let a = m.tri_area[p.triangle as usize] * p.area_fraction();
-        if target < acc + a || k + 1 == pieces.len() {
-            chosen = (k, acc, a);
-            break;
+    pieces
+        .iter()
+        .map(|p| {
+            acc += piece_area(m, p);
+            acc
+        })
+        .collect()
+}
+
+fn piece_area(m: &MeshData, p: &Piece) -> f64 {
+    m.tri_area[p.triangle as usize] * p.area_fraction()
+}
+
+/// The first piece whose running sum exceeds `target` (the last if none),
+/// with the sum before it and its area (`area_of(k)`, `n` pieces).
+fn chosen_piece(
+    n: usize,
+    area_of: impl Fn(usize) -> f64,
+    ends: &[f64],
+    target: f64,
+) -> (usize, f64, f64) {
+    let last = n - 1;
+    // The sums are non-decreasing when finite: the search then finds what
+    // the scan finds. Otherwise scan.
+    // `!(target < e)`, not `e <= target`: the scan's test, NaN included.
+    #[allow(clippy::neg_cmp_op_on_partial_ord)]
+    let k = if ends[last].is_finite() {
+        ends.partition_point(|&e| !(target < e)).min(last)
+    } else {
+        chosen_piece_linear(n, &area_of, target)
+    };
+    let start = if k == 0 { 0.0 } else { ends[k - 1] };
+    (k, start, area_of(k))
+}
+
+/// The linear scan (the reference of the binary search).
+fn chosen_piece_linear(n: usize, area_of: impl Fn(usize) -> f64, target: f64) -> usize {
+    let mut acc = 0.0;
+    for k in 0..n {
+        let a = area_of(k);
+        if target < acc + a || k + 1 == n {
+            return k;
         }
         acc += a;
     }
-    let (k, start, a) = chosen;
+    n - 1
+}
+
+/// Samples a cluster of `pieces` (of total area `area`) of a mesh: `u.x`
+/// picks a piece by its area and is rescaled within it, then the
+/// square-root map gives a uniform point of the piece. `ends` holds the
+/// running sums of the pieces' areas ([`piece_ends`]): a binary search
+/// picks the piece the linear scan would (the same sums, compared the
+/// same way), in O(log n) for charts of thousands of triangles.
+pub(crate) fn sample_cluster(
+    m: &MeshData,
+    pieces: &[Piece],
+    ends: &[f64],
+    area: f64,
+    u: DVec2,
+) -> SurfaceSample {
+    let target = u.x * area;
+    let (k, start, a) = chosen_piece(pieces.len(), |k| piece_area(m, &pieces[k]), ends, target);
     let ux = if a > 0.0 {
         ((target - start) / a).clamp(0.0, 1.0 - f64::EPSILON)
     } else {
@@ -136,5 +186,51 @@ pub(crate) fn sample_cluster(m: &MeshData, pieces: &[Piece], area: f64, u: DVec2
             index: p.triangle,
             bary,
         },
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The search picks the piece, start and area of the linear scan on
+    /// random areas (zeros and exact running sums as targets included).
+    #[test]
+    fn binary_search_picks_the_linear_scans_piece() {
+        let mut x = 0x2545_F491_4F6C_DD1Du64;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for case in 0..3_000 {
+            let n = 1 + (next() * 40.0) as usize;
+            let areas: Vec<f64> = (0..n)
+                .map(|_| if next() < 0.2 { 0.0 } else { next() * 1e3 })
+                .collect();
+            let mut acc = 0.0;
+            let ends: Vec<f64> = areas
+                .iter()
+                .map(|a| {
+                    acc += a;
+                    acc
+                })
+                .collect();
+            let total = ends[n - 1];
+            let targets = [
+                next() * total,
+                ends[(next() * n as f64) as usize],
+                total,
+                total * 1.5,
+                0.0,
+            ];
+            for target in targets {
+                let k = chosen_piece_linear(n, |k| areas[k], target);
+                let start: f64 = areas[..k].iter().fold(0.0, |s, a| s + a);
+                let got = chosen_piece(n, |k| areas[k], &ends, target);
+                assert_eq!(got, (k, start, areas[k]), "case {case}, target {target}");
+            }
+        }
     }
 }

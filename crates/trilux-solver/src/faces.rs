@@ -10,6 +10,7 @@ use trilux_brdf::Bsdf;
 use trilux_color::Spectrum;
 use trilux_geometry::{ElementForest, FaceId, PerFace, Side, SurfaceId};
 
+use crate::facing::{FaceProbes, facing, rounding_bound};
 use crate::settings::Transport;
 
 /// One face of an input surface as the solver sees it.
@@ -94,7 +95,8 @@ fn probe_points(forest: &ElementForest, surface: SurfaceId, sign: f64) -> Vec<(D
 /// some point of `b` lies in front of `a` and some point of `a` in front of
 /// `b`, both as seen by the same pair of points. Exact for planar surfaces
 /// (probing the corners and interior suffices: the conditions are
-/// linear), a dense probe for curved ones.
+/// linear), a dense probe for curved ones. Most pairs are decided by
+/// separated bounds, with the joint test's answer (`facing`).
 pub(crate) fn eligible_pairs<const N: usize>(
     forest: &ElementForest,
     faces: &PerFace<TransportFace<N>>,
@@ -102,12 +104,13 @@ pub(crate) fn eligible_pairs<const N: usize>(
 ) -> PerFace<Vec<FaceId>> {
     use rayon::prelude::*;
     let ids: Vec<FaceId> = faces.iter().map(|(f, _)| f).collect();
-    let probes: Vec<Vec<(DVec3, DVec3)>> = ids
+    let probes: Vec<FaceProbes> = ids
         .par_iter()
-        .map(|f| probe_points(forest, f.surface(), f.side().sign()))
+        .map(|f| FaceProbes::new(probe_points(forest, f.surface(), f.side().sign())))
         .collect();
     let scale = forest.geometry().bounds().diagonal().length().max(1e-300);
     let eps = 1e-9 * scale;
+    let tau = rounding_bound(probes.iter().map(FaceProbes::extent).fold(0.0, f64::max));
     let lists: Vec<Vec<FaceId>> = ids
         .par_iter()
         .map(|&a| {
@@ -119,13 +122,7 @@ pub(crate) fn eligible_pairs<const N: usize>(
                 if b.surface() == a.surface() {
                     continue;
                 }
-                let facing = probes[a.index()].iter().any(|&(p, np)| {
-                    probes[b.index()].iter().any(|&(q, nq)| {
-                        let d = q - p;
-                        d.dot(np) > eps && -d.dot(nq) > eps
-                    })
-                });
-                if facing {
+                if facing(&probes[a.index()], &probes[b.index()], eps, tau) {
                     out.push(b);
                 }
             }

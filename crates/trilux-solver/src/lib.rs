@@ -55,6 +55,7 @@ mod discretisation;
 mod divergence;
 pub mod error;
 mod faces;
+mod facing;
 mod final_gather;
 pub mod gather_links;
 mod glossy;

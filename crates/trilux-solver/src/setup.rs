@@ -93,11 +93,7 @@ impl<const N: usize> Setup<N> {
                 bands: N,
             });
         }
-        let albedo = scene
-            .materials()
-            .par_iter()
-            .map(Bsdf::albedo_table)
-            .collect();
+        let albedo = albedo_tables(scene.materials());
         let mut faces = build_faces(
             forest,
             scene.materials(),
@@ -184,6 +180,31 @@ impl<const N: usize> Setup<N> {
             albedo: &self.albedo,
         }
     }
+}
+
+/// The directional albedo table of every material, computed once per
+/// distinct material (a scene's shapes often repeat one; a table costs
+/// tens of milliseconds) and shared by its copies.
+fn albedo_tables<const N: usize>(materials: &[Bsdf<N>]) -> Vec<AlbedoTable<N>> {
+    let mut distinct: Vec<usize> = Vec::new();
+    let slot: Vec<usize> = materials
+        .iter()
+        .enumerate()
+        .map(
+            |(i, m)| match distinct.iter().position(|&d| materials[d] == *m) {
+                Some(k) => k,
+                None => {
+                    distinct.push(i);
+                    distinct.len() - 1
+                }
+            },
+        )
+        .collect();
+    let tables: Vec<AlbedoTable<N>> = distinct
+        .par_iter()
+        .map(|&d| materials[d].albedo_table())
+        .collect();
+    slot.into_iter().map(|k| tables[k].clone()).collect()
 }
 
 /// The flux IF = π A Le an emitting face sends, over its exposed area
@@ -382,4 +403,37 @@ fn root_pairs<const N: usize>(
         }
     }
     roots
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use trilux_brdf::{BsdfParams, Distribution, RoughConductorParams};
+    use trilux_color::ColorParam;
+
+    fn conductor(alpha: f64) -> Bsdf<3> {
+        let p = BsdfParams::RoughConductor(RoughConductorParams {
+            distribution: Distribution::Ggx,
+            alpha,
+            eta_k: None,
+            specular_reflectance: ColorParam::Float(0.8),
+        });
+        Bsdf::new(&p).expect("valid parameters")
+    }
+
+    /// Shared tables are each material's own table, in material order
+    /// (the rougher conductor's albedo differs, so a mix-up would show).
+    #[test]
+    fn albedo_tables_are_each_materials_own() {
+        let materials = vec![
+            conductor(0.1),
+            conductor(0.6),
+            conductor(0.1),
+            Bsdf::new(&BsdfParams::default()).expect("valid parameters"),
+            conductor(0.6),
+        ];
+        let expected: Vec<AlbedoTable<3>> = materials.iter().map(Bsdf::albedo_table).collect();
+        assert_ne!(expected[0], expected[1]);
+        assert_eq!(albedo_tables(&materials), expected);
+    }
 }
