@@ -76,7 +76,11 @@ fn a_stop_flag_ends_the_loop_after_the_shot_that_set_it_with_a_partial_solution(
     assert_eq!(stats.shots, 3);
     assert_eq!(stats.stop_reason, StopReason::Interrupted);
     assert!(stats.convergence_ratio > 0.0 && stats.convergence_ratio < 0.999);
-    let partial: Vec<_> = stats.warnings.iter().filter(|w| w.contains("partial")).collect();
+    let partial: Vec<_> = stats
+        .warnings
+        .iter()
+        .filter(|w| w.contains("partial"))
+        .collect();
     assert_eq!(partial.len(), 1, "{:?}", stats.warnings);
     // The last trace point is where it stopped.
     let last = stats.convergence_trace.last().unwrap();
