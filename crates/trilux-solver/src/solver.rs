@@ -250,7 +250,11 @@ impl<const N: usize> Solver<N> {
             {
                 return StopReason::TimeBudget;
             }
-            if self.stop.as_ref().is_some_and(|f| f.load(Ordering::Relaxed)) {
+            if self
+                .stop
+                .as_ref()
+                .is_some_and(|f| f.load(Ordering::Relaxed))
+            {
                 return StopReason::Interrupted;
             }
             let Some(source) = self.next_source() else {
