@@ -110,6 +110,7 @@ fn run_file(path: &std::path::Path, settings: &SolverSettings) -> Result<Row> {
     let observer = Observer {
         solve: &mut on_shot,
         render: &|_, _| {},
+        stop: None,
     };
     let outcome = trilux::pipeline::run(&scene, &plan, observer)?;
     let seconds = start.elapsed().as_secs_f64();

@@ -39,6 +39,7 @@ use crate::state::ShotState;
 use crate::stats::{StopReason, TracePoint};
 
 use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Progress after each shot, for progress bars (the solver never prints).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -80,6 +81,9 @@ pub struct Solver<const N: usize> {
     started: Instant,
     /// Stop shooting once this much time has passed since `started`.
     time_budget: Option<Duration>,
+    /// Stop shooting once this is set (by another thread or a signal
+    /// handler): an interrupted solve keeps the best solution so far.
+    stop: Option<Arc<AtomicBool>>,
 }
 
 impl<const N: usize> Solver<N> {
@@ -99,7 +103,16 @@ impl<const N: usize> Solver<N> {
             state,
             started,
             time_budget: budget.map(Duration::from_secs_f64),
+            stop: None,
         })
+    }
+
+    /// Stops the shooting loop, between shots, once `flag` is set: the
+    /// solve then ends as with a spent time budget, with stop reason
+    /// `interrupted` (a Ctrl-C or a scheduler's SIGTERM in the command).
+    pub fn stop_when(mut self, flag: Arc<AtomicBool>) -> Self {
+        self.stop = Some(flag);
+        self
     }
 
     /// Prepares `desc` ([`PreparedScene::new`]) and a solve of it.
@@ -206,8 +219,8 @@ impl<const N: usize> Solver<N> {
             .sum()
     }
 
-    /// Runs shots until the target convergence ratio, the shot cap or the
-    /// time budget, calling `progress` after each shot, then makes every
+    /// Runs shots until the target convergence ratio, the shot cap, the
+    /// time budget or the stop flag ([`Solver::stop_when`]), calling `progress` after each shot, then makes every
     /// hierarchy consistent and returns the solution.
     pub fn solve(mut self, mut progress: impl FnMut(&Progress)) -> Solution<N> {
         let start = Instant::now();
@@ -236,6 +249,13 @@ impl<const N: usize> Solver<N> {
                 .is_some_and(|b| self.started.elapsed() >= b)
             {
                 return StopReason::TimeBudget;
+            }
+            if self
+                .stop
+                .as_ref()
+                .is_some_and(|f| f.load(Ordering::Relaxed))
+            {
+                return StopReason::Interrupted;
             }
             let Some(source) = self.next_source() else {
                 return StopReason::NothingUnshot;
@@ -298,6 +318,9 @@ impl<const N: usize> Solver<N> {
             StopReason::TimeBudget => format!(
                 "the solve stopped at its time budget of {} s after {shots} shots with convergence ratio {cr:.4}, short of its target {target}: the solution is the best so far",
                 self.time_budget.map_or(0.0, |b| b.as_secs_f64())
+            ),
+            StopReason::Interrupted => format!(
+                "the solve was interrupted after {shots} shots with convergence ratio {cr:.4}, short of its target {target}: the solution is partial (the best so far)"
             ),
         };
         self.state.stats.warnings.push(warning);

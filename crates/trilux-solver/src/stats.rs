@@ -98,6 +98,9 @@ pub enum StopReason {
     ShotCap,
     /// The time budget ran out first: the solution is the best so far.
     TimeBudget,
+    /// The solve was asked to stop ([`crate::Solver::stop_when`]: SIGINT
+    /// or SIGTERM in the command): the solution is partial, the best so far.
+    Interrupted,
 }
 
 /// One point of [`SolveStats::convergence_trace`].

@@ -6,6 +6,8 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 use std::f64::consts::PI;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use glam::{DMat4, DVec3};
 use trilux_brdf::BsdfParams;
@@ -39,7 +41,7 @@ fn diffuse(r: f64) -> BsdfParams {
 
 /// Two facing plates that both reflect: light bounces between them, so the
 /// solve takes many shots to reach its target.
-fn solve(budget: Option<f64>) -> Result<Solution<3>, SolverError> {
+fn solver(budget: Option<f64>) -> Result<Solver<3>, SolverError> {
     let shapes = vec![
         square(DVec3::new(0.0, 0.0, 0.5), true),
         square(DVec3::ZERO, false),
@@ -54,7 +56,47 @@ fn solve(budget: Option<f64>) -> Result<Solution<3>, SolverError> {
     let mut settings = SolverSettings::preset(Quality::Draft);
     settings.convergence = 0.999;
     settings.time_budget_seconds = budget;
-    Ok(Solver::<3>::from_description(&input, settings)?.solve(|_| {}))
+    Solver::<3>::from_description(&input, settings)
+}
+
+fn solve(budget: Option<f64>) -> Result<Solution<3>, SolverError> {
+    Ok(solver(budget)?.solve(|_| {}))
+}
+
+#[test]
+fn a_stop_flag_ends_the_loop_after_the_shot_that_set_it_with_a_partial_solution() {
+    let flag = Arc::new(AtomicBool::new(false));
+    let setter = Arc::clone(&flag);
+    let s = solver(None)
+        .unwrap()
+        .stop_when(flag)
+        .solve(|p| setter.store(p.shots == 3, Ordering::Relaxed));
+    let stats = s.stats();
+    // The flag is read between shots: set after shot 3, no shot 4.
+    assert_eq!(stats.shots, 3);
+    assert_eq!(stats.stop_reason, StopReason::Interrupted);
+    assert!(stats.convergence_ratio > 0.0 && stats.convergence_ratio < 0.999);
+    let partial: Vec<_> = stats
+        .warnings
+        .iter()
+        .filter(|w| w.contains("partial"))
+        .collect();
+    assert_eq!(partial.len(), 1, "{:?}", stats.warnings);
+    // The last trace point is where it stopped.
+    let last = stats.convergence_trace.last().unwrap();
+    assert_eq!(last.shots, 3);
+    // Energy is still accounted for: emitted = absorbed + escaped + unshot.
+    for b in 0..3 {
+        let sum = stats.absorbed_flux[b] + stats.escaped_flux[b] + stats.residual_flux[b];
+        assert!((sum - stats.emitted_flux[b]).abs() <= 1e-9 * stats.emitted_flux[b]);
+    }
+    // A flag set before the first shot stops before it.
+    let s = solver(None)
+        .unwrap()
+        .stop_when(Arc::new(AtomicBool::new(true)))
+        .solve(|_| {});
+    assert_eq!(s.stats().shots, 0);
+    assert_eq!(s.stats().stop_reason, StopReason::Interrupted);
 }
 
 #[test]

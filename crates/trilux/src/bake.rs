@@ -87,7 +87,7 @@ pub fn run(args: &BakeArgs) -> Result<()> {
     let crate::plan::Finished {
         mut outcome,
         record,
-    } = crate::plan::run_plan(pending, &plan)?;
+    } = crate::plan::run_plan(pending, &plan, None)?;
     let baked = outcome.baked.take().context("the bake produced no file")?;
     let mut files = vec![baked.glb.clone()];
     if args.stats.is_some() {

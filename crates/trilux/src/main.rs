@@ -17,6 +17,7 @@
 
 mod bake;
 mod info;
+mod interrupt;
 mod options;
 mod output;
 mod plan;
@@ -143,15 +144,18 @@ fn render_default() -> anyhow::Result<()> {
     render::run_into(&args, true)
 }
 
-fn run(cli: Cli) -> anyhow::Result<()> {
-    match cli.command {
+/// Runs the command; its status is 0 unless it says otherwise (an
+/// interrupted solve, `interrupt`).
+fn run(cli: Cli) -> anyhow::Result<ExitCode> {
+    let done = match cli.command {
         Some(Command::Info(args)) => info::run(&args),
-        Some(Command::Solve(args)) => solve::run(&args),
+        Some(Command::Solve(args)) => return solve::run(&args),
         Some(Command::Render(args)) => render::run(&args),
         Some(Command::Bake(args)) => bake::run(&args),
         Some(Command::View(args)) => viewer::run(&args),
         None => render_default(),
-    }
+    };
+    done.map(|()| ExitCode::SUCCESS)
 }
 
 /// The longest line of an error message (a quoted value of megabytes
@@ -178,7 +182,7 @@ fn main() -> ExitCode {
         Err(e) => return usage_error(e),
     };
     match run(cli) {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(code) => code,
         Err(e) if e.is::<output::UsageError>() => {
             streams::eprint_line(&format!("error: {e}"));
             ExitCode::from(2)

@@ -9,6 +9,7 @@
 
 use std::path::Path;
 use std::sync::Arc;
+use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
 use trilux_color::{Mode, WithBands};
@@ -98,6 +99,9 @@ pub struct Observer<'o> {
     /// Called after every rendered tile, with (done, total), from worker
     /// threads.
     pub render: &'o (dyn Fn(usize, usize) + Sync),
+    /// Once set, the solve stops between shots with the solution so far
+    /// (`Solver::stop_when`; the command's SIGINT and SIGTERM).
+    pub stop: Option<Arc<AtomicBool>>,
 }
 
 impl Observer<'_> {
@@ -107,6 +111,7 @@ impl Observer<'_> {
         f(Observer {
             solve: &mut solve,
             render: &|_, _| {},
+            stop: None,
         })
     }
 }
@@ -245,9 +250,15 @@ impl WithBands for Run<'_, '_> {
         let prepare_seconds = start.elapsed().as_secs_f64();
         let start = Instant::now();
         let mut solution = match self.plan.source {
-            SolutionSource::Solve => Solver::new(prepared, self.plan.solver.clone())
-                .map_err(|e| located_solver(self.scene, e))?
-                .solve(|p| (self.observer.solve)(p)),
+            SolutionSource::Solve => {
+                let solver = Solver::new(prepared, self.plan.solver.clone())
+                    .map_err(|e| located_solver(self.scene, e))?;
+                match self.observer.stop {
+                    Some(flag) => solver.stop_when(flag),
+                    None => solver,
+                }
+                .solve(|p| (self.observer.solve)(p))
+            }
             SolutionSource::Load(path) => {
                 let mut s = Solution::load(path, prepared, &self.plan.solver)?;
                 s.stats_mut().solve_seconds = 0.0;

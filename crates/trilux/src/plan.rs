@@ -1,5 +1,8 @@
 //! Carrying out a command's plan: what `solve`, `render` and `bake` share.
 
+use std::sync::Arc;
+use std::sync::atomic::AtomicBool;
+
 use trilux_solver::Progress;
 
 use crate::progress::Bars;
@@ -18,9 +21,12 @@ pub struct Finished {
 /// (`pipeline::check`, then `pipeline::run`, then a warning for a scene
 /// without an emitter: after the work, so that an error stays one line,
 /// and a dark scene's solve has no light to shoot and ends at once).
+/// `stop`, when given, stops the solve between shots
+/// (`crate::interrupt`).
 pub fn run_plan(
     pending: trilux_scene::Pending,
     plan: &trilux::Plan<'_>,
+    stop: Option<Arc<AtomicBool>>,
 ) -> anyhow::Result<Finished> {
     trilux::pipeline::check(pending.scene(), plan)?;
     let scene = pending.finish()?;
@@ -35,6 +41,7 @@ pub fn run_plan(
         trilux::Observer {
             solve: &mut on_shot,
             render: &on_tile,
+            stop,
         },
     );
     bars.finish();

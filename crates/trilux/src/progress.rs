@@ -1,8 +1,12 @@
-//! The progress bar of `solve`, `render` and `bake` on a terminal, nothing
-//! otherwise (CI stays quiet).
+//! The progress of `solve`, `render` and `bake`: a bar on a terminal;
+//! elsewhere (a CI log, a scheduler's log file) a plain line now and then
+//! (`Plain`), so that a long run shows it is alive and how far it got, and
+//! a short one stays quiet.
 
 use std::io::IsTerminal;
+use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressStyle};
 use trilux_solver::Progress;
@@ -27,6 +31,8 @@ fn bar() -> Option<ProgressBar> {
 /// left that its rate so far predicts ([`time_left`]).
 pub struct Bars {
     bar: Option<ProgressBar>,
+    /// The plain lines when stderr is not a terminal.
+    plain: Option<Plain>,
     /// Set by the first tile: the bar then shows the render.
     rendering: AtomicBool,
 }
@@ -34,8 +40,11 @@ pub struct Bars {
 impl Bars {
     /// The bar of a command (on a terminal).
     pub fn new() -> Self {
+        let bar = bar();
+        let plain = bar.is_none().then(Plain::new);
         Bars {
-            bar: bar(),
+            bar,
+            plain,
             rendering: AtomicBool::new(false),
         }
     }
@@ -45,6 +54,9 @@ impl Bars {
     /// falls about geometrically with the shots, so this moves about evenly
     /// in time), with the time left that its rate so far predicts.
     pub fn solve(&self, p: &Progress) {
+        if let Some(plain) = &self.plain {
+            plain.report(solve_line(p));
+        }
         let Some(bar) = &self.bar else { return };
         let frac = convergence_fraction(p.convergence_ratio, p.target);
         bar.set_position((frac * 1000.0) as u64);
@@ -66,8 +78,16 @@ impl Bars {
     /// Shows the render's progress after a tile (from worker threads); the
     /// first tile turns the bar into the render's, its clock restarted.
     pub fn render(&self, done: usize, total: usize) {
+        let first = !self.rendering.swap(true, Ordering::AcqRel);
+        if let Some(plain) = &self.plain {
+            if first {
+                plain.end_phase();
+            }
+            let seconds = plain.phase_seconds();
+            plain.report(format!("render: {done}/{total} tiles after {seconds:.1} s"));
+        }
         let Some(bar) = &self.bar else { return };
-        if !self.rendering.swap(true, Ordering::AcqRel) {
+        if first {
             bar.set_prefix("render");
             bar.set_message("");
             bar.reset();
@@ -84,6 +104,9 @@ impl Bars {
 
     /// Clears the bar: the terminal is left as it was before.
     pub fn finish(&self) {
+        if let Some(plain) = &self.plain {
+            plain.end_phase();
+        }
         if let Some(bar) = &self.bar {
             bar.finish_and_clear();
         }
@@ -93,6 +116,100 @@ impl Bars {
 impl Default for Bars {
     fn default() -> Self {
         Self::new()
+    }
+}
+
+/// The plain line of the solve's progress.
+fn solve_line(p: &Progress) -> String {
+    format!(
+        "solve: CR {:.4} (target {}) after {:.1} s, {} shots",
+        p.convergence_ratio, p.target, p.elapsed_seconds, p.shots
+    )
+}
+
+/// The default seconds between two plain progress lines.
+const PLAIN_SECONDS: f64 = 10.0;
+
+/// Progress as plain lines on a stderr that is not a terminal: one line
+/// every `TRILUX_PROGRESS_SECONDS` (default 10 s), no carriage return,
+/// and the phase's last state when a phase (solve, render) that printed a
+/// line ends. A run shorter than the interval prints nothing.
+struct Plain {
+    every: Duration,
+    state: Mutex<PlainState>,
+}
+
+struct PlainState {
+    /// When the last line was printed (or the phase began).
+    last: Instant,
+    /// When the current phase began.
+    phase_start: Instant,
+    /// The current phase's latest line, if not printed yet.
+    pending: Option<String>,
+    /// Whether the current phase printed a line.
+    printed: bool,
+}
+
+impl Plain {
+    fn new() -> Self {
+        let every = std::env::var("TRILUX_PROGRESS_SECONDS")
+            .ok()
+            .map(|v| match v.trim().parse::<f64>() {
+                Ok(s) if s.is_finite() && s > 0.0 && s < 1e9 => s,
+                _ => {
+                    crate::streams::eprint_line(&format!(
+                        "warning: TRILUX_PROGRESS_SECONDS={v:?} is not a number of seconds above 0: a progress line every {PLAIN_SECONDS} s"
+                    ));
+                    PLAIN_SECONDS
+                }
+            })
+            .unwrap_or(PLAIN_SECONDS);
+        let now = Instant::now();
+        Plain {
+            every: Duration::from_secs_f64(every),
+            state: Mutex::new(PlainState {
+                last: now,
+                phase_start: now,
+                pending: None,
+                printed: false,
+            }),
+        }
+    }
+
+    fn lock(&self) -> std::sync::MutexGuard<'_, PlainState> {
+        self.state.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// Seconds since the current phase began.
+    fn phase_seconds(&self) -> f64 {
+        self.lock().phase_start.elapsed().as_secs_f64()
+    }
+
+    /// Prints `line` if the interval has passed since the last one, else
+    /// keeps it for the end of the phase.
+    fn report(&self, line: String) {
+        let mut st = self.lock();
+        if st.last.elapsed() >= self.every {
+            crate::streams::eprint_line(&line);
+            st.last = Instant::now();
+            st.printed = true;
+            st.pending = None;
+        } else {
+            st.pending = Some(line);
+        }
+    }
+
+    /// Ends a phase: its last state, if it printed a line and has a newer
+    /// one; the next phase starts its clock.
+    fn end_phase(&self) {
+        let mut st = self.lock();
+        if let Some(line) = st.pending.take()
+            && st.printed
+        {
+            crate::streams::eprint_line(&line);
+        }
+        let now = Instant::now();
+        (st.last, st.phase_start, st.printed) = (now, now, false);
     }
 }
 

@@ -228,7 +228,7 @@ pub fn run_into(args: &RenderArgs, in_out: bool) -> Result<()> {
     let crate::plan::Finished {
         outcome,
         mut record,
-    } = crate::plan::run_plan(pending, &plan)?;
+    } = crate::plan::run_plan(pending, &plan, None)?;
     record.set("png_exposure", serde_json::json!(args.exposure));
     let image = outcome
         .image

@@ -2,6 +2,7 @@
 //! that any number of views can be rendered from it.
 
 use std::path::{Path, PathBuf};
+use std::process::ExitCode;
 
 use crate::options::{Product, SolveOptions, parse_threads};
 use crate::output::{DEFAULT_FOLDER, Kind, Outputs, default_output, named, stats_json};
@@ -30,8 +31,9 @@ pub struct SolveArgs {
     pub options: SolveOptions,
 }
 
-/// Runs `trilux solve`.
-pub fn run(args: &SolveArgs) -> Result<()> {
+/// Runs `trilux solve`: status 0, or 128 + the signal's number when
+/// SIGINT or SIGTERM stopped it (`crate::interrupt`).
+pub fn run(args: &SolveArgs) -> Result<ExitCode> {
     let output = match &args.output {
         Some(path) => {
             named(path, "-o", Kind::Solution)?;
@@ -46,13 +48,14 @@ pub fn run(args: &SolveArgs) -> Result<()> {
     let outputs = Outputs::plan(&outputs, &[args.scene.as_path()], folder)?;
     let pending = trilux_scene::open_with_params(&args.scene, &args.params.define)?;
     outputs.check_inputs(&pending.input_files())?;
+    let interrupt = crate::interrupt::Interrupt::catch()?;
     let plan = args
         .options
         .plan(pending.scene(), None, Product::SolutionFile);
     let crate::plan::Finished {
         mut outcome,
         record,
-    } = crate::plan::run_plan(pending, &plan)?;
+    } = crate::plan::run_plan(pending, &plan, Some(interrupt.flag()))?;
     let solution = outcome
         .solution_file
         .take()
@@ -63,5 +66,6 @@ pub fn run(args: &SolveArgs) -> Result<()> {
     }
     outputs.write(&files)?;
     crate::warn(&outcome);
-    outputs.report(None)
+    outputs.report(None)?;
+    Ok(interrupt.status().map_or(ExitCode::SUCCESS, ExitCode::from))
 }
