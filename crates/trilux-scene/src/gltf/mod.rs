@@ -32,8 +32,8 @@ use crate::scene::Scene;
 pub(crate) use nodes::GltfMeshes;
 
 /// Extensions a file may require (others in `extensionsRequired` are
-/// refused; others only used are ignored, as the glTF specification
-/// allows).
+/// refused; others only used are refused where they may change the light,
+/// see [`IGNORED_EXTENSIONS`]).
 pub(crate) const SUPPORTED_EXTENSIONS: [&str; 3] = [
     "KHR_materials_specular",
     "KHR_materials_emissive_strength",
