@@ -86,17 +86,7 @@ pub(crate) fn build(resolved: Resolved, path: &Path) -> Result<(Scene, Requests)
                 integrator = Some(e);
                 max_depth = integrator_max_depth(e)?;
             }
-            "emitter" => {
-                let t = e.plugin_type()?;
-                let message = if t == "area" {
-                    "an area <emitter> must be placed inside a <shape>".to_string()
-                } else {
-                    format!(
-                        "unknown emitter plugin \"{t}\" (only area emitters inside shapes are supported)"
-                    )
-                };
-                return Err(SceneError::at(&e.loc, message));
-            }
+            "emitter" => top_level_emitter(e)?,
             other => {
                 return Err(SceneError::at(
                     &e.loc,
@@ -125,6 +115,21 @@ pub(crate) fn build(resolved: Resolved, path: &Path) -> Result<(Scene, Requests)
         warnings: Vec::new(),
     };
     Ok((scene, requests))
+}
+
+/// A top-level area `<emitter id>` is a definition, attached to the shape
+/// whose `<ref>` names it (checked here, so that an unused one's errors
+/// are reported); any other is refused.
+fn top_level_emitter(e: &Element) -> Result<()> {
+    let t = e.plugin_type()?;
+    let message = match t {
+        "area" if e.attr("id").is_some() => return area_emitter(e).map(|_| ()),
+        "area" => "an area <emitter> must be placed inside a <shape> (or given an id and named there by a <ref>)".to_string(),
+        _ => format!(
+            "unknown emitter plugin \"{t}\" (only area emitters inside shapes are supported)"
+        ),
+    };
+    Err(SceneError::at(&e.loc, message))
 }
 
 /// True when some colour of the BSDF is a sampled spectrum.

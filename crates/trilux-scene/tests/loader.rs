@@ -195,7 +195,7 @@ fn references_to_top_level_bsdfs() {
     );
     assert!(
         err(r#"<shape type="rectangle" id="a"/><shape type="cube"><ref id="a"/></shape>"#)
-            .contains("only <bsdf> and <texture> elements can be referenced")
+            .contains("only <bsdf>, <texture> and <emitter> elements can be referenced")
     );
     assert!(
         err(r#"<bsdf type="diffuse" id="a"/><bsdf type="diffuse" id="a"/>"#)
