@@ -86,17 +86,7 @@ pub(crate) fn build(resolved: Resolved, path: &Path) -> Result<(Scene, Requests)
                 integrator = Some(e);
                 max_depth = integrator_max_depth(e)?;
             }
-            "emitter" => {
-                let t = e.plugin_type()?;
-                let message = if t == "area" {
-                    "an area <emitter> must be placed inside a <shape>".to_string()
-                } else {
-                    format!(
-                        "unknown emitter plugin \"{t}\" (only area emitters inside shapes are supported)"
-                    )
-                };
-                return Err(SceneError::at(&e.loc, message));
-            }
+            "emitter" => top_level_emitter(e)?,
             other => {
                 return Err(SceneError::at(
                     &e.loc,
@@ -125,6 +115,21 @@ pub(crate) fn build(resolved: Resolved, path: &Path) -> Result<(Scene, Requests)
         warnings: Vec::new(),
     };
     Ok((scene, requests))
+}
+
+/// A top-level area `<emitter id>` is a definition, attached to the shape
+/// whose `<ref>` names it (checked here, so that an unused one's errors
+/// are reported); any other is refused.
+fn top_level_emitter(e: &Element) -> Result<()> {
+    let t = e.plugin_type()?;
+    let message = match t {
+        "area" if e.attr("id").is_some() => return area_emitter(e).map(|_| ()),
+        "area" => "an area <emitter> must be placed inside a <shape> (or given an id and named there by a <ref>)".to_string(),
+        _ => format!(
+            "unknown emitter plugin \"{t}\" (only area emitters inside shapes are supported)"
+        ),
+    };
+    Err(SceneError::at(&e.loc, message))
 }
 
 /// True when some colour of the BSDF is a sampled spectrum.
@@ -283,6 +288,7 @@ fn sensor(e: &Element) -> Result<Camera> {
     let (near_clip, far_clip) = clip_planes(&props)?;
     let principal_point_offset = principal_point_offset(&props)?;
     let children = sensor_children(&props)?;
+    ignored_sensor_params(&props)?;
     props.finish()?;
     Ok(Camera {
         origin: pose.origin,
@@ -306,6 +312,9 @@ fn sensor(e: &Element) -> Result<Camera> {
 /// The sensor's `fov` (strictly between 0 and 180 degrees) and the axis it
 /// spans; unwritten, Mitsuba's 50 mm lens along the diagonal.
 fn sensor_fov(props: &Props<'_>) -> Result<(f64, FovAxis)> {
+    if props.has("focal_length") {
+        return focal_length_fov(props);
+    }
     match props.float("fov")? {
         Some(fov) => {
             if !(fov > 0.0 && fov < 180.0) {
@@ -332,6 +341,50 @@ fn sensor_fov(props: &Props<'_>) -> Result<(f64, FovAxis)> {
         )),
         None => Ok((default_fov(), FovAxis::Diagonal)),
     }
+}
+
+/// Mitsuba's `focal_length` ("<x>mm" or "<x>", on a 36 × 24 mm film): the
+/// field of view along the diagonal, 2 atan(43.27 mm / 2x).
+fn focal_length_fov(props: &Props<'_>) -> Result<(f64, FovAxis)> {
+    let loc = props.loc("focal_length");
+    if props.has("fov") {
+        return Err(SceneError::at(
+            &loc,
+            "give either focal_length or fov, not both (as Mitsuba asks)",
+        ));
+    }
+    let text = props.string("focal_length")?.unwrap_or_default();
+    let digits = text.trim().strip_suffix("mm").unwrap_or(text.trim());
+    let diagonal = (36f64 * 36.0 + 24.0 * 24.0).sqrt();
+    let fov = |f: f64| (2.0 * (diagonal / (2.0 * f)).atan()).to_degrees();
+    match digits.parse::<f64>() {
+        Ok(f) if f.is_finite() && f > 0.0 && fov(f) < 180.0 => Ok((fov(f), FovAxis::Diagonal)),
+        _ => Err(SceneError::at(
+            &loc,
+            format!(
+                "focal_length must be a positive length in millimetres such as \"35mm\", found \"{text}\""
+            ),
+        )),
+    }
+}
+
+/// Parameters of Mitsuba's perspective sensor that do not change a
+/// pinhole camera's image of a static scene, read (so their type is
+/// checked) and ignored: `focus_distance` (only a lens has a focal plane)
+/// and the shutter interval (nothing in a trilux scene moves).
+fn ignored_sensor_params(props: &Props<'_>) -> Result<()> {
+    props.float("focus_distance")?;
+    let open = props.float("shutter_open")?.unwrap_or(0.0);
+    let close = props.float("shutter_close")?.unwrap_or(0.0);
+    if open > close {
+        return Err(SceneError::at(
+            &props.loc("shutter_open"),
+            format!(
+                "shutter_open {open} must not be later than shutter_close {close} (as Mitsuba asks)"
+            ),
+        ));
+    }
+    Ok(())
 }
 
 /// Where the sensor stands and looks: its `to_world` (a rigid motion) and

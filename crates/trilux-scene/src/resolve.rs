@@ -1,11 +1,13 @@
 //! Stage 3 of loading: resolve `<ref id>` against the objects that carry an
-//! `id` (top-level `<bsdf id>` and `<texture id>` in practice), and count
+//! `id` (top-level `<bsdf id>`, `<texture id>` and `<emitter id>` in
+//! practice), and count
 //! `<bsdf>` elements.
 //!
 //! After this pass the tree has no `<ref>` left: each reference is replaced
 //! by a copy of the element it names (BSDF parameters are plain data, and
 //! the texture cache reads an image once however many copies name it, so a
-//! copy is as good as sharing). Only BSDFs and textures can be referenced;
+//! copy is as good as sharing). BSDFs, textures and emitters can be
+//! referenced (an emitter from one shape only, as in Mitsuba);
 //! a texture's copy takes the `name` of its `<ref>` (the parameter it
 //! gives, as in Mitsuba).
 //!
@@ -36,6 +38,7 @@ pub(crate) fn resolve(scene: &Element) -> Result<Resolved> {
     collect_ids(scene, &mut ids)?;
     let mut bsdf_counts = BTreeMap::new();
     count_bsdfs(scene, &mut bsdf_counts);
+    refuse_shared_emitters(scene, &ids, &mut HashMap::new())?;
     let mut checker = Checker::new(&ids);
     checker.check(scene, 1)?;
     let scene = copy(&ids, scene)?;
@@ -61,6 +64,33 @@ fn collect_ids<'a>(e: &'a Element, ids: &mut HashMap<String, &'a Element>) -> Re
             ids.insert(id.value.clone(), child);
         }
         collect_ids(child, ids)?;
+    }
+    Ok(())
+}
+
+/// An area emitter belongs to one shape: a second `<ref>` to one is
+/// refused, as Mitsuba refuses it ("an endpoint can only be attached to a
+/// single shape"). `seen` maps an emitter's id to its first reference's line.
+fn refuse_shared_emitters<'a>(
+    e: &'a Element,
+    ids: &HashMap<String, &Element>,
+    seen: &mut HashMap<&'a str, u32>,
+) -> Result<()> {
+    for child in &e.children {
+        if child.tag == "ref"
+            && let Some(id) = child.attr("id")
+            && ids.get(&id.value).is_some_and(|t| t.tag == "emitter")
+            && let Some(line) = seen.insert(&id.value, child.loc.line)
+        {
+            return Err(SceneError::at(
+                &child.loc,
+                format!(
+                    "emitter \"{}\" is already attached to the shape at line {line}; an area emitter belongs to one shape (as in Mitsuba): define one per shape",
+                    id.value
+                ),
+            ));
+        }
+        refuse_shared_emitters(child, ids, seen)?;
     }
     Ok(())
 }
@@ -190,11 +220,11 @@ fn target<'a>(
     let (name, target) = ids.get_key_value(&id.value).ok_or_else(|| {
         SceneError::at(&id.loc, format!("reference to unknown id \"{}\"", id.value))
     })?;
-    if target.tag != "bsdf" && target.tag != "texture" {
+    if !matches!(target.tag.as_str(), "bsdf" | "texture" | "emitter") {
         return Err(SceneError::at(
             &id.loc,
             format!(
-                "\"{}\" names a {}; only <bsdf> and <texture> elements can be referenced",
+                "\"{}\" names a {}; only <bsdf>, <texture> and <emitter> elements can be referenced",
                 id.value,
                 target.describe()
             ),

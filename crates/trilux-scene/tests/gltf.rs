@@ -606,3 +606,109 @@ fn a_grayscale_jpeg_texture_is_read_through_gltf_and_xml() {
     assert_eq!(slot.kind, SlotKind::Reflectance);
     check(&slot.texture, "XML");
 }
+
+/// The error for a material carrying `ext` (with `body`), and listing it
+/// in `extensionsUsed` as the specification asks.
+fn material_extension_error(ext: &str, body: Value) -> String {
+    let m = json!({"name": "glass", "extensions": {ext: body}});
+    let mut j = with_material(Some(m));
+    j["extensionsUsed"] = json!([ext]);
+    let err = load(ext, &j).unwrap_err().to_string();
+    assert_eq!(err.lines().count(), 1, "{err}");
+    err
+}
+
+/// A material extension that changes the light and that trilux does not
+/// implement is refused at the material, naming it and the extension.
+fn assert_refused_on_material(ext: &str, body: Value) {
+    let err = material_extension_error(ext, body);
+    assert!(
+        err.contains(&format!("scene.gltf:/materials/0/extensions/{ext}")),
+        "{err}"
+    );
+    assert!(
+        err.contains("material \"glass\"") && err.contains("refused"),
+        "{err}"
+    );
+}
+
+macro_rules! refused_on_material {
+    ($($test:ident: $ext:literal $body:tt;)*) => {$(
+        #[test]
+        fn $test() {
+            assert_refused_on_material($ext, json!($body));
+        }
+    )*};
+}
+
+refused_on_material! {
+    transmission_is_refused: "KHR_materials_transmission" {"transmissionFactor": 1.0};
+    volume_is_refused: "KHR_materials_volume" {"thicknessFactor": 0.1};
+    ior_other_than_the_default_is_refused: "KHR_materials_ior" {"ior": 1.33};
+    clearcoat_is_refused: "KHR_materials_clearcoat" {"clearcoatFactor": 1.0};
+    sheen_is_refused: "KHR_materials_sheen" {"sheenColorFactor": [1.0, 1.0, 1.0]};
+    iridescence_is_refused: "KHR_materials_iridescence" {"iridescenceFactor": 1.0};
+    anisotropy_is_refused: "KHR_materials_anisotropy" {"anisotropyStrength": 0.5};
+    dispersion_is_refused: "KHR_materials_dispersion" {"dispersion": 0.1};
+    diffuse_transmission_is_refused: "KHR_materials_diffuse_transmission" {"diffuseTransmissionFactor": 0.5};
+    unlit_is_refused: "KHR_materials_unlit" {};
+    specular_glossiness_is_refused: "KHR_materials_pbrSpecularGlossiness" {"diffuseFactor": [1.0, 1.0, 1.0, 1.0]};
+    an_unknown_material_extension_is_refused: "VENDOR_materials_magic" {};
+}
+
+/// Transmission's refusal says why: ignored, glass would be opaque.
+#[test]
+fn transmission_is_refused_saying_that_glass_would_be_opaque() {
+    let err = material_extension_error("KHR_materials_transmission", json!({}));
+    assert!(err.contains("opaque"), "{err}");
+}
+
+/// glTF's default index of refraction (1.5, written or implied) is what
+/// trilux's dielectrics use, so it loads.
+#[test]
+fn the_default_index_of_refraction_loads() {
+    for body in [json!({"ior": 1.5}), json!({})] {
+        let m = json!({"extensions": {"KHR_materials_ior": body}});
+        let mut j = with_material(Some(m));
+        j["extensionsUsed"] = json!(["KHR_materials_ior"]);
+        assert!(load("ior-default", &j).is_ok());
+    }
+}
+
+/// An extension listed as used but found on no material or node of the
+/// scene (here: on a material no primitive uses) is refused at its entry
+/// in `extensionsUsed`, unless it does not change the light.
+#[test]
+fn an_unimplemented_extension_listed_as_used_is_refused_there() {
+    let mut j = with_material(None);
+    j["materials"] = json!([{"extensions": {"KHR_materials_sheen": {}}}]);
+    j["extensionsUsed"] = json!(["KHR_materials_specular", "KHR_materials_sheen"]);
+    let err = load("used", &j).unwrap_err().to_string();
+    assert!(err.contains("scene.gltf:/extensionsUsed/1"), "{err}");
+    assert!(err.contains("KHR_materials_sheen"), "{err}");
+    for harmless in [
+        "KHR_materials_variants",
+        "KHR_xmp_json_ld",
+        "KHR_mesh_quantization",
+    ] {
+        let mut j = with_material(None);
+        j["extensionsUsed"] = json!([harmless]);
+        assert!(load("harmless", &j).is_ok(), "{harmless}");
+    }
+}
+
+/// A node extension trilux does not implement (GPU instancing places
+/// more copies of the mesh) is refused at the node, naming it.
+#[test]
+fn an_unimplemented_node_extension_is_refused_at_the_node() {
+    let mut j = with_material(None);
+    j["extensionsUsed"] = json!(["EXT_mesh_gpu_instancing"]);
+    j["nodes"] = json!([{"mesh": 0, "name": "rows",
+        "extensions": {"EXT_mesh_gpu_instancing": {"attributes": {}}}}]);
+    let err = load("instancing", &j).unwrap_err().to_string();
+    assert!(
+        err.contains("scene.gltf:/nodes/0/extensions/EXT_mesh_gpu_instancing"),
+        "{err}"
+    );
+    assert!(err.contains("node \"rows\""), "{err}");
+}

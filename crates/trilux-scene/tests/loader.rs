@@ -195,7 +195,7 @@ fn references_to_top_level_bsdfs() {
     );
     assert!(
         err(r#"<shape type="rectangle" id="a"/><shape type="cube"><ref id="a"/></shape>"#)
-            .contains("only <bsdf> and <texture> elements can be referenced")
+            .contains("only <bsdf>, <texture> and <emitter> elements can be referenced")
     );
     assert!(
         err(r#"<bsdf type="diffuse" id="a"/><bsdf type="diffuse" id="a"/>"#)
@@ -306,8 +306,8 @@ fn sensor_errors() {
             .contains("fov_axis needs a fov")
     );
     assert!(
-        err(r#"<sensor type="perspective"><float name="focus_distance" value="0.1"/></sensor>"#)
-            .contains("unknown parameter \"focus_distance\"")
+        err(r#"<sensor type="perspective"><float name="aperture_radius" value="0.1"/></sensor>"#)
+            .contains("unknown parameter \"aperture_radius\"")
     );
     assert!(err(r#"<sensor type="perspective"><film type="hdrfilm"><integer name="width" value="0"/></film></sensor>"#).contains("width must be a positive integer"));
     assert!(err(r#"<sensor type="perspective"><film type="hdrfilm"><rfilter type="sinc"/></film></sensor>"#).contains("unknown rfilter plugin"));

@@ -294,7 +294,18 @@ fn refuse_unsupported(m: &gltf::Material<'_>, at: &At<'_>) -> Result<()> {
             return Err(at(suffix, message.into()));
         }
     }
-    Ok(())
+    let changes_light = |name: &str, value: &gltf::json::Value| {
+        let default_ior = name == "KHR_materials_ior"
+            && value.get("ior").is_none_or(|ior| ior.as_f64() == Some(1.5));
+        !default_ior && !super::IGNORED_EXTENSIONS.contains(&name)
+    };
+    match m
+        .extensions()
+        .and_then(|e| e.iter().find(|(k, v)| changes_light(k, v)))
+    {
+        Some((name, _)) => Err(at(&format!("/extensions/{name}"), super::refusal(name))),
+        None => Ok(()),
+    }
 }
 
 fn emission(m: &gltf::Material<'_>, at: &At<'_>) -> Result<Option<ColorParam>> {

@@ -32,8 +32,8 @@ use crate::scene::Scene;
 pub(crate) use nodes::GltfMeshes;
 
 /// Extensions a file may require (others in `extensionsRequired` are
-/// refused; others only used are ignored, as the glTF specification
-/// allows).
+/// refused; others only used are refused where they may change the light,
+/// see [`IGNORED_EXTENSIONS`]).
 pub(crate) const SUPPORTED_EXTENSIONS: [&str; 3] = [
     "KHR_materials_specular",
     "KHR_materials_emissive_strength",
@@ -85,7 +85,70 @@ pub(crate) fn open_bytes(
             ),
         ));
     }
-    nodes::build(file, gltf, camera)
+    let used: Vec<String> = gltf.document.extensions_used().map(String::from).collect();
+    let built = nodes::build(file, gltf, camera)?;
+    refuse_used(file, &used)?;
+    Ok(built)
+}
+
+/// Extensions ignored because they do not change the light: variants
+/// (the default material is the one rendered), XMP metadata, quantized
+/// attributes (the accessors trilux cannot read are refused there), and
+/// alternative image formats (the texture's fallback `source` is read).
+pub(crate) const IGNORED_EXTENSIONS: [&str; 5] = [
+    "KHR_materials_variants",
+    "KHR_xmp_json_ld",
+    "KHR_mesh_quantization",
+    "KHR_texture_basisu",
+    "EXT_texture_webp",
+];
+
+/// Extensions checked where they occur (a punctual light on a node; an
+/// index of refraction on a material, accepted at glTF's default 1.5).
+const CHECKED_WHERE_USED: [&str; 2] = ["KHR_lights_punctual", "KHR_materials_ior"];
+
+/// Refuses an extension listed in `extensionsUsed` that trilux neither
+/// implements nor ignores: after the walk, so that one used on a material
+/// or node of the scene is named there first.
+fn refuse_used(file: &Arc<Path>, used: &[String]) -> Result<()> {
+    let known = |e: &str| {
+        SUPPORTED_EXTENSIONS.contains(&e)
+            || IGNORED_EXTENSIONS.contains(&e)
+            || CHECKED_WHERE_USED.contains(&e)
+    };
+    match used.iter().enumerate().find(|(_, e)| !known(e)) {
+        Some((i, e)) => Err(SceneError::at(
+            &SourceLocation::json(file, format!("/extensionsUsed/{i}")),
+            refusal(e),
+        )),
+        None => Ok(()),
+    }
+}
+
+/// Why an extension trilux does not implement is refused rather than
+/// ignored: ignoring it would render something other than the file.
+pub(crate) fn refusal(ext: &str) -> String {
+    let why = match ext {
+        "KHR_materials_transmission"
+        | "KHR_materials_volume"
+        | "KHR_materials_diffuse_transmission"
+        | "KHR_materials_dispersion" => {
+            "it lets light through the surface, and trilux's surfaces are opaque (ignored, glass would render as an opaque surface)"
+        }
+        "KHR_materials_ior" => {
+            "an index of refraction other than glTF's default 1.5 changes the dielectric's reflectance, which trilux fixes at that default"
+        }
+        "KHR_materials_clearcoat"
+        | "KHR_materials_sheen"
+        | "KHR_materials_iridescence"
+        | "KHR_materials_anisotropy"
+        | "KHR_materials_pbrSpecularGlossiness"
+        | "KHR_materials_unlit" => {
+            "it changes how the surface reflects light, which trilux's materials do not model"
+        }
+        _ => "trilux does not implement it, and it may change the light",
+    };
+    format!("extension {ext} is refused rather than ignored: {why} (docs/gltf.md)")
 }
 
 /// A `gltf` crate error as one located line.

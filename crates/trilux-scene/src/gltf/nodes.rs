@@ -189,6 +189,19 @@ impl Walk<'_> {
                 ),
             ));
         }
+        if let Some(name) = node.extensions().and_then(|e| {
+            e.keys()
+                .find(|k| !super::IGNORED_EXTENSIONS.contains(&k.as_str()))
+        }) {
+            let named = node
+                .name()
+                .map(|n| format!("node \"{n}\": "))
+                .unwrap_or_default();
+            return Err(self.at(
+                format!("{here}/extensions/{name}"),
+                format!("{named}{}", super::refusal(name)),
+            ));
+        }
         if let Some(c) = node.camera() {
             match c.projection() {
                 gltf::camera::Projection::Perspective(p) => self.cameras.push(CameraNode {
