@@ -21,7 +21,7 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use common::{folder, trilux};
+use common::{folder, http_get, trilux};
 use glam::{DVec3, Vec3};
 use serde_json::Value;
 use trilux_color::WithBands;
@@ -528,24 +528,6 @@ fn a_bake_that_is_not_a_glb_is_refused() {
     assert!(err.contains("scene.gltf") && err.contains(".glb"), "{err}");
     assert_eq!(err.lines().count(), 1, "{err}");
     assert!(!out.exists());
-}
-
-/// `GET path` from the server at `port`: (status line, body).
-fn http_get(port: u16, path: &str) -> (String, Vec<u8>) {
-    use std::io::{Read, Write};
-    let mut s = std::net::TcpStream::connect(("127.0.0.1", port)).unwrap();
-    // A server that never answers fails the test instead of hanging it.
-    s.set_read_timeout(Some(std::time::Duration::from_secs(60)))
-        .unwrap();
-    write!(s, "GET {path} HTTP/1.1\r\nHost: localhost\r\n\r\n").unwrap();
-    let mut all = Vec::new();
-    s.read_to_end(&mut all).unwrap();
-    let split = all.windows(4).position(|w| w == b"\r\n\r\n").unwrap();
-    let head = String::from_utf8_lossy(&all[..split]).into_owned();
-    (
-        head.lines().next().unwrap().to_string(),
-        all[split + 4..].to_vec(),
-    )
 }
 
 /// `--open` serves the viewer with the bake on 127.0.0.1: the page, its

@@ -8,11 +8,11 @@
 
 mod common;
 
-use std::io::{BufRead, BufReader, Read, Write};
+use std::io::{BufRead, BufReader};
 use std::path::Path;
 use std::process::{Child, ChildStderr, Command, Stdio};
 
-use common::{folder, trilux};
+use common::{folder, http_get, trilux};
 
 /// A glTF binary (glTF 2.0 §4.4) of one JSON chunk, padded with spaces
 /// to 4 bytes, its header's length `extra` bytes off the true one.
@@ -138,22 +138,6 @@ fn serve(glb: &Path, open: bool, env: &[(&str, &str)], last: &str) -> (Child, Ve
     (child, lines, port)
 }
 
-/// `GET path`: (status line, body).
-fn get(port: u16, path: &str) -> (String, Vec<u8>) {
-    let mut s = std::net::TcpStream::connect(("127.0.0.1", port)).unwrap();
-    s.set_read_timeout(Some(std::time::Duration::from_secs(60)))
-        .unwrap();
-    write!(s, "GET {path} HTTP/1.1\r\nHost: localhost\r\n\r\n").unwrap();
-    let mut all = Vec::new();
-    s.read_to_end(&mut all).unwrap();
-    let split = all.windows(4).position(|w| w == b"\r\n\r\n").unwrap();
-    let head = String::from_utf8_lossy(&all[..split]).into_owned();
-    (
-        head.lines().next().unwrap().to_string(),
-        all[split + 4..].to_vec(),
-    )
-}
-
 fn first_line(stderr: ChildStderr) -> String {
     let mut line = String::new();
     BufReader::new(stderr).read_line(&mut line).unwrap();
@@ -173,10 +157,10 @@ fn a_good_file_is_served_as_it_is() {
             "viewer: http://127.0.0.1:{port}/index.html?file=/model.glb (Ctrl-C stops it)"
         )]
     );
-    let (status, model) = get(port, "/model.glb");
+    let (status, model) = http_get(port, "/model.glb");
     assert!(status.contains("200"), "{status}");
     assert_eq!(model, bytes);
-    let (status, page) = get(port, "/index.html?file=/model.glb");
+    let (status, page) = http_get(port, "/index.html?file=/model.glb");
     assert!(status.contains("200"), "{status}");
     assert!(String::from_utf8_lossy(&page).contains("viewer.js"));
     child.kill().unwrap();
@@ -227,7 +211,7 @@ fn open_without_a_browser_says_so_and_serves() {
     let said = first_line(child.stderr.take().unwrap());
     assert!(said.starts_with("warning: no browser to open"), "{said}");
     assert!(said.contains(&format!("127.0.0.1:{port}")), "{said}");
-    let (status, model) = get(port, "/model.glb");
+    let (status, model) = http_get(port, "/model.glb");
     assert!(status.contains("200"), "{status}");
     assert_eq!(model, bytes);
     child.kill().unwrap();
@@ -255,7 +239,7 @@ fn open_with_a_browser_that_does_not_start_says_so() {
         said.starts_with("warning: no browser to open (no command of $BROWSER started"),
         "{said}"
     );
-    let (status, _) = get(port, "/index.html");
+    let (status, _) = http_get(port, "/index.html");
     assert!(status.contains("200"), "{status}");
     child.kill().unwrap();
     child.wait().unwrap();

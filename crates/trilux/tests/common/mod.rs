@@ -22,3 +22,22 @@ pub fn folder(name: &str) -> PathBuf {
     std::fs::create_dir_all(&dir).expect("temp folder");
     dir
 }
+
+/// `GET path` from the local server on `port`: (status line, body). A
+/// server that never answers fails the test after a minute instead of
+/// hanging it.
+pub fn http_get(port: u16, path: &str) -> (String, Vec<u8>) {
+    use std::io::{Read, Write};
+    let mut s = std::net::TcpStream::connect(("127.0.0.1", port)).unwrap();
+    s.set_read_timeout(Some(std::time::Duration::from_secs(60)))
+        .unwrap();
+    write!(s, "GET {path} HTTP/1.1\r\nHost: localhost\r\n\r\n").unwrap();
+    let mut all = Vec::new();
+    s.read_to_end(&mut all).unwrap();
+    let split = all.windows(4).position(|w| w == b"\r\n\r\n").unwrap();
+    let head = String::from_utf8_lossy(&all[..split]).into_owned();
+    (
+        head.lines().next().unwrap().to_string(),
+        all[split + 4..].to_vec(),
+    )
+}
