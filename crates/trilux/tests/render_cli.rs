@@ -7,15 +7,7 @@ use std::path::Path;
 use std::process::Output;
 
 mod common;
-use common::{folder, trilux};
-
-fn scene(name: &str) -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../scenes")
-        .join(name)
-        .to_string_lossy()
-        .into_owned()
-}
+use common::{folder, scene, trilux};
 
 fn s(p: &Path) -> &str {
     p.to_str().expect("utf-8 path")

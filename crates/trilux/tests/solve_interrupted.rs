@@ -14,18 +14,10 @@ use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
 mod common;
-use common::{folder, trilux};
+use common::{folder, scene, trilux};
 
 /// A hang guard, not a speed figure.
 const GUARD: Duration = Duration::from_secs(300);
-
-fn scene(name: &str) -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../scenes")
-        .join(name)
-        .to_string_lossy()
-        .into_owned()
-}
 
 /// Starts a solve of the 64 boxes towards a convergence of 1 (which takes
 /// far longer than the test waits), sends `signal` once a plain progress

@@ -15,6 +15,16 @@ pub fn trilux(args: &[&str]) -> Output {
         .expect("the trilux binary runs")
 }
 
+/// The path of a bundled scene (`scenes/NAME`), as a string for the
+/// command line.
+pub fn scene(name: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../scenes")
+        .join(name)
+        .to_string_lossy()
+        .into_owned()
+}
+
 /// A fresh, empty folder for one test's files.
 pub fn folder(name: &str) -> PathBuf {
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("cli-{name}"));
