@@ -49,6 +49,7 @@
 // Band loops index several per-band arrays in step.
 #![allow(clippy::needless_range_loop)]
 
+mod ambient;
 mod cluster;
 mod cluster_transport;
 mod discretisation;
@@ -87,5 +88,5 @@ pub use prepared::{PrepareError, PreparedScene, SceneDescription};
 pub use settings::{Quality, SolverSettings, Transport};
 pub use solution::{FORMAT_VERSION, Solution, SurfaceSite, solve_hash};
 pub use solver::{Progress, Solver};
-pub use stats::{SolveStats, StopReason, TracePoint};
+pub use stats::{Ambient, SolveStats, StopReason, TracePoint};
 pub use textures::ElementTextures;

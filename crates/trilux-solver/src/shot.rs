@@ -131,6 +131,14 @@ impl<const N: usize> Solver<N> {
             return 0;
         };
         let send_face = sending.face();
+        // The emission a face's first shot carries (the rest is reflected
+        // light: `ambient`).
+        let emission = match source {
+            Source::Radiosity(face) => std::mem::take(&mut self.state.unshot_emission[face]),
+            _ => Spectrum::zero(),
+        };
+        let share = crate::ambient::Interreflection::reflected_share(phi, emission);
+        self.state.interreflection.book_shot(phi, share);
         let root_of = |f: FaceId| self.setup.forest().root(f.surface());
         let pairs: Vec<(ElementId, FaceId, ElementId)> = match &sending {
             Sending::Radiosity(f) => self.setup.partners[*f]
@@ -172,7 +180,7 @@ impl<const N: usize> Solver<N> {
         };
         let scale = shot_scale(&pair_links, phi, matches!(source, Source::Stored(_)));
         let node_links = self.book_lost(stage_two);
-        let group_scale = self.receive(&pair_links, &incidences, &node_links, scale, phi);
+        let group_scale = self.receive(&pair_links, &incidences, &node_links, scale, (phi, share));
         self.apply_node_links(&node_links, scale, &group_scale);
         let live = pair_links.len() + node_links.len();
         self.state.stats.links_peak = self.state.stats.links_peak.max(live);
@@ -437,14 +445,16 @@ impl<const N: usize> Solver<N> {
     /// straight into j's two-point radiance; the glossy share is what the
     /// group's node links gathered, renormalised (`glossy`) so that j never
     /// reflects more than arrived; the rest is absorbed. Books absorbed and
-    /// escaped flux in the ledger and returns each group's glossy scale.
+    /// escaped flux in the ledger, what was reflected in the
+    /// interreflection estimate (`share` of the shot's flux `phi` being
+    /// reflected light), and returns each group's glossy scale.
     fn receive(
         &mut self,
         pair_links: &[PairLink<N>],
         incidences: &[Option<Incidence<N>>],
         node_links: &[NodeLink<N>],
         shot_scale: Spectrum<N>,
-        phi: Spectrum<N>,
+        (phi, share): (Spectrum<N>, Spectrum<N>),
     ) -> Vec<(Spectrum<N>, Spectrum<N>)> {
         // Per group, the glossy flux of midpoint-rule links (renormalised)
         // and of sampled links (already conserving: docs/solver.md,
@@ -506,6 +516,9 @@ impl<const N: usize> Solver<N> {
                 .min(absorbed_g.min_value() / arrived.max_value().max(1e-300));
             total_arrived += arrived;
             absorbed += absorbed_g;
+            self.state
+                .interreflection
+                .book_group(l.face, arrived, arrived - absorbed_g, share);
             self.state.used[l.i.index()] = true;
             self.state.used[l.j.index()] = true;
         }

@@ -46,8 +46,11 @@ use std::sync::atomic::{AtomicBool, Ordering};
 pub struct Progress {
     /// Shots so far.
     pub shots: u64,
-    /// Convergence ratio CR = (IF − RF)/IF.
+    /// Convergence ratio CR: the share of the light the scene will reflect
+    /// that it has reflected (`SolveStats::convergence_ratio`).
     pub convergence_ratio: f64,
+    /// The paper's (IF − RF)/IF, which never falls between shots.
+    pub paper_convergence_ratio: f64,
     /// The target CR.
     pub target: f64,
     /// Stored interaction nodes.
@@ -142,8 +145,21 @@ impl<const N: usize> Solver<N> {
         r
     }
 
-    /// CR = (IF − RF)/IF (paper §6); 1 for a scene that emits nothing.
+    /// CR: the share of all the light the scene's surfaces will reflect
+    /// that they have reflected so far (`ambient`); 1 for a scene that
+    /// emits nothing.
     pub fn convergence_ratio(&self) -> f64 {
+        if self.setup.emitted.sum() <= 0.0 {
+            return 1.0;
+        }
+        self.state
+            .interreflection
+            .convergence_ratio(self.residual())
+    }
+
+    /// The paper's CR = (IF − RF)/IF (§6), which counts light that left
+    /// the scene as converged; 1 for a scene that emits nothing.
+    pub fn paper_convergence_ratio(&self) -> f64 {
         let emitted = self.setup.emitted.sum();
         if emitted <= 0.0 {
             return 1.0;
@@ -267,6 +283,7 @@ impl<const N: usize> Solver<N> {
             let p = Progress {
                 shots: self.state.stats.shots,
                 convergence_ratio: self.convergence_ratio(),
+                paper_convergence_ratio: self.paper_convergence_ratio(),
                 target,
                 interactions: self.interaction_count(),
                 live_links: live,
@@ -287,6 +304,7 @@ impl<const N: usize> Solver<N> {
             shots: p.shots,
             seconds: p.elapsed_seconds,
             convergence_ratio: p.convergence_ratio,
+            paper_convergence_ratio: p.paper_convergence_ratio,
         });
     }
 
@@ -294,6 +312,7 @@ impl<const N: usize> Solver<N> {
     /// its target.
     fn warn_if_short(&mut self, reason: StopReason) {
         let cr = self.convergence_ratio();
+        let paper_convergence_ratio = self.paper_convergence_ratio();
         let shots = self.state.stats.shots;
         if self
             .state
@@ -307,6 +326,7 @@ impl<const N: usize> Solver<N> {
                 shots,
                 seconds,
                 convergence_ratio: cr,
+                paper_convergence_ratio,
             });
         }
         let target = self.setup.settings.convergence;
@@ -355,8 +375,14 @@ impl<const N: usize> Solver<N> {
         let bytes = self.arena_bytes(0) + gather_bytes;
         self.state.stats.peak_memory_bytes = self.state.stats.peak_memory_bytes.max(bytes);
         let residual = self.residual();
+        let convergence_ratio = self.convergence_ratio();
+        let paper_convergence_ratio = self.paper_convergence_ratio();
+        let ambient = self.ambient(residual);
         let (setup, state) = (&self.setup, &mut self.state);
         let stats = &mut state.stats;
+        stats.convergence_ratio = convergence_ratio;
+        stats.paper_convergence_ratio = paper_convergence_ratio;
+        stats.ambient = ambient;
         stats.gather_links = links.len();
         stats.far_blocks = setup.clusters.cuts.values().map(|c| c.far.len()).sum();
         stats.far_fields = state.far.values().flatten().count();
@@ -367,12 +393,6 @@ impl<const N: usize> Solver<N> {
             .flatten()
             .map(|h| h.nodes.len())
             .sum();
-        let emitted_sum = setup.emitted.sum();
-        stats.convergence_ratio = if emitted_sum > 0.0 {
-            ((emitted_sum - residual.sum()) / emitted_sum).clamp(0.0, 1.0)
-        } else {
-            1.0
-        };
         stats.emitted_flux = state.ledger.emitted.clone();
         stats.absorbed_flux = state.ledger.absorbed.clone();
         stats.escaped_flux = state.ledger.escaped.clone();
@@ -381,6 +401,22 @@ impl<const N: usize> Solver<N> {
         stats.min_shot_escaped = state.ledger.min_shot_escaped;
         stats.min_element_absorbed = state.ledger.min_element_absorbed;
         self.into_solution(links)
+    }
+
+    /// The unshot remainder's estimate for `residual` (`ambient`): the
+    /// reflecting area from the faces that reflected light, else Σ ρ_d A
+    /// over every face.
+    fn ambient(&self, residual: Spectrum<N>) -> crate::stats::Ambient {
+        let forest = self.setup.forest();
+        let exposed = |f: FaceId| self.setup.exposed_area[f.side()][forest.root(f.surface()).index()];
+        let fallback: Spectrum<N> = self
+            .setup
+            .faces
+            .iter()
+            .map(|(f, face)| face.rho_d * exposed(f))
+            .sum();
+        let area = self.state.interreflection.reflecting_area(exposed, fallback);
+        self.state.interreflection.ambient(residual, area)
     }
 
     /// The solution of the finished solve: its discretisation, radiance,

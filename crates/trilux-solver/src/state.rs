@@ -13,6 +13,7 @@ use rayon::prelude::*;
 use trilux_color::Spectrum;
 use trilux_geometry::{ElementId, FaceElement, FaceId, PerFace, Visibility};
 
+use crate::ambient::Interreflection;
 use crate::cluster_transport::{FarContext, FarField, FarFields};
 use crate::interaction::Hierarchy;
 use crate::ledger::Ledger;
@@ -40,6 +41,11 @@ pub(crate) struct ShotState<const N: usize> {
     pub coverage: Mutex<HashMap<(FaceId, ElementId), f64>>,
     /// Where the energy went.
     pub ledger: Ledger,
+    /// Emitted flux of every face not yet shot (a shot's share of
+    /// emission, for the interreflection estimate).
+    pub unshot_emission: PerFace<Spectrum<N>>,
+    /// What the shots tell about interreflection (`ambient`).
+    pub interreflection: Interreflection<N>,
     /// Statistics so far.
     pub stats: SolveStats,
     /// Elements that a link or a stored node has used.
@@ -64,7 +70,10 @@ impl<const N: usize> ShotState<N> {
         let (field, face_flux) = emission(setup);
         let stats = initial_stats(setup, hierarchies.len());
         let count = forest.element_count();
+        let surfaces = forest.geometry().surfaces().len();
         ShotState {
+            unshot_emission: face_flux.clone(),
+            interreflection: Interreflection::new(surfaces),
             hierarchies: hierarchies.into_iter().map(Some).collect(),
             used: vec![false; count],
             ledger: Ledger::new(setup.emitted.to_array().to_vec()),

@@ -30,8 +30,19 @@ pub struct SolveStats {
     pub gather_links: usize,
     /// Shooting iterations.
     pub shots: u64,
-    /// CR = (IF − RF)/IF (paper §6).
+    /// CR: the share of all the light the scene's surfaces will reflect
+    /// that they have reflected so far (docs/solver.md, "Convergence ratio
+    /// and ambient term"); the paper's figure in a closed scene of uniform
+    /// reflectance. 1 − CR bounds the light the image is missing.
     pub convergence_ratio: f64,
+    /// The paper's CR = (IF − RF)/IF (§6), which counts light that left
+    /// the scene (or a black surface absorbed) as converged.
+    #[serde(default)]
+    pub paper_convergence_ratio: f64,
+    /// The unshot remainder's estimate and the ambient term the solution's
+    /// readers add for it.
+    #[serde(default)]
+    pub ambient: Ambient,
     /// Emitted flux per band (W).
     pub emitted_flux: Vec<f64>,
     /// Absorbed flux per band (W).
@@ -112,4 +123,31 @@ pub struct TracePoint {
     pub seconds: f64,
     /// The convergence ratio after those shots.
     pub convergence_ratio: f64,
+    /// The paper's (IF − RF)/IF after those shots (never falls).
+    #[serde(default)]
+    pub paper_convergence_ratio: f64,
+}
+
+/// The light the residual will still add, and the ambient term that stands
+/// in for it (Cohen et al. 1988; `crate::ambient`). Per band: watts and
+/// radiance in the scene's units.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[non_exhaustive]
+pub struct Ambient {
+    /// The ambient radiance A_amb: an element of reflectance ρ sends
+    /// ρ · A_amb more than the stopped solve gave it (empty for a solution
+    /// saved before the term existed: no ambient).
+    pub radiance: Vec<f64>,
+    /// The future reflected light as a share of all the light the scene
+    /// will reflect (band sum): 1 − CR.
+    pub share: f64,
+    /// The fraction a of a shot of reflected light that comes back as
+    /// reflected light (measured on the solve's shots).
+    pub return_fraction: Vec<f64>,
+    /// Light the scene's surfaces reflected during the solve (W).
+    pub reflected_flux: Vec<f64>,
+    /// Light the residual will still be reflected: RF · a / (1 − a) (W).
+    pub future_reflected_flux: Vec<f64>,
+    /// The lit reflecting area Σ ρ A the ambient light spreads over (m²).
+    pub reflecting_area: Vec<f64>,
 }

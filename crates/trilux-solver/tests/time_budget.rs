@@ -142,13 +142,16 @@ fn the_convergence_trace_rises_and_ends_at_the_last_shot() {
     for w in trace.windows(2) {
         assert!(w[1].shots > w[0].shots);
         // Shooting never adds unshot flux: what a shot delivers is at most
-        // what it sent, and receivers reflect at most what arrived.
-        assert!(w[1].convergence_ratio >= w[0].convergence_ratio);
+        // what it sent, and receivers reflect at most what arrived. (The
+        // convergence ratio itself may dip when the estimate of the
+        // interreflection changes: docs/solver.md.)
+        assert!(w[1].paper_convergence_ratio >= w[0].paper_convergence_ratio);
         assert!(w[1].seconds >= w[0].seconds);
     }
     let last = trace.last().unwrap();
     assert_eq!(last.shots, stats.shots);
     assert_eq!(last.convergence_ratio, stats.convergence_ratio);
+    assert_eq!(last.paper_convergence_ratio, stats.paper_convergence_ratio);
     assert!(last.convergence_ratio >= 0.999);
 }
 

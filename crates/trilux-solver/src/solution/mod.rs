@@ -1,6 +1,7 @@
 //! The solution: radiance leaving any point towards any other point, for
 //! final gathering (paper §4.5). Its file format is in [`file`].
 
+mod ambient;
 mod file;
 
 use std::collections::HashMap;
@@ -11,7 +12,7 @@ use trilux_geometry::{ElementForest, FaceId, Side, Sided, SurfaceCoord, SurfaceI
 
 use crate::cluster::{ClusterId, ClusterTree};
 use crate::discretisation::Discretisation;
-use crate::gather_links::{GatherLink, GatherLinks, link_radiance};
+use crate::gather_links::{GatherLink, GatherLinks, LinkSource, link_radiance};
 use crate::interaction::Hierarchy;
 use crate::prepared::PreparedScene;
 use crate::settings::SolverSettings;
@@ -45,8 +46,11 @@ pub struct Solution<const N: usize> {
     tree: ClusterTree,
     /// The final gather's links into every receiving element.
     links: GatherLinks,
-    /// The radiance every gather link's sender sends, in link order.
+    /// The radiance every gather link's sender sends, in link order
+    /// (with the ambient term when it is on).
     link_radiance: Vec<Spectrum<N>>,
+    /// The unshot remainder's stand-in (`crate::ambient`).
+    ambient: ambient::AmbientTerm<N>,
     stats: SolveStats,
 }
 
@@ -106,24 +110,6 @@ impl<const N: usize> Solution<N> {
     /// derived from them.
     pub(crate) fn assemble(p: Parts<N>) -> Self {
         let forest = p.discretisation.forest();
-        let link_radiance = p
-            .links
-            .iter()
-            .map(|(_, l)| {
-                link_radiance(
-                    l,
-                    &p.radiance,
-                    p.scene.emission(),
-                    |f| forest.geometry().surface(f.surface()).shape as usize,
-                    |h, n| {
-                        p.hierarchies
-                            .get(h as usize)
-                            .and_then(|h| h.nodes.get(n as usize))
-                            .map_or(Spectrum::zero(), |n| n.radiance)
-                    },
-                )
-            })
-            .collect();
         let far_index = p
             .far
             .iter()
@@ -135,7 +121,8 @@ impl<const N: usize> Solution<N> {
                 *f = true;
             }
         }
-        Solution {
+        let ambient = ambient::AmbientTerm::new(&p);
+        let mut s = Solution {
             tree: ClusterTree::build(forest.geometry()),
             far: p.far,
             far_index,
@@ -148,8 +135,65 @@ impl<const N: usize> Solution<N> {
             radiance: p.radiance,
             hierarchies: p.hierarchies,
             links: p.links,
-            link_radiance,
+            link_radiance: Vec::new(),
+            ambient,
             stats: p.stats,
+        };
+        s.link_radiance = s.sender_radiance();
+        s
+    }
+
+    /// The radiance every gather link's sender sends (`link_radiance`),
+    /// with the ambient term when it is on.
+    fn sender_radiance(&self) -> Vec<Spectrum<N>> {
+        let forest = self.forest();
+        self.links
+            .iter()
+            .map(|(_, l)| {
+                let base = link_radiance(
+                    l,
+                    &self.radiance,
+                    self.scene.emission(),
+                    |f| forest.geometry().surface(f.surface()).shape as usize,
+                    |h, n| {
+                        self.hierarchies
+                            .get(h as usize)
+                            .and_then(|h| h.nodes.get(n as usize))
+                            .map_or(Spectrum::zero(), |n| n.radiance)
+                    },
+                );
+                base + match l.source {
+                    LinkSource::Face(face) => {
+                        self.ambient
+                            .lambertian_element(&self.scene, forest, face, l.sender)
+                    }
+                    LinkSource::Node { hierarchy, .. } => self
+                        .hierarchies
+                        .get(hierarchy as usize)
+                        .map_or(Spectrum::zero(), |h| self.ambient.glossy(&self.scene, h.from)),
+                }
+            })
+            .collect()
+    }
+
+    /// Whether the readers add the ambient term (on by default; off gives
+    /// the stopped solve's light alone). Every reader follows: radiance
+    /// queries, face and surface means, the gather links' senders.
+    pub fn set_ambient(&mut self, on: bool) {
+        if self.ambient.on != on && !self.ambient.radiance.is_black() {
+            self.ambient.on = on;
+            self.link_radiance = self.sender_radiance();
+        }
+    }
+
+    /// The ambient radiance A_amb the readers add (times each face's
+    /// reflectance) for the light the solve left unshot; zero when off or
+    /// when the solve left nothing (stats' `ambient`).
+    pub fn ambient_radiance(&self) -> Spectrum<N> {
+        if self.ambient.on {
+            self.ambient.radiance
+        } else {
+            Spectrum::zero()
         }
     }
 
@@ -202,8 +246,7 @@ impl<const N: usize> Solution<N> {
     /// the stored part from the deepest node of hierarchy (from, to) whose
     /// elements contain both points (paper Fig. 11c).
     pub fn radiance(&self, from: &SurfaceSite, to: &SurfaceSite) -> Spectrum<N> {
-        let leaf = self.forest().locate(from.face.surface(), from.coord);
-        self.radiance[from.face.side()][leaf.index()] + self.stored_radiance(from, to)
+        self.lambertian_radiance(from) + self.stored_radiance(from, to)
     }
 
     /// The stored (glossy, direction-dependent) part alone of
@@ -212,10 +255,12 @@ impl<const N: usize> Solution<N> {
     /// radiance towards that block (`cluster_transport`); zero where
     /// neither exists.
     pub fn stored_radiance(&self, from: &SurfaceSite, to: &SurfaceSite) -> Spectrum<N> {
+        let ambient = self.ambient.glossy(&self.scene, from.face);
         if let Some(&h) = self.by_faces.get(&(from.face, to.face)) {
-            return self.hierarchies[h as usize].radiance_at(self.forest(), from.coord, to.coord);
+            return self.hierarchies[h as usize].radiance_at(self.forest(), from.coord, to.coord)
+                + ambient;
         }
-        self.far_radiance(from.face, to.face)
+        self.far_radiance(from.face, to.face) + ambient
     }
 
     /// The far radiance face `from` sends towards the far block holding
@@ -231,7 +276,8 @@ impl<const N: usize> Solution<N> {
     }
 
     /// The final radiance L + Le that element `e` of a face sends (its
-    /// two-point radiance and, on an emitter's front, its emission).
+    /// two-point radiance with the ambient term and, on an emitter's
+    /// front, its emission).
     pub fn face_radiance(&self, face: FaceId, e: trilux_geometry::ElementId) -> Spectrum<N> {
         let le = match face.side() {
             Side::Front => {
@@ -240,7 +286,11 @@ impl<const N: usize> Solution<N> {
             }
             Side::Back => Spectrum::zero(),
         };
-        self.radiance[face.side()][e.index()] + le
+        self.radiance[face.side()][e.index()]
+            + le
+            + self
+                .ambient
+                .lambertian_element(&self.scene, self.forest(), face, e)
     }
 
     /// The part of element `e`'s area that is exposed on `face`'s side
@@ -256,10 +306,12 @@ impl<const N: usize> Solution<N> {
         crate::ElementTextures::new(self.forest(), &self.scene, &self.exposed_area)
     }
 
-    /// The Lambertian (two-point) reflected radiance alone at a point.
+    /// The Lambertian (two-point) reflected radiance alone at a point, with
+    /// ρ_d times the ambient term.
     pub fn lambertian_radiance(&self, from: &SurfaceSite) -> Spectrum<N> {
         let leaf = self.forest().locate(from.face.surface(), from.coord);
         self.radiance[from.face.side()][leaf.index()]
+            + self.ambient.lambertian(&self.scene, from.face, || from.coord)
     }
 
     /// Area mean of the Lambertian (two-point) reflected radiance over one
@@ -278,7 +330,10 @@ impl<const N: usize> Solution<N> {
             if let Some(children) = e.children() {
                 stack.extend(children);
             } else {
-                sum += self.radiance[side][id.index()] * self.exposed_area[side][id.index()];
+                let ambient = self
+                    .ambient
+                    .lambertian_element(&self.scene, self.forest(), face, id);
+                sum += (self.radiance[side][id.index()] + ambient) * self.exposed_area[side][id.index()];
                 area += e.area;
             }
         }
