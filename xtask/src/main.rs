@@ -15,6 +15,7 @@ mod scale;
 mod scale_scenes;
 mod structure;
 mod surface;
+mod stopping;
 mod sweep;
 mod viewer;
 
@@ -161,10 +162,11 @@ fn main() -> Result<()> {
         Some("sweep") => sweep::main(&args[1..]),
         Some("rays") => rays::main(&args[1..]),
         Some("scale") => scale::main(&args[1..]),
+        Some("stopping") => stopping::main(&args[1..]),
         Some("viewer") => viewer::main(&args[1..]),
         _ => {
             eprintln!(
-                "usage: cargo xtask ci | structure | deps | surface | package | color | golden | sweep | rays | scale | viewer"
+                "usage: cargo xtask ci | structure | deps | surface | package | color | golden | sweep | rays | scale | stopping | viewer"
             );
             std::process::exit(2);
         }

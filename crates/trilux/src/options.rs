@@ -23,7 +23,8 @@ pub struct SolveOptions {
     /// Quality preset: error bounds, depth limit and default convergence.
     #[arg(long, value_enum, default_value = "default")]
     pub quality: QualityArg,
-    /// Target convergence ratio CR = (IF − RF)/IF in [0, 1] (default from
+    /// Target convergence ratio CR in [0, 1]: the share of all the light
+    /// the surfaces will reflect that they have reflected (default from
     /// --quality: 0.95, 0.999, 0.9999).
     #[arg(long, value_parser = parse_unit)]
     pub convergence: Option<f64>,
