@@ -78,6 +78,7 @@ fn an_early_stop_with_the_ambient_term_is_within_five_percent_of_the_converged_m
     stopped.set_ambient(false);
     let without = mean(&stopped);
     let (e_with, e_without) = (with / reference - 1.0, without / reference - 1.0);
+    println!("stopped at CR {cr}: with the term {e_with:+.4}, without {e_without:+.4}");
     assert!(
         e_without < -0.05,
         "stopped at CR {cr} the room should be visibly dark without the term: {e_without:+.4}"
