@@ -13,9 +13,9 @@ mod golden;
 mod rays;
 mod scale;
 mod scale_scenes;
+mod stopping;
 mod structure;
 mod surface;
-mod stopping;
 mod sweep;
 mod viewer;
 

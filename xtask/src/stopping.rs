@@ -180,7 +180,7 @@ pub fn main(args: &[String]) -> Result<()> {
         let scene = match name.as_str() {
             "atrium" => trilux_scene::load_str(ATRIUM, "atrium.xml"),
             "closed-room" => trilux_scene::load_str(CLOSED_ROOM, "closed-room.xml"),
-            other => trilux_scene::load(&root().join("scenes").join(format!("{other}.xml"))),
+            other => trilux_scene::load(root().join("scenes").join(format!("{other}.xml"))),
         }
         .map_err(|e| anyhow::anyhow!("{e}"))?;
         let rows = scene.mode().with_bands(Bench {
@@ -263,7 +263,10 @@ impl WithBands for Bench<'_> {
         before.set_ambient(false);
         let m = mean(&before)?;
         rows.push(row("before: paper CR, no ambient", &before, m));
-        let mut after = timed(Solver::new(Arc::clone(&prepared), settings(o.target))?, None);
+        let mut after = timed(
+            Solver::new(Arc::clone(&prepared), settings(o.target))?,
+            None,
+        );
         let m = mean(&after)?;
         after.set_ambient(false);
         let m_plain = mean(&after)?;

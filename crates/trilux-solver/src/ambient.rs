@@ -168,7 +168,11 @@ impl<const N: usize> Interreflection<N> {
     /// Σ ρ_k A_k when the light spreads evenly and the area of the part
     /// that is lit when it does not. `fallback` (Σ ρ A over every face)
     /// before any reflected light was shot.
-    pub fn reflecting_area(&self, area: impl Fn(FaceId) -> f64, fallback: Spectrum<N>) -> Spectrum<N> {
+    pub fn reflecting_area(
+        &self,
+        area: impl Fn(FaceId) -> f64,
+        fallback: Spectrum<N>,
+    ) -> Spectrum<N> {
         let mut sum = Spectrum::<N>::zero();
         let mut weighted = Spectrum::<N>::zero();
         for (face, (h, r)) in self.faces.iter() {
@@ -192,8 +196,12 @@ impl<const N: usize> Interreflection<N> {
     /// reflecting area `area`.
     pub fn ambient(&self, residual: Spectrum<N>, area: Spectrum<N>) -> Ambient {
         let a = self.return_fraction().unwrap_or_else(Spectrum::zero);
-        let future: Vec<f64> = (0..N).map(|b| future_reflected(residual[b], a[b])).collect();
-        let radiance = (0..N).map(|b| ambient_radiance(future[b], area[b])).collect();
+        let future: Vec<f64> = (0..N)
+            .map(|b| future_reflected(residual[b], a[b]))
+            .collect();
+        let radiance = (0..N)
+            .map(|b| ambient_radiance(future[b], area[b]))
+            .collect();
         let total: f64 = future.iter().sum();
         Ambient {
             radiance,
@@ -208,7 +216,11 @@ impl<const N: usize> Interreflection<N> {
 
 /// n / d, 0 when d is not positive.
 fn ratio(n: f64, d: f64) -> f64 {
-    if d > 0.0 { (n / d).clamp(0.0, 1.0) } else { 0.0 }
+    if d > 0.0 {
+        (n / d).clamp(0.0, 1.0)
+    } else {
+        0.0
+    }
 }
 
 #[cfg(test)]
@@ -281,7 +293,10 @@ mod tests {
             let emitted = le * PI * areas[0];
             let paper = (emitted - residual) / emitted;
             let cr = tracker.convergence_ratio(Spectrum::splat(residual));
-            assert!((cr - paper).abs() <= 1e-9, "{shots} shots: CR {cr} against the paper's {paper}");
+            assert!(
+                (cr - paper).abs() <= 1e-9,
+                "{shots} shots: CR {cr} against the paper's {paper}"
+            );
         }
     }
 
@@ -297,13 +312,23 @@ mod tests {
         // The emitter's shot: 1 W, 0.3 of it arrives.
         let one = Spectrum::splat(1.0);
         t.book_shot(one, Interreflection::reflected_share(one, one));
-        t.book_group(face, Spectrum::splat(0.3), Spectrum::splat(0.3 * rho), Spectrum::zero());
+        t.book_group(
+            face,
+            Spectrum::splat(0.3),
+            Spectrum::splat(0.3 * rho),
+            Spectrum::zero(),
+        );
         // One reflected shot of the 0.18 W.
         let phi = 0.3 * rho;
         let share = Interreflection::reflected_share(Spectrum::splat(phi), Spectrum::zero());
         t.book_shot(Spectrum::splat(phi), share);
         let arrived = phi * keep;
-        t.book_group(face, Spectrum::splat(arrived), Spectrum::splat(arrived * rho), share);
+        t.book_group(
+            face,
+            Spectrum::splat(arrived),
+            Spectrum::splat(arrived * rho),
+            share,
+        );
         let a = t.return_fraction().unwrap()[0];
         assert!((a - rho * keep).abs() < 1e-12);
         let residual = arrived * rho;

@@ -47,8 +47,9 @@ impl std::str::FromStr for Quality {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[non_exhaustive]
 pub struct SolverSettings {
-    /// Stop when the convergence ratio CR = (IF − RF)/IF reaches this
-    /// (paper §6).
+    /// Stop when the convergence ratio CR (the share of all the light the
+    /// surfaces will reflect that they have reflected; the paper's §6
+    /// figure in a closed scene) reaches this.
     pub convergence: f64,
     /// Stop after this many shots whatever the convergence ratio.
     pub max_shots: u32,

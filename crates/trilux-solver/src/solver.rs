@@ -408,14 +408,18 @@ impl<const N: usize> Solver<N> {
     /// over every face.
     fn ambient(&self, residual: Spectrum<N>) -> crate::stats::Ambient {
         let forest = self.setup.forest();
-        let exposed = |f: FaceId| self.setup.exposed_area[f.side()][forest.root(f.surface()).index()];
+        let exposed =
+            |f: FaceId| self.setup.exposed_area[f.side()][forest.root(f.surface()).index()];
         let fallback: Spectrum<N> = self
             .setup
             .faces
             .iter()
             .map(|(f, face)| face.rho_d * exposed(f))
             .sum();
-        let area = self.state.interreflection.reflecting_area(exposed, fallback);
+        let area = self
+            .state
+            .interreflection
+            .reflecting_area(exposed, fallback);
         self.state.interreflection.ambient(residual, area)
     }
 

@@ -172,7 +172,12 @@ fn check_ledger(solution: &Solution<3>) -> Result<(), TestCaseError> {
     }
     if reflected + future > 0.0 {
         let cr = reflected / (reflected + future);
-        prop_assert!((stats.convergence_ratio - cr).abs() <= 1e-9, "CR {} vs {}", stats.convergence_ratio, cr);
+        prop_assert!(
+            (stats.convergence_ratio - cr).abs() <= 1e-9,
+            "CR {} vs {}",
+            stats.convergence_ratio,
+            cr
+        );
     }
     Ok(())
 }

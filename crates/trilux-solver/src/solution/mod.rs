@@ -170,7 +170,9 @@ impl<const N: usize> Solution<N> {
                     LinkSource::Node { hierarchy, .. } => self
                         .hierarchies
                         .get(hierarchy as usize)
-                        .map_or(Spectrum::zero(), |h| self.ambient.glossy(&self.scene, h.from)),
+                        .map_or(Spectrum::zero(), |h| {
+                            self.ambient.glossy(&self.scene, h.from)
+                        }),
                 }
             })
             .collect()
@@ -311,7 +313,9 @@ impl<const N: usize> Solution<N> {
     pub fn lambertian_radiance(&self, from: &SurfaceSite) -> Spectrum<N> {
         let leaf = self.forest().locate(from.face.surface(), from.coord);
         self.radiance[from.face.side()][leaf.index()]
-            + self.ambient.lambertian(&self.scene, from.face, || from.coord)
+            + self
+                .ambient
+                .lambertian(&self.scene, from.face, || from.coord)
     }
 
     /// Area mean of the Lambertian (two-point) reflected radiance over one
@@ -333,7 +337,8 @@ impl<const N: usize> Solution<N> {
                 let ambient = self
                     .ambient
                     .lambertian_element(&self.scene, self.forest(), face, id);
-                sum += (self.radiance[side][id.index()] + ambient) * self.exposed_area[side][id.index()];
+                sum += (self.radiance[side][id.index()] + ambient)
+                    * self.exposed_area[side][id.index()];
                 area += e.area;
             }
         }
