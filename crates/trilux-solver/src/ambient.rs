@@ -202,10 +202,9 @@ impl<const N: usize> Interreflection<N> {
         let radiance = (0..N)
             .map(|b| ambient_radiance(future[b], area[b]))
             .collect();
-        let total: f64 = future.iter().sum();
         Ambient {
             radiance,
-            share: 1.0 - convergence_ratio(self.reflected.sum(), total),
+            share: 1.0 - self.convergence_ratio(residual),
             return_fraction: a.to_array().to_vec(),
             reflected_flux: self.reflected.to_array().to_vec(),
             future_reflected_flux: future,
