@@ -66,9 +66,11 @@ fn diffuse_receiver_one_bounce() {
     };
     let settings = one_bounce_settings();
     let ff_eps = settings.ff_eps;
-    let solution = Solver::<3>::from_description(&input, settings)
+    let mut solution = Solver::<3>::from_description(&input, settings)
         .expect("builds")
         .solve(|_| {});
+    // One bounce as shot, without the estimate of the bounces to come.
+    solution.set_ambient(false);
     let rho_le = 0.5;
     // Area-weighted mean over a fine grid of the receiver (uv is uniform in
     // area on a rectangle).
@@ -233,9 +235,10 @@ fn textured_receiver_one_bounce_resolves_the_texture() {
         to_uv: trilux_brdf::UvTransform::IDENTITY,
     };
     let prepared = PreparedScene::<3>::new_textured(&input, &[vec![], vec![slot]]).unwrap();
-    let solution = Solver::new(Arc::new(prepared), one_bounce_settings())
+    let mut solution = Solver::new(Arc::new(prepared), one_bounce_settings())
         .expect("builds")
         .solve(|_| {});
+    solution.set_ambient(false);
     // Means over the halves u < ½, u > ½, v < ½, v > ½ of a fine grid.
     let g = 64;
     let mut halves = [0.0; 4];
