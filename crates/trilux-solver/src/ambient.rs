@@ -205,7 +205,13 @@ impl<const N: usize> Interreflection<N> {
         // much light to an open scene.
         let measured = self.shot.max_value() > 0.0;
         let radiance = (0..N)
-            .map(|b| if measured { ambient_radiance(future[b], area[b]) } else { 0.0 })
+            .map(|b| {
+                if measured {
+                    ambient_radiance(future[b], area[b])
+                } else {
+                    0.0
+                }
+            })
             .collect();
         Ambient {
             radiance,
