@@ -45,6 +45,7 @@ pub mod camera;
 pub mod error;
 pub mod gltf;
 pub mod image;
+mod integrator;
 pub mod limits;
 mod material;
 pub mod meshes;
