@@ -18,7 +18,8 @@ image means give the relative standard error of the reference's mean
 (their spread / sqrt(K) / mean), per channel.
 
 Writes beside this script:
-  NAME.exr     RGB float32, linear sRGB, the film's size (256 x 256)
+  NAME.exr     RGB half float (far below the noise), linear sRGB, the film's
+               size (256 x 256)
   NAME.json    variant, spp, passes, per-channel means and their standard
                errors, the mean at the file's own max_depth, seconds, command
 
@@ -88,6 +89,7 @@ def main():
         file_depth, _ = render_passes(mi, path, 6, a.file_depth_spp, 4)
         file_mean = file_depth.reshape(-1, 3).mean(axis=0)
         bmp = mi.Bitmap(ref.astype(np.float32), pixel_format=mi.Bitmap.PixelFormat.RGB)
+        bmp = bmp.convert(mi.Bitmap.PixelFormat.RGB, mi.Struct.Type.Float16, False)
         bmp.write(os.path.join(HERE, f"{name}.exr"))
         rec = {
             "scene": f"scenes/mitsuba-cbox/{name}.xml",
