@@ -719,7 +719,13 @@ fn sampler(e: &Element) -> Result<u32> {
     // Mitsuba 3.9.1's samplers all converge to the same image; trilux uses
     // its own low-discrepancy sequences in their place.
     let t = e.plugin_type()?;
-    const SAMPLERS: [&str; 5] = ["independent", "stratified", "multijitter", "orthogonal", "ldsampler"];
+    const SAMPLERS: [&str; 5] = [
+        "independent",
+        "stratified",
+        "multijitter",
+        "orthogonal",
+        "ldsampler",
+    ];
     if !SAMPLERS.contains(&t) {
         return Err(SceneError::at(
             &e.required("type")?.loc,

@@ -131,11 +131,7 @@ pub(crate) fn build_bsdf(e: &Element, tex: &mut TextureCollector<'_>) -> Result<
 }
 
 /// A `twosided` BSDF: one nested BSDF (both sides) or two (front, back).
-fn twosided(
-    e: &Element,
-    props: &Props<'_>,
-    tex: &mut TextureCollector<'_>,
-) -> Result<BsdfParams> {
+fn twosided(e: &Element, props: &Props<'_>, tex: &mut TextureCollector<'_>) -> Result<BsdfParams> {
     Ok(match props.objects.as_slice() {
         [front] => BsdfParams::TwoSided {
             front: Box::new(tex.nested(Branch::Front, front)?),
@@ -282,10 +278,7 @@ fn bitmap(e: &Element, kind: SlotKind, tex: &TextureCollector<'_>) -> Result<Tex
     // How Mitsuba stores the image (its precision: PNG and JPEG hold 8-bit
     // values, which every format keeps, float16 within 0.05 %) and whether
     // it uses the GPU's texture units: not the light.
-    choice(
-        "format",
-        &["auto", "variant", "float16", "fp16", "uint8"],
-    )?;
+    choice("format", &["auto", "variant", "float16", "fp16", "uint8"])?;
     props.boolean("accel")?;
     let to_uv = to_uv(&props)?;
     let location = props.loc("filename");

@@ -48,8 +48,8 @@ fn negative_eta_and_k_match_mitsuba() {
             r#"<scene version="3.0.0"><shape type="rectangle"><bsdf type="roughconductor"><string name="distribution" value="{}"/><float name="alpha" value="{}"/>{}</bsdf></shape></scene>"#,
             case.distribution, case.alpha, case.body
         );
-        let scene = load_str(&xml, dir.join("inline.xml"))
-            .unwrap_or_else(|e| panic!("{}: {e}", case.name));
+        let scene =
+            load_str(&xml, dir.join("inline.xml")).unwrap_or_else(|e| panic!("{}: {e}", case.name));
         let bsdf = Bsdf::<3>::new(&scene.shapes[0].bsdf).unwrap();
         for s in &case.samples {
             let got = bsdf.eval(DVec3::from_array(s.wi), DVec3::from_array(s.wo));

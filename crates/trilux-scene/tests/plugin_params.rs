@@ -47,10 +47,12 @@ fn summary(s: &Scene) -> String {
             )
         })
         .collect();
-    let camera = s
-        .camera
-        .as_ref()
-        .map(|c| format!("{}x{} {:?} {}", c.width, c.height, c.rfilter, c.sample_count));
+    let camera = s.camera.as_ref().map(|c| {
+        format!(
+            "{}x{} {:?} {}",
+            c.width, c.height, c.rfilter, c.sample_count
+        )
+    });
     format!("{shapes:?} {camera:?} {:?}", s.max_depth)
 }
 
@@ -126,8 +128,14 @@ fn parameters_that_change_the_light_are_refused() {
             r#"<integrator type="path"><boolean name="hide_emitters" value="true"/></integrator>"#,
             "hide_emitters",
         ),
-        (r#"<integrator type="direct"/>"#, "\"direct\" does not compute global illumination"),
-        (r#"<integrator type="aov"/>"#, "\"aov\" does not compute global illumination"),
+        (
+            r#"<integrator type="direct"/>"#,
+            "\"direct\" does not compute global illumination",
+        ),
+        (
+            r#"<integrator type="aov"/>"#,
+            "\"aov\" does not compute global illumination",
+        ),
         (
             r#"<integrator type="path"><boolean name="use_spectral_mis" value="true"/></integrator>"#,
             "unknown parameter \"use_spectral_mis\"",
@@ -170,9 +178,8 @@ fn an_emitter_without_a_bsdf_reflects_nothing() {
 /// -1 (unlimited, Mitsuba's default) warns about nothing.
 #[test]
 fn a_finite_max_depth_is_warned_about() {
-    let s = load(
-        "<integrator type=\"path\">\n<integer name=\"max_depth\" value=\"6\"/></integrator>",
-    );
+    let s =
+        load("<integrator type=\"path\">\n<integer name=\"max_depth\" value=\"6\"/></integrator>");
     assert_eq!(s.warnings.len(), 1, "{:?}", s.warnings);
     assert!(s.warnings[0].contains("inline.xml:2:"), "{}", s.warnings[0]);
     assert!(s.warnings[0].contains("max_depth 6"), "{}", s.warnings[0]);

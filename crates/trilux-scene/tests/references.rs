@@ -96,9 +96,18 @@ fn sensor_children_can_be_referenced() {
 #[test]
 fn sensor_child_definitions_are_checked() {
     for (body, want) in [
-        (r#"<film type="hdrfilm" id="f"><integer name="width" value="-4"/></film>"#, "width"),
-        (r#"<sampler type="halton" id="s"/>"#, "unknown sampler plugin"),
-        (r#"<rfilter type="tent" id="r"><float name="radius" value="0"/></rfilter>"#, "radius"),
+        (
+            r#"<film type="hdrfilm" id="f"><integer name="width" value="-4"/></film>"#,
+            "width",
+        ),
+        (
+            r#"<sampler type="halton" id="s"/>"#,
+            "unknown sampler plugin",
+        ),
+        (
+            r#"<rfilter type="tent" id="r"><float name="radius" value="0"/></rfilter>"#,
+            "radius",
+        ),
         (r#"<film type="hdrfilm"/>"#, "unsupported element <film>"),
         (
             r#"<shape type="rectangle" id="a"/><shape type="cube"><ref id="a"/></shape>"#,

@@ -52,20 +52,26 @@ fn mitsubas_cornell_box_renders_unedited_and_matches_mitsuba() {
         ]);
         let stderr = String::from_utf8_lossy(&run.stderr);
         assert!(run.status.success(), "{name}: {stderr}");
-        let warnings: Vec<&str> = stderr.lines().filter(|l| l.starts_with("warning:")).collect();
+        let warnings: Vec<&str> = stderr
+            .lines()
+            .filter(|l| l.starts_with("warning:"))
+            .collect();
         assert_eq!(warnings.len(), 1, "{name}: {stderr}");
         assert!(warnings[0].contains("max_depth 6"), "{name}: {stderr}");
         let image = Image::read_exr(&out).unwrap();
-        let reference =
-            Image::read_exr(std::path::Path::new(&scene(&format!("mitsuba-cbox/{name}.exr"))))
-                .unwrap();
+        let reference = Image::read_exr(std::path::Path::new(&scene(&format!(
+            "mitsuba-cbox/{name}.exr"
+        ))))
+        .unwrap();
         assert_eq!(
             (image.width(), image.height()),
             (reference.width(), reference.height())
         );
         let (m, r) = (mean(&image), mean(&reference));
         let ratio = m.iter().sum::<f64>() / r.iter().sum::<f64>();
-        let per_channel: Vec<String> = (0..3).map(|c| format!("{:+.2} %", 100.0 * (m[c] / r[c] - 1.0))).collect();
+        let per_channel: Vec<String> = (0..3)
+            .map(|c| format!("{:+.2} %", 100.0 * (m[c] / r[c] - 1.0)))
+            .collect();
         report.push(format!(
             "{name}: image mean {:+.2} % against Mitsuba (channels {})",
             100.0 * (ratio - 1.0),
