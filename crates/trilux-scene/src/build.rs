@@ -88,17 +88,7 @@ pub(crate) fn build(resolved: Resolved, path: &Path) -> Result<(Scene, Requests)
                 max_depth = crate::integrator::integrator(e)?.max_depth;
             }
             "emitter" => top_level_emitter(e)?,
-            // Definitions that a sensor's or a film's <ref> names, checked
-            // here so that an unused one's errors are reported too.
-            "film" if e.attr("id").is_some() => {
-                film(e)?;
-            }
-            "sampler" if e.attr("id").is_some() => {
-                sampler(e)?;
-            }
-            "rfilter" if e.attr("id").is_some() => {
-                rfilter(e)?;
-            }
+            "film" | "sampler" | "rfilter" if e.attr("id").is_some() => sensor_definition(e)?,
             other => {
                 return Err(SceneError::at(
                     &e.loc,
@@ -131,6 +121,17 @@ pub(crate) fn build(resolved: Resolved, path: &Path) -> Result<(Scene, Requests)
             .collect(),
     };
     Ok((scene, requests))
+}
+
+/// A top-level `<film>`, `<sampler>` or `<rfilter>` with an id is a
+/// definition that a sensor's or a film's `<ref>` names, checked here so
+/// that an unused one's errors are reported too.
+fn sensor_definition(e: &Element) -> Result<()> {
+    match e.tag.as_str() {
+        "film" => film(e).map(|_| ()),
+        "sampler" => sampler(e).map(|_| ()),
+        _ => rfilter(e).map(|_| ()),
+    }
 }
 
 /// A top-level area `<emitter id>` is a definition, attached to the shape
