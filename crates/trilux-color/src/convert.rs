@@ -34,7 +34,8 @@ pub enum Role {
     Reflectance,
     /// Emitted radiance of an area emitter.
     Emission,
-    /// A non-negative quantity without upper bound (η and k of a conductor).
+    /// A quantity without upper bound (η and k of a conductor); negative
+    /// values act as Mitsuba's Fresnel term takes them (their magnitude).
     Unbounded,
 }
 
@@ -50,9 +51,12 @@ fn check(v: f64) -> Result<f64, ColorError> {
 
 impl ColorParam {
     /// This value as a spectrum of `N` bands (3: RGB mode; otherwise
-    /// spectral mode) in the given role. Non-finite or negative values, and
-    /// malformed sampled spectra, are errors.
+    /// spectral mode) in the given role. Non-finite values, negative ones
+    /// (but in [`Role::Unbounded`]) and malformed sampled spectra are errors.
     pub fn to_spectrum<const N: usize>(&self, role: Role) -> Result<Spectrum<N>, ColorError> {
+        if role == Role::Unbounded && self.values().iter().any(|v| *v < 0.0) {
+            return self.signed_unbounded();
+        }
         for v in self.values() {
             check(v)?;
         }
@@ -119,6 +123,28 @@ impl ColorParam {
         } else {
             Err(ColorError::NotFinite)
         }
+    }
+
+    /// A conductor's η or k with negative values, as Mitsuba 3.9.1 takes
+    /// them: its Fresnel term sees only η², k² and η²k², so a negative
+    /// number, RGB channel or wavelength's value acts as its magnitude,
+    /// except that a sampled spectrum is first converted to RGB in RGB
+    /// mode, where Mitsuba clamps negative channels to 0 (checked against
+    /// Mitsuba's `eval` in `scalar_rgb`: crates/trilux-scene/tests/negative_ior.rs).
+    fn signed_unbounded<const N: usize>(&self) -> Result<Spectrum<N>, ColorError> {
+        let magnitude = match self {
+            ColorParam::Float(v) => ColorParam::Float(v.abs()),
+            ColorParam::Constant(v) => ColorParam::Constant(v.abs()),
+            ColorParam::Rgb(c) => ColorParam::Rgb(c.map(f64::abs)),
+            ColorParam::Sampled(s) if N == 3 => {
+                let rgb = mitsuba::spectrum_to_srgb(&SampledSpectrum::new(s)?, false, true);
+                ColorParam::Rgb(rgb)
+            }
+            ColorParam::Sampled(s) => {
+                ColorParam::Sampled(s.iter().map(|&(l, v)| (l, v.abs())).collect())
+            }
+        };
+        magnitude.to_spectrum(Role::Unbounded)
     }
 
     /// This value as a reflectance (see [`Role::Reflectance`]).

@@ -1,8 +1,9 @@
 //! Stage 4 of loading: the resolved tree → the [`Scene`] model.
 //!
 //! Top level: `<shape>`, `<sensor>` (one), `<integrator>` (at most one,
-//! ignored except `max_depth`), `<bsdf>` definitions. Anything else is
-//! refused with its location.
+//! `crate::integrator`), `<bsdf>`, `<texture>`, `<emitter>`, `<film>`,
+//! `<sampler>` and `<rfilter>` definitions (with an `id`, for `<ref>`s).
+//! Anything else is refused with its location.
 
 use std::path::Path;
 
@@ -84,14 +85,15 @@ pub(crate) fn build(resolved: Resolved, path: &Path) -> Result<(Scene, Requests)
                     ));
                 }
                 integrator = Some(e);
-                max_depth = integrator_max_depth(e)?;
+                max_depth = crate::integrator::integrator(e)?.max_depth;
             }
             "emitter" => top_level_emitter(e)?,
+            "film" | "sampler" | "rfilter" if e.attr("id").is_some() => sensor_definition(e)?,
             other => {
                 return Err(SceneError::at(
                     &e.loc,
                     format!(
-                        "unsupported element <{other}> in <scene> (supported: shape, bsdf, texture with an id, sensor, integrator, default, include)"
+                        "unsupported element <{other}> in <scene> (supported: shape, sensor, integrator, default, include, and bsdf, texture, emitter, film, sampler, rfilter with an id)"
                     ),
                 ));
             }
@@ -112,9 +114,24 @@ pub(crate) fn build(resolved: Resolved, path: &Path) -> Result<(Scene, Requests)
         spectral,
         bsdf_counts: resolved.bsdf_counts,
         camera_names: Vec::new(),
-        warnings: Vec::new(),
+        warnings: integrator
+            .zip(max_depth.filter(|d| *d >= 0))
+            .map(|(e, d)| crate::integrator::max_depth_warning(e, d))
+            .into_iter()
+            .collect(),
     };
     Ok((scene, requests))
+}
+
+/// A top-level `<film>`, `<sampler>` or `<rfilter>` with an id is a
+/// definition that a sensor's or a film's `<ref>` names, checked here so
+/// that an unused one's errors are reported too.
+fn sensor_definition(e: &Element) -> Result<()> {
+    match e.tag.as_str() {
+        "film" => film(e).map(|_| ()),
+        "sampler" => sampler(e).map(|_| ()),
+        _ => rfilter(e).map(|_| ()),
+    }
 }
 
 /// A top-level area `<emitter id>` is a definition, attached to the shape
@@ -201,7 +218,14 @@ fn scene_shape(e: &Element, folder: &Path) -> Result<ShapeRequests> {
     let shape = SceneShape {
         id: e.attr("id").map(|a| a.value.clone()),
         shape,
-        bsdf: bsdf.unwrap_or_default(),
+        // Without a <bsdf>, Mitsuba 3.9.1 makes an emitter's shape black
+        // (its Shape constructor: diffuse 0) and any other diffuse 0.5.
+        bsdf: bsdf.unwrap_or_else(|| match emitter {
+            Some(_) => BsdfParams::Diffuse {
+                reflectance: ColorParam::Float(0.0),
+            },
+            None => BsdfParams::default(),
+        }),
         emitter,
         textures: Vec::new(),
         location: e.loc.clone(),
@@ -220,6 +244,9 @@ fn area_emitter(e: &Element) -> Result<AreaEmitter> {
     }
     let props = Props::new(e)?;
     props.no_objects()?;
+    // How often Mitsuba's light sampling picks this emitter: its noise, not
+    // its image.
+    props.float("sampling_weight")?;
     // Mitsuba's default radiance is 1.
     let radiance = props.color("radiance")?.unwrap_or(ColorParam::Float(1.0));
     check_color(&radiance, &props.loc("radiance"), "radiance", None)?;
@@ -241,36 +268,6 @@ fn area_emitter(e: &Element) -> Result<AreaEmitter> {
         radiance,
         location: e.loc.clone(),
     })
-}
-
-fn integrator_max_depth(e: &Element) -> Result<Option<i64>> {
-    e.check_attrs(&["type", "id", "name"])?;
-    e.plugin_type()?;
-    // Only max_depth is read; everything else is accepted and ignored.
-    match e
-        .children
-        .iter()
-        .find(|c| c.attr("name").is_some_and(|n| n.value == "max_depth"))
-    {
-        None => Ok(None),
-        Some(c) if c.tag == "integer" => {
-            let v = c.required("value")?;
-            let d: i64 = v.value.trim().parse().map_err(|_| {
-                SceneError::at(&v.loc, format!("\"{}\" is not an integer", v.value))
-            })?;
-            if d < -1 {
-                return Err(SceneError::at(
-                    &v.loc,
-                    format!("max_depth must be -1 (unlimited) or at least 0, found {d}"),
-                ));
-            }
-            Ok(Some(d))
-        }
-        Some(c) => Err(SceneError::at(
-            &c.loc,
-            format!("max_depth must be an <integer>, found <{}>", c.tag),
-        )),
-    }
 }
 
 fn sensor(e: &Element) -> Result<Camera> {
@@ -570,7 +567,21 @@ fn film(e: &Element) -> Result<FilmParams> {
     })?;
     // What the output file holds and how it is written: trilux's command
     // line decides (EXR, PNG); radiance is the same.
-    props.ignore(&["pixel_format", "component_format", "file_format"]);
+    // `compensate` (Kahan summation) and `banner` change the sums' rounding
+    // and the file's pixels' text, not the light.
+    props.ignore(&[
+        "pixel_format",
+        "component_format",
+        "file_format",
+        "compensate",
+        "banner",
+    ]);
+    if props.boolean("sample_border")?.unwrap_or(false) {
+        return Err(SceneError::at(
+            &props.loc("sample_border"),
+            "sample_border: trilux samples the film only, so its border pixels would differ from Mitsuba's (leave it out or false)",
+        ));
+    }
     let crop = crop_window(&props, width, height)?;
     let mut rfilter = ReconstructionFilter::default();
     for (i, o) in props.objects.iter().enumerate() {
@@ -580,11 +591,7 @@ fn film(e: &Element) -> Result<FilmParams> {
                 format!("a <film> takes one <rfilter>; unexpected {}", o.describe()),
             ));
         }
-        o.check_attrs(&["type", "id", "name"])?;
-        let fp = Props::new(o)?;
-        fp.no_objects()?;
-        rfilter = rfilter_of(o, &fp)?;
-        fp.finish()?;
+        rfilter = self::rfilter(o)?;
     }
     props.finish()?;
     Ok(FilmParams {
@@ -631,6 +638,16 @@ fn crop_window(props: &Props<'_>, width: u32, height: u32) -> Result<Option<Crop
         offset: [x as u32, y as u32],
         size: [w as u32, h as u32],
     }))
+}
+
+/// An `<rfilter>` element, inside a film or defined for a `<ref>`.
+fn rfilter(o: &Element) -> Result<ReconstructionFilter> {
+    o.check_attrs(&["type", "id", "name"])?;
+    let fp = Props::new(o)?;
+    fp.no_objects()?;
+    let rfilter = rfilter_of(o, &fp)?;
+    fp.finish()?;
+    Ok(rfilter)
 }
 
 /// Widest reconstruction filter, in pixels: every sample is added to
@@ -700,8 +717,22 @@ fn rfilter_of(o: &Element, fp: &Props<'_>) -> Result<ReconstructionFilter> {
 
 fn sampler(e: &Element) -> Result<u32> {
     e.check_attrs(&["type", "id", "name"])?;
-    // Any Mitsuba sampler type: trilux uses its own low-discrepancy sampler.
-    e.plugin_type()?;
+    // Mitsuba 3.9.1's samplers all converge to the same image; trilux uses
+    // its own low-discrepancy sequences in their place.
+    let t = e.plugin_type()?;
+    const SAMPLERS: [&str; 5] = [
+        "independent",
+        "stratified",
+        "multijitter",
+        "orthogonal",
+        "ldsampler",
+    ];
+    if !SAMPLERS.contains(&t) {
+        return Err(SceneError::at(
+            &e.required("type")?.loc,
+            format!("unknown sampler plugin \"{t}\" ({})", SAMPLERS.join(", ")),
+        ));
+    }
     let props = Props::new(e)?;
     props.no_objects()?;
     let n = positive_u32(&props, "sample_count", 4)?;
@@ -712,9 +743,13 @@ fn sampler(e: &Element) -> Result<u32> {
             format!("sample_count {n} is more than the {max} samples per pixel trilux renders"),
         ));
     }
-    // Mitsuba's seed picks other random numbers (the noise, not the
-    // image it converges to); trilux's sequences are its own (`--seed`).
-    props.ignore(&["seed"]);
+    // Mitsuba's seed picks other random numbers, and `jitter` and
+    // `strength` (stratified, multijitter, orthogonal) place them
+    // otherwise: the noise, not the image it converges to; trilux's
+    // sequences are its own (`--seed`).
+    props.integer("seed")?;
+    props.boolean("jitter")?;
+    props.integer("strength")?;
     props.finish()?;
     Ok(n)
 }

@@ -16,11 +16,13 @@
 //!
 //! 1. `xml`: XML text → an intermediate tree of elements and attributes,
 //!    each with its source location; `<default>` and `$name` substitution.
-//! 2. `resolve`: `<ref id>` replaced by the `<bsdf id>` it names.
+//! 2. `resolve`: `<ref id>` replaced by the object it names (a BSDF,
+//!    texture, emitter, film, sampler or filter).
 //! 3. `build`: typed parameters (`props`, `value`, [`transform`], their
 //!    numbers read by `numbers`) → the
 //!    model: shapes ([`shape`]), materials (`material`), area lights and the
-//!    camera ([`camera`], its film's filter in [`rfilter`]).
+//!    camera ([`camera`], its film's filter in [`rfilter`]), and the
+//!    `integrator` a solve stands for.
 //! 4. [`meshes`]: the OBJ, PLY and serialized files the shapes name
 //!    ([`obj`], [`ply`], [`serialized`]) and the
 //!    textures' images, read last, so that a command can check the camera
@@ -45,6 +47,7 @@ pub mod camera;
 pub mod error;
 pub mod gltf;
 pub mod image;
+mod integrator;
 pub mod limits;
 mod material;
 pub mod meshes;

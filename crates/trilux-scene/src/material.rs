@@ -16,8 +16,9 @@
 //! ([`crate::textures`]).
 //!
 //! Refused: other plugins, anisotropic roughness (`alpha_u` ≠ `alpha_v`),
-//! named conductor materials, other textures, `alpha` ≤ 0, negative or NaN
-//! values, and reflectances above 1 (they would create energy and keep the
+//! named conductor materials, other textures, `alpha` ≤ 0, negative (but
+//! for a conductor's `eta` and `k`, as in Mitsuba) or NaN values, and
+//! reflectances above 1 (they would create energy and keep the
 //! solver from converging; Mitsuba renders them, trilux refuses them).
 
 use std::path::Path;
@@ -110,22 +111,12 @@ pub(crate) fn build_bsdf(e: &Element, tex: &mut TextureCollector<'_>) -> Result<
                 second: Box::new(tex.nested(Branch::Second, second)?),
             }
         }
-        "twosided" => match props.objects.as_slice() {
-            [front] => BsdfParams::TwoSided {
-                front: Box::new(tex.nested(Branch::Front, front)?),
-                back: None,
-            },
-            [front, back] => BsdfParams::TwoSided {
-                front: Box::new(tex.nested(Branch::Front, front)?),
-                back: Some(Box::new(tex.nested(Branch::Back, back)?)),
-            },
-            _ => {
-                return Err(SceneError::at(
-                    &e.loc,
-                    "<bsdf type=\"twosided\"> needs one or two nested BSDFs",
-                ));
-            }
-        },
+        "twosided" => {
+            // Mitsuba's check that nested BSDFs do not transmit, relaxed:
+            // trilux's BSDFs never do, so it changes nothing.
+            props.boolean("allow_transmission")?;
+            twosided(e, &props, tex)?
+        }
         other => {
             return Err(SceneError::at(
                 &e.required("type")?.loc,
@@ -137,6 +128,26 @@ pub(crate) fn build_bsdf(e: &Element, tex: &mut TextureCollector<'_>) -> Result<
     };
     props.finish()?;
     Ok(bsdf)
+}
+
+/// A `twosided` BSDF: one nested BSDF (both sides) or two (front, back).
+fn twosided(e: &Element, props: &Props<'_>, tex: &mut TextureCollector<'_>) -> Result<BsdfParams> {
+    Ok(match props.objects.as_slice() {
+        [front] => BsdfParams::TwoSided {
+            front: Box::new(tex.nested(Branch::Front, front)?),
+            back: None,
+        },
+        [front, back] => BsdfParams::TwoSided {
+            front: Box::new(tex.nested(Branch::Front, front)?),
+            back: Some(Box::new(tex.nested(Branch::Back, back)?)),
+        },
+        _ => {
+            return Err(SceneError::at(
+                &e.loc,
+                "<bsdf type=\"twosided\"> needs one or two nested BSDFs",
+            ));
+        }
+    })
 }
 
 fn build_nested(e: &Element, tex: &mut TextureCollector<'_>) -> Result<BsdfParams> {
@@ -264,6 +275,11 @@ fn bitmap(e: &Element, kind: SlotKind, tex: &TextureCollector<'_>) -> Result<Tex
         _ => Wrap::Repeat,
     };
     let raw = props.boolean("raw")?.unwrap_or(false);
+    // How Mitsuba stores the image (its precision: PNG and JPEG hold 8-bit
+    // values, which every format keeps, float16 within 0.05 %) and whether
+    // it uses the GPU's texture units: not the light.
+    choice("format", &["auto", "variant", "float16", "fp16", "uint8"])?;
+    props.boolean("accel")?;
     let to_uv = to_uv(&props)?;
     let location = props.loc("filename");
     props.finish()?;
@@ -432,13 +448,10 @@ fn rough_conductor(props: &Props<'_>, textured: bool) -> Result<RoughConductorPa
             ));
         }
     }
+    // Negative values are Mitsuba's too (published data have them): its
+    // Fresnel term sees only their squares (`trilux_color::Role::Unbounded`).
     let eta = props.color("eta")?;
     let k = props.color("k")?;
-    for (c, name) in [(&eta, "eta"), (&k, "k")] {
-        if let Some(c) = c {
-            check_color(c, &props.loc(name), name, None)?;
-        }
-    }
     let eta_k = match (eta, k) {
         (None, None) => None,
         // Mitsuba's defaults for a conductor given by eta/k: eta 0, k 1.

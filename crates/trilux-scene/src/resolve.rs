@@ -1,13 +1,14 @@
 //! Stage 3 of loading: resolve `<ref id>` against the objects that carry an
-//! `id` (top-level `<bsdf id>`, `<texture id>` and `<emitter id>` in
-//! practice), and count
-//! `<bsdf>` elements.
+//! `id` (every object type trilux reads: `<bsdf>`, `<texture>`,
+//! `<emitter>`, and a sensor's `<film>`, `<sampler>` and a film's
+//! `<rfilter>`), and count `<bsdf>` elements.
 //!
 //! After this pass the tree has no `<ref>` left: each reference is replaced
 //! by a copy of the element it names (BSDF parameters are plain data, and
 //! the texture cache reads an image once however many copies name it, so a
-//! copy is as good as sharing). BSDFs, textures and emitters can be
-//! referenced (an emitter from one shape only, as in Mitsuba);
+//! copy is as good as sharing). BSDFs, textures, emitters, films, samplers
+//! and filters can be referenced (an emitter from one shape only, as in
+//! Mitsuba);
 //! a texture's copy takes the `name` of its `<ref>` (the parameter it
 //! gives, as in Mitsuba).
 //!
@@ -220,11 +221,14 @@ fn target<'a>(
     let (name, target) = ids.get_key_value(&id.value).ok_or_else(|| {
         SceneError::at(&id.loc, format!("reference to unknown id \"{}\"", id.value))
     })?;
-    if !matches!(target.tag.as_str(), "bsdf" | "texture" | "emitter") {
+    if !matches!(
+        target.tag.as_str(),
+        "bsdf" | "texture" | "emitter" | "film" | "sampler" | "rfilter"
+    ) {
         return Err(SceneError::at(
             &id.loc,
             format!(
-                "\"{}\" names a {}; only <bsdf>, <texture> and <emitter> elements can be referenced",
+                "\"{}\" names a {}; only <bsdf>, <texture>, <emitter>, <film>, <sampler> and <rfilter> elements can be referenced (trilux reads no shape groups)",
                 id.value,
                 target.describe()
             ),

@@ -166,12 +166,22 @@ pub(crate) fn build_shape(
         .map(|t| t.matrix)
         .unwrap_or_default();
     let flip_normals = props.boolean("flip_normals")?.unwrap_or(false);
+    // How often Mitsuba's differentiable renderers sample the silhouette:
+    // not the light.
+    props.float("silhouette_sampling_weight")?;
     let l = check_to_world(props, &to_world)?;
     let mut request = None;
     let plugin = e.plugin_type()?;
     let kind = match plugin {
-        "rectangle" => ShapeKind::Rectangle,
-        "cube" => ShapeKind::Cube,
+        // Mitsuba's rectangle and cube are meshes with a normal per face
+        // already: `face_normals` changes nothing.
+        "rectangle" | "cube" => {
+            props.boolean("face_normals")?;
+            match plugin {
+                "rectangle" => ShapeKind::Rectangle,
+                _ => ShapeKind::Cube,
+            }
+        }
         "disk" => ShapeKind::Disk,
         "sphere" => sphere(props, &l)?,
         "cylinder" => cylinder(props, &l)?,
