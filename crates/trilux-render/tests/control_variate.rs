@@ -41,8 +41,7 @@ fn furnace_mean(reflected: f64, estimator: Estimator, lookups: u32) -> f64 {
         ..Default::default()
     };
     let (img, stats) =
-        render_image::<_, 3>(&scene, &furnace_camera(48, 32), &settings, rgb3, |_, _| {})
-            .unwrap();
+        render_image::<_, 3>(&scene, &furnace_camera(48, 32), &settings, rgb3, |_, _| {}).unwrap();
     assert_eq!(stats.gather.dropped, 0);
     img.mean()[0]
 }
