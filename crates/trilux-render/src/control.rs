@@ -37,8 +37,10 @@ use crate::scene::GatherScene;
 /// The most lookup rays per camera sample (their sample dimensions).
 pub const MAX_LOOKUPS: u32 = 32;
 
-/// Lookup rays per camera sample by default (docs/results.md, "The control
-/// variate": the best of 1, 2, 4, 8 at equal time on the Cornell box).
+/// Lookup rays per camera sample by default. Not the best at equal time:
+/// on the Cornell box and paper-scene1, M = 1 (the plain path tracer) was
+/// (docs/results.md, "The control variate"); 4 shows the control's effect
+/// per sample.
 pub const DEFAULT_LOOKUPS: u32 = 4;
 
 /// Path vertices (from the camera hit, which is vertex 1) before Russian
@@ -173,7 +175,7 @@ impl<S> ControlVariate<'_, S> {
                 if q.is_nan() || q <= 0.0 || sampler.get1(base + 5) >= q {
                     break;
                 }
-                beta = beta * (1.0 / q);
+                beta *= 1.0 / q;
             }
             let (pick, u) = (sampler.get1(base), sampler.get2(base + 1));
             let fr = |wi| scene.bsdf_cos(&x, wi, wo);
@@ -181,7 +183,7 @@ impl<S> ControlVariate<'_, S> {
             let Some((bs, xn)) = self.gather_ray(&x, wo, sampler.get2(base + 3), stats) else {
                 break;
             };
-            beta = beta * bs.weight;
+            beta *= bs.weight;
             let back = -bs.wi;
             if let Some(le) = hit_emission(scene, &xn, back, bs.pdf, beta) {
                 l += le;
