@@ -170,7 +170,8 @@ pub fn estimator(name: &str) -> Result<Estimator> {
         "links" => Estimator::Links,
         "paths" => Estimator::Paths,
         "preview" => Estimator::Preview,
-        other => bail!("unknown estimator {other} (links, paths, preview)"),
+        "control" => Estimator::Control,
+        other => bail!("unknown estimator {other} (links, paths, preview, control)"),
     })
 }
 

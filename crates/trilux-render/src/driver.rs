@@ -15,6 +15,7 @@ use trilux_color::Spectrum;
 
 use crate::adaptive::{PILOT_SPP, Pilot, allot};
 use crate::camera::Camera;
+use crate::control::{ControlVariate, DEFAULT_LOOKUPS, MAX_LOOKUPS};
 use crate::error::RenderError;
 use crate::film::Film;
 use crate::filter::ReconstructionFilter;
@@ -43,6 +44,10 @@ pub enum Estimator {
     /// No random rays: the links with their own visibility, one mirror
     /// reading for glossy parts (`link_gather::Preview`).
     Preview,
+    /// The solution as a control variate: its lookups along
+    /// [`RenderSettings::lookups`] gather rays plus a path-traced residual;
+    /// unbiased whatever the solution's error (`control`).
+    Control,
 }
 
 /// How to render.
@@ -67,6 +72,9 @@ pub struct RenderSettings {
     pub target_error: Option<f64>,
     /// Tile edge in pixels.
     pub tile_size: u32,
+    /// Lookup rays per camera sample of the control variate
+    /// ([`Estimator::Control`], `--lookups`).
+    pub lookups: u32,
 }
 
 /// Samples every pixel takes under adaptive sampling: its pilot's, which
@@ -83,6 +91,7 @@ impl Default for RenderSettings {
             extra_bounce: ExtraBounce::default(),
             target_error: None,
             tile_size: 16,
+            lookups: DEFAULT_LOOKUPS,
         }
     }
 }
@@ -104,6 +113,12 @@ impl RenderSettings {
             return Err(RenderError::Settings(format!(
                 "samples per pixel {} must lie in 1..={MAX_SAMPLES}",
                 self.spp
+            )));
+        }
+        if self.lookups == 0 || self.lookups > MAX_LOOKUPS {
+            return Err(RenderError::Settings(format!(
+                "lookups per sample {} must lie in 1..={MAX_LOOKUPS}",
+                self.lookups
             )));
         }
         if self.tile_size == 0 {
@@ -133,9 +148,10 @@ impl RenderSettings {
     }
 }
 
-/// The three estimators over one scene, chosen by the settings.
+/// The four estimators over one scene, chosen by the settings.
 struct Estimators<'a, S> {
     estimator: Estimator,
+    control: ControlVariate<'a, S>,
     paths: FinalGather<'a, S>,
     links: LinkGather<'a, S>,
     preview: Preview<'a, S>,
@@ -152,6 +168,10 @@ impl<'a, S> Estimators<'a, S> {
         };
         Estimators {
             estimator: settings.estimator,
+            control: ControlVariate {
+                scene,
+                lookups: settings.lookups,
+            },
             paths: paths(),
             links: LinkGather {
                 scene,
@@ -180,6 +200,7 @@ impl<'a, S> Estimators<'a, S> {
             Estimator::Links => self.links.camera_sample::<N>(o, d, sampler, caches, stats),
             Estimator::Paths => self.paths.camera_sample::<N>(o, d, sampler, stats),
             Estimator::Preview => self.preview.camera_sample::<N>(o, d, caches, stats),
+            Estimator::Control => self.control.camera_sample::<N>(o, d, sampler, stats),
         }
     }
 }

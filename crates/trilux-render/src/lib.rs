@@ -33,6 +33,8 @@
 //! - [`gather`]: the path gather of paper §4.5 (the default estimator).
 //! - [`link_gather`]: rendering from the solution's gather links, and the
 //!   noise-free preview.
+//! - [`control`]: the solution as a control variate (lookups plus a
+//!   path-traced residual): unbiased whatever the solution's error.
 //! - [`solved`]: [`GatherScene`] and [`SolutionGather`] for trilux's
 //!   geometry, BRDFs and a solution ([`SolvedScene`]).
 //! - [`filter`]: reconstruction filters (Mitsuba's Gaussian, box, ...).
@@ -52,6 +54,7 @@ mod adaptive;
 pub mod analytic;
 pub mod camera;
 pub mod compare;
+pub mod control;
 pub mod driver;
 pub mod error;
 pub mod film;

@@ -32,6 +32,16 @@ pub mod dims {
     pub const DEEP_GATHER: u32 = 256;
     /// First dimension of the shadow rays of partly visible gather links.
     pub const LINKS: u32 = GLOSSY_SENDERS + 6;
+    /// The control variate's lookup rays 1.. (2 dimensions each, up to
+    /// `control::MAX_LOOKUPS`; lookup 0 uses the first gather level's).
+    pub const CONTROL_LOOKUPS: u32 = 32;
+    /// The control variate's residual path: vertex v ≥ 2 uses
+    /// [`PER_PATH_VERTEX`] dimensions from PATH + (v − 2) · PER_PATH_VERTEX
+    /// (past the table's 256 they are folded into the scramble).
+    pub const PATH: u32 = 96;
+    /// Dimensions one path vertex uses: light pick (1), point on the light
+    /// (2), BSDF direction (2), Russian roulette (1).
+    pub const PER_PATH_VERTEX: u32 = 6;
 }
 
 /// Largest number of samples per pixel the sequence supports (the limit

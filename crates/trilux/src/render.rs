@@ -38,6 +38,10 @@ pub enum GatherArg {
     /// The solution's gather links re-evaluated at every pixel for
     /// Lambertian parts, sampled rays for glossy parts (docs/rendering.md).
     Links,
+    /// The solution as a control variate: --lookups solution lookups at
+    /// the first hit plus a path-traced residual; unbiased whatever the
+    /// solution's error (docs/rendering.md).
+    Control,
 }
 
 /// Arguments of `trilux render`.
@@ -110,6 +114,11 @@ pub struct RenderArgs {
     /// solution (--gather paths).
     #[arg(long, value_enum, default_value = "always")]
     pub extra_bounce: ExtraBounceArg,
+    /// Solution lookups per camera sample of the control variate
+    /// (--gather control), 1 to 32; 1 is a plain path tracer.
+    #[arg(long, default_value_t = trilux_render::control::DEFAULT_LOOKUPS,
+          value_parser = clap::value_parser!(u32).range(1..=i64::from(trilux_render::control::MAX_LOOKUPS)))]
+    pub lookups: u32,
     #[command(flatten)]
     pub options: SolveOptions,
 }
@@ -176,7 +185,9 @@ impl RenderArgs {
             (true, _) => Estimator::Preview,
             (false, GatherArg::Links) => Estimator::Links,
             (false, GatherArg::Paths) => Estimator::Paths,
+            (false, GatherArg::Control) => Estimator::Control,
         };
+        settings.lookups = self.lookups;
         settings.target_error = self.target_error;
         settings.extra_bounce = match self.extra_bounce {
             ExtraBounceArg::Always => ExtraBounce::Always,

@@ -55,6 +55,7 @@ fn render(scene: &trilux_scene::Scene, plan: &RenderPlan) -> Result<Value> {
         Estimator::Paths => "paths",
         Estimator::Links => "links",
         Estimator::Preview => "preview",
+        Estimator::Control => "control",
         // A kind added later: its Debug name until it is named here.
         other => &format!("{other:?}"),
     };
@@ -76,6 +77,7 @@ fn render(scene: &trilux_scene::Scene, plan: &RenderPlan) -> Result<Value> {
         "extra_bounce": extra_bounce,
         "target_error": s.target_error,
         "tile_size": s.tile_size,
+        "lookups": s.lookups,
         "scene_camera": serde_json::to_value(&scene.camera)?,
         "view": { "lookat": lookat, "fov": v.fov, "width": v.width, "height": v.height },
     }))

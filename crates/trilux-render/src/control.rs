@@ -1,0 +1,195 @@
+//! The solution as a control variate: an unbiased estimator whatever the
+//! solution's error (Szirmay-Kalos, Csonka & Antal 2001; docs/rendering.md,
+//! "The control variate").
+//!
+//! A camera ray meets the scene at x_s. With ω sampled from the BSDF
+//! (density p), x_d(ω) the first hit along ω and w(ω) = fr·cos/p, the
+//! reflected radiance towards the eye is
+//!
+//! L_r(x_s) = L_direct + E_ω[w L_r(x_d → x_s)]
+//!          = L_direct + E_ω[w L̃(x_d → x_s)] + E_ω[w (L_r − L̃)(x_d → x_s)],
+//!
+//! L̃ the solution's reflected radiance at the gather hit (exactly
+//! `GatherScene::reflected`, a pure function of the two points). Each
+//! camera sample estimates
+//!
+//! - L_direct by one light sample and the BSDF ray's emission, MIS-combined;
+//! - the **control** E[w L̃] by M BSDF-sampled *lookup* rays ω_0..ω_{M−1},
+//!   each a ray and one solution lookup, averaged;
+//! - the **residual** E[w (L_r − L̃)] along ω_0 alone: a path traced from
+//!   x_d(ω_0) (light sampling, MIS, Russian roulette) less L̃ there.
+//!
+//! The control and the subtracted term are the same function of ω under the
+//! same density, so their expectations are equal and the sum's expectation
+//! is the true L_r: a solution scaled by 0.5 (or zero) changes the
+//! variance, never the mean. With M = 1 the estimator is the path tracer;
+//! each further lookup costs one ray and replaces the first bounce's
+//! directional noise by the solution's, 1/M of it.
+
+use glam::{DVec2, DVec3};
+use trilux_color::Spectrum;
+
+use crate::mis::{hit_emission, light_sample};
+use crate::records::{BsdfSample, GatherStats, SurfacePoint};
+use crate::sampler::{PixelSampler, dims};
+use crate::scene::GatherScene;
+
+/// The most lookup rays per camera sample (their sample dimensions).
+pub const MAX_LOOKUPS: u32 = 32;
+
+/// Lookup rays per camera sample by default. Not the best at equal time:
+/// on the Cornell box and paper-scene1, M = 1 (the plain path tracer) was
+/// (docs/results.md, "The control variate"); 4 shows the control's effect
+/// per sample.
+pub const DEFAULT_LOOKUPS: u32 = 4;
+
+/// Path vertices (from the camera hit, which is vertex 1) before Russian
+/// roulette starts.
+const RR_DEPTH: u32 = 3;
+
+/// Highest survival probability under Russian roulette.
+const RR_MAX: f64 = 0.95;
+
+/// A hard stop on path length: reached with probability below 0.95^250
+/// (about 3e-6) under Russian roulette, so its bias is far below any
+/// reference's noise; it guards against a cycle of lossless bounces.
+const MAX_VERTICES: u32 = 256;
+
+/// The control-variate estimator (module docs).
+pub struct ControlVariate<'a, S> {
+    /// The scene and its solution.
+    pub scene: &'a S,
+    /// M, the lookup rays per camera sample (1..=[`MAX_LOOKUPS`]).
+    pub lookups: u32,
+}
+
+impl<S> ControlVariate<'_, S> {
+    /// Radiance arriving at the eye along a camera ray (one sample).
+    pub fn camera_sample<const N: usize>(
+        &self,
+        origin: DVec3,
+        dir: DVec3,
+        sampler: &PixelSampler,
+        stats: &mut GatherStats,
+    ) -> Spectrum<N>
+    where
+        S: GatherScene<N>,
+    {
+        stats.camera_rays += 1;
+        let Some(xs) = self.scene.intersect(origin, dir) else {
+            return Spectrum::zero();
+        };
+        let wo = -dir;
+        let l = self.scene.emitted(&xs, wo) + self.reflected(&xs, wo, sampler, stats);
+        if l.is_finite() {
+            l
+        } else {
+            stats.dropped += 1;
+            Spectrum::zero()
+        }
+    }
+
+    /// Reflected radiance leaving the camera hit `xs` towards `wo`: direct
+    /// light, the control's lookups and the residual path (module docs).
+    fn reflected<const N: usize>(
+        &self,
+        xs: &SurfacePoint<S::Locator>,
+        wo: DVec3,
+        sampler: &PixelSampler,
+        stats: &mut GatherStats,
+    ) -> Spectrum<N>
+    where
+        S: GatherScene<N>,
+    {
+        let scene = self.scene;
+        let base = dims::GATHER;
+        let (pick, u) = (sampler.get1(base), sampler.get2(base + 1));
+        let fr = |wi| scene.bsdf_cos(xs, wi, wo);
+        let mut l = light_sample(scene, xs, wo, pick, u, fr, true, stats);
+        let m = self.lookups.clamp(1, MAX_LOOKUPS);
+        // Lookups 1..M: the control's other terms, w L̃ each.
+        let mut control = Spectrum::zero();
+        for j in 1..m {
+            let u = sampler.get2(dims::CONTROL_LOOKUPS + 2 * (j - 1));
+            if let Some((bs, xd)) = self.gather_ray(xs, wo, u, stats) {
+                control += bs.weight * scene.reflected(&xd, xs);
+            }
+        }
+        // Lookup 0, shared with the residual: w L̃ (1/M of the control)
+        // less w L̃ (the residual's subtracted term), plus w L_r by a path.
+        let Some((bs, xd)) = self.gather_ray(xs, wo, sampler.get2(base + 3), stats) else {
+            return l + control * (1.0 / f64::from(m));
+        };
+        let back = -bs.wi;
+        if let Some(le) = hit_emission(scene, &xd, back, bs.pdf, bs.weight) {
+            l += le;
+        }
+        let own = scene.reflected(&xd, xs);
+        let path = self.path(xd, back, bs.weight, sampler, stats);
+        let lookups = (control + bs.weight * own) * (1.0 / f64::from(m));
+        l + lookups + path - bs.weight * own
+    }
+
+    /// A direction sampled from the BSDF at `x` with `u` and the hit it
+    /// leads to; `None` when the sample or the ray yields nothing.
+    fn gather_ray<const N: usize>(
+        &self,
+        x: &SurfacePoint<S::Locator>,
+        wo: DVec3,
+        u: DVec2,
+        stats: &mut GatherStats,
+    ) -> Option<(BsdfSample<N>, SurfacePoint<S::Locator>)>
+    where
+        S: GatherScene<N>,
+    {
+        let bs = self.scene.sample_bsdf(x, wo, u)?;
+        if bs.pdf.is_nan() || bs.pdf <= 0.0 || bs.weight.is_black() {
+            return None;
+        }
+        stats.gather_rays += 1;
+        let xd = self.scene.intersect(x.point, bs.wi)?;
+        Some((bs, xd))
+    }
+
+    /// β times the reflected radiance leaving `x` (vertex 2 of the path)
+    /// towards `wo`, path-traced: at each vertex a light sample and a BSDF
+    /// ray whose emission is MIS-weighted, Russian roulette from vertex
+    /// [`RR_DEPTH`] on.
+    fn path<const N: usize>(
+        &self,
+        mut x: SurfacePoint<S::Locator>,
+        mut wo: DVec3,
+        mut beta: Spectrum<N>,
+        sampler: &PixelSampler,
+        stats: &mut GatherStats,
+    ) -> Spectrum<N>
+    where
+        S: GatherScene<N>,
+    {
+        let scene = self.scene;
+        let mut l = Spectrum::zero();
+        for vertex in 2..MAX_VERTICES {
+            let base = dims::PATH + (vertex - 2) * dims::PER_PATH_VERTEX;
+            if vertex >= RR_DEPTH {
+                let q = beta.max_value().min(RR_MAX);
+                if q.is_nan() || q <= 0.0 || sampler.get1(base + 5) >= q {
+                    break;
+                }
+                beta *= 1.0 / q;
+            }
+            let (pick, u) = (sampler.get1(base), sampler.get2(base + 1));
+            let fr = |wi| scene.bsdf_cos(&x, wi, wo);
+            l += beta * light_sample(scene, &x, wo, pick, u, fr, true, stats);
+            let Some((bs, xn)) = self.gather_ray(&x, wo, sampler.get2(base + 3), stats) else {
+                break;
+            };
+            beta *= bs.weight;
+            let back = -bs.wi;
+            if let Some(le) = hit_emission(scene, &xn, back, bs.pdf, beta) {
+                l += le;
+            }
+            (x, wo) = (xn, back);
+        }
+        l
+    }
+}
