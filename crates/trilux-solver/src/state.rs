@@ -11,7 +11,7 @@ use std::sync::Mutex;
 
 use rayon::prelude::*;
 use trilux_color::Spectrum;
-use trilux_geometry::{ElementId, FaceElement, FaceId, PerFace, Visibility};
+use trilux_geometry::{ElementForest, ElementId, FaceId, PerFace};
 
 use crate::cluster_transport::{FarContext, FarField, FarFields};
 use crate::interaction::Hierarchy;
@@ -19,7 +19,7 @@ use crate::ledger::Ledger;
 use crate::radiosity::ElementRadiance;
 use crate::setup::{Setup, emitted_flux};
 use crate::stats::SolveStats;
-use crate::throughput::{ThroughputCache, compute_throughput};
+use crate::throughput::ThroughputCache;
 
 /// What the shots change (module docs).
 pub(crate) struct ShotState<const N: usize> {
@@ -52,15 +52,7 @@ impl<const N: usize> ShotState<N> {
     pub fn new(setup: &Setup<N>) -> Self {
         let forest = setup.forest();
         let far = far_fields(setup);
-        let vis = setup.visibility();
-        let samples = |pair| {
-            crate::refine::visibility_samples_for(
-                &setup.clusters.partly_cut,
-                pair,
-                setup.settings.visibility_samples,
-            )
-        };
-        let hierarchies = root_interactions(&vis, &setup.root_pairs, samples);
+        let hierarchies = root_interactions(forest, &setup.root_pairs);
         let (field, face_flux) = emission(setup);
         let stats = initial_stats(setup, hierarchies.len());
         let count = forest.element_count();
@@ -102,21 +94,15 @@ fn far_fields<const N: usize>(setup: &Setup<N>) -> FarFields<N> {
 
 /// The root interactions of the setup's root pairs (sender face, receiver
 /// face): one node each, joining the two surfaces' roots, with nothing
-/// gathered yet.
+/// gathered yet and its throughput made when light first arrives at the
+/// sender (`RefineContext::make_root`): O(pairs) here, no shadow rays.
 fn root_interactions<const N: usize>(
-    vis: &Visibility<'_>,
+    forest: &ElementForest,
     roots: &[(FaceId, FaceId)],
-    samples: impl Fn([FaceElement; 2]) -> u32 + Sync,
 ) -> Vec<Hierarchy<N>> {
-    let forest = vis.forest();
-    let root_of = |f: FaceId| f.of(forest.root(f.surface()));
     roots
-        .par_iter()
-        .map(|&(a, b)| {
-            let pair = [root_of(b), root_of(a)];
-            let t = compute_throughput(vis, pair[0], pair[1], samples(pair), false);
-            Hierarchy::new(a, b, root_of(a).element, root_of(b).element, t)
-        })
+        .iter()
+        .map(|&(a, b)| Hierarchy::pending(a, b, forest.root(a.surface()), forest.root(b.surface())))
         .collect()
 }
 
