@@ -213,3 +213,59 @@ fn far_gather_links<const N: usize>(
     }
     out
 }
+
+#[cfg(test)]
+mod tests {
+    use std::collections::BTreeSet;
+    use std::time::Instant;
+
+    use glam::DVec3;
+    use trilux_geometry::FaceId;
+
+    use super::*;
+    use crate::state::ShotState;
+    use crate::test_scenes as ts;
+
+    /// The (receiving face, sending face) pairs the links cover.
+    fn covered(links: &GatherLinks, forest: &trilux_geometry::ElementForest) -> BTreeSet<(u32, u32)> {
+        let face = |e: trilux_geometry::FaceElement| {
+            FaceId::new(forest.element(e.element).surface, e.side).0
+        };
+        links.iter().map(|(e, l)| (face(e), l.sender_face.0)).collect()
+    }
+
+    /// A gather whose budget is already spent links every sender at its
+    /// roots: no sender is refined, yet every (receiver, sender) pair the
+    /// refined gather covers is still covered (the renderer misses no
+    /// light), with one link per pair.
+    #[test]
+    fn a_spent_budget_links_every_sender_at_its_roots() {
+        let shapes = [
+            ts::square(DVec3::new(0.0, 0.0, 1.0), 0.5, true),
+            ts::square(DVec3::ZERO, 2.0, false),
+            ts::square(DVec3::new(0.5, 0.0, 0.5), 0.5, true),
+        ];
+        let setup = ts::setup(
+            &shapes,
+            &[ts::diffuse(0.0), ts::diffuse(0.5), ts::diffuse(0.5)],
+            &[Some(1.0), None, None],
+            ts::settings(4),
+        );
+        let state = ShotState::new(&setup);
+        let cache = ThroughputCache::new(1 << 16);
+        let (full, report) = gather_links(&setup, &state.field, &cache, None);
+        assert_eq!((report.senders, report.coarse_senders), (1, 0));
+        let past = Instant::now();
+        let (coarse, report) = gather_links(&setup, &state.field, &cache, Some(past));
+        assert_eq!((report.senders, report.coarse_senders), (1, 1));
+        let forest = setup.forest();
+        assert!(
+            full.len() > coarse.len(),
+            "the refined gather splits: {} links, coarse {}",
+            full.len(),
+            coarse.len()
+        );
+        assert_eq!(covered(&full, forest), covered(&coarse, forest));
+        assert_eq!(coarse.len(), covered(&coarse, forest).len());
+    }
+}

@@ -144,3 +144,47 @@ fn initial_stats<const N: usize>(setup: &Setup<N>, root_interactions: usize) -> 
         ..SolveStats::default()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use std::sync::Arc;
+
+    use glam::DVec3;
+    use trilux_color::ColorParam;
+
+    use crate::prepared::{PreparedScene, SceneDescription};
+    use crate::solver::Solver;
+    use crate::test_scenes as ts;
+
+    /// Root throughputs are made only for the hierarchies whose sender
+    /// face receives light: none before the first shot, and after a
+    /// converged solve all but the one leaving a glossy plate G that no
+    /// light reaches (G and a diffuse plate D face each other under the
+    /// lit glossy floor R, which hides them from the light E).
+    #[test]
+    fn root_throughputs_are_made_only_where_light_arrives() {
+        let shapes = [
+            ts::square(DVec3::new(0.0, 0.0, 2.0), 1.0, true), // E
+            ts::square(DVec3::ZERO, 2.0, false),              // R
+            ts::square(DVec3::new(0.0, 0.0, -5.0), 1.0, false), // D
+            ts::square(DVec3::new(0.0, 0.0, -3.0), 1.0, true), // G
+        ];
+        let bsdfs = [ts::diffuse(0.0), ts::glossy(0.3), ts::diffuse(0.5), ts::glossy(0.3)];
+        let emission = [Some(ColorParam::Float(1.0)), None, None, None];
+        let desc = SceneDescription {
+            shapes: &shapes,
+            bsdfs: &bsdfs,
+            emission: &emission,
+        };
+        let scene = Arc::new(PreparedScene::<3>::new(&desc).expect("prepares"));
+        let solver = Solver::new(scene, ts::settings(3)).expect("sets up");
+        let (g, d) = (ts::front(3), ts::front(2));
+        assert!(solver.setup.stored_pairs.contains(&(g, d)), "G stores towards D");
+        assert!(solver.state.hierarchies.iter().flatten().all(|h| h.pending));
+        let solution = solver.solve(|_| {});
+        let stats = solution.stats();
+        assert!(stats.root_interactions >= 2, "{stats:?}");
+        assert_eq!(stats.root_throughputs, stats.root_interactions - 1);
+        assert_eq!(solution.interaction_flux(g, d).map(|f| f.sum()), Some(0.0));
+    }
+}
