@@ -248,7 +248,12 @@ mod tests {
             let a = square(DVec3::ZERO, 0.1 + rnd(), 0.0, 0.0);
             let offset = DVec3::new(rnd() - 0.5, rnd() - 0.5, 0.2 + 4.0 * rnd());
             // Facing a (rotated by π about x), tilted by up to ±1 rad.
-            let b = square(offset, 0.1 + rnd(), std::f64::consts::PI + rnd() - 0.5, rnd() - 0.5);
+            let b = square(
+                offset,
+                0.1 + rnd(),
+                std::f64::consts::PI + rnd() - 0.5,
+                rnd() - 0.5,
+            );
             let g = Geometry::build(&[a, b]).expect("geometry");
             let forest = ElementForest::new(std::sync::Arc::new(g));
             let g = forest.geometry();
@@ -257,7 +262,8 @@ mod tests {
             let fb = FaceElement::new(rb, Side::Front);
             let (area_a, area_b) = (forest.element(ra).area, forest.element(rb).area);
             let t = area_a * form_factor(&forest, fa, fb, &opts).value;
-            let bound = ClusterTree::build(g).throughput_bound(SurfaceId(0), area_a, SurfaceId(1), area_b);
+            let bound =
+                ClusterTree::build(g).throughput_bound(SurfaceId(0), area_a, SurfaceId(1), area_b);
             assert!(t <= bound * (1.0 + 1e-3), "T {t} above its bound {bound}");
             tight = tight.max(t / bound);
         }

@@ -60,21 +60,27 @@ pub(crate) fn gather_links<const N: usize>(
 ) -> (GatherLinks, GatherReport) {
     let ctx = setup.refine_context(cache);
     let forest = setup.forest();
-    let mut faces: Vec<(FaceId, &TransportFace<N>, f64)> = setup
+    let mut faces: Vec<(usize, FaceId, &TransportFace<N>, f64)> = setup
         .faces
         .iter()
         .filter(|(_, f)| !(f.rho_d.is_black() && f.emission.is_black()))
         .filter(|&(face, f)| !sent(setup, field, face, f).is_black())
-        .map(|(face, f)| (face, f, PI * sent(setup, field, face, f).sum() * area(setup, face)))
+        .enumerate()
+        .map(|(k, (face, f))| {
+            let flux = PI * sent(setup, field, face, f).sum() * area(setup, face);
+            (k, face, f, flux)
+        })
         .collect();
     // The brightest senders first: if the budget runs out, what is left
     // coarse carries the least light.
-    faces.sort_by(|a, b| b.2.total_cmp(&a.2));
+    faces.sort_by(|a, b| b.3.total_cmp(&a.3));
     let mut report = GatherReport {
         senders: faces.len(),
         ..GatherReport::default()
     };
-    let mut pairs: Vec<(u64, GatherLink)> = Vec::new();
+    // Per sender in face order, so that the links' order (and the saved
+    // solution) does not depend on the senders' brightness order.
+    let mut by_sender: Vec<Vec<(u64, GatherLink)>> = vec![Vec::new(); faces.len()];
     for batch in faces.chunks(BATCH) {
         let depth = if deadline.is_some_and(|d| Instant::now() >= d) {
             report.coarse_senders += batch.len();
@@ -82,9 +88,9 @@ pub(crate) fn gather_links<const N: usize>(
         } else {
             Depth::Refined
         };
-        let made: Vec<(Vec<(u64, GatherLink)>, u64)> = batch
+        let made: Vec<(usize, Vec<(u64, GatherLink)>, u64)> = batch
             .par_iter()
-            .map(|&(face, f, _)| {
+            .map(|&(k, face, f, _)| {
                 let sender = Sender::Radiosity {
                     field,
                     side: face.side(),
@@ -94,15 +100,19 @@ pub(crate) fn gather_links<const N: usize>(
                 let partners = &setup.partners[face];
                 let (mut out, bounded) = links(&ctx, &sender, (face, partners), depth);
                 out.extend(far_gather_links(&ctx, field, face, f));
-                (out, bounded)
+                (k, out, bounded)
             })
             .collect();
-        for (out, bounded) in made {
-            pairs.extend(out);
+        for (k, out, bounded) in made {
+            by_sender[k] = out;
             report.bounded_pairs += bounded;
         }
     }
-    (GatherLinks::from_pairs(forest.element_count(), pairs), report)
+    let pairs: Vec<(u64, GatherLink)> = by_sender.into_iter().flatten().collect();
+    (
+        GatherLinks::from_pairs(forest.element_count(), pairs),
+        report,
+    )
 }
 
 /// The radiance L + Le a face sends (its root's average).
@@ -227,11 +237,17 @@ mod tests {
     use crate::test_scenes as ts;
 
     /// The (receiving face, sending face) pairs the links cover.
-    fn covered(links: &GatherLinks, forest: &trilux_geometry::ElementForest) -> BTreeSet<(u32, u32)> {
+    fn covered(
+        links: &GatherLinks,
+        forest: &trilux_geometry::ElementForest,
+    ) -> BTreeSet<(u32, u32)> {
         let face = |e: trilux_geometry::FaceElement| {
             FaceId::new(forest.element(e.element).surface, e.side).0
         };
-        links.iter().map(|(e, l)| (face(e), l.sender_face.0)).collect()
+        links
+            .iter()
+            .map(|(e, l)| (face(e), l.sender_face.0))
+            .collect()
     }
 
     /// A gather whose budget is already spent links every sender at its

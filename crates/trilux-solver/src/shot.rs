@@ -403,7 +403,10 @@ fn stage_two<const N: usize>(
     let memo = IncidenceMemo::new();
     // The hierarchy sending this shot is out of its slot (unless it is a
     // face's interaction with itself, which receives).
-    let ranges: Vec<Range<usize>> = groups_of_face.keys().map(|&f| stored_from[f].clone()).collect();
+    let ranges: Vec<Range<usize>> = groups_of_face
+        .keys()
+        .map(|&f| stored_from[f].clone())
+        .collect();
     let tasks: Vec<(usize, &mut Hierarchy<N>)> = receiving(hierarchies, ranges)
         .into_iter()
         .flat_map(|(start, part)| {

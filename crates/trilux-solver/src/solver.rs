@@ -358,7 +358,12 @@ impl<const N: usize> Solver<N> {
         state.stats.gather_senders = report.senders;
         state.stats.gather_coarse_senders = report.coarse_senders;
         state.stats.gather_bounded_pairs = report.bounded_pairs;
-        state.stats.root_throughputs = state.hierarchies.iter().flatten().filter(|h| !h.pending).count();
+        state.stats.root_throughputs = state
+            .hierarchies
+            .iter()
+            .flatten()
+            .filter(|h| !h.pending)
+            .count();
         let gather_bytes = links.bytes() as u64;
         let bytes = self.arena_bytes(0) + gather_bytes;
         self.state.stats.peak_memory_bytes = self.state.stats.peak_memory_bytes.max(bytes);

@@ -169,7 +169,12 @@ mod tests {
             ts::square(DVec3::new(0.0, 0.0, -5.0), 1.0, false), // D
             ts::square(DVec3::new(0.0, 0.0, -3.0), 1.0, true), // G
         ];
-        let bsdfs = [ts::diffuse(0.0), ts::glossy(0.3), ts::diffuse(0.5), ts::glossy(0.3)];
+        let bsdfs = [
+            ts::diffuse(0.0),
+            ts::glossy(0.3),
+            ts::diffuse(0.5),
+            ts::glossy(0.3),
+        ];
         let emission = [Some(ColorParam::Float(1.0)), None, None, None];
         let desc = SceneDescription {
             shapes: &shapes,
@@ -179,7 +184,10 @@ mod tests {
         let scene = Arc::new(PreparedScene::<3>::new(&desc).expect("prepares"));
         let solver = Solver::new(scene, ts::settings(3)).expect("sets up");
         let (g, d) = (ts::front(3), ts::front(2));
-        assert!(solver.setup.stored_pairs.contains(&(g, d)), "G stores towards D");
+        assert!(
+            solver.setup.stored_pairs.contains(&(g, d)),
+            "G stores towards D"
+        );
         assert!(solver.state.hierarchies.iter().flatten().all(|h| h.pending));
         let solution = solver.solve(|_| {});
         let stats = solution.stats();
