@@ -40,6 +40,10 @@ pub(crate) struct GatherReport {
     pub bounded_pairs: u64,
 }
 
+/// One sender's links: its place in face order, its links keyed by
+/// receiver, and how many of its pairs were linked by their bound.
+type SenderLinks = (usize, Vec<(u64, GatherLink)>, u64);
+
 /// How one sender is gathered.
 #[derive(Clone, Copy, PartialEq, Eq)]
 enum Depth {
@@ -88,7 +92,7 @@ pub(crate) fn gather_links<const N: usize>(
         } else {
             Depth::Refined
         };
-        let made: Vec<(usize, Vec<(u64, GatherLink)>, u64)> = batch
+        let made: Vec<SenderLinks> = batch
             .par_iter()
             .map(|&(k, face, f, _)| {
                 let sender = Sender::Radiosity {
