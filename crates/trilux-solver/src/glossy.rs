@@ -190,12 +190,9 @@ impl<const N: usize> Solver<N> {
         }
         let vis = self.setup.visibility();
         let mut t = 0.0;
-        for h in self
-            .state
-            .hierarchies
+        for h in self.state.hierarchies[self.setup.stored_from[face].clone()]
             .iter()
             .flatten()
-            .filter(|h| h.from == face)
         {
             let k = h.to.of(h.nodes[0].to);
             t += compute_throughput(

@@ -76,6 +76,13 @@ pub(crate) struct Hierarchy<const N: usize> {
     /// Unshot flux of the whole hierarchy (the selection key δΦ, kept current
     /// as energy arrives: paper Eq. 6 in its exact flux form).
     pub unshot_flux: Spectrum<N>,
+    /// True while the root's throughput is not made yet: it is made when
+    /// light first arrives at the sender face (`RefineContext::nodes_for`),
+    /// so that setup traces no shadow rays for root pairs that never carry
+    /// light (docs/solver.md, "Lazy root throughputs"). A pending root
+    /// has T = 0 and radiance 0. Not saved: a saved root is made or dark.
+    #[serde(skip)]
+    pub pending: bool,
 }
 
 impl<const N: usize> Hierarchy<N> {
@@ -97,7 +104,24 @@ impl<const N: usize> Hierarchy<N> {
                 gathered: Spectrum::zero(),
             }],
             unshot_flux: Spectrum::zero(),
+            pending: false,
         }
+    }
+
+    /// A hierarchy whose root throughput is made later
+    /// ([`Hierarchy::make_root`]).
+    pub fn pending(from: FaceId, to: FaceId, i: ElementId, j: ElementId) -> Self {
+        let mut h = Hierarchy::new(from, to, i, j, Throughput::default());
+        h.pending = true;
+        h
+    }
+
+    /// Gives a pending root its throughput (before any energy reaches it).
+    pub fn make_root(&mut self, t: Throughput) {
+        debug_assert!(self.pending && self.nodes.len() == 1);
+        let root = &mut self.nodes[0];
+        (root.t, root.v, root.spread) = (t.t, t.v, t.spread);
+        self.pending = false;
     }
 
     /// True for a side's interaction with itself (a concave surface lighting

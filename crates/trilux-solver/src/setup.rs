@@ -59,6 +59,10 @@ pub(crate) struct Setup<const N: usize> {
     pub root_pairs: Vec<(FaceId, FaceId)>,
     /// The same pairs, for lookup.
     pub stored_pairs: HashSet<(FaceId, FaceId)>,
+    /// The range of `root_pairs` (and of the hierarchies) whose sender is
+    /// each face: they are contiguous, so a shot and the glossy coverage
+    /// visit a face's hierarchies without scanning all of them.
+    pub stored_from: PerFace<std::ops::Range<usize>>,
     /// Exposed area of every element's faces, per side.
     pub exposed_area: Sided<Vec<f64>>,
     /// `element_points` of every element (refinement reads them often).
@@ -131,8 +135,10 @@ impl<const N: usize> Setup<N> {
         let shading = (0..count)
             .map(|e| forest.shading_moments(ElementId(e)))
             .collect();
+        let stored_from = ranges_by_sender(faces.len(), &root_pairs);
         Ok(Setup {
             stored_pairs: root_pairs.iter().copied().collect(),
+            stored_from,
             root_pairs,
             scene,
             discretisation,
@@ -403,6 +409,22 @@ fn root_pairs<const N: usize>(
         }
     }
     roots
+}
+
+/// The range of `roots` whose sender is each face (`roots` are grouped by
+/// sender, as `root_pairs` makes them).
+fn ranges_by_sender(faces: usize, roots: &[(FaceId, FaceId)]) -> PerFace<std::ops::Range<usize>> {
+    let mut out: Vec<std::ops::Range<usize>> = vec![0..0; faces];
+    let mut start = 0;
+    for k in 1..=roots.len() {
+        if k == roots.len() || roots[k].0 != roots[start].0 {
+            let face = roots[start].0;
+            debug_assert!(out[face.index()].is_empty(), "root pairs grouped by sender");
+            out[face.index()] = start..k;
+            start = k;
+        }
+    }
+    PerFace::from(out)
 }
 
 #[cfg(test)]

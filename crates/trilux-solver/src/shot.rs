@@ -17,10 +17,11 @@
 
 use std::collections::HashMap;
 use std::f64::consts::PI;
+use std::ops::Range;
 
 use rayon::prelude::*;
 use trilux_color::Spectrum;
-use trilux_geometry::{ElementId, FaceId};
+use trilux_geometry::{ElementId, FaceId, PerFace};
 
 use crate::cluster_transport::{FarField, far_links};
 use crate::interaction::Hierarchy;
@@ -172,7 +173,7 @@ impl<const N: usize> Solver<N> {
                 &ctx.refine,
                 &sender,
                 send_face,
-                hierarchies,
+                (hierarchies, ctx.stored_from),
                 &pair_links,
                 &incidences,
             );
@@ -252,6 +253,7 @@ impl<const N: usize> Solver<N> {
         let ctx = ShotContext {
             refine: self.setup.refine_context(&state.cache),
             field: &state.field,
+            stored_from: &self.setup.stored_from,
         };
         (ctx, &mut state.hierarchies)
     }
@@ -336,6 +338,8 @@ impl<const N: usize> Solver<N> {
 pub(crate) struct ShotContext<'a, const N: usize> {
     pub refine: RefineContext<'a, N>,
     pub field: &'a crate::radiosity::ElementRadiance<N>,
+    /// The hierarchies of every sending face (`Setup::stored_from`).
+    pub stored_from: &'a PerFace<Range<usize>>,
 }
 
 /// Each pair link's part of its three-point links, once for all the
@@ -394,7 +398,7 @@ fn stage_two<const N: usize>(
     ctx: &RefineContext<'_, N>,
     sender: &Sender<'_, N>,
     send_face: FaceId,
-    hierarchies: &mut [Option<Hierarchy<N>>],
+    (hierarchies, stored_from): (&mut [Option<Hierarchy<N>>], &PerFace<Range<usize>>),
     pair_links: &[PairLink<N>],
     incidences: &[Option<Incidence<N>>],
 ) -> StageTwo<N> {
@@ -407,11 +411,20 @@ fn stage_two<const N: usize>(
     let memo = IncidenceMemo::new();
     // The hierarchy sending this shot is out of its slot (unless it is a
     // face's interaction with itself, which receives).
-    hierarchies
-        .par_iter_mut()
-        .enumerate()
-        .filter_map(|(h, hier)| hier.as_mut().map(|hier| (h, hier)))
-        .filter(|(_, hier)| groups_of_face.contains_key(&hier.from))
+    let ranges: Vec<Range<usize>> = groups_of_face
+        .keys()
+        .map(|&f| stored_from[f].clone())
+        .collect();
+    let tasks: Vec<(usize, &mut Hierarchy<N>)> = receiving(hierarchies, ranges)
+        .into_iter()
+        .flat_map(|(start, part)| {
+            part.iter_mut()
+                .enumerate()
+                .filter_map(move |(k, hier)| hier.as_mut().map(|hier| (start + k, hier)))
+        })
+        .collect();
+    tasks
+        .into_par_iter()
         .map(|(h, hier)| {
             let from = hier.from;
             let mut task = TripleTask {
@@ -437,6 +450,21 @@ fn stage_two<const N: usize>(
             (task.out, h as u32, task.lost)
         })
         .collect()
+}
+
+/// The disjoint parts of `hierarchies` in `ranges` (with their first
+/// index), so that stage 2 visits only the receiving faces' hierarchies.
+fn receiving<T>(hierarchies: &mut [T], mut ranges: Vec<Range<usize>>) -> Vec<(usize, &mut [T])> {
+    ranges.sort_by_key(|r| r.start);
+    let mut out = Vec::with_capacity(ranges.len());
+    let (mut rest, mut base) = (hierarchies, 0);
+    for r in ranges.into_iter().filter(|r| !r.is_empty()) {
+        let tail = std::mem::take(&mut rest).split_at_mut(r.start - base).1;
+        let (part, tail) = tail.split_at_mut(r.len());
+        out.push((r.start, part));
+        (rest, base) = (tail, r.end);
+    }
+    out
 }
 
 impl<const N: usize> Solver<N> {

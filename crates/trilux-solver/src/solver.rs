@@ -101,6 +101,7 @@ impl<const N: usize> Solver<N> {
         let mut state = ShotState::new(&setup);
         let budget = setup.settings.time_budget_seconds;
         state.stats.time_budget_seconds = budget;
+        state.stats.prepare_seconds = started.elapsed().as_secs_f64();
         Ok(Solver {
             setup,
             state,
@@ -370,7 +371,19 @@ impl<const N: usize> Solver<N> {
                 state.used[n.to.index()] = true;
             }
         }
-        let links = gather_links(setup, &state.field, &state.cache);
+        let gather_start = Instant::now();
+        let deadline = self.time_budget.map(|b| self.started + b);
+        let (links, report) = gather_links(setup, &state.field, &state.cache, deadline);
+        state.stats.gather_seconds = gather_start.elapsed().as_secs_f64();
+        state.stats.gather_senders = report.senders;
+        state.stats.gather_coarse_senders = report.coarse_senders;
+        state.stats.gather_bounded_pairs = report.bounded_pairs;
+        state.stats.root_throughputs = state
+            .hierarchies
+            .iter()
+            .flatten()
+            .filter(|h| !h.pending)
+            .count();
         let gather_bytes = links.bytes() as u64;
         let bytes = self.arena_bytes(0) + gather_bytes;
         self.state.stats.peak_memory_bytes = self.state.stats.peak_memory_bytes.max(bytes);

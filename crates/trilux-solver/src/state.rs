@@ -11,7 +11,7 @@ use std::sync::Mutex;
 
 use rayon::prelude::*;
 use trilux_color::Spectrum;
-use trilux_geometry::{ElementId, FaceElement, FaceId, PerFace, Visibility};
+use trilux_geometry::{ElementForest, ElementId, FaceId, PerFace};
 
 use crate::ambient::Interreflection;
 use crate::cluster_transport::{FarContext, FarField, FarFields};
@@ -20,7 +20,7 @@ use crate::ledger::Ledger;
 use crate::radiosity::ElementRadiance;
 use crate::setup::{Setup, emitted_flux};
 use crate::stats::SolveStats;
-use crate::throughput::{ThroughputCache, compute_throughput};
+use crate::throughput::ThroughputCache;
 
 /// What the shots change (module docs).
 pub(crate) struct ShotState<const N: usize> {
@@ -58,15 +58,7 @@ impl<const N: usize> ShotState<N> {
     pub fn new(setup: &Setup<N>) -> Self {
         let forest = setup.forest();
         let far = far_fields(setup);
-        let vis = setup.visibility();
-        let samples = |pair| {
-            crate::refine::visibility_samples_for(
-                &setup.clusters.partly_cut,
-                pair,
-                setup.settings.visibility_samples,
-            )
-        };
-        let hierarchies = root_interactions(&vis, &setup.root_pairs, samples);
+        let hierarchies = root_interactions(forest, &setup.root_pairs);
         let (field, face_flux) = emission(setup);
         let stats = initial_stats(setup, hierarchies.len());
         let count = forest.element_count();
@@ -111,21 +103,15 @@ fn far_fields<const N: usize>(setup: &Setup<N>) -> FarFields<N> {
 
 /// The root interactions of the setup's root pairs (sender face, receiver
 /// face): one node each, joining the two surfaces' roots, with nothing
-/// gathered yet.
+/// gathered yet and its throughput made when light first arrives at the
+/// sender (`RefineContext::make_root`): O(pairs) here, no shadow rays.
 fn root_interactions<const N: usize>(
-    vis: &Visibility<'_>,
+    forest: &ElementForest,
     roots: &[(FaceId, FaceId)],
-    samples: impl Fn([FaceElement; 2]) -> u32 + Sync,
 ) -> Vec<Hierarchy<N>> {
-    let forest = vis.forest();
-    let root_of = |f: FaceId| f.of(forest.root(f.surface()));
     roots
-        .par_iter()
-        .map(|&(a, b)| {
-            let pair = [root_of(b), root_of(a)];
-            let t = compute_throughput(vis, pair[0], pair[1], samples(pair), false);
-            Hierarchy::new(a, b, root_of(a).element, root_of(b).element, t)
-        })
+        .iter()
+        .map(|&(a, b)| Hierarchy::pending(a, b, forest.root(a.surface()), forest.root(b.surface())))
         .collect()
 }
 
@@ -165,5 +151,57 @@ fn initial_stats<const N: usize>(setup: &Setup<N>, root_interactions: usize) -> 
         wavelengths_nm: (N != 3).then(trilux_color::Bands::<N>::edges),
         warnings: setup.warnings.clone(),
         ..SolveStats::default()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::sync::Arc;
+
+    use glam::DVec3;
+    use trilux_color::ColorParam;
+
+    use crate::prepared::{PreparedScene, SceneDescription};
+    use crate::solver::Solver;
+    use crate::test_scenes as ts;
+
+    /// Root throughputs are made only for the hierarchies whose sender
+    /// face receives light: none before the first shot, and after a
+    /// converged solve all but the one leaving a glossy plate G that no
+    /// light reaches (G and a diffuse plate D face each other under the
+    /// lit glossy floor R, which hides them from the light E).
+    #[test]
+    fn root_throughputs_are_made_only_where_light_arrives() {
+        let shapes = [
+            ts::square(DVec3::new(0.0, 0.0, 2.0), 1.0, true), // E
+            ts::square(DVec3::ZERO, 2.0, false),              // R
+            ts::square(DVec3::new(0.0, 0.0, -5.0), 1.0, false), // D
+            ts::square(DVec3::new(0.0, 0.0, -3.0), 1.0, true), // G
+        ];
+        let bsdfs = [
+            ts::diffuse(0.0),
+            ts::glossy(0.3),
+            ts::diffuse(0.5),
+            ts::glossy(0.3),
+        ];
+        let emission = [Some(ColorParam::Float(1.0)), None, None, None];
+        let desc = SceneDescription {
+            shapes: &shapes,
+            bsdfs: &bsdfs,
+            emission: &emission,
+        };
+        let scene = Arc::new(PreparedScene::<3>::new(&desc).expect("prepares"));
+        let solver = Solver::new(scene, ts::settings(3)).expect("sets up");
+        let (g, d) = (ts::front(3), ts::front(2));
+        assert!(
+            solver.setup.stored_pairs.contains(&(g, d)),
+            "G stores towards D"
+        );
+        assert!(solver.state.hierarchies.iter().flatten().all(|h| h.pending));
+        let solution = solver.solve(|_| {});
+        let stats = solution.stats();
+        assert!(stats.root_interactions >= 2, "{stats:?}");
+        assert_eq!(stats.root_throughputs, stats.root_interactions - 1);
+        assert_eq!(solution.interaction_flux(g, d).map(|f| f.sum()), Some(0.0));
     }
 }

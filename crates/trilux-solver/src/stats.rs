@@ -20,6 +20,11 @@ pub struct SolveStats {
     pub potential_interactions: u64,
     /// Root interactions (pairs of input-surface sides that exchange light).
     pub root_interactions: usize,
+    /// Root interactions whose throughput was made: those whose sender
+    /// face received light (the rest stay dark and trace no rays;
+    /// docs/solver.md, "Lazy root throughputs").
+    #[serde(default)]
+    pub root_throughputs: usize,
     /// Most links alive at once (links live for one shot, paper §4.2).
     pub links_peak: usize,
     /// Links created over the whole solve.
@@ -28,6 +33,26 @@ pub struct SolveStats {
     /// gather's transfers, `gather_links`).
     #[serde(default)]
     pub gather_links: usize,
+    /// Senders the final gather refined (faces that send light).
+    #[serde(default)]
+    pub gather_senders: usize,
+    /// Of those, the senders reached after the time budget was spent:
+    /// linked at their roots, with a few shadow rays per pair, not
+    /// refined (docs/solver.md, "The final gather").
+    #[serde(default)]
+    pub gather_coarse_senders: usize,
+    /// Sender–receiver pairs the gather linked without tracing the root
+    /// pair, because a bound of the flux they can carry was below the
+    /// photometric threshold.
+    #[serde(default)]
+    pub gather_bounded_pairs: u64,
+    /// Seconds spent preparing (before the first shot) and in the final
+    /// gather; `solve_seconds` counts the shots, push-pull and gather.
+    #[serde(default)]
+    pub prepare_seconds: f64,
+    /// See `prepare_seconds`.
+    #[serde(default)]
+    pub gather_seconds: f64,
     /// Shooting iterations.
     pub shots: u64,
     /// CR: the share of all the light the scene's surfaces will reflect

@@ -7,10 +7,11 @@ use std::f64::consts::PI;
 
 use glam::DVec3;
 use trilux_brdf::{AlbedoTable, Bsdf};
-use trilux_geometry::{ElementForest, FaceElement, PerFace, Sided, Visibility};
+use trilux_geometry::{ElementForest, FaceElement, FaceId, PerFace, Sided, Visibility};
 
 use crate::cluster_transport::{Clusters, FarContext};
 use crate::faces::TransportFace;
+use crate::interaction::Hierarchy;
 use crate::settings::SolverSettings;
 use crate::textures::ElementTextures;
 use crate::throughput::{Throughput, ThroughputCache, compute_throughput};
@@ -129,6 +130,46 @@ impl<const N: usize> RefineContext<'_, N> {
         let t = compute_throughput(&self.visibility, a, b, samples, visible);
         self.cache.insert(a, b, t);
         t
+    }
+
+    /// The visible fraction of a pair from the base number of shadow
+    /// rays (not the ×16 of a root pair), or the cached one: for gather
+    /// links whose flux is negligible or whose sender comes after the
+    /// time budget. Not cached, so that refinement never takes it for a
+    /// root pair's T.
+    pub fn cheap_visibility(&self, recv: FaceElement, send: FaceElement) -> f64 {
+        if let Some(t) = self.cache.get(recv, send) {
+            return t.v;
+        }
+        let samples = visibility_samples_for(
+            &self.clusters.partly_cut,
+            [recv, send],
+            self.settings.visibility_samples,
+        );
+        self.visibility.weighted(recv, send, samples)
+    }
+
+    /// Makes the root throughput of a pending hierarchy (light is about to
+    /// arrive at its sender face): the same T the setup used to make for
+    /// every root pair, with the root pair's shadow rays.
+    pub fn make_root(&self, h: &mut Hierarchy<N>) {
+        if !h.pending {
+            return;
+        }
+        let root_of = |f: FaceId| f.of(self.forest.root(f.surface()));
+        let pair = [root_of(h.to), root_of(h.from)];
+        let samples = visibility_samples_for(
+            &self.clusters.partly_cut,
+            pair,
+            self.settings.visibility_samples,
+        );
+        h.make_root(compute_throughput(
+            &self.visibility,
+            pair[0],
+            pair[1],
+            samples,
+            false,
+        ));
     }
 
     /// Both point-to-disc estimates F̂_{a→b} and F̂_{b→a}.

@@ -639,6 +639,7 @@ impl<const N: usize> RefineContext<'_, N> {
         j: ElementId,
         lost: &mut Spectrum<N>,
     ) -> Vec<u32> {
+        self.make_root(h);
         // The chain of elements from the surface's root down to j.
         let mut chain = vec![j];
         let mut cur = j;
@@ -733,6 +734,7 @@ mod tests {
             .position(|h| h.as_ref().is_some_and(|h| (h.from, h.to) == (r, k)))
             .expect("R stores an interaction towards K");
         let mut h = state.hierarchies[h_index].take().unwrap();
+        ctx.make_root(&mut h);
         let sender = Sender::Radiosity {
             field: &state.field,
             side: e.side(),

@@ -431,6 +431,7 @@ fn read_hierarchies<const N: usize>(
             to: FaceId(to),
             nodes,
             unshot_flux: Spectrum::zero(),
+            pending: false,
         });
     }
     Ok(out)
