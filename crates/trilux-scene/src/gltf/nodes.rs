@@ -36,7 +36,7 @@ use super::accessor::{self, Kind};
 use super::buffers::{Buffers, data_uri, relative_path};
 use super::material::{Mapped, TextureUse, map};
 use crate::camera::{Camera, FovAxis, ReconstructionFilter};
-use crate::error::{Result, SceneError, SourceLocation};
+use crate::error::{Errors, Result, SceneError, SourceLocation};
 use crate::limits::{
     MAX_GLTF_NODES, MAX_GLTF_TRIANGLES, MAX_MESH_TRIANGLES, MAX_MESH_VERTICES, MAX_NODE_DEPTH,
     MAX_SHAPES,
@@ -454,19 +454,30 @@ impl GltfMeshes {
     }
 
     /// Reads every placed primitive's mesh into `scene` and returns the
-    /// texture requests of their materials.
-    pub fn finish(self, scene: &mut Scene) -> Result<Vec<(usize, TextureRequest)>> {
+    /// texture requests of their materials; the errors of each mesh and
+    /// image go into `errors` (a failed mesh's textures are not
+    /// requested).
+    pub fn finish(
+        self,
+        scene: &mut Scene,
+        errors: &mut Errors,
+    ) -> Vec<(usize, TextureRequest)> {
         let mut buffers = Buffers::new(
             Arc::clone(&self.file),
             self.blob.clone(),
             self.document.buffers().count(),
         );
+        let mut failed = HashSet::new();
         for placed in &self.placed {
-            let mesh = self.read_mesh(&mut buffers, placed)?;
-            let shape = &mut scene.shapes[placed.shape];
-            shape.shape.kind = ShapeKind::Mesh(mesh);
-            let describe = format!("mesh {} primitive {}", placed.mesh, placed.primitive);
-            check_area(&shape.shape, &shape.location, &describe)?;
+            let read = self.read_mesh(&mut buffers, placed).and_then(|mesh| {
+                let shape = &mut scene.shapes[placed.shape];
+                shape.shape.kind = ShapeKind::Mesh(mesh);
+                let describe = format!("mesh {} primitive {}", placed.mesh, placed.primitive);
+                check_area(&shape.shape, &shape.location, &describe)
+            });
+            if errors.keep(read).is_none() {
+                failed.insert(placed.shape);
+            }
         }
         let folder: PathBuf = self
             .file
@@ -476,10 +487,16 @@ impl GltfMeshes {
         let mut images: HashMap<usize, ImageSource> = HashMap::new();
         let mut out = Vec::with_capacity(self.textures.len());
         for (shape, t) in &self.textures {
+            if failed.contains(shape) {
+                continue;
+            }
             let source = match images.get(&t.image) {
                 Some(s) => s.clone(),
                 None => {
-                    let s = self.image_source(&mut buffers, &folder, t.image)?;
+                    let read = self.image_source(&mut buffers, &folder, t.image);
+                    let Some(s) = errors.keep(read) else {
+                        continue;
+                    };
                     images.insert(t.image, s.clone());
                     s
                 }
@@ -498,7 +515,7 @@ impl GltfMeshes {
                 },
             ));
         }
-        Ok(out)
+        out
     }
 
     fn image_source(
