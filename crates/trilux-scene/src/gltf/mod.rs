@@ -91,7 +91,11 @@ pub(crate) fn open_bytes(
         Ok(built) => built,
         Err(limit) => return Err(errors.stop(limit)),
     };
-    errors.keep(refuse_used(file, &used));
+    // Only after a clean walk: an extension refused where it is used is
+    // not reported a second time at its listing.
+    if errors.is_empty() {
+        errors.keep(refuse_used(file, &used));
+    }
     errors.or(built)
 }
 
