@@ -52,7 +52,9 @@ pub(crate) fn build(resolved: Resolved, path: &Path) -> Result<(Scene, Requests)
             if b.shape_elements == MAX_SHAPES {
                 return Err(errors.stop(SceneError::at(
                     &e.loc,
-                    format!("the scene has more than {MAX_SHAPES} shapes, the limit (docs/limits.md)"),
+                    format!(
+                        "the scene has more than {MAX_SHAPES} shapes, the limit (docs/limits.md)"
+                    ),
                 )));
             }
             b.shape_elements += 1;

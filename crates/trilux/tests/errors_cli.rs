@@ -29,7 +29,10 @@ const FIVE: [(&str, &str); 5] = [
         "<sensor type=\"perspective\">\n    <float name=\"fov\" value=\"200\"/>\n</sensor>",
         "fov must lie strictly between 0 and 180 degrees, found 200",
     ),
-    ("<light type=\"point\"/>", "unsupported element <light> in <scene>"),
+    (
+        "<light type=\"point\"/>",
+        "unsupported element <light> in <scene>",
+    ),
 ];
 
 /// A scene holding `elements`, with a valid lit cube first.
@@ -93,7 +96,11 @@ fn a_file_with_five_independent_errors_reports_all_five() {
     for (k, (needle, (_, problem))) in places.iter().zip(FIVE).enumerate() {
         let (line, col) = line_col(&text, needle);
         let expected = format!("error: {p}:{line}:{col}: {problem}");
-        assert!(lines[k].starts_with(&expected), "{k}: {} vs {expected}", lines[k]);
+        assert!(
+            lines[k].starts_with(&expected),
+            "{k}: {} vs {expected}",
+            lines[k]
+        );
     }
     for (k, element) in elements.iter().enumerate() {
         let alone_text = scene(&[element]);
@@ -146,7 +153,10 @@ fn at_most_twenty_errors_are_reported_and_the_rest_counted() {
     assert_eq!(lines.len(), 21, "{stderr}");
     for (i, line) in lines[..20].iter().enumerate() {
         // The scene's four first lines, then one shape a line.
-        assert!(line.starts_with(&format!("error: {p}:{}:", i + 5)), "{line}");
+        assert!(
+            line.starts_with(&format!("error: {p}:{}:", i + 5)),
+            "{line}"
+        );
         assert!(line.contains(&format!("nosuch{i}\"")), "{line}");
     }
     assert_eq!(
@@ -223,7 +233,7 @@ fn malformed_xml_and_a_missing_include_are_still_one_error() {
 }
 
 /// Three shapes naming missing mesh files: each reported, at its
-/// `filename`.
+/// `filename` parameter.
 #[test]
 fn every_missing_mesh_file_is_reported() {
     let dir = folder("errors-meshes");
@@ -242,7 +252,7 @@ fn every_missing_mesh_file_is_reported() {
     let lines: Vec<&str> = stderr.lines().collect();
     assert_eq!(lines.len(), 3, "{stderr}");
     for (line, f) in lines.iter().zip(["a.obj", "b.ply", "c.obj"]) {
-        let (l, c) = line_col(&text, &format!("{f}\""));
+        let (l, c) = line_col(&text, &format!("<string name=\"filename\" value=\"{f}\""));
         assert!(line.starts_with(&format!("error: {p}:{l}:{c}: ")), "{line}");
         assert!(line.contains(f), "{line}");
     }

@@ -268,7 +268,8 @@ fn several_bad_materials_are_reported_in_one_run() {
             {"extensions": {"KHR_materials_clearcoat": {"clearcoatFactor": 1.0}}},
             {"emissiveFactor": [1.0, 1.0, 1.0], "doubleSided": true}
         ]);
-        j["extensions"] = serde_json::json!({"KHR_lights_punctual": {"lights": [{"type": "point"}]}});
+        j["extensions"] =
+            serde_json::json!({"KHR_lights_punctual": {"lights": [{"type": "point"}]}});
         j["nodes"] = serde_json::json!([
             {"mesh": 0},
             {"mesh": 1, "translation": [2.0, 0.0, 0.0]},
@@ -297,7 +298,10 @@ fn several_bad_materials_are_reported_in_one_run() {
         ("/nodes/4/extensions/KHR_lights_punctual", "point light"),
     ];
     for (line, (pointer, what)) in lines.iter().zip(expected) {
-        assert!(line.starts_with(&format!("error: {p}:{pointer}: ")), "{line}");
+        assert!(
+            line.starts_with(&format!("error: {p}:{pointer}: ")),
+            "{line}"
+        );
         assert!(line.contains(what), "{line}");
     }
 }

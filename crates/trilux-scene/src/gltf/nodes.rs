@@ -496,11 +496,7 @@ impl GltfMeshes {
     /// texture requests of their materials; the errors of each mesh and
     /// image go into `errors` (a failed mesh's textures are not
     /// requested).
-    pub fn finish(
-        self,
-        scene: &mut Scene,
-        errors: &mut Errors,
-    ) -> Vec<(usize, TextureRequest)> {
+    pub fn finish(self, scene: &mut Scene, errors: &mut Errors) -> Vec<(usize, TextureRequest)> {
         let mut buffers = Buffers::new(
             Arc::clone(&self.file),
             self.blob.clone(),
