@@ -3,7 +3,9 @@
 //! Top level: `<shape>`, `<sensor>` (one), `<integrator>` (at most one,
 //! `crate::integrator`), `<bsdf>`, `<texture>`, `<emitter>`, `<film>`,
 //! `<sampler>` and `<rfilter>` definitions (with an `id`, for `<ref>`s).
-//! Anything else is refused with its location.
+//! Anything else is refused with its location. Each top-level element is
+//! built on its own, so that the errors of all of them are reported
+//! together.
 
 use std::path::Path;
 
@@ -26,80 +28,56 @@ use trilux_geometry::ShapeKind;
 
 /// Builds the scene from the resolved tree. `path` is the scene file. OBJ
 /// shapes come with empty meshes and, beside the scene, the requests to
-/// read them (shape index, request).
+/// read them (shape index, request). Each top-level element is built on
+/// its own: the errors of all of them are returned together (with those
+/// `resolved` found), and the shape limit stops at once.
 pub(crate) fn build(resolved: Resolved, path: &Path) -> Result<(Scene, Requests)> {
-    let scene_el = &resolved.scene;
-    scene_el.check_attrs(&["version"])?;
-    let folder = path.parent().unwrap_or(Path::new("."));
-    let mut shapes = Vec::new();
-    let mut requests = Requests::default();
-    let mut camera: Option<(Camera, &Element)> = None;
-    let mut integrator: Option<&Element> = None;
-    let mut max_depth = None;
-    for e in &scene_el.children {
-        match e.tag.as_str() {
-            "shape" => {
-                if shapes.len() == MAX_SHAPES {
-                    return Err(SceneError::at(
-                        &e.loc,
-                        format!(
-                            "the scene has more than {MAX_SHAPES} shapes, the limit (docs/limits.md)"
-                        ),
-                    ));
-                }
-                let (shape, request, textures) = scene_shape(e, folder)?;
-                requests.meshes.extend(request.map(|r| (shapes.len(), r)));
-                requests
-                    .textures
-                    .extend(textures.into_iter().map(|t| (shapes.len(), t)));
-                shapes.push(shape);
-            }
-            "bsdf" => {
-                // A definition: built once here so that errors in unused
-                // definitions are reported too.
-                build_bsdf(e, &mut TextureCollector::new(folder))?;
-            }
-            // A texture definition, checked where a <ref> places it (it
-            // needs the name the <ref> gives it).
-            "texture" if e.attr("id").is_some() => {}
-            "sensor" => {
-                if let Some((_, first)) = &camera {
-                    return Err(SceneError::at(
-                        &e.loc,
-                        format!(
-                            "only one <sensor> is supported (the first is at line {})",
-                            first.loc.line
-                        ),
-                    ));
-                }
-                camera = Some((sensor(e)?, e));
-            }
-            "integrator" => {
-                if let Some(first) = integrator {
-                    return Err(SceneError::at(
-                        &e.loc,
-                        format!(
-                            "only one <integrator> is allowed (the first is at line {})",
-                            first.loc.line
-                        ),
-                    ));
-                }
-                integrator = Some(e);
-                max_depth = crate::integrator::integrator(e)?.max_depth;
-            }
-            "emitter" => top_level_emitter(e)?,
-            "film" | "sampler" | "rfilter" if e.attr("id").is_some() => sensor_definition(e)?,
-            other => {
-                return Err(SceneError::at(
+    let Resolved {
+        scene: scene_el,
+        failed,
+        bsdf_counts,
+        mut errors,
+    } = resolved;
+    errors.keep_at(0, scene_el.check_attrs(&["version"]));
+    let mut b = Builder {
+        folder: path.parent().unwrap_or(Path::new(".")),
+        shapes: Vec::new(),
+        shape_elements: 0,
+        requests: Requests::default(),
+        camera: None,
+        sensor: None,
+        integrator: None,
+        max_depth: None,
+    };
+    for (k, (e, &failed)) in scene_el.children.iter().zip(&failed).enumerate() {
+        if e.tag == "shape" {
+            if b.shape_elements == MAX_SHAPES {
+                return Err(errors.stop(SceneError::at(
                     &e.loc,
                     format!(
-                        "unsupported element <{other}> in <scene> (supported: shape, sensor, integrator, default, include, and bsdf, texture, emitter, film, sampler, rfilter with an id)"
+                        "the scene has more than {MAX_SHAPES} shapes, the limit (docs/limits.md)"
                     ),
-                ));
+                )));
             }
+            b.shape_elements += 1;
+        }
+        if failed {
+            // Its errors are reported; it still counts as the first
+            // <sensor> or <integrator>.
+            b.sensor = b.sensor.or((e.tag == "sensor").then_some(e));
+            b.integrator = b.integrator.or((e.tag == "integrator").then_some(e));
+        } else {
+            errors.keep_at(k + 1, b.top_level(e));
         }
     }
-    let camera = camera.map(|(c, _)| c);
+    let Builder {
+        shapes,
+        requests,
+        camera,
+        integrator,
+        max_depth,
+        ..
+    } = b;
     let spectral = shapes.iter().any(|s| {
         bsdf_is_sampled(&s.bsdf)
             || s.emitter
@@ -112,7 +90,7 @@ pub(crate) fn build(resolved: Resolved, path: &Path) -> Result<(Scene, Requests)
         camera,
         max_depth,
         spectral,
-        bsdf_counts: resolved.bsdf_counts,
+        bsdf_counts,
         camera_names: Vec::new(),
         warnings: integrator
             .zip(max_depth.filter(|d| *d >= 0))
@@ -120,7 +98,83 @@ pub(crate) fn build(resolved: Resolved, path: &Path) -> Result<(Scene, Requests)
             .into_iter()
             .collect(),
     };
-    Ok((scene, requests))
+    errors.or((scene, requests))
+}
+
+/// What [`build`] has built so far.
+struct Builder<'a> {
+    /// The scene file's folder (relative file names start there).
+    folder: &'a Path,
+    shapes: Vec<SceneShape>,
+    /// `<shape>` elements met, built or not (the limit counts them).
+    shape_elements: usize,
+    requests: Requests,
+    camera: Option<Camera>,
+    /// The first `<sensor>` and `<integrator>`, built or not.
+    sensor: Option<&'a Element>,
+    integrator: Option<&'a Element>,
+    max_depth: Option<i64>,
+}
+
+impl<'a> Builder<'a> {
+    /// Builds top-level element `e` into the scene.
+    fn top_level(&mut self, e: &'a Element) -> Result<()> {
+        match e.tag.as_str() {
+            "shape" => {
+                let (shape, request, textures) = scene_shape(e, self.folder)?;
+                let index = self.shapes.len();
+                self.requests.meshes.extend(request.map(|r| (index, r)));
+                let textures = textures.into_iter().map(|t| (index, t));
+                self.requests.textures.extend(textures);
+                self.shapes.push(shape);
+            }
+            "bsdf" => {
+                // A definition: built once here so that errors in unused
+                // definitions are reported too.
+                build_bsdf(e, &mut TextureCollector::new(self.folder))?;
+            }
+            // A texture definition, checked where a <ref> places it (it
+            // needs the name the <ref> gives it).
+            "texture" if e.attr("id").is_some() => {}
+            "sensor" => {
+                if let Some(first) = self.sensor {
+                    return Err(SceneError::at(
+                        &e.loc,
+                        format!(
+                            "only one <sensor> is supported (the first is at line {})",
+                            first.loc.line
+                        ),
+                    ));
+                }
+                self.sensor = Some(e);
+                self.camera = Some(sensor(e)?);
+            }
+            "integrator" => {
+                if let Some(first) = self.integrator {
+                    return Err(SceneError::at(
+                        &e.loc,
+                        format!(
+                            "only one <integrator> is allowed (the first is at line {})",
+                            first.loc.line
+                        ),
+                    ));
+                }
+                self.integrator = Some(e);
+                self.max_depth = crate::integrator::integrator(e)?.max_depth;
+            }
+            "emitter" => top_level_emitter(e)?,
+            "film" | "sampler" | "rfilter" if e.attr("id").is_some() => sensor_definition(e)?,
+            other => {
+                return Err(SceneError::at(
+                    &e.loc,
+                    format!(
+                        "unsupported element <{other}> in <scene> (supported: shape, sensor, integrator, default, include, and bsdf, texture, emitter, film, sampler, rfilter with an id)"
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
 }
 
 /// A top-level `<film>`, `<sampler>` or `<rfilter>` with an id is a

@@ -3,8 +3,15 @@
 //! Every error displays as `FILE:LINE:COL: what is wrong` (README, "Scene format"), like a
 //! compiler's, so that the command line can print it on one line. Lines and
 //! columns count from 1 and point at the element or attribute value at fault.
+//!
+//! Errors in independent objects of one file (different top-level
+//! elements, glTF materials or nodes) are collected ([`Errors`]) and
+//! returned together as [`SceneError::Several`], as a compiler reports
+//! every error of a file in one run; one error alone is returned as itself.
 
+use std::collections::HashSet;
 use std::fmt;
+use std::hash::{DefaultHasher, Hash, Hasher};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -65,6 +72,17 @@ pub enum SceneError {
         #[source]
         source: trilux_files::ReadError,
     },
+    /// Several independent errors of one file, each an `At` or a `Read`
+    /// (never nested), in the order found: the first
+    /// [`MAX_REPORTED_ERRORS`](crate::limits::MAX_REPORTED_ERRORS), and how
+    /// many more there were. Displays one error a line.
+    #[error("{}", self.lines().join("\n"))]
+    Several {
+        /// The errors reported, at least two.
+        errors: Vec<SceneError>,
+        /// How many more errors were found and left out.
+        more: usize,
+    },
 }
 
 impl SceneError {
@@ -79,11 +97,155 @@ impl SceneError {
         }
     }
 
-    /// Where the error is, when it is at a place in the file.
+    /// Where the error is, when it is at a place in the file (the first
+    /// one's, for [`SceneError::Several`]).
     pub fn location(&self) -> Option<&SourceLocation> {
         match self {
             SceneError::At { location, .. } => Some(location),
             SceneError::Read { .. } => None,
+            SceneError::Several { errors, .. } => errors.first().and_then(SceneError::location),
+        }
+    }
+
+    /// The errors this one holds: itself, or each of [`SceneError::Several`].
+    pub fn errors(&self) -> &[SceneError] {
+        match self {
+            SceneError::Several { errors, .. } => errors,
+            single => std::slice::from_ref(single),
+        }
+    }
+
+    /// The error as lines to print: one a located error, and for
+    /// [`SceneError::Several`] with errors left out, a last line counting
+    /// them.
+    pub fn lines(&self) -> Vec<String> {
+        let mut lines: Vec<String> = self.errors().iter().map(ToString::to_string).collect();
+        if let SceneError::Several { errors, more, .. } = self
+            && *more > 0
+        {
+            let file = match errors.first() {
+                Some(SceneError::Read { path, .. }) => path.display().to_string(),
+                Some(e) => e
+                    .location()
+                    .map_or_else(String::new, |l| l.file.display().to_string()),
+                None => String::new(),
+            };
+            lines.push(format!(
+                "{file}: and {more} more errors (only the first {} are reported)",
+                errors.len()
+            ));
+        }
+        lines
+    }
+}
+
+/// The errors of independent objects, collected while loading goes on:
+/// at most [`MAX_REPORTED_ERRORS`](crate::limits::MAX_REPORTED_ERRORS)
+/// kept, the rest counted; an error found twice (a definition's, met
+/// again through each object that references it) counts once. Each error
+/// has a place in the file's order (its top-level element's index), so
+/// that those reported are the file's first, in its order, whatever stage
+/// found them.
+#[derive(Debug, Default)]
+pub(crate) struct Errors {
+    /// (place, error), at most the limit.
+    kept: Vec<(usize, SceneError)>,
+    more: usize,
+    /// Hashes of the messages seen: a hostile file's million errors cost
+    /// 8 bytes each, not their text.
+    seen: HashSet<u64>,
+}
+
+impl Errors {
+    /// Adds `e` (each of its errors, if it holds several) after those of
+    /// every place.
+    pub fn push(&mut self, e: SceneError) {
+        self.push_at(usize::MAX, e);
+    }
+
+    /// Adds `e` (each of its errors, if it holds several) at `place`.
+    pub fn push_at(&mut self, place: usize, e: SceneError) {
+        if let SceneError::Several { errors, more } = e {
+            errors.into_iter().for_each(|e| self.push_at(place, e));
+            self.more += more;
+            return;
+        }
+        let mut hasher = DefaultHasher::new();
+        e.to_string().hash(&mut hasher);
+        if !self.seen.insert(hasher.finish()) {
+            return;
+        }
+        if self.kept.len() < crate::limits::MAX_REPORTED_ERRORS {
+            self.kept.push((place, e));
+            return;
+        }
+        self.more += 1;
+        // Full: `e` replaces the kept error latest in the file, if it is
+        // earlier.
+        if let Some(last) = self.latest()
+            && self.kept[last].0 > place
+        {
+            self.kept[last] = (place, e);
+        }
+    }
+
+    /// The index of the kept error latest in the file (the last found
+    /// among equals).
+    fn latest(&self) -> Option<usize> {
+        (0..self.kept.len()).max_by_key(|&k| self.kept[k].0)
+    }
+
+    /// The value of `r`, or `None` with its error kept (after every
+    /// place).
+    pub fn keep<T>(&mut self, r: Result<T>) -> Option<T> {
+        self.keep_at(usize::MAX, r)
+    }
+
+    /// The value of `r`, or `None` with its error kept at `place`.
+    pub fn keep_at<T>(&mut self, place: usize, r: Result<T>) -> Option<T> {
+        r.map_err(|e| self.push_at(place, e)).ok()
+    }
+
+    /// True when no error was found.
+    pub fn is_empty(&self) -> bool {
+        self.kept.is_empty()
+    }
+
+    /// `value` when no error was found, else the errors.
+    pub fn or<T>(self, value: T) -> Result<T> {
+        if self.is_empty() {
+            Ok(value)
+        } else {
+            Err(self.into_error())
+        }
+    }
+
+    /// The errors found and then `last`, one that stops loading at once (a
+    /// limit passed): reported last, whatever else is left out.
+    pub fn stop(mut self, last: SceneError) -> SceneError {
+        if self.is_empty() {
+            return last;
+        }
+        if self.kept.len() == crate::limits::MAX_REPORTED_ERRORS
+            && let Some(k) = self.latest()
+        {
+            self.kept.remove(k);
+            self.more += 1;
+        }
+        self.kept.push((usize::MAX, last));
+        self.into_error()
+    }
+
+    /// One error as itself, several as [`SceneError::Several`] in the
+    /// file's order; only when some error was found.
+    fn into_error(mut self) -> SceneError {
+        if self.kept.len() == 1 && self.more == 0 {
+            return self.kept.remove(0).1;
+        }
+        self.kept.sort_by_key(|(place, _)| *place);
+        SceneError::Several {
+            errors: self.kept.into_iter().map(|(_, e)| e).collect(),
+            more: self.more,
         }
     }
 }

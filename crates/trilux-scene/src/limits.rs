@@ -95,3 +95,7 @@ pub const MAX_SHAPES: usize = 100_000;
 /// Most node instances a glTF scene places (a node reached twice is
 /// refused: glTF's node graph is a set of disjoint trees).
 pub const MAX_GLTF_NODES: usize = 1_000_000;
+
+/// Most errors reported at once (20, then a count of the rest): as a
+/// compiler's, enough to repair a file in few runs, few enough to read.
+pub const MAX_REPORTED_ERRORS: usize = 20;

@@ -9,7 +9,7 @@
 //! options against it before it spends the time (and memory) of reading
 //! them ([`Pending::finish`]).
 
-use crate::error::{Result, SceneError};
+use crate::error::{Errors, Result, SceneError};
 use crate::gltf::GltfMeshes;
 use crate::scene::Scene;
 use crate::shape::{MeshRequest, check_area};
@@ -84,58 +84,43 @@ impl Pending {
     }
 
     /// Reads every mesh and texture; errors point at the place in the
-    /// scene that names the file.
+    /// scene that names the file. A mesh or texture that fails does not
+    /// stop the others: their errors are returned together.
     pub fn finish(mut self) -> Result<Scene> {
+        let mut errors = Errors::default();
         let mut flat = Vec::new();
+        let mut failed = std::collections::HashSet::new();
         for (index, request) in self.requests.meshes {
-            let mut mesh = request
-                .format
-                .load(&request.path, request.face_normals, request.flip_tex_coords)
-                .map_err(|e| SceneError::at(&request.filename, e))?;
-            let scene_shape = &mut self.scene.shapes[index];
-            let shape = &mut scene_shape.shape;
-            let (total, dropped) = drop_zero_area(&mut mesh, &shape.world_from_object);
-            shape.kind = ShapeKind::Mesh(mesh);
-            let element = request.format.element();
-            if let (true, Some(emitter)) = (dropped == total, &scene_shape.emitter) {
-                return Err(SceneError::at(
-                    &emitter.location,
-                    format!(
-                        "every triangle of this {element} has zero area: it has no surface to emit from (Mitsuba refuses it too)"
-                    ),
-                ));
+            match read_mesh(&mut self.scene, index, &request) {
+                Ok(true) => flat.push(index),
+                Ok(false) => {}
+                Err(e) => {
+                    failed.insert(index);
+                    errors.push(e);
+                }
             }
-            if dropped == total {
-                self.scene.warnings.push(format!(
-                    "{}: every triangle of this {element} has zero area: it is left out (Mitsuba loads it and never hits it)",
-                    request.shape
-                ));
-                flat.push(index);
-                continue;
-            }
-            if dropped > 0 {
-                self.scene.warnings.push(format!(
-                    "{}: {dropped} of the {total} triangles of this {element} have zero area and are left out",
-                    request.shape
-                ));
-            }
-            check_area(shape, &request.shape, element)?;
         }
         let mut cache = TextureCache::default();
         let mut textures = self.requests.textures;
         if let Some(gltf) = self.requests.gltf {
-            textures.extend(gltf.finish(&mut self.scene)?);
+            textures.extend(gltf.finish(&mut self.scene, &mut errors));
         }
         for (index, request) in &textures {
-            let slot = cache.slot(request)?;
+            if failed.contains(index) {
+                continue;
+            }
+            let Some(slot) = errors.keep(cache.slot(request)) else {
+                continue;
+            };
             let shape = &mut self.scene.shapes[*index];
             if let ShapeKind::Mesh(m) = &shape.shape.kind
                 && m.texcoords.is_none()
             {
-                return Err(SceneError::at(
+                errors.push(SceneError::at(
                     &request.location,
                     "this texture's shape has no texture coordinates (OBJ vt, PLY u v, glTF TEXCOORD_0)",
                 ));
+                continue;
             }
             shape.textures.push(slot);
         }
@@ -145,8 +130,46 @@ impl Pending {
             index += 1;
             !flat.contains(&(index - 1))
         });
-        Ok(self.scene)
+        errors.or(self.scene)
     }
+}
+
+/// Reads the mesh of `request` into shape `index` of `scene`; true when
+/// every triangle has zero area (the shape is to be left out, with a
+/// warning).
+fn read_mesh(scene: &mut Scene, index: usize, request: &MeshRequest) -> Result<bool> {
+    let mut mesh = request
+        .format
+        .load(&request.path, request.face_normals, request.flip_tex_coords)
+        .map_err(|e| SceneError::at(&request.filename, e))?;
+    let scene_shape = &mut scene.shapes[index];
+    let shape = &mut scene_shape.shape;
+    let (total, dropped) = drop_zero_area(&mut mesh, &shape.world_from_object);
+    shape.kind = ShapeKind::Mesh(mesh);
+    let element = request.format.element();
+    if let (true, Some(emitter)) = (dropped == total, &scene_shape.emitter) {
+        return Err(SceneError::at(
+            &emitter.location,
+            format!(
+                "every triangle of this {element} has zero area: it has no surface to emit from (Mitsuba refuses it too)"
+            ),
+        ));
+    }
+    if dropped == total {
+        scene.warnings.push(format!(
+            "{}: every triangle of this {element} has zero area: it is left out (Mitsuba loads it and never hits it)",
+            request.shape
+        ));
+        return Ok(true);
+    }
+    if dropped > 0 {
+        scene.warnings.push(format!(
+            "{}: {dropped} of the {total} triangles of this {element} have zero area and are left out",
+            request.shape
+        ));
+    }
+    check_area(shape, &request.shape, element)?;
+    Ok(false)
 }
 
 /// Leaves out the triangles of `mesh` that have zero area once

@@ -15,85 +15,155 @@
 //! A reference to a BSDF that is being expanded is a cycle, refused as
 //! one; the expanded tree is bounded in depth and in size
 //! (`crate::limits`), since references can nest and multiply.
+//!
+//! Each top-level element is checked on its own: its errors are collected
+//! and it is left as written, marked failed, for `build` to skip, so that
+//! one run reports the errors of every top-level object. An element that
+//! references a failed definition fails with the definition's error
+//! (reported once). A limit passed stops at once.
 
 use std::collections::{BTreeMap, HashMap};
 
-use crate::error::{Result, SceneError};
+use crate::error::{Errors, Result, SceneError};
 use crate::limits::{MAX_DEPTH, MAX_ELEMENTS};
 use crate::xml::Element;
 
 /// The tree with references replaced, and how many `<bsdf>` elements of each
 /// type the file holds (nested ones included, each written element once).
 pub(crate) struct Resolved {
-    /// The `<scene>` element, without `<ref>`s.
+    /// The `<scene>` element, without `<ref>`s in the children that did
+    /// not fail.
     pub scene: Element,
+    /// For each child of `<scene>`: true when its references failed (its
+    /// errors are in `errors`; it is left as written, for the next stage
+    /// to skip).
+    pub failed: Vec<bool>,
     /// `<bsdf>` type → number of `<bsdf>` elements written with it.
     pub bsdf_counts: BTreeMap<String, usize>,
+    /// The errors found so far, each at its top-level element's place
+    /// (index + 1; the `<scene>` element is 0).
+    pub errors: Errors,
 }
 
 /// Resolves references in `scene`: every reference is checked first,
 /// without copying (so that a file whose references multiply is refused in
-/// time proportional to the file, not to its expansion), then copied.
+/// time proportional to the file, not to its expansion), then copied. The
+/// errors of each top-level object are collected; a limit passed stops at
+/// once.
 pub(crate) fn resolve(scene: &Element) -> Result<Resolved> {
+    let mut errors = Errors::default();
+    let mut failed = vec![false; scene.children.len()];
     let mut ids: HashMap<String, &Element> = HashMap::new();
-    collect_ids(scene, &mut ids)?;
+    let mut seen_emitters = HashMap::new();
+    for (k, child) in scene.children.iter().enumerate() {
+        let mut found = Vec::new();
+        collect_ids(child, &mut ids, &mut found);
+        failed[k] = !found.is_empty();
+        found.into_iter().for_each(|e| errors.push_at(k + 1, e));
+    }
+    for (k, child) in scene.children.iter().enumerate() {
+        let mut found = Vec::new();
+        refuse_shared_emitters(child, &ids, &mut seen_emitters, &mut found);
+        failed[k] |= !found.is_empty();
+        found.into_iter().for_each(|e| errors.push_at(k + 1, e));
+    }
     let mut bsdf_counts = BTreeMap::new();
     count_bsdfs(scene, &mut bsdf_counts);
-    refuse_shared_emitters(scene, &ids, &mut HashMap::new())?;
     let mut checker = Checker::new(&ids);
-    checker.check(scene, 1)?;
-    let scene = copy(&ids, scene)?;
-    Ok(Resolved { scene, bsdf_counts })
+    checker.elements = 1;
+    for (k, child) in scene.children.iter().enumerate() {
+        checker.expanding.clear();
+        let checked = if child.tag == "ref" {
+            checker.check_reference(child, 1)
+        } else {
+            checker.check(child, 2)
+        };
+        match checked {
+            Ok(_) => {}
+            Err(e) if checker.over_limit => return Err(errors.stop(e)),
+            Err(e) => {
+                failed[k] = true;
+                errors.push_at(k + 1, e);
+            }
+        }
+    }
+    let mut children = Vec::with_capacity(scene.children.len());
+    for (child, &failed) in scene.children.iter().zip(&failed) {
+        children.push(if failed {
+            child.clone()
+        } else {
+            copy_child(&ids, child)?
+        });
+    }
+    let scene = Element {
+        tag: scene.tag.clone(),
+        attrs: scene.attrs.clone(),
+        children,
+        loc: scene.loc.clone(),
+    };
+    Ok(Resolved {
+        scene,
+        failed,
+        bsdf_counts,
+        errors,
+    })
 }
 
-fn collect_ids<'a>(e: &'a Element, ids: &mut HashMap<String, &'a Element>) -> Result<()> {
-    for child in &e.children {
-        if child.tag != "ref"
-            && let Some(id) = child.attr("id")
-        {
-            if let Some(first) = ids.get(&id.value) {
-                return Err(SceneError::at(
-                    &id.loc,
-                    format!(
-                        "id \"{}\" is already used by the {} at line {}",
-                        id.value,
-                        first.describe(),
-                        first.loc.line
-                    ),
-                ));
-            }
-            ids.insert(id.value.clone(), child);
+/// Registers the ids of `e` and the elements in it; an id used twice is
+/// an error in `found` (the first use keeps it).
+fn collect_ids<'a>(
+    e: &'a Element,
+    ids: &mut HashMap<String, &'a Element>,
+    found: &mut Vec<SceneError>,
+) {
+    if e.tag != "ref"
+        && let Some(id) = e.attr("id")
+    {
+        if let Some(first) = ids.get(&id.value) {
+            found.push(SceneError::at(
+                &id.loc,
+                format!(
+                    "id \"{}\" is already used by the {} at line {}",
+                    id.value,
+                    first.describe(),
+                    first.loc.line
+                ),
+            ));
+        } else {
+            ids.insert(id.value.clone(), e);
         }
-        collect_ids(child, ids)?;
     }
-    Ok(())
+    for child in &e.children {
+        collect_ids(child, ids, found);
+    }
 }
 
 /// An area emitter belongs to one shape: a second `<ref>` to one is
-/// refused, as Mitsuba refuses it ("an endpoint can only be attached to a
-/// single shape"). `seen` maps an emitter's id to its first reference's line.
+/// refused (an error in `found`), as Mitsuba refuses it ("an endpoint can
+/// only be attached to a single shape"). `seen` maps an emitter's id to
+/// its first reference's line.
 fn refuse_shared_emitters<'a>(
     e: &'a Element,
     ids: &HashMap<String, &Element>,
     seen: &mut HashMap<&'a str, u32>,
-) -> Result<()> {
-    for child in &e.children {
-        if child.tag == "ref"
-            && let Some(id) = child.attr("id")
-            && ids.get(&id.value).is_some_and(|t| t.tag == "emitter")
-            && let Some(line) = seen.insert(&id.value, child.loc.line)
-        {
-            return Err(SceneError::at(
-                &child.loc,
-                format!(
-                    "emitter \"{}\" is already attached to the shape at line {line}; an area emitter belongs to one shape (as in Mitsuba): define one per shape",
-                    id.value
-                ),
-            ));
-        }
-        refuse_shared_emitters(child, ids, seen)?;
+    found: &mut Vec<SceneError>,
+) {
+    if e.tag == "ref"
+        && let Some(id) = e.attr("id")
+        && ids.get(&id.value).is_some_and(|t| t.tag == "emitter")
+        && let Some(line) = seen.insert(&id.value, e.loc.line)
+    {
+        found.push(SceneError::at(
+            &e.loc,
+            format!(
+                "emitter \"{}\" is already attached to the shape at line {line}; an area emitter belongs to one shape (as in Mitsuba): define one per shape",
+                id.value
+            ),
+        ));
     }
-    Ok(())
+    for child in &e.children {
+        refuse_shared_emitters(child, ids, seen, found);
+    }
 }
 
 fn count_bsdfs(e: &Element, counts: &mut BTreeMap<String, usize>) {
@@ -128,6 +198,8 @@ struct Checker<'a> {
     expanding: Vec<&'a str>,
     /// Elements with an id whose whole expansion is valid, by id.
     checked: HashMap<&'a str, Extent>,
+    /// True once the expansion passed a limit: loading stops there.
+    over_limit: bool,
 }
 
 impl<'a> Checker<'a> {
@@ -138,6 +210,7 @@ impl<'a> Checker<'a> {
             walked: 0,
             expanding: Vec::new(),
             checked: HashMap::new(),
+            over_limit: false,
         }
     }
 
@@ -146,6 +219,7 @@ impl<'a> Checker<'a> {
     /// document order, that breaks a rule.
     fn check(&mut self, e: &'a Element, depth: usize) -> Result<Extent> {
         if depth > MAX_DEPTH {
+            self.over_limit = true;
             return Err(SceneError::at(
                 &e.loc,
                 format!(
@@ -156,6 +230,7 @@ impl<'a> Checker<'a> {
         self.walked += 1;
         self.elements += 1;
         if self.elements > MAX_ELEMENTS {
+            self.over_limit = true;
             return Err(SceneError::at(
                 &e.loc,
                 format!(
@@ -245,21 +320,7 @@ fn target<'a>(
 fn copy(ids: &HashMap<String, &Element>, e: &Element) -> Result<Element> {
     let mut children = Vec::with_capacity(e.children.len());
     for child in &e.children {
-        children.push(if child.tag == "ref" {
-            let (_, named) = target(ids, child)?;
-            let mut c = copy(ids, named)?;
-            if named.tag == "texture" {
-                // Placed where the <ref> is: errors of its use point there.
-                c.loc = child.loc.clone();
-                if let Some(name) = child.attr("name") {
-                    c.attrs.retain(|a| a.name != "name");
-                    c.attrs.push(name.clone());
-                }
-            }
-            c
-        } else {
-            copy(ids, child)?
-        });
+        children.push(copy_child(ids, child)?);
     }
     Ok(Element {
         tag: e.tag.clone(),
@@ -267,6 +328,25 @@ fn copy(ids: &HashMap<String, &Element>, e: &Element) -> Result<Element> {
         children,
         loc: e.loc.clone(),
     })
+}
+
+/// A copy of checked element `child`, or of what it names if it is a
+/// `<ref>`.
+fn copy_child(ids: &HashMap<String, &Element>, child: &Element) -> Result<Element> {
+    if child.tag != "ref" {
+        return copy(ids, child);
+    }
+    let (_, named) = target(ids, child)?;
+    let mut c = copy(ids, named)?;
+    if named.tag == "texture" {
+        // Placed where the <ref> is: errors of its use point there.
+        c.loc = child.loc.clone();
+        if let Some(name) = child.attr("name") {
+            c.attrs.retain(|a| a.name != "name");
+            c.attrs.push(name.clone());
+        }
+    }
+    Ok(c)
 }
 
 #[cfg(test)]
@@ -297,7 +377,9 @@ mod tests {
     fn walk(levels: usize) -> (Result<Extent>, usize) {
         let tree = doubling_chain(levels);
         let mut ids = HashMap::new();
-        collect_ids(&tree, &mut ids).expect("ids are unique");
+        let mut found = Vec::new();
+        collect_ids(&tree, &mut ids, &mut found);
+        assert!(found.is_empty(), "ids are unique");
         let mut checker = Checker::new(&ids);
         let result = checker.check(&tree, 1);
         (result, checker.walked)

@@ -357,11 +357,15 @@ fn fuzz_xml(rng: &mut Rng) -> usize {
         match trilux_scene::load_str(&text, "mutated.xml") {
             Ok(_) => loaded += 1,
             Err(e) => {
-                let msg = e.to_string();
-                assert!(
-                    msg.starts_with("mutated.xml:") && !msg.contains('\n'),
-                    "case {case}: {msg}"
-                );
+                // Each error one located line (a mutation can break
+                // several independent elements).
+                for one in e.errors() {
+                    let msg = one.to_string();
+                    assert!(
+                        msg.starts_with("mutated.xml:") && !msg.contains('\n'),
+                        "case {case}: {msg}"
+                    );
+                }
             }
         }
         let used = peak() - base;

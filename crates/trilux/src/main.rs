@@ -1,7 +1,8 @@
 //! The `trilux` command: solve, render and inspect scenes.
 //!
-//! Runtime errors print one line `error: ...` on stderr and exit with status
-//! 1; command-line usage errors (unknown options, malformed values) keep
+//! Runtime errors print one line `error: ...` on stderr (one a line for
+//! a scene file's independent errors) and exit with status 1;
+//! command-line usage errors (unknown options, malformed values) keep
 //! clap's message and exit with status 2, before any file is read, and so
 //! does an output named for a format trilux does not write (one line,
 //! `output::named`). Each file written is reported as `wrote PATH`.
@@ -188,10 +189,28 @@ fn main() -> ExitCode {
             ExitCode::from(2)
         }
         Err(e) => {
-            let message = e.to_string().replace(['\n', '\r'], " ");
-            let message = trilux_scene::error::elide(&message, MAX_LINE_CHARS);
-            streams::eprint_line(&format!("error: {message}"));
+            let lines = match scene_error(&e) {
+                Some(scene) => scene.lines(),
+                None => vec![e.to_string()],
+            };
+            for line in lines {
+                let line = line.replace(['\n', '\r'], " ");
+                let line = trilux_scene::error::elide(&line, MAX_LINE_CHARS);
+                streams::eprint_line(&format!("error: {line}"));
+            }
             ExitCode::FAILURE
         }
+    }
+}
+
+/// The scene error `e` is, directly or as the pipeline's: its errors are
+/// printed one a line (a file's independent errors together).
+fn scene_error(e: &anyhow::Error) -> Option<&trilux_scene::SceneError> {
+    if let Some(scene) = e.downcast_ref::<trilux_scene::SceneError>() {
+        return Some(scene);
+    }
+    match e.downcast_ref::<trilux::PipelineError>() {
+        Some(trilux::PipelineError::Scene(scene)) => Some(scene),
+        _ => None,
     }
 }

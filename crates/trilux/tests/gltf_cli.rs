@@ -249,6 +249,63 @@ fn refused_material_features() {
     assert_refused("alpha", &j, "/materials/0/alphaMode", "not supported");
 }
 
+/// Three meshes placed by three nodes, each with its own bad material
+/// (alpha blending, an extension that changes the light, a double-sided
+/// emitter), and a fourth node with a point light: all four reported in
+/// one run, one line each at its JSON path, exit 1.
+#[test]
+fn several_bad_materials_are_reported_in_one_run() {
+    let j = triangle(|j| {
+        let primitive = j["meshes"][0]["primitives"][0].clone();
+        let mesh = |m: usize| {
+            let mut p = primitive.clone();
+            p["material"] = m.into();
+            serde_json::json!({"primitives": [p]})
+        };
+        j["meshes"] = serde_json::json!([mesh(0), mesh(1), mesh(2)]);
+        j["materials"] = serde_json::json!([
+            {"alphaMode": "BLEND"},
+            {"extensions": {"KHR_materials_clearcoat": {"clearcoatFactor": 1.0}}},
+            {"emissiveFactor": [1.0, 1.0, 1.0], "doubleSided": true}
+        ]);
+        j["extensions"] =
+            serde_json::json!({"KHR_lights_punctual": {"lights": [{"type": "point"}]}});
+        j["nodes"] = serde_json::json!([
+            {"mesh": 0},
+            {"mesh": 1, "translation": [2.0, 0.0, 0.0]},
+            {"mesh": 2, "translation": [4.0, 0.0, 0.0]},
+            {"name": "eye", "camera": 0, "translation": [0.2, 0.2, 2.0]},
+            {"extensions": {"KHR_lights_punctual": {"light": 0}}}
+        ]);
+        j["scenes"] = serde_json::json!([{"nodes": [0, 1, 2, 3, 4]}]);
+    });
+    let dir = folder("gltf-several");
+    let path = dir.join("several.gltf");
+    std::fs::write(&path, serde_json::to_vec(&j).unwrap()).unwrap();
+    let p = path.to_str().unwrap();
+    let out = trilux(&["info", p]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    let lines: Vec<&str> = stderr.lines().collect();
+    assert_eq!(lines.len(), 4, "{stderr}");
+    let expected = [
+        ("/materials/0/alphaMode", "alphaMode MASK and BLEND"),
+        (
+            "/materials/1/extensions/KHR_materials_clearcoat",
+            "extension KHR_materials_clearcoat is refused",
+        ),
+        ("/materials/2/doubleSided", "double-sided emissive"),
+        ("/nodes/4/extensions/KHR_lights_punctual", "point light"),
+    ];
+    for (line, (pointer, what)) in lines.iter().zip(expected) {
+        assert!(
+            line.starts_with(&format!("error: {p}:{pointer}: ")),
+            "{line}"
+        );
+        assert!(line.contains(what), "{line}");
+    }
+}
+
 #[test]
 fn malformed_json_and_truncated_glb() {
     let dir = folder("gltf-malformed");

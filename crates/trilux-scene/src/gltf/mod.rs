@@ -25,7 +25,7 @@ mod nodes;
 use std::path::Path;
 use std::sync::Arc;
 
-use crate::error::{Result, SceneError, SourceLocation};
+use crate::error::{Errors, Result, SceneError, SourceLocation};
 use crate::limits::{MAX_GLB_BYTES, MAX_SCENE_BYTES};
 use crate::scene::Scene;
 
@@ -86,9 +86,17 @@ pub(crate) fn open_bytes(
         ));
     }
     let used: Vec<String> = gltf.document.extensions_used().map(String::from).collect();
-    let built = nodes::build(file, gltf, camera)?;
-    refuse_used(file, &used)?;
-    Ok(built)
+    let mut errors = Errors::default();
+    let built = match nodes::build(file, gltf, camera, &mut errors) {
+        Ok(built) => built,
+        Err(limit) => return Err(errors.stop(limit)),
+    };
+    // Only after a clean walk: an extension refused where it is used is
+    // not reported a second time at its listing.
+    if errors.is_empty() {
+        errors.keep(refuse_used(file, &used));
+    }
+    errors.or(built)
 }
 
 /// Extensions ignored because they do not change the light: variants
@@ -189,19 +197,19 @@ fn parse(bytes: &[u8], file: &Arc<Path>) -> Result<gltf::Gltf> {
 
 fn parse_error(file: &Arc<Path>, e: gltf::Error) -> SceneError {
     match e {
-        gltf::Error::Validation(errors) => {
-            let (path, error) = match errors.first() {
-                Some((p, e)) => (pointer(&p.to_string()), e.to_string()),
-                None => ("/".into(), "invalid".into()),
-            };
-            let more = match errors.len() {
-                0 | 1 => String::new(),
-                n => format!(" (and {} more problems)", n - 1),
-            };
-            SceneError::at(
-                &SourceLocation::json(file, path),
-                format!("invalid glTF: {error}{more}"),
-            )
+        gltf::Error::Validation(problems) => {
+            // Each problem is at its own JSON path: all are reported.
+            let mut errors = Errors::default();
+            for (p, e) in &problems {
+                errors.push(SceneError::at(
+                    &SourceLocation::json(file, pointer(&p.to_string())),
+                    format!("invalid glTF: {e}"),
+                ));
+            }
+            match errors.or(()) {
+                Err(e) => e,
+                Ok(()) => SceneError::at(&SourceLocation::json(file, "/"), "invalid glTF"),
+            }
         }
         gltf::Error::Deserialize(e) => SceneError::at(
             &SourceLocation {

@@ -36,7 +36,7 @@ use super::accessor::{self, Kind};
 use super::buffers::{Buffers, data_uri, relative_path};
 use super::material::{Mapped, TextureUse, map};
 use crate::camera::{Camera, FovAxis, ReconstructionFilter};
-use crate::error::{Result, SceneError, SourceLocation};
+use crate::error::{Errors, Result, SceneError, SourceLocation};
 use crate::limits::{
     MAX_GLTF_NODES, MAX_GLTF_TRIANGLES, MAX_MESH_TRIANGLES, MAX_MESH_VERTICES, MAX_NODE_DEPTH,
     MAX_SHAPES,
@@ -75,10 +75,13 @@ impl fmt::Debug for GltfMeshes {
 }
 
 /// The scene of `gltf` (its default scene, else its first) with `camera`.
+/// The errors of each node, primitive and material go into `errors`,
+/// their place the order of the walk; a limit passed is returned at once.
 pub(crate) fn build(
     file: &Arc<Path>,
     gltf: gltf::Gltf,
     camera: Option<&str>,
+    errors: &mut Errors,
 ) -> Result<(Scene, GltfMeshes)> {
     let doc = &gltf.document;
     let at = |p: String, m: String| SceneError::at(&SourceLocation::json(file, p), m);
@@ -93,6 +96,7 @@ pub(crate) fn build(
         textures: Vec::new(),
         cameras: Vec::new(),
         materials: HashMap::new(),
+        errors,
         bsdf_counts: BTreeMap::new(),
         seen: HashSet::new(),
         triangles: 0,
@@ -100,7 +104,10 @@ pub(crate) fn build(
     for node in root.nodes() {
         walk.node(&node, DMat4::IDENTITY, 1)?;
     }
-    let camera = choose_camera(file, &walk.cameras, camera)?;
+    let camera = walk
+        .errors
+        .keep(choose_camera(file, &walk.cameras, camera))
+        .flatten();
     let camera_names = walk
         .cameras
         .iter()
@@ -134,7 +141,11 @@ struct Walk<'f> {
     textures: Vec<(usize, TextureUse)>,
     /// (camera name, node name, node index, camera, world transform).
     cameras: Vec<CameraNode>,
-    materials: HashMap<Option<usize>, Mapped>,
+    /// Each material mapped, `None` for one that failed (its error is
+    /// reported once).
+    materials: HashMap<Option<usize>, Option<Mapped>>,
+    /// The errors found (a limit passed is returned instead).
+    errors: &'f mut Errors,
     bsdf_counts: BTreeMap<String, usize>,
     seen: HashSet<usize>,
     triangles: usize,
@@ -166,15 +177,45 @@ impl Walk<'_> {
                 ),
             ));
         }
-        if !self.seen.insert(i) || self.seen.len() > MAX_GLTF_NODES {
-            return Err(self.at(here, "the node is reached twice (glTF's nodes form disjoint trees), or the scene has too many nodes"));
+        if self.seen.len() == MAX_GLTF_NODES {
+            return Err(self.at(
+                here,
+                format!("the scene has more than {MAX_GLTF_NODES} nodes (docs/limits.md)"),
+            ));
+        }
+        if !self.seen.insert(i) {
+            let e = self.at(
+                here,
+                "the node is reached twice (glTF's nodes form disjoint trees)",
+            );
+            self.errors.push(e);
+            return Ok(());
         }
         let m = node.transform().matrix();
         let local = DMat4::from_cols_array_2d(&m.map(|c| c.map(f64::from)));
         if !local.is_finite() {
-            return Err(self.at(here, "the node's transform has a number that is not finite"));
+            let e = self.at(here, "the node's transform has a number that is not finite");
+            self.errors.push(e);
+            return Ok(());
         }
         let world = parent * local;
+        let checked = self.check_node(node, &here, world);
+        self.errors.keep(checked);
+        if let Some(mesh) = node.mesh() {
+            for p in mesh.primitives() {
+                self.primitive(node, &mesh, &p, world)?;
+            }
+        }
+        for child in node.children() {
+            self.node(&child, world, depth + 1)?;
+        }
+        Ok(())
+    }
+
+    /// Refuses what node `node` (at `here`) carries and trilux does not
+    /// take (a punctual light, an extension, an orthographic camera), and
+    /// notes its perspective camera.
+    fn check_node(&mut self, node: &gltf::Node<'_>, here: &str, world: DMat4) -> Result<()> {
         if let Some(light) = node.light() {
             let kind = match light.kind() {
                 gltf::khr_lights_punctual::Kind::Directional => "directional",
@@ -209,7 +250,7 @@ impl Walk<'_> {
                         c.name().map(str::to_string),
                         node.name().map(str::to_string),
                     ],
-                    node: i,
+                    node: node.index(),
                     yfov: f64::from(p.yfov()),
                     aspect: p.aspect_ratio().map(f64::from),
                     znear: f64::from(p.znear()),
@@ -224,17 +265,11 @@ impl Walk<'_> {
                 }
             }
         }
-        if let Some(mesh) = node.mesh() {
-            for p in mesh.primitives() {
-                self.primitive(node, &mesh, &p, world)?;
-            }
-        }
-        for child in node.children() {
-            self.node(&child, world, depth + 1)?;
-        }
         Ok(())
     }
 
+    /// Places primitive `p` of `mesh` as a shape; its errors (and its
+    /// material's, once) go into `errors`, a limit passed is returned.
     fn primitive(
         &mut self,
         node: &gltf::Node<'_>,
@@ -243,21 +278,34 @@ impl Walk<'_> {
         world: DMat4,
     ) -> Result<()> {
         let here = format!("/meshes/{}/primitives/{}", mesh.index(), p.index());
+        let material = p.material();
+        let key = material.index();
+        if !self.materials.contains_key(&key) {
+            let mapped = self.errors.keep(map(self.file, &material));
+            for t in mapped.iter().flat_map(|m| &m.types) {
+                *self.bsdf_counts.entry((*t).to_string()).or_default() += 1;
+            }
+            self.materials.insert(key, mapped);
+        }
         if p.mode() != gltf::mesh::Mode::Triangles {
-            return Err(self.at(
+            let e = self.at(
                 format!("{here}/mode"),
                 format!(
                     "primitive mode {:?} is not supported (only TRIANGLES)",
                     p.mode()
                 ),
-            ));
+            );
+            self.errors.push(e);
+            return Ok(());
         }
-        let positions = p.get(&gltf::Semantic::Positions).ok_or_else(|| {
-            self.at(
+        let Some(positions) = p.get(&gltf::Semantic::Positions) else {
+            let e = self.at(
                 format!("{here}/attributes"),
                 "the primitive has no POSITION",
-            )
-        })?;
+            );
+            self.errors.push(e);
+            return Ok(());
+        };
         if self.shapes.len() == MAX_SHAPES {
             return Err(self.at(
                 format!("/nodes/{}", node.index()),
@@ -276,16 +324,7 @@ impl Walk<'_> {
                 ),
             ));
         }
-        let material = p.material();
-        let key = material.index();
-        if !self.materials.contains_key(&key) {
-            let mapped = map(self.file, &material)?;
-            for t in &mapped.types {
-                *self.bsdf_counts.entry((*t).to_string()).or_default() += 1;
-            }
-            self.materials.insert(key, mapped);
-        }
-        let Some(mapped) = self.materials.get(&key) else {
+        let Some(Some(mapped)) = self.materials.get(&key) else {
             return Ok(());
         };
         let shape = self.shapes.len();
@@ -454,19 +493,26 @@ impl GltfMeshes {
     }
 
     /// Reads every placed primitive's mesh into `scene` and returns the
-    /// texture requests of their materials.
-    pub fn finish(self, scene: &mut Scene) -> Result<Vec<(usize, TextureRequest)>> {
+    /// texture requests of their materials; the errors of each mesh and
+    /// image go into `errors` (a failed mesh's textures are not
+    /// requested).
+    pub fn finish(self, scene: &mut Scene, errors: &mut Errors) -> Vec<(usize, TextureRequest)> {
         let mut buffers = Buffers::new(
             Arc::clone(&self.file),
             self.blob.clone(),
             self.document.buffers().count(),
         );
+        let mut failed = HashSet::new();
         for placed in &self.placed {
-            let mesh = self.read_mesh(&mut buffers, placed)?;
-            let shape = &mut scene.shapes[placed.shape];
-            shape.shape.kind = ShapeKind::Mesh(mesh);
-            let describe = format!("mesh {} primitive {}", placed.mesh, placed.primitive);
-            check_area(&shape.shape, &shape.location, &describe)?;
+            let read = self.read_mesh(&mut buffers, placed).and_then(|mesh| {
+                let shape = &mut scene.shapes[placed.shape];
+                shape.shape.kind = ShapeKind::Mesh(mesh);
+                let describe = format!("mesh {} primitive {}", placed.mesh, placed.primitive);
+                check_area(&shape.shape, &shape.location, &describe)
+            });
+            if errors.keep(read).is_none() {
+                failed.insert(placed.shape);
+            }
         }
         let folder: PathBuf = self
             .file
@@ -476,10 +522,16 @@ impl GltfMeshes {
         let mut images: HashMap<usize, ImageSource> = HashMap::new();
         let mut out = Vec::with_capacity(self.textures.len());
         for (shape, t) in &self.textures {
+            if failed.contains(shape) {
+                continue;
+            }
             let source = match images.get(&t.image) {
                 Some(s) => s.clone(),
                 None => {
-                    let s = self.image_source(&mut buffers, &folder, t.image)?;
+                    let read = self.image_source(&mut buffers, &folder, t.image);
+                    let Some(s) = errors.keep(read) else {
+                        continue;
+                    };
                     images.insert(t.image, s.clone());
                     s
                 }
@@ -498,7 +550,7 @@ impl GltfMeshes {
                 },
             ));
         }
-        Ok(out)
+        out
     }
 
     fn image_source(
