@@ -15,8 +15,12 @@ pub enum BrdfError {
         source: trilux_color::ColorError,
     },
     /// Roughness must be finite and positive.
-    #[error("roughconductor alpha must be finite and > 0, got {0}")]
+    #[error("roughness alpha must be finite and > 0, got {0}")]
     BadAlpha(f64),
+    /// Indices of refraction must be finite and positive (and differ for a
+    /// rough coat, as Mitsuba requires).
+    #[error("plastic int_ior and ext_ior must be finite, > 0 (and differ for roughplastic), got {0}")]
+    BadIor(f64),
     /// The blend weight must lie in [0, 1].
     #[error("blendbsdf weight must lie in [0, 1], got {0}")]
     BadWeight(f64),
@@ -43,6 +47,10 @@ pub enum BrdfError {
     /// More textures on one material than it takes.
     #[error("a material takes at most 4 textures (MAX_SLOTS), found {0}")]
     TooManyTextures(usize),
+    /// A texture on a `nonlinear` plastic: its Lambertian part would not be
+    /// linear in the texture.
+    #[error("a texture on the diffuse_reflectance of a plastic with nonlinear=true is not supported")]
+    TexturedNonlinear,
     /// A texture stands for no parameter of its material.
     #[error("a texture stands for no parameter of its material ({0})")]
     TextureSlot(String),

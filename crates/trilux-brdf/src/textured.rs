@@ -53,7 +53,8 @@ pub enum Branch {
 /// Which parameter a texture stands for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 pub enum SlotKind {
-    /// `reflectance` of a `diffuse`.
+    /// `reflectance` of a `diffuse`, `diffuse_reflectance` of a `plastic`
+    /// or `roughplastic`.
     Reflectance,
     /// `specular_reflectance` of a `roughconductor`.
     SpecularReflectance,
@@ -125,6 +126,15 @@ enum Value<const N: usize> {
 enum Node<const N: usize> {
     Diffuse(Value<N>),
     Conductor(Value<N>),
+    /// A plastic: ρ_d = scale ⊙ diffuse + fixed, glossy weight `glossy`
+    /// (its ρ_d is linear in the diffuse reflectance unless `nonlinear`,
+    /// which [`TexturedBsdf::new`] refuses with a texture).
+    Plastic {
+        diffuse: Value<N>,
+        scale: Spectrum<N>,
+        fixed: Spectrum<N>,
+        glossy: Spectrum<N>,
+    },
     Blend {
         weight: Value<N>,
         first: Box<Node<N>>,
@@ -145,6 +155,12 @@ impl<const N: usize> Node<N> {
         match self {
             Node::Diffuse(v) => (Self::value(v, slots), Spectrum::zero()),
             Node::Conductor(v) => (Spectrum::zero(), Self::value(v, slots)),
+            Node::Plastic {
+                diffuse,
+                scale,
+                fixed,
+                glossy,
+            } => (Self::value(diffuse, slots) * *scale + *fixed, *glossy),
             Node::Blend {
                 weight,
                 first,
@@ -163,6 +179,7 @@ impl<const N: usize> Node<N> {
         match self {
             Node::Diffuse(_) => 0,
             Node::Conductor(_) => 1,
+            Node::Plastic { glossy, .. } => usize::from(!glossy.is_black()),
             Node::Blend { first, second, .. } => first.conductors() + second.conductors(),
         }
     }
@@ -214,6 +231,13 @@ fn compile<const N: usize>(
                 )?),
             })
         }
+        BsdfParams::Plastic(pp) => {
+            let diffuse = slot(SlotKind::Reflectance, path, used);
+            if diffuse.is_some() && pp.nonlinear {
+                return Err(BrdfError::TexturedNonlinear);
+            }
+            plastic_node(pp, diffuse)?
+        }
         BsdfParams::Blend {
             weight,
             first,
@@ -239,6 +263,40 @@ fn compile<const N: usize>(
     })
 }
 
+/// A plastic's node: ρ_d per unit diffuse reflectance (the material with
+/// diffuse 1, less its fixed part), the fixed part (the smooth coat's
+/// mirror albedo) and the glossy weight (its specular reflectance when the
+/// coat is rough).
+fn plastic_node<const N: usize>(
+    pp: &crate::params::PlasticParams,
+    diffuse: Option<Value<N>>,
+) -> Result<Node<N>, BrdfError> {
+    let rho = |d: f64| -> Result<Spectrum<N>, BrdfError> {
+        let p = BsdfParams::Plastic(crate::params::PlasticParams {
+            diffuse_reflectance: ColorParam::Float(d),
+            ..pp.clone()
+        });
+        Ok(Bsdf::<N>::new(&p)?.diffuse_albedo(Side::Front))
+    };
+    let fixed = rho(0.0)?;
+    let scale = rho(1.0)? - fixed;
+    let glossy = if pp.coat.is_some() {
+        color(&pp.specular_reflectance, "plastic specular_reflectance")?
+    } else {
+        Spectrum::zero()
+    };
+    let diffuse = match diffuse {
+        Some(v) => v,
+        None => Value::Const(color(&pp.diffuse_reflectance, "plastic diffuse_reflectance")?),
+    };
+    Ok(Node::Plastic {
+        diffuse,
+        scale,
+        fixed,
+        glossy,
+    })
+}
+
 /// A slot's value for texture value `rgb`, within its parameter's range
 /// ([0, 1]; a weight is the luminance).
 fn slot_value(s: &TextureSlot, rgb: [f64; 3]) -> [f64; 3] {
@@ -255,6 +313,9 @@ fn set_nominal(p: &mut BsdfParams, path: &[Branch], kind: SlotKind, value: [f64;
     match (p, path.split_first()) {
         (BsdfParams::Diffuse { reflectance }, None) if kind == SlotKind::Reflectance => {
             *reflectance = ColorParam::Rgb(value);
+        }
+        (BsdfParams::Plastic(pp), None) if kind == SlotKind::Reflectance => {
+            pp.diffuse_reflectance = ColorParam::Rgb(value);
         }
         (BsdfParams::RoughConductor(rc), None) if kind == SlotKind::SpecularReflectance => {
             rc.specular_reflectance = ColorParam::Rgb(value);
@@ -471,6 +532,28 @@ impl<'a, const N: usize> Shading<'a, N> {
             (Some(parts), Some(side)) => g * parts[side].glossy,
             _ => g,
         }
+    }
+
+    /// fr less its Lambertian part (see [`Bsdf::eval_non_lambertian`]): at
+    /// a textured point, the glossy part times g plus the nominal
+    /// material's non-Lambertian base term (a plastic's) scaled by the
+    /// point's ρ_d over the nominal ρ_d.
+    pub fn eval_non_lambertian(&self, wi: DVec3, wo: DVec3) -> Spectrum<N> {
+        let all = self.bsdf.eval_non_lambertian(wi, wo);
+        let (Some(parts), Some(side)) = (&self.parts, Self::reflecting(wi, wo)) else {
+            return all;
+        };
+        let g = self.bsdf.eval_glossy(wi, wo);
+        let nominal = self.bsdf.diffuse_albedo(side);
+        let p = parts[side];
+        let ratio = Spectrum::from_fn(|b| {
+            if nominal[b] > 0.0 {
+                p.rho[b] / nominal[b]
+            } else {
+                0.0
+            }
+        });
+        g * p.glossy + (all - g) * ratio
     }
 
     /// The Lambertian reflectance ρ_d on `side`.
