@@ -94,7 +94,8 @@ fn lobe<const N: usize>(p: &BsdfParams) -> Result<Lobe<N>, BrdfError> {
     })
 }
 
-fn plastic<const N: usize>(pp: &PlasticParams) -> Result<Plastic<N>, BrdfError> {
+/// The plastic side of `pp`, its parameters checked.
+pub(crate) fn plastic<const N: usize>(pp: &PlasticParams) -> Result<Plastic<N>, BrdfError> {
     use trilux_color::Role;
     for ior in [pp.int_ior, pp.ext_ior] {
         if !(ior.is_finite() && ior > 0.0) {

@@ -47,10 +47,6 @@ pub enum BrdfError {
     /// More textures on one material than it takes.
     #[error("a material takes at most 4 textures (MAX_SLOTS), found {0}")]
     TooManyTextures(usize),
-    /// A texture on a `nonlinear` plastic: its Lambertian part would not be
-    /// linear in the texture.
-    #[error("a texture on the diffuse_reflectance of a plastic with nonlinear=true is not supported")]
-    TexturedNonlinear,
     /// A texture stands for no parameter of its material.
     #[error("a texture stands for no parameter of its material ({0})")]
     TextureSlot(String),

@@ -59,6 +59,8 @@ pub struct Plastic<const N: usize> {
     tables: Option<Arc<CoatTables>>,
     /// T̄ = 2∫T(μ)μ dμ.
     mean_transmittance: f64,
+    /// F_dr.
+    fdr: f64,
 }
 
 /// What a rough coat needs precomputed (Mitsuba's `parameters_changed`).
@@ -308,7 +310,19 @@ impl<const N: usize> Plastic<N> {
             },
             tables,
             mean_transmittance,
+            fdr,
         }
+    }
+
+    /// T̄ = 2∫T(μ)μ dμ, the coat's transmittance under uniform light.
+    pub fn mean_transmittance(&self) -> f64 {
+        self.mean_transmittance
+    }
+
+    /// F_dr: the coat's reflectance seen from inside under uniform light
+    /// (Mitsuba's fit for a smooth coat, its quadrature for a rough one).
+    pub fn internal_reflectance(&self) -> f64 {
+        self.fdr
     }
 
     /// The coat's transmittance T(μ) from outside.

@@ -126,14 +126,16 @@ enum Value<const N: usize> {
 enum Node<const N: usize> {
     Diffuse(Value<N>),
     Conductor(Value<N>),
-    /// A plastic: ρ_d = scale ⊙ diffuse + fixed, glossy weight `glossy`
-    /// (its ρ_d is linear in the diffuse reflectance unless `nonlinear`,
-    /// which [`TexturedBsdf::new`] refuses with a texture).
+    /// A plastic: ρ_d = scale ⊙ ρ' + fixed with ρ' = d/(1 − F_dr), or
+    /// d/(1 − d F_dr) when `nonlinear` (d the diffuse reflectance), glossy
+    /// weight `glossy`.
     Plastic {
         diffuse: Value<N>,
         scale: Spectrum<N>,
         fixed: Spectrum<N>,
         glossy: Spectrum<N>,
+        fdr: f64,
+        nonlinear: bool,
     },
     Blend {
         weight: Value<N>,
@@ -160,7 +162,16 @@ impl<const N: usize> Node<N> {
                 scale,
                 fixed,
                 glossy,
-            } => (Self::value(diffuse, slots) * *scale + *fixed, *glossy),
+                fdr,
+                nonlinear,
+            } => {
+                let d = Self::value(diffuse, slots);
+                let base = Spectrum::from_fn(|b| {
+                    let denom = 1.0 - if *nonlinear { d[b] * fdr } else { *fdr };
+                    d[b] / denom
+                });
+                (base * *scale + *fixed, *glossy)
+            }
             Node::Blend {
                 weight,
                 first,
@@ -233,9 +244,6 @@ fn compile<const N: usize>(
         }
         BsdfParams::Plastic(pp) => {
             let diffuse = slot(SlotKind::Reflectance, path, used);
-            if diffuse.is_some() && pp.nonlinear {
-                return Err(BrdfError::TexturedNonlinear);
-            }
             plastic_node(pp, diffuse)?
         }
         BsdfParams::Blend {
@@ -263,25 +271,25 @@ fn compile<const N: usize>(
     })
 }
 
-/// A plastic's node: ρ_d per unit diffuse reflectance (the material with
-/// diffuse 1, less its fixed part), the fixed part (the smooth coat's
-/// mirror albedo) and the glossy weight (its specular reflectance when the
-/// coat is rough).
+/// A plastic's node: ρ_d per unit ρ' (the base's T̄²/η²), the fixed part
+/// (the smooth coat's mirror albedo), the glossy weight (its specular
+/// reflectance when the coat is rough) and F_dr. ρ_d is not linear in a
+/// `nonlinear` plastic's texture: the solve takes it at the element's
+/// average reflectance, the render at each hit.
 fn plastic_node<const N: usize>(
     pp: &crate::params::PlasticParams,
     diffuse: Option<Value<N>>,
 ) -> Result<Node<N>, BrdfError> {
-    let rho = |d: f64| -> Result<Spectrum<N>, BrdfError> {
-        let p = BsdfParams::Plastic(crate::params::PlasticParams {
-            diffuse_reflectance: ColorParam::Float(d),
-            ..pp.clone()
-        });
-        Ok(Bsdf::<N>::new(&p)?.diffuse_albedo(Side::Front))
+    let p: crate::plastic::Plastic<N> = crate::bsdf::plastic(pp)?;
+    let t = p.mean_transmittance();
+    let scale = Spectrum::splat(t * t / (p.eta * p.eta));
+    let fixed = if p.coat.is_none() {
+        p.specular_reflectance * (1.0 - t)
+    } else {
+        Spectrum::zero()
     };
-    let fixed = rho(0.0)?;
-    let scale = rho(1.0)? - fixed;
-    let glossy = if pp.coat.is_some() {
-        color(&pp.specular_reflectance, "plastic specular_reflectance")?
+    let glossy = if p.coat.is_some() {
+        p.specular_reflectance
     } else {
         Spectrum::zero()
     };
@@ -294,6 +302,8 @@ fn plastic_node<const N: usize>(
         scale,
         fixed,
         glossy,
+        fdr: p.internal_reflectance(),
+        nonlinear: pp.nonlinear,
     })
 }
 

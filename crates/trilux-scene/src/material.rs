@@ -14,7 +14,7 @@
 //! `filename`, `filter_type` `bilinear` | `nearest`, `wrap_mode` `repeat` |
 //! `mirror` | `clamp`, `raw`) as the `reflectance` of `diffuse`, the
 //! `specular_reflectance` of `roughconductor`, the `diffuse_reflectance`
-//! of `plastic` and `roughplastic` (not with `nonlinear`) and the `weight` of
+//! of `plastic` and `roughplastic` and the `weight` of
 //! `blendbsdf`; the image is read when the scene is finished
 //! ([`crate::textures`]).
 //!
@@ -491,12 +491,6 @@ fn plastic(props: &Props<'_>, rough: bool, textured: bool) -> Result<PlasticPara
         ));
     }
     let nonlinear = props.boolean("nonlinear")?.unwrap_or(false);
-    if textured && nonlinear {
-        return Err(SceneError::at(
-            &props.loc("nonlinear"),
-            "a texture on diffuse_reflectance needs nonlinear=false (the Lambertian part must be linear in it)",
-        ));
-    }
     let diffuse_reflectance = if textured {
         ColorParam::Float(0.5)
     } else {
