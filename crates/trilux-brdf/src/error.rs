@@ -19,7 +19,9 @@ pub enum BrdfError {
     BadAlpha(f64),
     /// Indices of refraction must be finite and positive (and differ for a
     /// rough coat, as Mitsuba requires).
-    #[error("plastic int_ior and ext_ior must be finite, > 0 (and differ for roughplastic), got {0}")]
+    #[error(
+        "plastic int_ior and ext_ior must be finite, > 0 (and differ for roughplastic), got {0}"
+    )]
     BadIor(f64),
     /// The blend weight must lie in [0, 1].
     #[error("blendbsdf weight must lie in [0, 1], got {0}")]

@@ -102,9 +102,9 @@ impl<const N: usize> Conductor<N> {
 /// is rotated into the xz plane). ≈ 28k evaluations. Accuracy: see the
 /// tests (against docs/validation.md's table and against sampling).
 pub fn microfacet_albedo<const N: usize>(
-microfacet: &Microfacet,
-wo: DVec3,
-fresnel: impl Fn(f64) -> Spectrum<N>,
+    microfacet: &Microfacet,
+    wo: DVec3,
+    fresnel: impl Fn(f64) -> Spectrum<N>,
 ) -> Spectrum<N> {
     if wo.z <= 0.0 {
         return Spectrum::zero();

@@ -486,7 +486,11 @@ mod tests {
             // Exact for degree 2n − 1: ∫x^k over [−1, 1].
             for k in 0..(2 * n) {
                 let got: f64 = x.iter().zip(&w).map(|(x, w)| w * x.powi(k as i32)).sum();
-                let want = if k % 2 == 1 { 0.0 } else { 2.0 / (k + 1) as f64 };
+                let want = if k % 2 == 1 {
+                    0.0
+                } else {
+                    2.0 / (k + 1) as f64
+                };
                 assert!((got - want).abs() < 1e-12, "n {n} k {k}: {got} {want}");
             }
         }

@@ -295,7 +295,10 @@ fn plastic_node<const N: usize>(
     };
     let diffuse = match diffuse {
         Some(v) => v,
-        None => Value::Const(color(&pp.diffuse_reflectance, "plastic diffuse_reflectance")?),
+        None => Value::Const(color(
+            &pp.diffuse_reflectance,
+            "plastic diffuse_reflectance",
+        )?),
     };
     Ok(Node::Plastic {
         diffuse,

@@ -84,7 +84,10 @@ fn pdf_tolerance(pp: &PlasticParams) -> f64 {
 /// Mitsuba's probability of sampling a smooth coat for viewer cosθ = `f`'s
 /// angle, from F (trilux's delta weight over specular_reflectance).
 fn prob_specular(pp: &PlasticParams, f: f64) -> f64 {
-    let (d, s) = (mean(&pp.diffuse_reflectance), mean(&pp.specular_reflectance));
+    let (d, s) = (
+        mean(&pp.diffuse_reflectance),
+        mean(&pp.specular_reflectance),
+    );
     let w = s / (d + s);
     f * w / (f * w + (1.0 - f) * (1.0 - w))
 }

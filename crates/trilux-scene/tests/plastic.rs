@@ -31,7 +31,10 @@ fn err(body: &str) -> String {
 
 #[test]
 fn defaults_are_mitsubas() {
-    assert_eq!(plastic(r#"<bsdf type="plastic"/>"#), PlasticParams::smooth());
+    assert_eq!(
+        plastic(r#"<bsdf type="plastic"/>"#),
+        PlasticParams::smooth()
+    );
     let r = plastic(r#"<bsdf type="roughplastic"/>"#);
     assert_eq!(r, PlasticParams::rough());
     assert_eq!((r.int_ior, r.ext_ior), (1.49, 1.000277));

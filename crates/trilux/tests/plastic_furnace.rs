@@ -94,7 +94,10 @@ fn smooth_plastic_furnace_renders_two() {
         .filter(|p| p.iter().all(|&c| (c - 2.0).abs() <= 0.02 * 2.0))
         .count() as f64
         / img.pixels().len() as f64;
-    println!("d = {d}: mean {:?}, {within:.4} of pixels within 2 %", img.mean());
+    println!(
+        "d = {d}: mean {:?}, {within:.4} of pixels within 2 %",
+        img.mean()
+    );
     for m in img.mean() {
         assert!((m - 2.0).abs() <= 0.005 * 2.0, "mean {:?}", img.mean());
     }
