@@ -75,8 +75,10 @@ pub struct CoatTables {
 /// Tables already computed, by (distribution, α, η) bits: scenes reuse a
 /// few coats for many materials, and each table costs ≈ 1 M microfacet
 /// samples.
-fn table_cache() -> &'static Mutex<HashMap<(bool, u64, u64), Arc<CoatTables>>> {
-    static CACHE: OnceLock<Mutex<HashMap<(bool, u64, u64), Arc<CoatTables>>>> = OnceLock::new();
+type TableCache = Mutex<HashMap<(bool, u64, u64), Arc<CoatTables>>>;
+
+fn table_cache() -> &'static TableCache {
+    static CACHE: OnceLock<TableCache> = OnceLock::new();
     CACHE.get_or_init(|| Mutex::new(HashMap::new()))
 }
 
