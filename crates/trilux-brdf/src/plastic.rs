@@ -33,9 +33,9 @@ use std::sync::{Arc, Mutex, OnceLock};
 use glam::{DVec2, DVec3};
 use trilux_color::Spectrum;
 
+use crate::frame::square_to_cosine_hemisphere;
 use crate::fresnel::{fresnel_dielectric, fresnel_diffuse_reflectance};
-use crate::lobe::{microfacet_albedo, square_to_cosine_hemisphere};
-use crate::microfacet::Microfacet;
+use crate::microfacet::{Microfacet, microfacet_albedo};
 use crate::params::Distribution;
 
 /// Entries of the rough coat's transmittance table (Mitsuba's
