@@ -24,13 +24,18 @@ For each scene it writes
                              emitter: what was there, what it became, why
 
 What trilux reads (README "Scene format"): diffuse, roughconductor (isotropic
-GGX or Beckmann, alpha > 0), blendbsdf, twosided, bitmap textures, area
+GGX or Beckmann, alpha > 0), plastic, roughplastic, blendbsdf, twosided, bitmap textures, area
 emitters on shapes; obj/ply/rectangle/cube/disk/sphere/cylinder shapes. The
 rules for everything else (the nearest supported equivalent, or removal):
 
-    plastic, roughplastic, phong, ward, roughdiffuse
+    plastic, roughplastic
+                        -> kept (Mitsuba 3's names: diffuse_reflectance,
+                           specular_reflectance, int_ior, ext_ior, nonlinear;
+                           roughplastic's distribution and alpha as for
+                           roughconductor below)
+    phong, ward, roughdiffuse
                         -> diffuse with the diffuse reflectance (the specular
-                           coat or lobe is dropped)
+                           lobe is dropped)
     conductor           -> roughconductor, GGX, alpha = MIN_ALPHA (the smallest
                            roughness trilux's glTF reader maps to; a mirror
                            cannot be resolved by an element-based solve), same
@@ -357,7 +362,9 @@ class MaterialBuilder:
         if typ == "diffuse":
             x, uv = self.color(e, "reflectance", 0.5, label)
             return '<bsdf type="diffuse">' + x.format(n="reflectance") + "</bsdf>", uv
-        if typ in ("plastic", "roughplastic", "phong", "ward", "roughdiffuse"):
+        if typ in ("plastic", "roughplastic"):
+            return self.plastic(e, typ, label)
+        if typ in ("phong", "ward", "roughdiffuse"):
             pname = "reflectance" if typ == "roughdiffuse" else "diffuseReflectance"
             x, uv = self.color(e, pname, 0.5, label)
             why = {"roughdiffuse": "Mitsuba 3 and trilux have no Oren-Nayar; its Lambertian limit",
@@ -395,6 +402,54 @@ class MaterialBuilder:
         self.notes.add("material", f"`{label}`: {typ}", "diffuse 0.5", "no nearer model in trilux")
         return '<bsdf type="diffuse"/>', False
 
+    def roughness(self, e, label):
+        """0.6 distribution and alpha(U/V) -> (Mitsuba 3 distribution, isotropic alpha)."""
+        dist = sval(e, "distribution", "beckmann")
+        au, av = fval(e, "alphaU"), fval(e, "alphaV")
+        alpha = fval(e, "alpha", 0.1)
+        if au is not None or av is not None:
+            au = au if au is not None else 0.1
+            av = av if av is not None else 0.1
+            alpha = 0.5 * (au + av)
+            if au != av:
+                self.notes.add("material", f"`{label}`: anisotropic alpha {au}/{av}", f"alpha {alpha}", "trilux refuses anisotropic roughness")
+        if dist not in ("ggx", "beckmann"):
+            self.notes.add("material", f"`{label}`: distribution {dist}", "ggx", "Mitsuba 3 and trilux have Beckmann and GGX only")
+            dist = "ggx"
+        if alpha < MIN_ALPHA:
+            self.notes.add("material", f"`{label}`: alpha {alpha}", f"alpha {MIN_ALPHA}", "the smallest roughness trilux resolves")
+            alpha = MIN_ALPHA
+        return dist, alpha
+
+    def plastic(self, e, typ, label):
+        """plastic/roughplastic, kept: Mitsuba 0.6 names -> Mitsuba 3 names."""
+        parts = []
+        if typ == "roughplastic":
+            dist, alpha = self.roughness(e, label)
+            parts.append(f'<string name="distribution" value="{dist}"/><float name="alpha" value="{alpha:g}"/>')
+        for old, new in (("intIOR", "int_ior"), ("extIOR", "ext_ior")):
+            p = prop(e, old)
+            if p is None:
+                continue
+            if p.tag == "string":
+                parts.append(f'<string name="{new}" value="{p.get("value")}"/>')
+            else:
+                parts.append(f'<float name="{new}" value="{float(p.get("value")):g}"/>')
+        nl = prop(e, "nonlinear")
+        if nl is not None and nl.get("value") == "true":
+            parts.append('<boolean name="nonlinear" value="true"/>')
+        x, uv = self.color(e, "diffuseReflectance", 0.5, label)
+        parts.append(x.format(n="diffuse_reflectance"))
+        sp = prop(e, "specularReflectance")
+        if sp is not None:
+            if self.resolve(sp).tag == "texture":
+                self.notes.add("material", f"`{label}`: {typ} with a specularReflectance texture", "specular_reflectance 1",
+                               "trilux takes a texture on a plastic's diffuse_reflectance only")
+            else:
+                y, _ = self.color(e, "specularReflectance", 1.0, label)
+                parts.append(y.format(n="specular_reflectance"))
+        return f'<bsdf type="{typ}">' + "".join(parts) + "</bsdf>", uv
+
     def conductor(self, e, typ, label):
         parts = []
         if typ == "conductor":
@@ -403,21 +458,7 @@ class MaterialBuilder:
             self.notes.add("material", f"`{label}`: conductor (smooth)", f"roughconductor GGX alpha {MIN_ALPHA}",
                            "trilux needs alpha > 0; 0.01 is the smallest roughness it maps glTF to (a mirror cannot be resolved by elements)")
         else:
-            dist = sval(e, "distribution", "beckmann")
-            au, av = fval(e, "alphaU"), fval(e, "alphaV")
-            alpha = fval(e, "alpha", 0.1)
-            if au is not None or av is not None:
-                au = au if au is not None else 0.1
-                av = av if av is not None else 0.1
-                alpha = 0.5 * (au + av)
-                if au != av:
-                    self.notes.add("material", f"`{label}`: anisotropic alpha {au}/{av}", f"alpha {alpha}", "trilux refuses anisotropic roughness")
-            if dist not in ("ggx", "beckmann"):
-                self.notes.add("material", f"`{label}`: distribution {dist}", "ggx", "Mitsuba 3 and trilux have Beckmann and GGX only")
-                dist = "ggx"
-            if alpha < MIN_ALPHA:
-                self.notes.add("material", f"`{label}`: alpha {alpha}", f"alpha {MIN_ALPHA}", "the smallest roughness trilux resolves")
-                alpha = MIN_ALPHA
+            dist, alpha = self.roughness(e, label)
         parts.append(f'<string name="distribution" value="{dist}"/><float name="alpha" value="{alpha:g}"/>')
         material = sval(e, "material")
         eta, k = prop(e, "eta"), prop(e, "k")

@@ -15,7 +15,8 @@ use trilux_frame::Side;
 use crate::error::BrdfError;
 use crate::lobe::{Conductor, Lobe};
 use crate::microfacet::Microfacet;
-use crate::params::BsdfParams;
+use crate::params::{BsdfParams, PlasticParams};
+use crate::plastic::Plastic;
 
 /// A sampled light direction for a given viewer direction.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -74,6 +75,7 @@ fn lobe<const N: usize>(p: &BsdfParams) -> Result<Lobe<N>, BrdfError> {
                 )?,
             })
         }
+        BsdfParams::Plastic(pp) => Lobe::Plastic(plastic(pp)?),
         BsdfParams::Blend {
             weight,
             first,
@@ -90,6 +92,50 @@ fn lobe<const N: usize>(p: &BsdfParams) -> Result<Lobe<N>, BrdfError> {
         }
         BsdfParams::TwoSided { .. } => return Err(BrdfError::NestedTwoSided),
     })
+}
+
+/// The plastic side of `pp`, its parameters checked.
+pub(crate) fn plastic<const N: usize>(pp: &PlasticParams) -> Result<Plastic<N>, BrdfError> {
+    use trilux_color::Role;
+    for ior in [pp.int_ior, pp.ext_ior] {
+        if !(ior.is_finite() && ior > 0.0) {
+            return Err(BrdfError::BadIor(ior));
+        }
+    }
+    if pp.coat.is_some() && pp.int_ior == pp.ext_ior {
+        return Err(BrdfError::BadIor(pp.int_ior));
+    }
+    let coat = match pp.coat {
+        None => None,
+        Some((distribution, alpha)) => {
+            if !(alpha.is_finite() && alpha > 0.0) {
+                return Err(BrdfError::BadAlpha(alpha));
+            }
+            Some(Microfacet {
+                distribution,
+                alpha,
+            })
+        }
+    };
+    let diffuse: Spectrum<N> = color(
+        "plastic diffuse_reflectance",
+        &pp.diffuse_reflectance,
+        Role::Reflectance,
+    )?;
+    let specular: Spectrum<N> = color(
+        "plastic specular_reflectance",
+        &pp.specular_reflectance,
+        Role::Reflectance,
+    )?;
+    let mean = |s: &Spectrum<N>| s.0.iter().sum::<f64>() / N as f64;
+    Ok(Plastic::new(
+        diffuse,
+        specular,
+        pp.int_ior / pp.ext_ior,
+        pp.nonlinear,
+        coat,
+        (mean(&diffuse), mean(&specular)),
+    ))
 }
 
 impl<const N: usize> Bsdf<N> {
@@ -159,6 +205,31 @@ impl<const N: usize> Bsdf<N> {
         }
     }
 
+    /// fr less its Lambertian part ρ_d/π: what a gather must estimate
+    /// beyond the solution's Lambertian radiance. It equals
+    /// [`Bsdf::eval_glossy`] except for plastics, whose base term is not
+    /// Lambertian (it may be negative there; see [`crate::plastic`]).
+    pub fn eval_non_lambertian(&self, wi: DVec3, wo: DVec3) -> Spectrum<N> {
+        match self.oriented(wi, wo) {
+            Some((l, wi, wo)) => {
+                Self::finite(l.eval(wi, wo) - l.diffuse_albedo() * std::f64::consts::FRAC_1_PI)
+            }
+            None => Spectrum::zero(),
+        }
+    }
+
+    /// The mirror reflection of a smooth coat (`plastic`) for viewer `wo`
+    /// (local frame): the direction towards the light and the fraction
+    /// reflected, which [`Bsdf::eval`] and [`Bsdf::sample`] leave out (a
+    /// delta lobe). `None` for materials without one.
+    pub fn delta_reflection(&self, wo: DVec3) -> Option<(DVec3, Spectrum<N>)> {
+        let side = Side::of_local(wo)?;
+        let l = self.side(side)?;
+        let sign = if side == Side::Front { 1.0 } else { -1.0 };
+        let (wi, w) = l.delta(DVec3::new(wo.x, wo.y, wo.z * sign))?;
+        Some((DVec3::new(wi.x, wi.y, wi.z * sign), w))
+    }
+
     /// The Lambertian part's BRDF value fr_d = ρ_d/π on `side` (a constant).
     pub fn diffuse_reflectance(&self, side: Side) -> Spectrum<N> {
         self.diffuse_albedo(side) * std::f64::consts::FRAC_1_PI
@@ -221,7 +292,8 @@ impl<const N: usize> Bsdf<N> {
 
     /// Directional albedo ∫ fr(wi, wo) |cosθi| dωi for viewer `wo`: the
     /// fraction of light arriving from all directions (or, by reciprocity,
-    /// leaving towards all directions) that is reflected. ≤ 1 per band.
+    /// leaving towards all directions) that is reflected, a smooth coat's
+    /// mirror included. ≤ 1 per band.
     pub fn albedo(&self, wo: DVec3) -> Spectrum<N> {
         let Some(side) = Side::of_local(wo) else {
             return Spectrum::zero();

@@ -15,8 +15,14 @@ pub enum BrdfError {
         source: trilux_color::ColorError,
     },
     /// Roughness must be finite and positive.
-    #[error("roughconductor alpha must be finite and > 0, got {0}")]
+    #[error("roughness alpha must be finite and > 0, got {0}")]
     BadAlpha(f64),
+    /// Indices of refraction must be finite and positive (and differ for a
+    /// rough coat, as Mitsuba requires).
+    #[error(
+        "plastic int_ior and ext_ior must be finite, > 0 (and differ for roughplastic), got {0}"
+    )]
+    BadIor(f64),
     /// The blend weight must lie in [0, 1].
     #[error("blendbsdf weight must lie in [0, 1], got {0}")]
     BadWeight(f64),

@@ -4,7 +4,7 @@
 //! surface's front normal (after `flip_normals`); `wi` points towards the
 //! light and `wo` towards the viewer, both away from the surface.
 
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 
 /// An orthonormal frame (s, t, n) with n the front normal.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -41,6 +41,25 @@ impl Frame {
 /// from the surface).
 pub fn reflect(v: DVec3, n: DVec3) -> DVec3 {
     2.0 * v.dot(n) * n - v
+}
+
+/// Malley's method: a concentric disk sample lifted to the hemisphere; pdf
+/// cosθ/π.
+pub fn square_to_cosine_hemisphere(u: DVec2) -> DVec3 {
+    let a = 2.0 * u - DVec2::ONE;
+    let (r, phi) = if a.x == 0.0 && a.y == 0.0 {
+        (0.0, 0.0)
+    } else if a.x.abs() > a.y.abs() {
+        (a.x, std::f64::consts::FRAC_PI_4 * (a.y / a.x))
+    } else {
+        (
+            a.y,
+            std::f64::consts::FRAC_PI_2 - std::f64::consts::FRAC_PI_4 * (a.x / a.y),
+        )
+    };
+    let d = DVec2::new(r * phi.cos(), r * phi.sin());
+    let z = (1.0 - d.length_squared()).max(0.0).sqrt();
+    DVec3::new(d.x, d.y, z)
 }
 
 #[cfg(test)]

@@ -15,12 +15,15 @@
 //! - [`frame`]: local frames (z = front normal; `wi` to the light, `wo` to the
 //!   viewer).
 //! - [`lobe`]: one side of a material: `diffuse`, `roughconductor`,
-//!   `blendbsdf`.
+//!   `plastic`/`roughplastic`, `blendbsdf`.
+//! - [`plastic`]: Mitsuba's `plastic` and `roughplastic` (a diffuse base
+//!   under a dielectric coat) and how the solver splits them.
 //! - [`microfacet`]: Mitsuba's Beckmann and GGX D, separable Smith G (its
 //!   rational G1 for Beckmann), and their sampling.
 //! - `special` (private): erf and its inverse (Beckmann visible-normal
 //!   sampling).
-//! - `fresnel` (private): conductor Fresnel from η and k.
+//! - `fresnel` (private): conductor Fresnel from η and k, dielectric
+//!   Fresnel and its diffuse reflectance F_dr.
 //! - [`albedo`]: [`AlbedoTable`], the directional albedo tabulated per
 //!   degree for frequent use.
 //! - [`texture`]: bitmap textures ([`Texture`]) with Mitsuba 3's
@@ -44,6 +47,7 @@ mod fresnel;
 pub mod lobe;
 pub mod microfacet;
 pub mod params;
+pub mod plastic;
 mod special;
 pub mod texture;
 pub mod textured;
@@ -56,7 +60,10 @@ pub use area::{
 pub use bsdf::{Bsdf, BsdfSample};
 pub use error::BrdfError;
 pub use frame::Frame;
-pub use params::{BsdfParams, Distribution, RoughConductorParams};
+pub use params::{
+    BsdfParams, Distribution, NAMED_IORS, PlasticParams, RoughConductorParams, named_ior,
+};
+pub use plastic::Plastic;
 pub use texture::{Filter, Texture, UvTransform, Wrap};
 pub use textured::{Branch, PointParts, Shading, SlotKind, SlotValues, TextureSlot, TexturedBsdf};
 pub use trilux_frame::Side;

@@ -1,15 +1,16 @@
 //! One side of a material: the one-sided models of Mitsuba 3's subset
-//! (`diffuse`, `roughconductor`, `blendbsdf`) in the local frame of their
+//! (`diffuse`, `roughconductor`, `plastic`/`roughplastic`, `blendbsdf`) in the local frame of their
 //! front side. Every function here assumes `wo.z > 0` and returns zero when
 //! `wi.z ≤ 0` (no transmission).
 
-use std::f64::consts::{FRAC_1_PI, PI};
+use std::f64::consts::FRAC_1_PI;
 
 use glam::{DVec2, DVec3};
 use trilux_color::Spectrum;
 
 use crate::fresnel::fresnel_conductor;
-use crate::microfacet::Microfacet;
+use crate::microfacet::{Microfacet, microfacet_albedo};
+use crate::plastic::Plastic;
 
 /// A rough conductor, ready to evaluate.
 #[derive(Clone, Debug, PartialEq)]
@@ -83,64 +84,9 @@ impl<const N: usize> Conductor<N> {
         if p.is_finite() { p } else { 0.0 }
     }
 
-    /// Directional albedo ∫ fr(wi, wo) cosθi dωi by deterministic quadrature
-    /// over the microfacet normal: m is mapped from the unit square by the
-    /// inverse CDF of D(m)cosθ_m in θ (u) and uniformly in φ, so the remaining
-    /// integrand F·G·|wo·m|/(cosθo cosθm) is smooth (it is continuous where
-    /// wi or m cross the horizon, since G1 and wo·m vanish there). The u axis
-    /// is split into dyadic segments [1 − 2^−s, 1 − 2^−(s+1)] (24 of them,
-    /// 12 midpoints each) so that the distributions' long tails are resolved;
-    /// φ uses 96 midpoints over a half turn (the integrand is even in φ once wo
-    /// is rotated into the xz plane). ≈ 28k evaluations. Accuracy: see the
-    /// tests (against docs/validation.md's table and against sampling).
+    /// Directional albedo ∫ fr(wi, wo) cosθi dωi ([`microfacet_albedo`]).
     pub fn albedo(&self, wo: DVec3) -> Spectrum<N> {
-        if wo.z <= 0.0 {
-            return Spectrum::zero();
-        }
-        // Rotate wo into the xz plane (isotropic model).
-        let wo = DVec3::new((1.0 - wo.z * wo.z).max(0.0).sqrt(), 0.0, wo.z);
-        const SEGMENTS: usize = 24;
-        const PER_SEGMENT: usize = 12;
-        const NPHI: usize = 96;
-        let a2 = self.microfacet.alpha * self.microfacet.alpha;
-        let mut acc = Spectrum::<N>::zero();
-        for seg in 0..SEGMENTS {
-            let lo = 1.0 - 0.5f64.powi(seg as i32);
-            let width = if seg + 1 == SEGMENTS {
-                1.0 - lo
-            } else {
-                0.5f64.powi(seg as i32 + 1)
-            };
-            for i in 0..PER_SEGMENT {
-                let u = lo + (i as f64 + 0.5) / PER_SEGMENT as f64 * width;
-                let du = width / PER_SEGMENT as f64;
-                let tan2 = match self.microfacet.distribution {
-                    crate::Distribution::Beckmann => -a2 * (1.0 - u).ln(),
-                    crate::Distribution::Ggx => a2 * u / (1.0 - u),
-                };
-                let cos_m = 1.0 / (1.0 + tan2).sqrt();
-                let sin_m = (1.0 - cos_m * cos_m).max(0.0).sqrt();
-                let mut ring = Spectrum::<N>::zero();
-                for j in 0..NPHI {
-                    let phi = (j as f64 + 0.5) / NPHI as f64 * PI;
-                    let m = DVec3::new(sin_m * phi.cos(), sin_m * phi.sin(), cos_m);
-                    let dot = wo.dot(m);
-                    if dot <= 0.0 {
-                        continue;
-                    }
-                    let wi = 2.0 * dot * m - wo;
-                    if wi.z <= 0.0 {
-                        continue;
-                    }
-                    let w = self.microfacet.g(wi, wo, m) * dot / (wo.z * cos_m);
-                    if w.is_finite() {
-                        ring += self.fresnel(dot) * w;
-                    }
-                }
-                acc += ring * (du / NPHI as f64);
-            }
-        }
-        acc
+        microfacet_albedo(&self.microfacet, wo, |c| self.fresnel(c))
     }
 }
 
@@ -154,6 +100,8 @@ pub enum Lobe<const N: usize> {
     },
     /// Rough conductor.
     Conductor(Conductor<N>),
+    /// Plastic (smooth or rough coat).
+    Plastic(Plastic<N>),
     /// (1 − weight)·first + weight·second.
     Blend {
         /// Weight of `second`.
@@ -177,6 +125,7 @@ impl<const N: usize> Lobe<N> {
                 }
             }
             Lobe::Conductor(c) => c.eval(wi, wo),
+            Lobe::Plastic(p) => p.eval(wi, wo),
             Lobe::Blend {
                 weight,
                 first,
@@ -190,6 +139,7 @@ impl<const N: usize> Lobe<N> {
         match self {
             Lobe::Diffuse { .. } => Spectrum::zero(),
             Lobe::Conductor(c) => c.eval(wi, wo),
+            Lobe::Plastic(p) => p.eval_coat(wi, wo),
             Lobe::Blend {
                 weight,
                 first,
@@ -203,6 +153,7 @@ impl<const N: usize> Lobe<N> {
         match self {
             Lobe::Diffuse { rho } => *rho,
             Lobe::Conductor(_) => Spectrum::zero(),
+            Lobe::Plastic(p) => p.diffuse_albedo(),
             Lobe::Blend {
                 weight,
                 first,
@@ -216,6 +167,7 @@ impl<const N: usize> Lobe<N> {
         match self {
             Lobe::Diffuse { .. } => false,
             Lobe::Conductor(c) => !c.specular_reflectance.is_black(),
+            Lobe::Plastic(p) => p.coat.is_some() && !p.specular_reflectance.is_black(),
             Lobe::Blend {
                 weight,
                 first,
@@ -230,6 +182,7 @@ impl<const N: usize> Lobe<N> {
         match self {
             Lobe::Diffuse { .. } => None,
             Lobe::Conductor(c) => Some(c.microfacet.alpha),
+            Lobe::Plastic(p) => p.coat.map(|m| m.alpha),
             Lobe::Blend {
                 weight,
                 first,
@@ -250,11 +203,34 @@ impl<const N: usize> Lobe<N> {
         match self {
             Lobe::Diffuse { rho } => rho.is_black(),
             Lobe::Conductor(c) => c.specular_reflectance.is_black(),
+            Lobe::Plastic(p) => p.base.is_black() && p.specular_reflectance.is_black(),
             Lobe::Blend {
                 weight,
                 first,
                 second,
             } => (*weight >= 1.0 || first.is_black()) && (*weight <= 0.0 || second.is_black()),
+        }
+    }
+
+    /// The mirror reflection of a smooth coat for viewer `wo`: its
+    /// direction and weight (the fraction of light it reflects), `None`
+    /// when there is none.
+    pub fn delta(&self, wo: DVec3) -> Option<(DVec3, Spectrum<N>)> {
+        match self {
+            Lobe::Diffuse { .. } | Lobe::Conductor(_) => None,
+            Lobe::Plastic(p) => p.delta(wo),
+            Lobe::Blend {
+                weight,
+                first,
+                second,
+            } => {
+                let a = first.delta(wo).map(|(d, w)| (d, w * (1.0 - weight)));
+                let b = second.delta(wo).map(|(d, w)| (d, w * *weight));
+                match (a, b) {
+                    (Some((d, x)), Some((_, y))) => Some((d, x + y)),
+                    (x, y) => x.or(y),
+                }
+            }
         }
     }
 
@@ -266,6 +242,7 @@ impl<const N: usize> Lobe<N> {
                 (wi.z > 0.0).then_some(wi)
             }
             Lobe::Conductor(c) => c.sample(wo, u),
+            Lobe::Plastic(p) => p.sample(wo, u),
             Lobe::Blend {
                 weight,
                 first,
@@ -296,6 +273,7 @@ impl<const N: usize> Lobe<N> {
                 }
             }
             Lobe::Conductor(c) => c.pdf(wo, wi),
+            Lobe::Plastic(p) => p.pdf(wo, wi),
             Lobe::Blend {
                 weight,
                 first,
@@ -321,6 +299,7 @@ impl<const N: usize> Lobe<N> {
         match self {
             Lobe::Diffuse { rho } => *rho,
             Lobe::Conductor(c) => c.albedo(wo),
+            Lobe::Plastic(p) => p.albedo(wo),
             Lobe::Blend {
                 weight,
                 first,
@@ -339,21 +318,4 @@ impl<const N: usize> Lobe<N> {
     }
 }
 
-/// Malley's method: a concentric disk sample lifted to the hemisphere; pdf
-/// cosθ/π.
-pub fn square_to_cosine_hemisphere(u: DVec2) -> DVec3 {
-    let a = 2.0 * u - DVec2::ONE;
-    let (r, phi) = if a.x == 0.0 && a.y == 0.0 {
-        (0.0, 0.0)
-    } else if a.x.abs() > a.y.abs() {
-        (a.x, std::f64::consts::FRAC_PI_4 * (a.y / a.x))
-    } else {
-        (
-            a.y,
-            std::f64::consts::FRAC_PI_2 - std::f64::consts::FRAC_PI_4 * (a.x / a.y),
-        )
-    };
-    let d = DVec2::new(r * phi.cos(), r * phi.sin());
-    let z = (1.0 - d.length_squared()).max(0.0).sqrt();
-    DVec3::new(d.x, d.y, z)
-}
+pub use crate::frame::square_to_cosine_hemisphere;

@@ -53,7 +53,8 @@ pub enum Branch {
 /// Which parameter a texture stands for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 pub enum SlotKind {
-    /// `reflectance` of a `diffuse`.
+    /// `reflectance` of a `diffuse`, `diffuse_reflectance` of a `plastic`
+    /// or `roughplastic`.
     Reflectance,
     /// `specular_reflectance` of a `roughconductor`.
     SpecularReflectance,
@@ -125,6 +126,17 @@ enum Value<const N: usize> {
 enum Node<const N: usize> {
     Diffuse(Value<N>),
     Conductor(Value<N>),
+    /// A plastic: ρ_d = scale ⊙ ρ' + fixed with ρ' = d/(1 − F_dr), or
+    /// d/(1 − d F_dr) when `nonlinear` (d the diffuse reflectance), glossy
+    /// weight `glossy`.
+    Plastic {
+        diffuse: Value<N>,
+        scale: Spectrum<N>,
+        fixed: Spectrum<N>,
+        glossy: Spectrum<N>,
+        fdr: f64,
+        nonlinear: bool,
+    },
     Blend {
         weight: Value<N>,
         first: Box<Node<N>>,
@@ -145,6 +157,21 @@ impl<const N: usize> Node<N> {
         match self {
             Node::Diffuse(v) => (Self::value(v, slots), Spectrum::zero()),
             Node::Conductor(v) => (Spectrum::zero(), Self::value(v, slots)),
+            Node::Plastic {
+                diffuse,
+                scale,
+                fixed,
+                glossy,
+                fdr,
+                nonlinear,
+            } => {
+                let d = Self::value(diffuse, slots);
+                let base = Spectrum::from_fn(|b| {
+                    let denom = 1.0 - if *nonlinear { d[b] * fdr } else { *fdr };
+                    d[b] / denom
+                });
+                (base * *scale + *fixed, *glossy)
+            }
             Node::Blend {
                 weight,
                 first,
@@ -163,6 +190,7 @@ impl<const N: usize> Node<N> {
         match self {
             Node::Diffuse(_) => 0,
             Node::Conductor(_) => 1,
+            Node::Plastic { glossy, .. } => usize::from(!glossy.is_black()),
             Node::Blend { first, second, .. } => first.conductors() + second.conductors(),
         }
     }
@@ -214,6 +242,10 @@ fn compile<const N: usize>(
                 )?),
             })
         }
+        BsdfParams::Plastic(pp) => {
+            let diffuse = slot(SlotKind::Reflectance, path, used);
+            plastic_node(pp, diffuse)?
+        }
         BsdfParams::Blend {
             weight,
             first,
@@ -239,6 +271,45 @@ fn compile<const N: usize>(
     })
 }
 
+/// A plastic's node: ρ_d per unit ρ' (the base's T̄²/η²), the fixed part
+/// (the smooth coat's mirror albedo), the glossy weight (its specular
+/// reflectance when the coat is rough) and F_dr. ρ_d is not linear in a
+/// `nonlinear` plastic's texture: the solve takes it at the element's
+/// average reflectance, the render at each hit.
+fn plastic_node<const N: usize>(
+    pp: &crate::params::PlasticParams,
+    diffuse: Option<Value<N>>,
+) -> Result<Node<N>, BrdfError> {
+    let p: crate::plastic::Plastic<N> = crate::bsdf::plastic(pp)?;
+    let t = p.mean_transmittance();
+    let scale = Spectrum::splat(t * t / (p.eta * p.eta));
+    let fixed = if p.coat.is_none() {
+        p.specular_reflectance * (1.0 - t)
+    } else {
+        Spectrum::zero()
+    };
+    let glossy = if p.coat.is_some() {
+        p.specular_reflectance
+    } else {
+        Spectrum::zero()
+    };
+    let diffuse = match diffuse {
+        Some(v) => v,
+        None => Value::Const(color(
+            &pp.diffuse_reflectance,
+            "plastic diffuse_reflectance",
+        )?),
+    };
+    Ok(Node::Plastic {
+        diffuse,
+        scale,
+        fixed,
+        glossy,
+        fdr: p.internal_reflectance(),
+        nonlinear: pp.nonlinear,
+    })
+}
+
 /// A slot's value for texture value `rgb`, within its parameter's range
 /// ([0, 1]; a weight is the luminance).
 fn slot_value(s: &TextureSlot, rgb: [f64; 3]) -> [f64; 3] {
@@ -255,6 +326,9 @@ fn set_nominal(p: &mut BsdfParams, path: &[Branch], kind: SlotKind, value: [f64;
     match (p, path.split_first()) {
         (BsdfParams::Diffuse { reflectance }, None) if kind == SlotKind::Reflectance => {
             *reflectance = ColorParam::Rgb(value);
+        }
+        (BsdfParams::Plastic(pp), None) if kind == SlotKind::Reflectance => {
+            pp.diffuse_reflectance = ColorParam::Rgb(value);
         }
         (BsdfParams::RoughConductor(rc), None) if kind == SlotKind::SpecularReflectance => {
             rc.specular_reflectance = ColorParam::Rgb(value);
@@ -471,6 +545,28 @@ impl<'a, const N: usize> Shading<'a, N> {
             (Some(parts), Some(side)) => g * parts[side].glossy,
             _ => g,
         }
+    }
+
+    /// fr less its Lambertian part (see [`Bsdf::eval_non_lambertian`]): at
+    /// a textured point, the glossy part times g plus the nominal
+    /// material's non-Lambertian base term (a plastic's) scaled by the
+    /// point's ρ_d over the nominal ρ_d.
+    pub fn eval_non_lambertian(&self, wi: DVec3, wo: DVec3) -> Spectrum<N> {
+        let all = self.bsdf.eval_non_lambertian(wi, wo);
+        let (Some(parts), Some(side)) = (&self.parts, Self::reflecting(wi, wo)) else {
+            return all;
+        };
+        let g = self.bsdf.eval_glossy(wi, wo);
+        let nominal = self.bsdf.diffuse_albedo(side);
+        let p = parts[side];
+        let ratio = Spectrum::from_fn(|b| {
+            if nominal[b] > 0.0 {
+                p.rho[b] / nominal[b]
+            } else {
+                0.0
+            }
+        });
+        g * p.glossy + (all - g) * ratio
     }
 
     /// The Lambertian reflectance ρ_d on `side`.

@@ -138,8 +138,9 @@ pub trait SolutionGather<const N: usize>: GatherScene<N> {
     /// True when the BSDF at `at` has a glossy part on the side of `wo`.
     fn is_glossy(&self, at: &SurfacePoint<Self::Locator>, wo: DVec3) -> bool;
 
-    /// The glossy part fr_glossy(ω_i, ω_o)·|cos θ_i| of
-    /// [`GatherScene::bsdf_cos`].
+    /// The part of [`GatherScene::bsdf_cos`] beyond the Lambertian ρ_d/π,
+    /// (fr − ρ_d/π)·|cos θ_i|: the glossy part, and for plastics also their
+    /// base term's departure from Lambertian (which may be negative).
     fn glossy_cos(&self, at: &SurfacePoint<Self::Locator>, wi: DVec3, wo: DVec3) -> Spectrum<N>;
 
     /// The solution's reflected radiance at `from` towards `towards`

@@ -373,7 +373,9 @@ impl<const N: usize, S: RadianceSolution<N>> SolutionGather<N> for SolvedScene<'
     fn glossy_cos(&self, at: &SurfacePoint<HitLocator>, wi: DVec3, wo: DVec3) -> Spectrum<N> {
         let frame = Frame::from_normal(at.locator.shading_normal);
         let (wi, wo) = (frame.to_local(wi), frame.to_local(wo));
-        self.bsdf(at).eval_glossy(wi, wo) * wi.z.abs()
+        // fr less ρ_d/π: the glossy part, and for plastics also the base
+        // term's departure from Lambertian (trilux_brdf::plastic).
+        self.bsdf(at).eval_non_lambertian(wi, wo) * wi.z.abs()
     }
 
     fn reflected_glossy(

@@ -214,6 +214,9 @@ fn bsdf_is_sampled(b: &BsdfParams) -> bool {
                     .as_ref()
                     .is_some_and(|(eta, k)| eta.is_sampled() || k.is_sampled())
         }
+        BsdfParams::Plastic(p) => {
+            p.diffuse_reflectance.is_sampled() || p.specular_reflectance.is_sampled()
+        }
         BsdfParams::Blend { first, second, .. } => {
             bsdf_is_sampled(first) || bsdf_is_sampled(second)
         }

@@ -5,26 +5,31 @@
 //! |---|---|
 //! | `diffuse` | `reflectance` (0.5) |
 //! | `roughconductor` | `distribution` (`beckmann` \| `ggx`), `alpha` (0.1) or `alpha_u` = `alpha_v`, `material` (`none`: Fresnel = 1), `eta` (0) / `k` (1), `specular_reflectance` (1); `sample_visible` ignored |
+//! | `plastic` | `diffuse_reflectance` (0.5), `specular_reflectance` (1), `int_ior` (`polypropylene`: 1.49) / `ext_ior` (`air`: 1.000277), as a float or one of Mitsuba's named indices (`bk7`, `water`, …), `nonlinear` (false) |
+//! | `roughplastic` | as `plastic`, with `distribution` (`beckmann` \| `ggx`) and `alpha` (0.1) or `alpha_u` = `alpha_v`; `sample_visible` ignored |
 //! | `blendbsdf` | `weight` (required, in \[0, 1\]), two nested BSDFs |
 //! | `twosided` | one nested BSDF (both sides) or two (front, back) |
 //!
 //! Textures: `<texture type="bitmap" name="...">` (Mitsuba's `bitmap`:
 //! `filename`, `filter_type` `bilinear` | `nearest`, `wrap_mode` `repeat` |
 //! `mirror` | `clamp`, `raw`) as the `reflectance` of `diffuse`, the
-//! `specular_reflectance` of `roughconductor` and the `weight` of
+//! `specular_reflectance` of `roughconductor`, the `diffuse_reflectance`
+//! of `plastic` and `roughplastic` and the `weight` of
 //! `blendbsdf`; the image is read when the scene is finished
 //! ([`crate::textures`]).
 //!
 //! Refused: other plugins, anisotropic roughness (`alpha_u` ≠ `alpha_v`),
-//! named conductor materials, other textures, `alpha` ≤ 0, negative (but
-//! for a conductor's `eta` and `k`, as in Mitsuba) or NaN values, and
-//! reflectances above 1 (they would create energy and keep the
+//! named conductor materials, other textures, `alpha` ≤ 0, indices of
+//! refraction ≤ 0 (or equal inside and out for `roughplastic`, as in
+//! Mitsuba), negative (but for a conductor's `eta` and `k`, as in Mitsuba)
+//! or NaN values, and reflectances above 1 (they would create energy and keep the
 //! solver from converging; Mitsuba renders them, trilux refuses them).
 
 use std::path::Path;
 
 use trilux_brdf::{
-    Branch, BsdfParams, Distribution, Filter, RoughConductorParams, SlotKind, UvTransform, Wrap,
+    Branch, BsdfParams, Distribution, Filter, NAMED_IORS, PlasticParams, RoughConductorParams,
+    SlotKind, UvTransform, Wrap, named_ior,
 };
 use trilux_color::ColorParam;
 
@@ -86,6 +91,11 @@ pub(crate) fn build_bsdf(e: &Element, tex: &mut TextureCollector<'_>) -> Result<
             no_other_objects(&props)?;
             BsdfParams::RoughConductor(rough_conductor(&props, textured)?)
         }
+        kind @ ("plastic" | "roughplastic") => {
+            let textured = texture(&props, "diffuse_reflectance", SlotKind::Reflectance, tex)?;
+            no_other_objects(&props)?;
+            BsdfParams::Plastic(plastic(&props, kind == "roughplastic", textured)?)
+        }
         "blendbsdf" => {
             let textured = texture(&props, "weight", SlotKind::Weight, tex)?;
             let [first, second] = nested::<2>(&props, "exactly two nested BSDFs")?;
@@ -121,7 +131,7 @@ pub(crate) fn build_bsdf(e: &Element, tex: &mut TextureCollector<'_>) -> Result<
             return Err(SceneError::at(
                 &e.required("type")?.loc,
                 format!(
-                    "unknown bsdf plugin \"{other}\" (supported: diffuse, roughconductor, blendbsdf, twosided)"
+                    "unknown bsdf plugin \"{other}\" (supported: diffuse, roughconductor, plastic, roughplastic, blendbsdf, twosided)"
                 ),
             ));
         }
@@ -389,6 +399,46 @@ pub(crate) fn check_color(
 }
 
 fn rough_conductor(props: &Props<'_>, textured: bool) -> Result<RoughConductorParams> {
+    let (distribution, alpha) = roughness(props)?;
+    match props.string("material")?.as_deref() {
+        None | Some("none") => {}
+        Some(other) => {
+            return Err(SceneError::at(
+                &props.loc("material"),
+                format!(
+                    "named conductor materials are not supported (\"{other}\"): give eta and k, or material=\"none\""
+                ),
+            ));
+        }
+    }
+    // Negative values are Mitsuba's too (published data have them): its
+    // Fresnel term sees only their squares (`trilux_color::Role::Unbounded`).
+    let eta = props.color("eta")?;
+    let k = props.color("k")?;
+    let eta_k = match (eta, k) {
+        (None, None) => None,
+        // Mitsuba's defaults for a conductor given by eta/k: eta 0, k 1.
+        (eta, k) => Some((
+            eta.unwrap_or(ColorParam::Float(0.0)),
+            k.unwrap_or(ColorParam::Float(1.0)),
+        )),
+    };
+    let specular_reflectance = if textured {
+        ColorParam::Float(1.0)
+    } else {
+        reflectance(props, "specular_reflectance", 1.0)?
+    };
+    Ok(RoughConductorParams {
+        distribution,
+        alpha,
+        eta_k,
+        specular_reflectance,
+    })
+}
+
+/// A microfacet `distribution` and isotropic `alpha` (Mitsuba's defaults:
+/// Beckmann, 0.1).
+fn roughness(props: &Props<'_>) -> Result<(Distribution, f64)> {
     let distribution = match props.string("distribution")?.as_deref() {
         None | Some("beckmann") => Distribution::Beckmann,
         Some("ggx") => Distribution::Ggx,
@@ -431,45 +481,70 @@ fn rough_conductor(props: &Props<'_>, textured: bool) -> Result<RoughConductorPa
     } else {
         props.loc("alpha_u")
     };
-    if alpha <= 0.0 {
+    if !(alpha > 0.0 && alpha.is_finite()) {
         return Err(SceneError::at(
             &alpha_loc,
-            format!("roughness alpha must be positive, found {alpha}"),
+            format!("roughness alpha must be positive and finite, found {alpha}"),
         ));
     }
-    match props.string("material")?.as_deref() {
-        None | Some("none") => {}
-        Some(other) => {
-            return Err(SceneError::at(
-                &props.loc("material"),
-                format!(
-                    "named conductor materials are not supported (\"{other}\"): give eta and k, or material=\"none\""
-                ),
-            ));
-        }
-    }
-    // Negative values are Mitsuba's too (published data have them): its
-    // Fresnel term sees only their squares (`trilux_color::Role::Unbounded`).
-    let eta = props.color("eta")?;
-    let k = props.color("k")?;
-    let eta_k = match (eta, k) {
-        (None, None) => None,
-        // Mitsuba's defaults for a conductor given by eta/k: eta 0, k 1.
-        (eta, k) => Some((
-            eta.unwrap_or(ColorParam::Float(0.0)),
-            k.unwrap_or(ColorParam::Float(1.0)),
-        )),
-    };
-    let specular_reflectance = if textured {
-        ColorParam::Float(1.0)
-    } else {
-        reflectance(props, "specular_reflectance", 1.0)?
-    };
     props.ignore(&["sample_visible"]);
-    Ok(RoughConductorParams {
-        distribution,
-        alpha,
-        eta_k,
-        specular_reflectance,
+    Ok((distribution, alpha))
+}
+
+/// `plastic` (`rough` false) or `roughplastic`, Mitsuba's parameters and
+/// defaults.
+fn plastic(props: &Props<'_>, rough: bool, textured: bool) -> Result<PlasticParams> {
+    let coat = if rough { Some(roughness(props)?) } else { None };
+    let int_ior = ior(props, "int_ior", "polypropylene")?;
+    let ext_ior = ior(props, "ext_ior", "air")?;
+    if rough && int_ior == ext_ior {
+        return Err(SceneError::at(
+            &props.loc("int_ior"),
+            format!("int_ior and ext_ior must differ (both {int_ior}), as Mitsuba requires"),
+        ));
+    }
+    let nonlinear = props.boolean("nonlinear")?.unwrap_or(false);
+    let diffuse_reflectance = if textured {
+        ColorParam::Float(0.5)
+    } else {
+        reflectance(props, "diffuse_reflectance", 0.5)?
+    };
+    Ok(PlasticParams {
+        diffuse_reflectance,
+        specular_reflectance: reflectance(props, "specular_reflectance", 1.0)?,
+        int_ior,
+        ext_ior,
+        nonlinear,
+        coat,
     })
+}
+
+/// An index of refraction given as a `<float>` or by one of Mitsuba's
+/// names (`default` when absent); finite and positive.
+fn ior(props: &Props<'_>, name: &str, default: &str) -> Result<f64> {
+    let loc = props.loc(name);
+    let value = match props.float(name) {
+        Ok(Some(v)) => v,
+        Ok(None) => named_ior(default).unwrap_or(1.0),
+        Err(_) => {
+            let given = props.string(name)?.unwrap_or_default();
+            named_ior(&given).ok_or_else(|| {
+                let names: Vec<&str> = NAMED_IORS.iter().map(|(n, _)| *n).collect();
+                SceneError::at(
+                    &loc,
+                    format!(
+                        "unknown index of refraction \"{given}\" for {name} (a float or one of: {})",
+                        names.join(", ")
+                    ),
+                )
+            })?
+        }
+    };
+    if !(value > 0.0 && value.is_finite()) {
+        return Err(SceneError::at(
+            &loc,
+            format!("{name} must be positive and finite, found {value}"),
+        ));
+    }
+    Ok(value)
 }
