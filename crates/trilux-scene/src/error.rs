@@ -5,7 +5,7 @@
 //! columns count from 1 and point at the element or attribute value at fault.
 //!
 //! Errors in independent objects of one file (different top-level
-//! elements, glTF materials or nodes) are collected ([`Errors`]) and
+//! elements, glTF materials or nodes) are collected (`Errors`) and
 //! returned together as [`SceneError::Several`], as a compiler reports
 //! every error of a file in one run; one error alone is returned as itself.
 
