@@ -160,6 +160,7 @@ fn a_baked_closed_box_keeps_its_flux_and_is_valid_gltf() {
         materials: &bsdfs,
         names: &names,
         camera: None,
+        glossy: None,
     };
     let baked = bake(&input, &BakeOptions::default()).expect("the box bakes");
     assert_eq!(baked.stats.bytes, baked.glb.len());
