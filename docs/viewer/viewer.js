@@ -7,7 +7,11 @@
 // width=PX & height=PX (fixed canvas size instead of the window's),
 // mode=walk|orbit|fly (else walk when the file's camera is enclosed by the
 // scene, orbit when not), glossy=0 (diffuse only: the baked glossy light,
-// glossy.js, left out; G toggles it).
+// glossy.js, left out; G toggles it), lookat=ox,oy,oz,tx,ty,tz[,ux,uy,uz]
+// (the first view from that eye towards that target, up +y unless given,
+// with the file camera's field of view: trilux render's --lookat),
+// mask=glossy (glossy sides white, the rest black, no tone mapping: which
+// pixels show baked glossy light, for tests).
 // The bar shows the frame rate (frames drawn back to back while moving);
 // window.viewer.frameTime(n) times n frames drawn on demand (for tests).
 // window.viewerReady becomes true once the first frame of a file is drawn;
@@ -448,6 +452,35 @@ function findSceneCamera(gltf) {
 	};
 }
 
+// The view `v` seen from the lookat parameter's eye, if there is one.
+function withLookat(v) {
+	const text = params.get('lookat');
+	if (text === null) return v;
+	const n = text.split(',').map(Number);
+	if (!(n.length === 6 || n.length === 9) || !n.every(Number.isFinite)) {
+		fail(`lookat=${text} is not ox,oy,oz,tx,ty,tz[,ux,uy,uz]`);
+		return v;
+	}
+	const eye = new THREE.Vector3(n[0], n[1], n[2]);
+	const up = n.length === 9 ? new THREE.Vector3(n[6], n[7], n[8]) : new THREE.Vector3(0, 1, 0);
+	const m = new THREE.Matrix4().lookAt(eye, new THREE.Vector3(n[3], n[4], n[5]), up);
+	return { ...v, position: eye, quaternion: new THREE.Quaternion().setFromRotationMatrix(m), from: `lookat ${text}` };
+}
+
+// Glossy sides (extras.trilux.glossy) white, every other surface black.
+function maskGlossy(root) {
+	const white = new THREE.MeshBasicMaterial({ color: 0xffffff, toneMapped: false });
+	const black = new THREE.MeshBasicMaterial({ color: 0x000000, toneMapped: false });
+	root.traverse((obj) => {
+		if (!obj.isMesh) return;
+		const pick = (m) => {
+			const t = m && m.userData && m.userData.trilux;
+			return t && t.glossy ? white : black;
+		};
+		obj.material = Array.isArray(obj.material) ? obj.material.map(pick) : pick(obj.material);
+	});
+}
+
 // ---------------------------------------------------------------- loading
 
 const loader = new GLTFLoader();
@@ -554,7 +587,8 @@ async function openBuffer(buffer, name, basePath) {
 		setExposure(trilux.exposure);
 	}
 
-	state.view = findSceneCamera(gltf) ?? frameBox();
+	state.view = withLookat(findSceneCamera(gltf) ?? frameBox());
+	if (params.get('mask') === 'glossy') maskGlossy(gltf.scene);
 	state.inside = walker.encloses(state.view.position);
 	goToSceneCamera();
 	setMode(modeParam ?? (state.inside ? 'walk' : 'orbit'));

@@ -33,6 +33,10 @@ use trilux_render::Estimator;
 use trilux_solver::{Quality, SolverSettings};
 
 use crate::golden::root;
+use crate::viewer_glossy::{
+    FULL_SPP, MAX_FRAME_RATIO, ViewFigures, compare_views, frame_cost, full_renders,
+};
+use crate::viewer_shots::{node, png_compare, png_size};
 
 /// Exposure of both PNGs, in stops (the furnace's radiance of 2.0 shows
 /// as grey, not clipped white).
@@ -56,10 +60,17 @@ struct Row {
     /// solution.
     solve_seconds: f64,
     bake_seconds: f64,
+    /// Of `bake_seconds`, the glossy light's.
+    glossy_seconds: f64,
     bytes: usize,
     triangles: usize,
     /// Preview mean, viewer mean, RMSE of the PNG values.
     means: Option<(f64, f64, f64)>,
+    /// The views of a glossy scene's full renders (viewer `lookat`, if
+    /// not the file's camera).
+    views: Vec<(&'static str, Option<String>)>,
+    /// The viewer against the full renders, per view.
+    against_full: Vec<ViewFigures>,
 }
 
 /// The bundled scenes (scenes/*.xml, *.gltf, *.glb), then the bake's own
@@ -142,9 +153,12 @@ fn bake_scene(path: &Path, dir: &Path, solutions: Option<&Path>) -> Result<Vec<R
             glossy: scene.shapes.iter().any(|s| glossy(&s.bsdf)),
             solve_seconds,
             bake_seconds: baked.stats.seconds,
+            glossy_seconds: baked.stats.glossy_seconds,
             bytes: baked.stats.bytes,
             triangles: baked.stats.triangles,
             means: None,
+            views: Vec::new(),
+            against_full: Vec::new(),
         })
     };
     let mut rows = vec![row(
@@ -152,6 +166,9 @@ fn bake_scene(path: &Path, dir: &Path, solutions: Option<&Path>) -> Result<Vec<R
         true,
         outcome.baked.context("the plan bakes")?,
     )?];
+    if rows[0].glossy {
+        rows[0].views = full_renders(&scene, &name, &solution, dir, EXPOSURE)?;
+    }
     if scene.shapes.iter().any(|s| !s.textures.is_empty()) {
         plan.source = SolutionSource::Load(&solution);
         plan.save = None;
@@ -164,58 +181,6 @@ fn bake_scene(path: &Path, dir: &Path, solutions: Option<&Path>) -> Result<Vec<R
         rows.push(row(format!("{name}-vertex"), false, baked)?);
     }
     Ok(rows)
-}
-
-/// A PNG's RGB values in [0, 1].
-fn png_values(path: &Path) -> Result<Vec<f64>> {
-    let file = std::fs::File::open(path).with_context(|| format!("{}", path.display()))?;
-    let mut decoder = png::Decoder::new(std::io::BufReader::new(file));
-    decoder.set_transformations(png::Transformations::EXPAND | png::Transformations::STRIP_16);
-    let mut reader = decoder.read_info()?;
-    let mut buf = vec![0; reader.output_buffer_size().context("PNG size")?];
-    let info = reader.next_frame(&mut buf)?;
-    let channels = info.color_type.samples();
-    if channels < 3 {
-        bail!("{}: not an RGB PNG", path.display());
-    }
-    let pixels = &buf[..info.buffer_size()];
-    Ok(pixels
-        .chunks(channels)
-        .flat_map(|p| &p[..3])
-        .map(|&v| f64::from(v) / 255.0)
-        .collect())
-}
-
-/// (preview mean, viewer mean, RMSE between them) of two PNGs of one size.
-fn png_compare(preview: &Path, viewer: &Path) -> Result<(f64, f64, f64)> {
-    let (p, v) = (png_values(preview)?, png_values(viewer)?);
-    if p.len() != v.len() || p.is_empty() {
-        bail!(
-            "{} and {} differ in size",
-            preview.display(),
-            viewer.display()
-        );
-    }
-    let n = p.len() as f64;
-    let mean = |x: &[f64]| x.iter().sum::<f64>() / n;
-    let sq: f64 = p.iter().zip(&v).map(|(a, b)| (a - b) * (a - b)).sum();
-    Ok((mean(&p), mean(&v), (sq / n).sqrt()))
-}
-
-fn node(script: &str, args: &[String]) -> Result<()> {
-    let script = root().join("docs/viewer").join(script);
-    eprintln!("xtask: node {} {}", script.display(), args.join(" "));
-    let status = Command::new("node")
-        .arg(&script)
-        .args(args)
-        .status()
-        .context(
-            "could not start node (docs/viewer/scripts/ci.sh installs what the viewer needs)",
-        )?;
-    if !status.success() {
-        bail!("node {} failed ({status})", script.display());
-    }
-    Ok(())
 }
 
 /// docs/viewer/test/interior.test.mjs on the bakes in `dir`, with the
@@ -272,13 +237,8 @@ fn photograph(row: &mut Row, dir: &Path) -> Result<()> {
     ];
     node("test/screenshot.mjs", &args)?;
     row.means = Some(png_compare(&preview, &shot)?);
+    row.against_full = compare_views(&row.scene, &row.name, &row.views, dir, EXPOSURE)?;
     Ok(())
-}
-
-fn png_size(path: &Path) -> Result<(u32, u32)> {
-    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(path)?));
-    let info = decoder.read_info()?;
-    Ok((info.info().width, info.info().height))
 }
 
 /// Runs the whole check (module docs).
@@ -303,7 +263,14 @@ pub fn main(args: &[String]) -> Result<()> {
     for row in &mut rows {
         photograph(row, &dir)?;
     }
-    let report = report(&rows);
+    let largest = rows
+        .iter()
+        .filter(|r| r.glossy)
+        .max_by_key(|r| r.triangles)
+        .context("no glossy scene to time the shader on")?;
+    let cost = frame_cost(&dir.join(format!("{}.glb", largest.name)))?;
+    let ratio = cost["ratio"].as_f64().unwrap_or(f64::INFINITY);
+    let report = report(&rows) + &glossy_report(&rows, &cost, largest);
     print!("{report}");
     std::fs::write(dir.join("report.md"), &report)?;
     interior_tests(&dir)?;
@@ -315,6 +282,9 @@ pub fn main(args: &[String]) -> Result<()> {
     if !failed.is_empty() {
         bail!("the bakes of {} miss the viewer gates", failed.join(", "));
     }
+    if ratio > MAX_FRAME_RATIO {
+        bail!("the glossy shader takes {ratio:.2} × the diffuse frame time (at most {MAX_FRAME_RATIO})");
+    }
     Ok(())
 }
 
@@ -324,7 +294,47 @@ fn gap(r: &Row) -> Option<f64> {
 
 fn passes(r: &Row) -> bool {
     let mean_ok = r.glossy || !r.default || gap(r).is_none_or(|g| g.abs() <= MAX_MEAN_GAP);
-    mean_ok && r.bake_seconds < MAX_BAKE_SECONDS
+    let glossy_ok = !r.default || r.against_full.iter().all(ViewFigures::passes);
+    mean_ok && glossy_ok && r.bake_seconds - r.glossy_seconds < MAX_BAKE_SECONDS
+}
+
+/// The glossy scenes' table: the viewer against the full renders, per
+/// view; then the shader's frame time.
+fn glossy_report(rows: &[Row], cost: &serde_json::Value, largest: &Row) -> String {
+    let mut s = format!(
+        "\nViewer against the full render ({FULL_SPP} spp), glossy scenes:\n\n\
+         | bake | view | glossy s | full mean | viewer mean | gap | RMSE | glossy sides: full | viewer | gap |\n\
+         |---|---|---|---|---|---|---|---|---|---|\n"
+    );
+    for r in rows.iter().filter(|r| r.default) {
+        for v in &r.against_full {
+            let (f, m, e) = v.means;
+            let (mf, mv, mg) = match (v.masked, v.mask_gap()) {
+                (Some((a, b)), Some(g)) => (format!("{a:.4}"), format!("{b:.4}"), format!("{:+.2} %", 100.0 * g)),
+                _ => ("–".into(), "–".into(), "–".into()),
+            };
+            s += &format!(
+                "| {} | {} | {:.2} | {f:.4} | {m:.4} | {:+.2} % | {e:.4} | {mf} | {mv} | {mg} |\n",
+                r.scene,
+                v.view,
+                r.glossy_seconds,
+                100.0 * v.gap(),
+            );
+        }
+    }
+    let ms = |k: &str| cost[k].as_f64().unwrap_or(f64::NAN);
+    s += &format!(
+        "\nFrame time on {} ({} triangles, {:.1} bytes a triangle, {}×{}): glossy {:.1} ms, diffuse only {:.1} ms, ratio {:.2}\n",
+        largest.name,
+        largest.triangles,
+        largest.bytes as f64 / largest.triangles.max(1) as f64,
+        cost["width"],
+        cost["height"],
+        ms("glossy_ms"),
+        ms("diffuse_ms"),
+        ms("ratio"),
+    );
+    s
 }
 
 fn report(rows: &[Row]) -> String {

@@ -66,10 +66,18 @@ pub struct BakeOptions {
     /// Directions per vertex over which the glossy light is fitted
     /// (module `directional`; at least 9).
     pub glossy_directions: u32,
-    /// Estimates of the glossy light per direction and vertex (read by
-    /// the [`GlossyLight`] the caller supplies; 0: leave glossy light out).
+    /// Estimates of the glossy light per direction and vertex (0: leave
+    /// glossy light out).
     pub glossy_samples: u32,
+    /// Most estimates of glossy light in one bake (vertices × directions
+    /// × samples): a larger bake takes fewer samples per direction, then
+    /// fewer directions, down to [`MIN_GLOSSY_DIRECTIONS`] and one sample.
+    pub glossy_budget: u64,
 }
+
+/// Fewest directions a vertex's glossy light is fitted over (a budget
+/// stops lowering them here).
+pub const MIN_GLOSSY_DIRECTIONS: u32 = 16;
 
 impl Default for BakeOptions {
     fn default() -> Self {
@@ -78,6 +86,7 @@ impl Default for BakeOptions {
             albedo_maps: true,
             glossy_directions: 48,
             glossy_samples: 4,
+            glossy_budget: 8_000_000,
         }
     }
 }
@@ -130,7 +139,7 @@ pub fn bake<const N: usize>(
     let mut doc = Document::default();
     let mut flux = FluxCheck::default();
     let (mut vertices, mut triangles) = (0, 0);
-    let mut glossy = GlossyCount::default();
+    let mut glossy = GlossyCount::new(input, options, &meshes);
     for mesh in meshes.iter().filter(|m| !m.triangles.is_empty()) {
         let sides = Side::BOTH.map(|side| {
             let mut light = SideLight::new(input.solution, textures.as_ref(), mesh, side);
@@ -240,14 +249,47 @@ impl<'t, const N: usize> SideLight<'t, N> {
     }
 }
 
-/// The glossy light's fits, counted.
-#[derive(Default)]
+/// The glossy light's fits: directions and samples per vertex, counted.
 struct GlossyCount {
+    directions: usize,
+    samples: u32,
     vertices: usize,
     seconds: f64,
 }
 
 impl GlossyCount {
+    /// Directions and samples within `options.glossy_budget` for every
+    /// used vertex of every glossy side of `meshes`.
+    fn new<const N: usize>(
+        input: &BakeInput<'_, N>,
+        options: &BakeOptions,
+        meshes: &[ShapeMesh],
+    ) -> Self {
+        let scene = input.solution.scene();
+        let mut total = 0u64;
+        for mesh in meshes {
+            let material = scene.material(mesh.shape as usize);
+            let sides = Side::BOTH.iter().filter(|&&s| material.has_glossy(s)).count();
+            if sides > 0 {
+                let mut used = vec![false; mesh.positions.len()];
+                for &v in mesh.triangles.iter().flatten() {
+                    used[v as usize] = true;
+                }
+                total += (sides * used.iter().filter(|&&u| u).count()) as u64;
+            }
+        }
+        let per_vertex = options.glossy_budget.checked_div(total).unwrap_or(u64::MAX);
+        let wanted = u64::from(options.glossy_directions.max(MIN_GLOSSY_DIRECTIONS));
+        let directions = wanted.min(per_vertex.max(u64::from(MIN_GLOSSY_DIRECTIONS)));
+        let samples = (per_vertex / directions).clamp(1, u64::from(options.glossy_samples.max(1)));
+        GlossyCount {
+            directions: directions as usize,
+            samples: samples as u32,
+            vertices: 0,
+            seconds: 0.0,
+        }
+    }
+
     /// The SH coefficients of `mesh`'s vertices on `side` (module
     /// `directional`), when the bake has glossy light and the side's
     /// material a glossy part; `first` numbers the mesh's vertices in the
@@ -287,8 +329,11 @@ impl GlossyCount {
                 (v, point)
             })
             .collect();
-        let n_dir = (options.glossy_directions as usize).max(SH_COEFFICIENTS);
-        let sh = fit_vertices(light, &points, mesh.positions.len(), n_dir);
+        if options.glossy_samples == 0 {
+            return None;
+        }
+        let sizes = (self.directions, self.samples);
+        let sh = fit_vertices(light, &points, mesh.positions.len(), sizes);
         self.vertices += points.len();
         self.seconds += start.elapsed().as_secs_f64();
         Some(sh)

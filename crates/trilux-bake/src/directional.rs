@@ -6,7 +6,7 @@
 //! The bake asks a [`GlossyLight`] (the renderer's own estimate of the
 //! glossy part, supplied by the `trilux` crate) for L_g at every vertex
 //! towards [`BakeOptions::glossy_directions`](crate::BakeOptions)
-//! directions spread uniformly in solid angle over the side's hemisphere
+//! directions (fewer in a bake larger than its `glossy_budget`) spread uniformly in solid angle over the side's hemisphere
 //! (a spherical Fibonacci set), and fits the nine coefficients by least
 //! squares over them. The constant Y₀₀ is in the basis, so the residuals
 //! sum to zero: the fit's mean over the hemisphere is the estimate's mean
@@ -46,10 +46,12 @@ pub struct GlossyPoint {
 /// The glossy part of the radiance leaving surface points.
 pub trait GlossyLight: Sync {
     /// The glossy radiance, linear Rec. 709, leaving each of `points`
-    /// towards each of its directions: `directions` holds
-    /// `directions.len() / points.len()` unit vectors per point, point
-    /// after point, and the answer is laid out the same way.
-    fn outgoing(&self, points: &[GlossyPoint], directions: &[DVec3]) -> Vec<[f64; 3]>;
+    /// towards each of its directions, each the mean of `samples`
+    /// estimates: `directions` holds `directions.len() / points.len()`
+    /// unit vectors per point, point after point, and the answer is laid
+    /// out the same way.
+    fn outgoing(&self, points: &[GlossyPoint], directions: &[DVec3], samples: u32)
+    -> Vec<[f64; 3]>;
 }
 
 /// The order-2 real spherical harmonics at unit direction `d` (the usual
@@ -157,12 +159,12 @@ fn cholesky_solve<const M: usize>(
 
 /// The fitted coefficients of every vertex of `points`' side (zero for
 /// vertices not in `points`): asks `light` in batches of
-/// [`BATCH_POINTS`] points, `n_dir` directions each.
+/// [`BATCH_POINTS`] points, (directions, samples per direction) each.
 pub(crate) fn fit_vertices(
     light: &dyn GlossyLight,
     points: &[(usize, GlossyPoint)],
     vertices: usize,
-    n_dir: usize,
+    (n_dir, samples): (usize, u32),
 ) -> Vec<[[f64; 3]; SH_COEFFICIENTS]> {
     let mut out = vec![[[0.0; 3]; SH_COEFFICIENTS]; vertices];
     for batch in points.chunks(BATCH_POINTS) {
@@ -172,7 +174,7 @@ pub(crate) fn fit_vertices(
             .collect();
         let flat: Vec<DVec3> = dirs.iter().flatten().copied().collect();
         let only: Vec<GlossyPoint> = batch.iter().map(|(_, p)| *p).collect();
-        let values = light.outgoing(&only, &flat);
+        let values = light.outgoing(&only, &flat, samples);
         for (k, ((v, _), d)) in batch.iter().zip(&dirs).enumerate() {
             let measured = values.get(k * n_dir..(k + 1) * n_dir).unwrap_or(&[]);
             if let Some(c) = fit_sh(d, measured) {

@@ -35,7 +35,7 @@ mod glb;
 pub mod reconstruct;
 mod tessellate;
 
-pub use bake::{BakeInput, BakeOptions, BakeStats, Baked, bake};
+pub use bake::{BakeInput, BakeOptions, BakeStats, Baked, MIN_GLOSSY_DIRECTIONS, bake};
 pub use camera::BakeCamera;
 pub use directional::{GlossyLight, GlossyPoint};
 pub use error::BakeError;

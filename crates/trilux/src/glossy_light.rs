@@ -17,20 +17,24 @@ use trilux_solver::Solution;
 /// The render's glossy light over a solution.
 pub(crate) struct RenderedGlossy<'a, const N: usize> {
     scene: SolvedScene<'a, N, Solution<N>>,
-    /// Estimates averaged per direction.
-    samples: u32,
 }
 
 impl<'a, const N: usize> RenderedGlossy<'a, N> {
-    pub(crate) fn new(solution: &'a Solution<N>, samples: u32) -> Self {
+    pub(crate) fn new(solution: &'a Solution<N>) -> Self {
         RenderedGlossy {
             scene: SolvedScene::new(solution),
-            samples: samples.max(1),
         }
     }
 
     /// Glossy radiance at `p` towards each of `dirs`.
-    fn at(&self, p: &GlossyPoint, dirs: &[DVec3], caches: &mut Caches<N>) -> Vec<[f64; 3]> {
+    fn at(
+        &self,
+        p: &GlossyPoint,
+        dirs: &[DVec3],
+        samples: u32,
+        caches: &mut Caches<N>,
+    ) -> Vec<[f64; 3]> {
+        let samples = samples.max(1);
         let gather = LinkGather {
             scene: &self.scene,
             fallback: FinalGather {
@@ -58,18 +62,23 @@ impl<'a, const N: usize> RenderedGlossy<'a, N> {
             .map(|(k, &wo)| {
                 let mut sampler = PixelSampler::new(hi ^ (k as u32).wrapping_mul(0x9e37_79b9), lo, k as u32);
                 let mut sum = trilux_color::Spectrum::<N>::zero();
-                for s in 0..self.samples {
+                for s in 0..samples {
                     sampler.start_sample(s);
                     sum += gather.glossy_sample(&x, wo, &sampler, caches, &mut stats);
                 }
-                (sum * (1.0 / f64::from(self.samples))).to_linear_srgb()
+                (sum * (1.0 / f64::from(samples))).to_linear_srgb()
             })
             .collect()
     }
 }
 
 impl<const N: usize> GlossyLight for RenderedGlossy<'_, N> {
-    fn outgoing(&self, points: &[GlossyPoint], directions: &[DVec3]) -> Vec<[f64; 3]> {
+    fn outgoing(
+        &self,
+        points: &[GlossyPoint],
+        directions: &[DVec3],
+        samples: u32,
+    ) -> Vec<[f64; 3]> {
         let per = directions.len().checked_div(points.len()).unwrap_or(0);
         if per == 0 {
             return Vec::new();
@@ -77,7 +86,9 @@ impl<const N: usize> GlossyLight for RenderedGlossy<'_, N> {
         points
             .par_iter()
             .zip(directions.par_chunks(per))
-            .map_init(Caches::<N>::default, |caches, (p, dirs)| self.at(p, dirs, caches))
+            .map_init(Caches::<N>::default, |caches, (p, dirs)| {
+                self.at(p, dirs, samples, caches)
+            })
             .flatten_iter()
             .collect()
     }

@@ -325,7 +325,7 @@ fn bake<const N: usize>(
         });
     let materials = scene.bsdf_params();
     let names: Vec<Option<String>> = scene.shapes.iter().map(|s| s.id.clone()).collect();
-    let glossy = crate::glossy_light::RenderedGlossy::new(solution, options.glossy_samples);
+    let glossy = crate::glossy_light::RenderedGlossy::new(solution);
     let input = trilux_bake::BakeInput {
         solution,
         materials: &materials,
