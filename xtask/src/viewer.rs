@@ -283,7 +283,9 @@ pub fn main(args: &[String]) -> Result<()> {
         bail!("the bakes of {} miss the viewer gates", failed.join(", "));
     }
     if ratio > MAX_FRAME_RATIO {
-        bail!("the glossy shader takes {ratio:.2} × the diffuse frame time (at most {MAX_FRAME_RATIO})");
+        bail!(
+            "the glossy shader takes {ratio:.2} × the diffuse frame time (at most {MAX_FRAME_RATIO})"
+        );
     }
     Ok(())
 }
@@ -310,7 +312,11 @@ fn glossy_report(rows: &[Row], cost: &serde_json::Value, largest: &Row) -> Strin
         for v in &r.against_full {
             let (f, m, e) = v.means;
             let (mf, mv, mg) = match (v.masked, v.mask_gap()) {
-                (Some((a, b)), Some(g)) => (format!("{a:.4}"), format!("{b:.4}"), format!("{:+.2} %", 100.0 * g)),
+                (Some((a, b)), Some(g)) => (
+                    format!("{a:.4}"),
+                    format!("{b:.4}"),
+                    format!("{:+.2} %", 100.0 * g),
+                ),
                 _ => ("–".into(), "–".into(), "–".into()),
             };
             s += &format!(

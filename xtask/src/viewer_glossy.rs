@@ -1,7 +1,9 @@
 //! `cargo xtask viewer`'s glossy checks: a scene with glossy materials is
 //! rendered in full (`trilux render`'s default estimator, [`FULL_SPP`]
-//! samples a pixel) from its camera and from a second viewpoint (the
-//! camera turned [`SIDE_DEGREES`] about its up axis through its target),
+//! samples a pixel) from its camera and from a second viewpoint (the eye
+//! moved to [`SIDE_DISTANCE`] of its distance from the target and turned
+//! [`SIDE_DEGREES`] about the up axis through the target: still inside an
+//! interior, seeing the glossy surfaces from other directions),
 //! and the viewer's screenshots of the bake from the same two views are
 //! compared with them: the image means, and the means over the glossy
 //! sides alone (the viewer's `mask=glossy` picture). Then the glossy
@@ -21,7 +23,9 @@ use crate::viewer_shots::{masked_means, node, node_output, png_compare, png_size
 /// Samples per pixel of the full renders.
 pub(crate) const FULL_SPP: u32 = 64;
 /// How far the second viewpoint turns from the scene's camera.
-pub(crate) const SIDE_DEGREES: f64 = 25.0;
+pub(crate) const SIDE_DEGREES: f64 = 20.0;
+/// The second viewpoint's distance from the target, over the camera's.
+pub(crate) const SIDE_DISTANCE: f64 = 0.6;
 /// Largest relative gap between the viewer's mean and the full render's.
 pub(crate) const MAX_GLOSSY_GAP: f64 = 0.05;
 /// Largest relative gap over the glossy sides alone.
@@ -50,7 +54,8 @@ impl ViewFigures {
     }
 
     pub(crate) fn passes(&self) -> bool {
-        self.gap().abs() <= MAX_GLOSSY_GAP && self.mask_gap().is_none_or(|g| g.abs() <= MAX_MASK_GAP)
+        self.gap().abs() <= MAX_GLOSSY_GAP
+            && self.mask_gap().is_none_or(|g| g.abs() <= MAX_MASK_GAP)
     }
 }
 
@@ -58,12 +63,16 @@ impl ViewFigures {
 fn side_view(camera: &trilux_scene::Camera) -> (DVec3, DVec3, DVec3) {
     let up = camera.up.try_normalize().unwrap_or(DVec3::Y);
     let turn = DQuat::from_axis_angle(up, SIDE_DEGREES.to_radians());
-    let eye = camera.target + turn * (camera.origin - camera.target);
+    let eye = camera.target + turn * (SIDE_DISTANCE * (camera.origin - camera.target));
     (eye, camera.target, up)
 }
 
 fn csv(v: [DVec3; 3]) -> String {
-    let n: Vec<String> = v.iter().flat_map(|p| p.to_array()).map(|x| format!("{x}")).collect();
+    let n: Vec<String> = v
+        .iter()
+        .flat_map(|p| p.to_array())
+        .map(|x| format!("{x}"))
+        .collect();
     n.join(",")
 }
 
@@ -81,10 +90,7 @@ pub(crate) fn full_renders(
         return Ok(Vec::new());
     };
     let (eye, target, up) = side_view(camera);
-    let views = [
-        ("camera", None),
-        ("side", Some((eye, target, Some(up)))),
-    ];
+    let views = [("camera", None), ("side", Some((eye, target, Some(up))))];
     let mut out = Vec::new();
     for (view, lookat) in views {
         let mut settings = trilux::render_settings(camera);
@@ -109,7 +115,10 @@ pub(crate) fn full_renders(
         let image = outcome.image.context("the plan renders")?;
         let png = dir.join(format!("{name}-full-{view}.png"));
         std::fs::write(&png, image.png_bytes(exposure)?)?;
-        out.push((view, lookat.map(|(e, t, u)| csv([e, t, u.unwrap_or(DVec3::Y)]))));
+        out.push((
+            view,
+            lookat.map(|(e, t, u)| csv([e, t, u.unwrap_or(DVec3::Y)])),
+        ));
     }
     Ok(out)
 }

@@ -66,7 +66,6 @@ pub(crate) fn png_size(path: &Path) -> Result<(u32, u32)> {
     Ok((info.info().width, info.info().height))
 }
 
-
 /// A node script's standard output (its standard error passed through).
 pub(crate) fn node_output(script: &str, args: &[String]) -> Result<String> {
     let script = root().join("docs/viewer").join(script);
@@ -88,7 +87,10 @@ pub(crate) fn node_output(script: &str, args: &[String]) -> Result<String> {
 pub(crate) fn masked_means(a: &Path, b: &Path, mask: &Path) -> Result<Option<(f64, f64)>> {
     let (a, b, m) = (png_values(a)?, png_values(b)?, png_values(mask)?);
     if a.len() != b.len() || a.len() != m.len() {
-        bail!("{}: the pictures and the mask differ in size", mask.display());
+        bail!(
+            "{}: the pictures and the mask differ in size",
+            mask.display()
+        );
     }
     let (mut sa, mut sb, mut n) = (0.0, 0.0, 0usize);
     for ((pa, pb), pm) in a.chunks(3).zip(b.chunks(3)).zip(m.chunks(3)) {

@@ -269,7 +269,10 @@ impl GlossyCount {
         let mut total = 0u64;
         for mesh in meshes {
             let material = scene.material(mesh.shape as usize);
-            let sides = Side::BOTH.iter().filter(|&&s| material.has_glossy(s)).count();
+            let sides = Side::BOTH
+                .iter()
+                .filter(|&&s| material.has_glossy(s))
+                .count();
             if sides > 0 {
                 let mut used = vec![false; mesh.positions.len()];
                 for &v in mesh.triangles.iter().flatten() {
@@ -350,7 +353,13 @@ fn write_shape<const N: usize>(
 ) -> Result<(), BakeError> {
     for light in sides {
         let sh = light.sh.iter().flatten().flatten().flatten();
-        if light.values.iter().flatten().chain(sh).any(|x| !x.is_finite()) {
+        if light
+            .values
+            .iter()
+            .flatten()
+            .chain(sh)
+            .any(|x| !x.is_finite())
+        {
             return Err(BakeError::NotFinite { shape: mesh.shape });
         }
     }
@@ -431,7 +440,8 @@ fn side_primitives<const N: usize>(
     let (radiance, display) = (doc.vec3(&radiance, false), doc.vec3(&display, false));
     let material = doc.materials.len();
     let mut m = material_of(input, shape, side);
-    m["extras"]["trilux"]["glossy_left_out"] = json!(light.sh.is_none() && glossy_side(input, shape, side));
+    m["extras"]["trilux"]["glossy_left_out"] =
+        json!(light.sh.is_none() && glossy_side(input, shape, side));
     if light.sh.is_some() {
         m["extras"]["trilux"]["glossy"] = json!("sh2");
     }

@@ -124,10 +124,7 @@ pub fn fit_sh(directions: &[DVec3], values: &[[f64; 3]]) -> Option<[[f64; 3]; SH
 
 /// Solves A x = b (A symmetric positive definite) by Cholesky, three
 /// right-hand sides at once.
-fn cholesky_solve<const M: usize>(
-    a: [[f64; M]; M],
-    b: [[f64; 3]; M],
-) -> Option<[[f64; 3]; M]> {
+fn cholesky_solve<const M: usize>(a: [[f64; M]; M], b: [[f64; 3]; M]) -> Option<[[f64; 3]; M]> {
     let mut l = [[0.0; M]; M];
     for j in 0..M {
         let d = a[j][j] - (0..j).map(|k| l[j][k] * l[j][k]).sum::<f64>();
@@ -215,7 +212,11 @@ mod tests {
         for a in 0..9 {
             for b in 0..9 {
                 let expect = if a == b { 1.0 } else { 0.0 };
-                assert!((gram[a][b] - expect).abs() < 1e-4, "{a} {b}: {}", gram[a][b]);
+                assert!(
+                    (gram[a][b] - expect).abs() < 1e-4,
+                    "{a} {b}: {}",
+                    gram[a][b]
+                );
             }
         }
     }
@@ -224,8 +225,18 @@ mod tests {
     /// is fitted exactly from hemisphere samples, whatever the normal.
     #[test]
     fn quadratics_are_fitted_exactly() {
-        let f = |d: DVec3| [1.0 + 0.5 * d.x - d.y * d.z, 2.0 * d.z * d.z, 0.3 - d.x * d.y];
-        for n in [DVec3::Z, DVec3::new(0.3, -0.8, 0.2).normalize(), DVec3::NEG_Y] {
+        let f = |d: DVec3| {
+            [
+                1.0 + 0.5 * d.x - d.y * d.z,
+                2.0 * d.z * d.z,
+                0.3 - d.x * d.y,
+            ]
+        };
+        for n in [
+            DVec3::Z,
+            DVec3::new(0.3, -0.8, 0.2).normalize(),
+            DVec3::NEG_Y,
+        ] {
             let dirs = hemisphere_directions(n, 48);
             assert!(dirs.iter().all(|d| d.dot(n) > 0.0));
             let vals: Vec<[f64; 3]> = dirs.iter().map(|&d| f(d)).collect();

@@ -339,11 +339,18 @@ fn a_glossy_floor_carries_its_glossy_light_as_spherical_harmonics() {
                 .collect();
             for (v, (&p, &n)) in positions.iter().zip(&normals).enumerate() {
                 // Directions over the front hemisphere, grazing ones too.
-                for w in [n, (n + DVec3::X).normalize(), (n - 0.9 * DVec3::Y).normalize()] {
+                for w in [
+                    n,
+                    (n + DVec3::X).normalize(),
+                    (n - 0.9 * DVec3::Y).normalize(),
+                ] {
                     let y = sh(w);
                     let got: DVec3 = (0..9).map(|j| c[j][v] * y[j]).sum();
                     let want = DVec3::from_array(quadratic(p, w));
-                    assert!((got - want).abs().max_element() < 1e-4, "{p} {w}: {got} vs {want}");
+                    assert!(
+                        (got - want).abs().max_element() < 1e-4,
+                        "{p} {w}: {got} vs {want}"
+                    );
                 }
             }
         }

@@ -60,7 +60,8 @@ impl<'a, const N: usize> RenderedGlossy<'a, N> {
         dirs.iter()
             .enumerate()
             .map(|(k, &wo)| {
-                let mut sampler = PixelSampler::new(hi ^ (k as u32).wrapping_mul(0x9e37_79b9), lo, k as u32);
+                let mut sampler =
+                    PixelSampler::new(hi ^ (k as u32).wrapping_mul(0x9e37_79b9), lo, k as u32);
                 let mut sum = trilux_color::Spectrum::<N>::zero();
                 for s in 0..samples {
                     sampler.start_sample(s);
