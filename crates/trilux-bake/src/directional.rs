@@ -202,21 +202,17 @@ mod tests {
             for k in 0..nphi {
                 let phi = (k as f64 + 0.5) * 2.0 * std::f64::consts::PI / nphi as f64;
                 let y = sh_basis(DVec3::new(r * phi.cos(), r * phi.sin(), z));
-                for a in 0..9 {
-                    for b in 0..9 {
-                        gram[a][b] += y[a] * y[b] * cell;
+                for (row, ya) in gram.iter_mut().zip(y) {
+                    for (g, yb) in row.iter_mut().zip(y) {
+                        *g += ya * yb * cell;
                     }
                 }
             }
         }
-        for a in 0..9 {
-            for b in 0..9 {
+        for (a, row) in gram.iter().enumerate() {
+            for (b, g) in row.iter().enumerate() {
                 let expect = if a == b { 1.0 } else { 0.0 };
-                assert!(
-                    (gram[a][b] - expect).abs() < 1e-4,
-                    "{a} {b}: {}",
-                    gram[a][b]
-                );
+                assert!((g - expect).abs() < 1e-4, "{a} {b}: {g}");
             }
         }
     }
