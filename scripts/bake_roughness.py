@@ -4,7 +4,7 @@
 Writes the bundled glossy tube (scenes/glossy-tube.xml) with its
 roughconductor's alpha replaced by each value of --alphas into a temporary
 folder; for each, `trilux solve`, `trilux render` (the full render, --spp
-samples a pixel, PNG at --exposure), `trilux bake` of the same solution,
+samples a pixel, PNG at --exposure), `trilux bake --glossy` of the same solution,
 and the viewer's screenshots of the bake from the scene's camera in
 headless Chromium (docs/viewer/test/screenshot.mjs): glossy light shown,
 diffuse only (--glossy 0), and the mask of the glossy sides (--mask
@@ -52,7 +52,7 @@ def row(alpha, tmp, args):
     run([EXE, "solve", xml, "-o", stem + ".sol"])
     run([EXE, "render", xml, "--solution", stem + ".sol", "--spp", str(args.spp),
          "-o", stem + "-full.exr", "--png", stem + "-full.png", "--exposure", str(args.exposure)])
-    run([EXE, "bake", xml, "--solution", stem + ".sol", "-o", stem + ".glb", "--stats", stem + ".json"])
+    run([EXE, "bake", xml, "--glossy", "--solution", stem + ".sol", "-o", stem + ".glb", "--stats", stem + ".json"])
     full = png(stem + "-full.png")
     h, w = full.shape[:2]
     shots = {}

@@ -63,6 +63,10 @@ pub struct BakeOptions {
     /// without, their radiance goes into the vertex colours like any other
     /// (smaller files, texture detail finer than the leaves lost).
     pub albedo_maps: bool,
+    /// Fit the glossy light of glossy sides as spherical harmonics
+    /// (module `directional`; slow on large scenes, so off by default:
+    /// the glossy light is then left out and its materials marked).
+    pub glossy: bool,
     /// Directions per vertex over which the glossy light is fitted
     /// (module `directional`; at least 9).
     pub glossy_directions: u32,
@@ -84,6 +88,7 @@ impl Default for BakeOptions {
         BakeOptions {
             exposure: 0.0,
             albedo_maps: true,
+            glossy: false,
             glossy_directions: 48,
             glossy_samples: 4,
             glossy_budget: 8_000_000,
@@ -305,7 +310,7 @@ impl GlossyCount {
         side: Side,
         first: usize,
     ) -> Option<Vec<[[f64; 3]; SH_COEFFICIENTS]>> {
-        let light = input.glossy?;
+        let light = input.glossy.filter(|_| options.glossy)?;
         let scene = input.solution.scene();
         if !scene.material(mesh.shape as usize).has_glossy(side) {
             return None;

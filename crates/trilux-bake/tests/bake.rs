@@ -314,7 +314,21 @@ fn a_glossy_floor_carries_its_glossy_light_as_spherical_harmonics() {
         camera: None,
         glossy: Some(&Quadratic),
     };
-    let baked = bake(&input, &BakeOptions::default()).expect("the box bakes");
+    // Off by default: the glossy light is left out and the floor marked.
+    let plain = bake(&input, &BakeOptions::default()).expect("the box bakes");
+    let (json, _) = chunks(&plain.glb);
+    assert!(!String::from_utf8_lossy(&plain.glb).contains("_TRILUX_SH0"));
+    let left_out = json["materials"]
+        .as_array()
+        .expect("materials")
+        .iter()
+        .filter(|m| m["extras"]["trilux"]["glossy_left_out"] == true)
+        .count();
+    assert_eq!(left_out, 1, "the floor's front is marked");
+    assert_eq!(plain.stats.glossy_vertices, 0);
+    let mut options = BakeOptions::default();
+    options.glossy = true;
+    let baked = bake(&input, &options).expect("the box bakes");
     let (json, bin) = chunks(&baked.glb);
     gltf::Gltf::from_slice(&baked.glb).expect("the gltf crate reads the file");
     let mut glossy_primitives = 0;

@@ -331,7 +331,8 @@ fn bake<const N: usize>(
         materials: &materials,
         names: &names,
         camera,
-        glossy: (options.glossy_samples > 0).then_some(&glossy as &dyn trilux_bake::GlossyLight),
+        glossy: (options.glossy && options.glossy_samples > 0)
+            .then_some(&glossy as &dyn trilux_bake::GlossyLight),
     };
     Ok(trilux_bake::bake(&input, options)?)
 }

@@ -446,8 +446,8 @@ fn cornell_box_bakes_to_its_solution() {
     assert_eq!(check_scene(&repo("scenes/cornell-box.xml"), "cornell"), 0);
 }
 
-/// Curved pieces: a cylinder (the glossy tube; its diffuse part is what is
-/// checked, its glossy light is the directional bake's).
+/// Curved pieces: a cylinder (the glossy tube; its glossy part is left out
+/// of the bake, its diffuse part is what is checked).
 #[test]
 fn glossy_tube_bakes_to_its_solution() {
     assert_eq!(check_scene(&repo("scenes/glossy-tube.xml"), "tube"), 0);
