@@ -6,7 +6,14 @@
 // Query parameters: file=URL, exposure=STOPS, ui=0 (no overlays),
 // width=PX & height=PX (fixed canvas size instead of the window's),
 // mode=walk|orbit|fly (else walk when the file's camera is enclosed by the
-// scene, orbit when not).
+// scene, orbit when not), glossy=0 (diffuse only: the baked glossy light,
+// glossy.js, left out; G toggles it), lookat=ox,oy,oz,tx,ty,tz[,ux,uy,uz]
+// (the first view from that eye towards that target, up +y unless given,
+// with the file camera's field of view: trilux render's --lookat),
+// mask=glossy (glossy sides white, the rest black, no tone mapping: which
+// pixels show baked glossy light, for tests).
+// The bar shows the frame rate (frames drawn back to back while moving);
+// window.viewer.frameTime(n) times n frames drawn on demand (for tests).
 // window.viewerReady becomes true once the first frame of a file is drawn;
 // window.viewerError holds the message of a failure (also shown on the page).
 
@@ -15,6 +22,7 @@ import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import { PointerLockControls } from 'three/addons/controls/PointerLockControls.js';
 import { Walker } from './walk.js';
+import { useGlossyAttributes } from './glossy.js';
 
 const params = new URLSearchParams(location.search);
 const $ = (id) => document.getElementById(id);
@@ -22,6 +30,7 @@ const ui = {
 	stage: $('stage'), file: $('file'), exposure: $('exposure'), exposureText: $('exposure-text'),
 	sceneCamera: $('scene-camera'), navMode: $('nav-mode'), info: $('info'), error: $('error'),
 	menu: $('menu'), panel: $('panel'), notice: $('notice'), glossyList: $('glossy-list'),
+	glossy: $('glossy'), fps: $('fps'),
 };
 const MODES = ['orbit', 'walk', 'fly'];
 
@@ -205,6 +214,7 @@ window.addEventListener('keydown', (e) => {
 	if (e.code === 'KeyV') setMode(nextMode());
 	else if (e.code === 'KeyH') togglePanel();
 	else if (e.code === 'KeyC') goToSceneCamera();
+	else if (e.code === 'KeyG') setGlossy(glossyUniform.value === 0);
 	else if (e.code === 'BracketLeft') setExposure(Math.round((state.stops - 0.5) * 2) / 2, true);
 	else if (e.code === 'BracketRight') setExposure(Math.round((state.stops + 0.5) * 2) / 2, true);
 	else if (state.mode !== 'orbit' && FLY_KEYS.has(e.code)) {
@@ -251,6 +261,7 @@ function requestRender() {
 function frame(now) {
 	frameRequested = false;
 	const moving = flyStep(now);
+	showFrameRate(now, moving);
 	drawNow();
 	updateNotice();
 	if (moving) requestRender();
@@ -278,6 +289,46 @@ function drawNow() {
 	renderer.render(scene, camera);
 }
 window.addEventListener('resize', () => requestRender());
+
+// ---------------------------------------------------------------- glossy light, frame rate
+
+// Scales the baked glossy light (glossy.js): 1 shown, 0 diffuse only.
+const glossyUniform = { value: params.get('glossy') === '0' ? 0 : 1 };
+function setGlossy(on) {
+	glossyUniform.value = on ? 1 : 0;
+	ui.glossy.setAttribute('aria-pressed', String(on));
+	ui.glossy.textContent = on ? 'glossy' : 'diffuse';
+	if (window.viewerInfo) window.viewerInfo.glossyShown = on;
+	requestRender();
+}
+ui.glossy.addEventListener('click', () => setGlossy(glossyUniform.value === 0));
+
+// Frames drawn back to back (a frame scheduled by the one before, while
+// moving) give the rate; the bar keeps the last figure when idle.
+let lastFrame = null;
+let frameMs = null;
+function showFrameRate(now, moving) {
+	if (lastFrame !== null && now - lastFrame < 1000) {
+		frameMs = frameMs === null ? now - lastFrame : 0.8 * frameMs + 0.2 * (now - lastFrame);
+		ui.fps.textContent = `${(1000 / frameMs).toFixed(0)} fps`;
+	}
+	lastFrame = moving ? now : null;
+}
+
+// Milliseconds per frame over n frames, each drawn and waited for (one
+// pixel read back), after one frame not counted (shader compilation).
+function frameTime(n = 20) {
+	const gl = renderer.getContext();
+	const px = new Uint8Array(4);
+	const one = () => {
+		drawNow();
+		gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, px);
+	};
+	one();
+	const t0 = performance.now();
+	for (let i = 0; i < n; i++) one();
+	return (performance.now() - t0) / n;
+}
 
 // ---------------------------------------------------------------- overlay
 
@@ -401,6 +452,35 @@ function findSceneCamera(gltf) {
 	};
 }
 
+// The view `v` seen from the lookat parameter's eye, if there is one.
+function withLookat(v) {
+	const text = params.get('lookat');
+	if (text === null) return v;
+	const n = text.split(',').map(Number);
+	if (!(n.length === 6 || n.length === 9) || !n.every(Number.isFinite)) {
+		fail(`lookat=${text} is not ox,oy,oz,tx,ty,tz[,ux,uy,uz]`);
+		return v;
+	}
+	const eye = new THREE.Vector3(n[0], n[1], n[2]);
+	const up = n.length === 9 ? new THREE.Vector3(n[6], n[7], n[8]) : new THREE.Vector3(0, 1, 0);
+	const m = new THREE.Matrix4().lookAt(eye, new THREE.Vector3(n[3], n[4], n[5]), up);
+	return { ...v, position: eye, quaternion: new THREE.Quaternion().setFromRotationMatrix(m), from: `lookat ${text}` };
+}
+
+// Glossy sides (extras.trilux.glossy) white, every other surface black.
+function maskGlossy(root) {
+	const white = new THREE.MeshBasicMaterial({ color: 0xffffff, toneMapped: false });
+	const black = new THREE.MeshBasicMaterial({ color: 0x000000, toneMapped: false });
+	root.traverse((obj) => {
+		if (!obj.isMesh) return;
+		const pick = (m) => {
+			const t = m && m.userData && m.userData.trilux;
+			return t && t.glossy ? white : black;
+		};
+		obj.material = Array.isArray(obj.material) ? obj.material.map(pick) : pick(obj.material);
+	});
+}
+
 // ---------------------------------------------------------------- loading
 
 const loader = new GLTFLoader();
@@ -457,6 +537,8 @@ async function openBuffer(buffer, name, basePath) {
 	if (seq !== state.loadSeq) return;
 	disposeModel();
 	const hdrMeshes = useRadianceAttribute(gltf.scene);
+	const glossyMeshes = useGlossyAttributes(gltf.scene, glossyUniform);
+	ui.glossy.hidden = glossyMeshes === 0;
 	state.model = gltf.scene;
 	state.name = name;
 	scene.add(gltf.scene);
@@ -505,7 +587,8 @@ async function openBuffer(buffer, name, basePath) {
 		setExposure(trilux.exposure);
 	}
 
-	state.view = findSceneCamera(gltf) ?? frameBox();
+	state.view = withLookat(findSceneCamera(gltf) ?? frameBox());
+	if (params.get('mask') === 'glossy') maskGlossy(gltf.scene);
 	state.inside = walker.encloses(state.view.position);
 	goToSceneCamera();
 	setMode(modeParam ?? (state.inside ? 'walk' : 'orbit'));
@@ -513,6 +596,7 @@ async function openBuffer(buffer, name, basePath) {
 	window.viewerInfo = {
 		name, meshes, triangles, vertices, materials: mats, lit, radianceAttributeMeshes: hdrMeshes,
 		camera: state.view.from, trilux, inside: state.inside, mode: state.mode, glossyLeftOut: state.glossy,
+		glossyMeshes, glossyShown: glossyUniform.value !== 0,
 		bbox: { min: bbox.min.toArray(), max: bbox.max.toArray() },
 	};
 	window.viewerNotice = undefined; // drawn afresh for this file
@@ -583,7 +667,7 @@ window.addEventListener('unhandledrejection', (e) => {
 });
 
 // Hooks for scripted use (tests, the console).
-window.viewer = { THREE, renderer, scene, camera, setExposure, goToSceneCamera, setMode, openUrl, state, walker, togglePanel, requestRender };
+window.viewer = { THREE, renderer, scene, camera, setExposure, goToSceneCamera, setMode, openUrl, state, walker, togglePanel, requestRender, setGlossy, frameTime };
 
 const fileParam = params.get('file');
 if (window.viewerError) {

@@ -18,6 +18,8 @@ mod structure;
 mod surface;
 mod sweep;
 mod viewer;
+mod viewer_glossy;
+mod viewer_shots;
 
 /// Counts the process's allocations (the peak memory `scale` reports).
 #[global_allocator]

@@ -29,6 +29,7 @@ use trilux_solver::{ElementTextures, Solution};
 
 use crate::albedo::{AlbedoMap, albedo_map};
 use crate::camera::BakeCamera;
+use crate::directional::{GlossyLight, GlossyPoint, SH_COEFFICIENTS, fit_vertices};
 use crate::error::BakeError;
 use crate::glb::Document;
 use crate::reconstruct::{baked_flux, vertex_values};
@@ -46,6 +47,9 @@ pub struct BakeInput<'a, const N: usize> {
     pub names: &'a [Option<String>],
     /// The scene's camera.
     pub camera: Option<BakeCamera>,
+    /// The glossy light of glossy sides (module `directional`); without,
+    /// it is left out as before.
+    pub glossy: Option<&'a dyn GlossyLight>,
 }
 
 /// How to bake.
@@ -59,13 +63,35 @@ pub struct BakeOptions {
     /// without, their radiance goes into the vertex colours like any other
     /// (smaller files, texture detail finer than the leaves lost).
     pub albedo_maps: bool,
+    /// Fit the glossy light of glossy sides as spherical harmonics
+    /// (module `directional`; slow on large scenes, so off by default:
+    /// the glossy light is then left out and its materials marked).
+    pub glossy: bool,
+    /// Directions per vertex over which the glossy light is fitted
+    /// (module `directional`; at least 9).
+    pub glossy_directions: u32,
+    /// Estimates of the glossy light per direction and vertex (0: leave
+    /// glossy light out).
+    pub glossy_samples: u32,
+    /// Most estimates of glossy light in one bake (vertices × directions
+    /// × samples): a larger bake takes fewer samples per direction, then
+    /// fewer directions, down to [`MIN_GLOSSY_DIRECTIONS`] and one sample.
+    pub glossy_budget: u64,
 }
+
+/// Fewest directions a vertex's glossy light is fitted over (a budget
+/// stops lowering them here).
+pub const MIN_GLOSSY_DIRECTIONS: u32 = 16;
 
 impl Default for BakeOptions {
     fn default() -> Self {
         BakeOptions {
             exposure: 0.0,
             albedo_maps: true,
+            glossy: false,
+            glossy_directions: 48,
+            glossy_samples: 4,
+            glossy_budget: 8_000_000,
         }
     }
 }
@@ -86,6 +112,10 @@ pub struct BakeStats {
     /// than 10⁻⁶ of the scene's largest flux, between the flux the file
     /// shows and the solution's (module `reconstruct`).
     pub max_flux_error: f64,
+    /// Vertices (counted once per side) given directional glossy light.
+    pub glossy_vertices: usize,
+    /// Of `seconds`, those spent estimating and fitting glossy light.
+    pub glossy_seconds: f64,
 }
 
 /// A baked file and its statistics.
@@ -114,10 +144,12 @@ pub fn bake<const N: usize>(
     let mut doc = Document::default();
     let mut flux = FluxCheck::default();
     let (mut vertices, mut triangles) = (0, 0);
+    let mut glossy = GlossyCount::new(input, options, &meshes);
     for mesh in meshes.iter().filter(|m| !m.triangles.is_empty()) {
         let sides = Side::BOTH.map(|side| {
-            let light = SideLight::new(input.solution, textures.as_ref(), mesh, side);
+            let mut light = SideLight::new(input.solution, textures.as_ref(), mesh, side);
             flux.add(input.solution, mesh, side, &light);
+            light.sh = glossy.fit(input, options, mesh, side, vertices);
             light
         });
         write_shape(&mut doc, input, mesh, &sides, options.exposure.exp2())?;
@@ -134,6 +166,8 @@ pub fn bake<const N: usize>(
         bytes: glb.len(),
         seconds: start.elapsed().as_secs_f64(),
         max_flux_error: flux.max_error(),
+        glossy_vertices: glossy.vertices,
+        glossy_seconds: glossy.seconds,
     };
     Ok(Baked { glb, stats })
 }
@@ -163,6 +197,9 @@ struct SideLight<'t, const N: usize> {
     values: Vec<[f64; 3]>,
     map: Option<AlbedoMap>,
     textures: Option<&'t ElementTextures<N>>,
+    /// The glossy light's SH coefficients per vertex (module
+    /// `directional`), on a glossy side when the bake has them.
+    sh: Option<Vec<[[f64; 3]; SH_COEFFICIENTS]>>,
 }
 
 impl<'t, const N: usize> SideLight<'t, N> {
@@ -183,6 +220,7 @@ impl<'t, const N: usize> SideLight<'t, N> {
             values: Vec::new(),
             map,
             textures: textures.filter(|_| textured),
+            sh: None,
         };
         let values = vertex_values(
             mesh,
@@ -216,6 +254,100 @@ impl<'t, const N: usize> SideLight<'t, N> {
     }
 }
 
+/// The glossy light's fits: directions and samples per vertex, counted.
+struct GlossyCount {
+    directions: usize,
+    samples: u32,
+    vertices: usize,
+    seconds: f64,
+}
+
+impl GlossyCount {
+    /// Directions and samples within `options.glossy_budget` for every
+    /// used vertex of every glossy side of `meshes`.
+    fn new<const N: usize>(
+        input: &BakeInput<'_, N>,
+        options: &BakeOptions,
+        meshes: &[ShapeMesh],
+    ) -> Self {
+        let scene = input.solution.scene();
+        let mut total = 0u64;
+        for mesh in meshes {
+            let material = scene.material(mesh.shape as usize);
+            let sides = Side::BOTH
+                .iter()
+                .filter(|&&s| material.has_glossy(s))
+                .count();
+            if sides > 0 {
+                let mut used = vec![false; mesh.positions.len()];
+                for &v in mesh.triangles.iter().flatten() {
+                    used[v as usize] = true;
+                }
+                total += (sides * used.iter().filter(|&&u| u).count()) as u64;
+            }
+        }
+        let per_vertex = options.glossy_budget.checked_div(total).unwrap_or(u64::MAX);
+        let wanted = u64::from(options.glossy_directions.max(MIN_GLOSSY_DIRECTIONS));
+        let directions = wanted.min(per_vertex.max(u64::from(MIN_GLOSSY_DIRECTIONS)));
+        let samples = (per_vertex / directions).clamp(1, u64::from(options.glossy_samples.max(1)));
+        GlossyCount {
+            directions: directions as usize,
+            samples: samples as u32,
+            vertices: 0,
+            seconds: 0.0,
+        }
+    }
+
+    /// The SH coefficients of `mesh`'s vertices on `side` (module
+    /// `directional`), when the bake has glossy light and the side's
+    /// material a glossy part; `first` numbers the mesh's vertices in the
+    /// bake.
+    fn fit<const N: usize>(
+        &mut self,
+        input: &BakeInput<'_, N>,
+        options: &BakeOptions,
+        mesh: &ShapeMesh,
+        side: Side,
+        first: usize,
+    ) -> Option<Vec<[[f64; 3]; SH_COEFFICIENTS]>> {
+        let light = input.glossy.filter(|_| options.glossy)?;
+        let scene = input.solution.scene();
+        if !scene.material(mesh.shape as usize).has_glossy(side) {
+            return None;
+        }
+        let start = Instant::now();
+        let mut used = vec![false; mesh.positions.len()];
+        for &v in mesh.triangles.iter().flatten() {
+            used[v as usize] = true;
+        }
+        let points: Vec<(usize, GlossyPoint)> = (0..mesh.positions.len())
+            .filter(|&v| used[v])
+            .map(|v| {
+                let (surface, coord) = mesh.sites[v];
+                let key = 2 * (first + v) as u64 + u64::from(side == Side::Back);
+                let point = GlossyPoint {
+                    shape: mesh.shape,
+                    surface,
+                    coord,
+                    side,
+                    point: mesh.positions[v],
+                    normal: mesh.normals[v],
+                    key,
+                };
+                (v, point)
+            })
+            .collect();
+        if options.glossy_samples == 0 {
+            return None;
+        }
+        let sizes = (self.directions, self.samples);
+        let sh = fit_vertices(light, &points, mesh.positions.len(), sizes);
+        self.vertices += points.len();
+        self.seconds += start.elapsed().as_secs_f64();
+        Some(sh)
+    }
+}
+
 /// One shape's node, mesh, materials and accessors.
 fn write_shape<const N: usize>(
     doc: &mut Document,
@@ -225,7 +357,14 @@ fn write_shape<const N: usize>(
     scale: f64,
 ) -> Result<(), BakeError> {
     for light in sides {
-        if light.values.iter().flatten().any(|x| !x.is_finite()) {
+        let sh = light.sh.iter().flatten().flatten().flatten();
+        if light
+            .values
+            .iter()
+            .flatten()
+            .chain(sh)
+            .any(|x| !x.is_finite())
+        {
             return Err(BakeError::NotFinite { shape: mesh.shape });
         }
     }
@@ -306,6 +445,11 @@ fn side_primitives<const N: usize>(
     let (radiance, display) = (doc.vec3(&radiance, false), doc.vec3(&display, false));
     let material = doc.materials.len();
     let mut m = material_of(input, shape, side);
+    m["extras"]["trilux"]["glossy_left_out"] =
+        json!(light.sh.is_none() && glossy_side(input, shape, side));
+    if light.sh.is_some() {
+        m["extras"]["trilux"]["glossy"] = json!("sh2");
+    }
     if let Some(map) = &light.map {
         let png = map.png().map_err(|e| BakeError::Image(e.to_string()))?;
         let texture = doc.png_texture(&png, map.sampler());
@@ -321,6 +465,12 @@ fn side_primitives<const N: usize>(
     });
     if let (Some(uv), Some(_)) = (shared.texcoord, &light.map) {
         attributes["TEXCOORD_0"] = json!(uv);
+    }
+    if let Some(sh) = &light.sh {
+        for j in 0..SH_COEFFICIENTS {
+            let c: Vec<[f32; 3]> = sh.iter().map(|v| v[j].map(|x| x as f32)).collect();
+            attributes[format!("_TRILUX_SH{j}")] = json!(doc.vec3(&c, false));
+        }
     }
     let mut primitives = Vec::new();
     for (surface, triangles) in surfaces {
@@ -375,11 +525,7 @@ fn material_of<const N: usize>(input: &BakeInput<'_, N>, shape: u32, side: Side)
         .get(shape as usize)
         .and_then(|b| serde_json::to_value(b).ok())
         .unwrap_or(Value::Null);
-    let glossy = input
-        .solution
-        .scene()
-        .material(shape as usize)
-        .has_glossy(side);
+    let glossy = glossy_side(input, shape, side);
     json!({
         "name": format!("{} ({})", shape_name(input.names, shape), side_name(side)),
         "pbrMetallicRoughness": {
@@ -395,6 +541,15 @@ fn material_of<const N: usize>(input: &BakeInput<'_, N>, shape: u32, side: Side)
             "glossy_left_out": glossy,
         } },
     })
+}
+
+/// The side's material has a glossy part.
+fn glossy_side<const N: usize>(input: &BakeInput<'_, N>, shape: u32, side: Side) -> bool {
+    input
+        .solution
+        .scene()
+        .material(shape as usize)
+        .has_glossy(side)
 }
 
 /// The scene camera's node and camera.
@@ -423,6 +578,7 @@ fn asset(options: &BakeOptions) -> Value {
             "colour": "_RADIANCE is linear Rec. 709 radiance (W sr^-1 m^-2 per channel); COLOR_0 is it times 2^exposure, clamped to [0, 1]",
             "baked": "the view-independent (Lambertian) light of the solution, emission included",
             "left_out": "the glossy (view-dependent) reflection of materials marked glossy_left_out",
+            "glossy": "on materials marked glossy: \"sh2\", the glossy outgoing radiance towards a world direction w is max(0, sum_j _TRILUX_SHj * Y_j(w)), Y the order-2 real spherical harmonics (Y_0 = 0.282095, Y_1..3 = 0.488603 (y, z, x), Y_4 = 1.092548 xy, Y_5 = 1.092548 yz, Y_6 = 0.315392 (3z^2 - 1), Y_7 = 1.092548 xz, Y_8 = 0.546274 (x^2 - y^2)), added to _RADIANCE",
         } },
     })
 }

@@ -19,6 +19,8 @@
 //!   flux-conserving averaging (the rule and its error bound are there).
 //! - `albedo`: textured materials as an albedo map times the light.
 //! - `camera`: the scene's camera ([`BakeCamera`]) as a glTF camera node.
+//! - [`directional`]: the glossy light of glossy sides as spherical
+//!   harmonics per vertex, fitted from a [`GlossyLight`].
 //! - `glb`: the glTF JSON and the binary container.
 //! - [`bake()`](bake()): the whole, with its [`BakeStats`].
 //! - [`mod@error`]: the error type, [`BakeError`].
@@ -27,12 +29,14 @@
 mod albedo;
 pub mod bake;
 mod camera;
+pub mod directional;
 pub mod error;
 mod glb;
 pub mod reconstruct;
 mod tessellate;
 
-pub use bake::{BakeInput, BakeOptions, BakeStats, Baked, bake};
+pub use bake::{BakeInput, BakeOptions, BakeStats, Baked, MIN_GLOSSY_DIRECTIONS, bake};
 pub use camera::BakeCamera;
+pub use directional::{GlossyLight, GlossyPoint};
 pub use error::BakeError;
 pub use tessellate::ShapeMesh;

@@ -57,6 +57,9 @@ pub struct ShapeMesh {
     /// Texture coordinates of the vertices (`Geometry::texcoord`), where
     /// the surface has them.
     pub texcoords: Vec<Option<DVec2>>,
+    /// Where each vertex lies: its input surface and the surface's own
+    /// coordinates (the first computed, for a welded vertex).
+    pub sites: Vec<(SurfaceId, SurfaceCoord)>,
     /// Triangles, counter-clockwise seen from the front.
     pub triangles: Vec<[u32; 3]>,
     /// The leaf element each triangle covers part of.
@@ -234,6 +237,10 @@ fn key(p: DVec3) -> [u32; 3] {
     p.as_vec3().to_array().map(|x| (x + 0.0).to_bits())
 }
 
+/// A located point: where it is, its texture coordinates, its surface
+/// coordinates.
+type Located = (SurfacePoint, Option<DVec2>, SurfaceCoord);
+
 /// Builds one shape's mesh: the corner set, the welded vertices.
 struct Builder<'g> {
     geometry: &'g Geometry,
@@ -272,18 +279,18 @@ impl<'g> Builder<'g> {
     }
 
     /// The point `p` of `cell` with its texture coordinates.
-    fn located(&self, cell: &Cell, p: DVec2) -> Option<(SurfacePoint, Option<DVec2>)> {
+    fn located(&self, cell: &Cell, p: DVec2) -> Option<Located> {
         let coord = cell.coord(p);
         let point = self.geometry.surface_point(cell.surface, coord)?;
         let uv = match self.textured {
             true => self.geometry.texcoord(cell.surface, coord),
             false => None,
         };
-        Some((point, uv))
+        Some((point, uv, coord))
     }
 
     /// The welded vertex of `surface` at `p` with texture coordinates `uv`.
-    fn vertex(&mut self, surface: SurfaceId, (p, uv): (SurfacePoint, Option<DVec2>)) -> u32 {
+    fn vertex(&mut self, surface: SurfaceId, (p, uv, coord): Located) -> u32 {
         let k = key(p.point);
         let point = *self.canonical.entry(k).or_insert(p.point);
         let bucket = self.welded.entry((k, surface)).or_default();
@@ -298,6 +305,7 @@ impl<'g> Builder<'g> {
         self.mesh.positions.push(point);
         self.mesh.normals.push(p.normal);
         self.mesh.texcoords.push(uv);
+        self.mesh.sites.push((surface, coord));
         bucket.push(v);
         v
     }

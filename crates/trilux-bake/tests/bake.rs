@@ -160,6 +160,7 @@ fn a_baked_closed_box_keeps_its_flux_and_is_valid_gltf() {
         materials: &bsdfs,
         names: &names,
         camera: None,
+        glossy: None,
     };
     let baked = bake(&input, &BakeOptions::default()).expect("the box bakes");
     assert_eq!(baked.stats.bytes, baked.glb.len());
@@ -227,4 +228,147 @@ fn a_baked_closed_box_keeps_its_flux_and_is_valid_gltf() {
     }
     // The bake's own check agrees.
     assert!(baked.stats.max_flux_error < 1e-9, "{:?}", baked.stats);
+}
+
+/// A stand-in for the renderer's glossy light, a quadratic polynomial of
+/// the direction scaled by the position: order-2 spherical harmonics hold
+/// it exactly, so the file must give it back at every vertex.
+struct Quadratic;
+
+fn quadratic(p: DVec3, w: DVec3) -> [f64; 3] {
+    let s = 2.0 + p.x + 0.5 * p.y;
+    [
+        s * (1.0 + 0.3 * w.x - 0.2 * w.z),
+        s * (0.5 + w.x * w.y),
+        s * (0.2 + 0.4 * w.z * w.z - 0.1 * w.y),
+    ]
+}
+
+impl trilux_bake::GlossyLight for Quadratic {
+    fn outgoing(
+        &self,
+        points: &[trilux_bake::GlossyPoint],
+        directions: &[DVec3],
+        _samples: u32,
+    ) -> Vec<[f64; 3]> {
+        let per = directions.len() / points.len();
+        directions
+            .iter()
+            .enumerate()
+            .map(|(k, &w)| quadratic(points[k / per].point, w))
+            .collect()
+    }
+}
+
+/// The real spherical harmonics of order 2 from their closed forms
+/// (Sloan, "Stupid spherical harmonics tricks", appendix A2).
+fn sh(w: DVec3) -> [f64; 9] {
+    use std::f64::consts::PI;
+    let (x, y, z) = (w.x, w.y, w.z);
+    let (c1, c2) = ((3.0 / (4.0 * PI)).sqrt(), 0.5 * (15.0 / PI).sqrt());
+    [
+        0.5 / PI.sqrt(),
+        c1 * y,
+        c1 * z,
+        c1 * x,
+        c2 * x * y,
+        c2 * y * z,
+        0.25 * (5.0 / PI).sqrt() * (3.0 * z * z - 1.0),
+        c2 * x * z,
+        0.25 * (15.0 / PI).sqrt() * (x * x - y * y),
+    ]
+}
+
+#[test]
+fn a_glossy_floor_carries_its_glossy_light_as_spherical_harmonics() {
+    let shapes = box_shapes();
+    let mut bsdfs = vec![
+        BsdfParams::Diffuse {
+            reflectance: ColorParam::Float(RHO),
+        };
+        6
+    ];
+    bsdfs[1] = BsdfParams::RoughConductor(trilux_brdf::RoughConductorParams {
+        distribution: trilux_brdf::Distribution::Ggx,
+        alpha: 0.3,
+        eta_k: None,
+        specular_reflectance: ColorParam::Float(0.8),
+    });
+    let mut emission = vec![None; 6];
+    emission[0] = Some(ColorParam::Float(LE));
+    let input = SceneDescription {
+        shapes: &shapes,
+        bsdfs: &bsdfs,
+        emission: &emission,
+    };
+    let mut settings = SolverSettings::preset(Quality::Draft);
+    settings.max_depth = 2;
+    let solution = Solver::<3>::from_description(&input, settings)
+        .expect("the box builds")
+        .solve(|_| {});
+    let names: Vec<Option<String>> = vec![None; 6];
+    let input = BakeInput {
+        solution: &solution,
+        materials: &bsdfs,
+        names: &names,
+        camera: None,
+        glossy: Some(&Quadratic),
+    };
+    // Off by default: the glossy light is left out and the floor marked.
+    let plain = bake(&input, &BakeOptions::default()).expect("the box bakes");
+    let (json, _) = chunks(&plain.glb);
+    assert!(!String::from_utf8_lossy(&plain.glb).contains("_TRILUX_SH0"));
+    let left_out = json["materials"]
+        .as_array()
+        .expect("materials")
+        .iter()
+        .filter(|m| m["extras"]["trilux"]["glossy_left_out"] == true)
+        .count();
+    assert_eq!(left_out, 1, "the floor's front is marked");
+    assert_eq!(plain.stats.glossy_vertices, 0);
+    let mut options = BakeOptions::default();
+    options.glossy = true;
+    let baked = bake(&input, &options).expect("the box bakes");
+    let (json, bin) = chunks(&baked.glb);
+    gltf::Gltf::from_slice(&baked.glb).expect("the gltf crate reads the file");
+    let mut glossy_primitives = 0;
+    for mesh in json["meshes"].as_array().unwrap() {
+        let shape = mesh["extras"]["trilux"]["shape"].as_u64().unwrap();
+        for p in mesh["primitives"].as_array().unwrap() {
+            let material = &json["materials"][p["material"].as_u64().unwrap() as usize];
+            let front = p["extras"]["trilux"]["side"] == "front";
+            let glossy = shape == 1 && front;
+            let attrs = &p["attributes"];
+            assert_eq!(attrs.get("_TRILUX_SH0").is_some(), glossy, "shape {shape}");
+            assert_eq!(material["extras"]["trilux"]["glossy_left_out"], false);
+            if !glossy {
+                continue;
+            }
+            glossy_primitives += 1;
+            assert_eq!(material["extras"]["trilux"]["glossy"], "sh2");
+            let positions = vec3s(&json, bin, &attrs["POSITION"]);
+            let normals = vec3s(&json, bin, &attrs["NORMAL"]);
+            let c: Vec<Vec<DVec3>> = (0..9)
+                .map(|j| vec3s(&json, bin, &attrs[format!("_TRILUX_SH{j}")]))
+                .collect();
+            for (v, (&p, &n)) in positions.iter().zip(&normals).enumerate() {
+                // Directions over the front hemisphere, grazing ones too.
+                for w in [
+                    n,
+                    (n + DVec3::X).normalize(),
+                    (n - 0.9 * DVec3::Y).normalize(),
+                ] {
+                    let y = sh(w);
+                    let got: DVec3 = (0..9).map(|j| c[j][v] * y[j]).sum();
+                    let want = DVec3::from_array(quadratic(p, w));
+                    assert!(
+                        (got - want).abs().max_element() < 1e-4,
+                        "{p} {w}: {got} vs {want}"
+                    );
+                }
+            }
+        }
+    }
+    assert_eq!(glossy_primitives, 1);
+    assert!(baked.stats.glossy_vertices > 0);
 }

@@ -131,6 +131,28 @@ impl<S> LinkGather<'_, S> {
         finite_or_dropped(l, w.stats)
     }
 
+    /// One sample of the glossy part of the radiance leaving `x` towards
+    /// `wo`: the estimate a camera sample makes at its hit (module docs),
+    /// for directional bakes that fit it over many directions.
+    pub fn glossy_sample<const N: usize>(
+        &self,
+        x: &SurfacePoint<S::Locator>,
+        wo: DVec3,
+        sampler: &PixelSampler,
+        caches: &mut Caches<N>,
+        stats: &mut GatherStats,
+    ) -> Spectrum<N>
+    where
+        S: SolutionGather<N>,
+    {
+        let mut w = Walk {
+            sampler,
+            caches,
+            stats,
+        };
+        finite_or_dropped(self.glossy(x, wo, 0, &mut w), w.stats)
+    }
+
     /// The cosine ray's share of the irradiance at a Lambertian `x` at
     /// gather `level` (module docs): E_g, the glossy radiance it brings,
     /// and at the camera hit the near-field correction where it meets a

@@ -1,4 +1,4 @@
-//! `trilux bake SCENE [-o OUT.glb] [--open]`: the solution's view-independent
+//! `trilux bake SCENE [-o OUT.glb] [--glossy] [--open]`: the solution's view-independent
 //! light as a glTF 2.0 binary, for walkthroughs in any glTF viewer
 //! (docs/bake.md; the file's layout is `trilux_bake`'s), and with `--open`
 //! in trilux's own viewer on localhost (`serve`).
@@ -35,6 +35,12 @@ pub struct BakeArgs {
     /// the elements is lost).
     #[arg(long)]
     pub no_albedo_maps: bool,
+    /// Bake the glossy (view-dependent) light of glossy materials too, as
+    /// order-2 spherical harmonics per vertex that trilux's viewer shows
+    /// (docs/bake.md; slower to bake). Default: left out, the materials
+    /// marked glossy_left_out.
+    #[arg(long)]
+    pub glossy: bool,
     /// Write solve and bake statistics (file size, vertices, triangles) as
     /// JSON.
     #[arg(long)]
@@ -80,6 +86,7 @@ pub fn run(args: &BakeArgs) -> Result<()> {
     let mut options = BakeOptions::default();
     options.exposure = args.exposure;
     options.albedo_maps = !args.no_albedo_maps;
+    options.glossy = args.glossy;
     let bake = Product::Bake(options);
     let plan = args
         .options

@@ -20,6 +20,7 @@
 #![forbid(unsafe_code)]
 
 pub mod error;
+mod glossy_light;
 pub mod oneshot;
 pub mod pipeline;
 pub mod view;

@@ -292,7 +292,8 @@ pub fn stats_json(
 }
 
 /// The statistics JSON of a bake: the solver's figures plus the file's
-/// (`bake`: bytes, vertices, triangles, seconds, max_flux_error) and the
+/// (`bake`: bytes, vertices, triangles, seconds, max_flux_error,
+/// glossy_vertices, glossy_seconds) and the
 /// run's record.
 pub fn bake_stats_json(
     stats: &trilux_solver::SolveStats,
@@ -310,6 +311,8 @@ pub fn bake_stats_json(
                 "triangles": bake.triangles,
                 "seconds": bake.seconds,
                 "max_flux_error": bake.max_flux_error,
+                "glossy_vertices": bake.glossy_vertices,
+                "glossy_seconds": bake.glossy_seconds,
             }),
         );
     }

@@ -325,11 +325,14 @@ fn bake<const N: usize>(
         });
     let materials = scene.bsdf_params();
     let names: Vec<Option<String>> = scene.shapes.iter().map(|s| s.id.clone()).collect();
+    let glossy = crate::glossy_light::RenderedGlossy::new(solution);
     let input = trilux_bake::BakeInput {
         solution,
         materials: &materials,
         names: &names,
         camera,
+        glossy: (options.glossy && options.glossy_samples > 0)
+            .then_some(&glossy as &dyn trilux_bake::GlossyLight),
     };
     Ok(trilux_bake::bake(&input, options)?)
 }

@@ -37,10 +37,11 @@ macro_rules! viewer_files {
 const JS: &str = "text/javascript; charset=utf-8";
 
 /// The viewer's files.
-const VIEWER: [Served; 10] = viewer_files![
+const VIEWER: [Served; 11] = viewer_files![
     ("index.html", "text/html; charset=utf-8"),
     ("viewer.js", JS),
     ("walk.js", JS),
+    ("glossy.js", JS),
     ("vendor/three/build/three.module.js", JS),
     ("vendor/three/build/three.core.js", JS),
     ("vendor/three/examples/jsm/controls/OrbitControls.js", JS),

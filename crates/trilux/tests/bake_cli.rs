@@ -453,6 +453,63 @@ fn glossy_tube_bakes_to_its_solution() {
     assert_eq!(check_scene(&repo("scenes/glossy-tube.xml"), "tube"), 0);
 }
 
+/// The glossy tube's glossy light: left out and marked by default, as
+/// spherical harmonics on the glossy sides with `--glossy` (the same
+/// solution, the same diffuse light).
+#[test]
+fn glossy_light_is_baked_only_with_the_glossy_flag() {
+    let dir = folder("bake-glossy-flag");
+    let (sol, plain) = solve_and_bake(&repo("scenes/glossy-tube.xml"), &dir, &[]);
+    let glossy = dir.join("glossy.glb");
+    let out = trilux(&[
+        "bake",
+        repo("scenes/glossy-tube.xml").to_str().unwrap(),
+        "--quality",
+        "draft",
+        "--solution",
+        sol.to_str().unwrap(),
+        "-o",
+        glossy.to_str().unwrap(),
+        "--glossy",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let marks = |glb: &Path| {
+        let (prims, json) = read_primitives(glb);
+        let materials = json["materials"].as_array().unwrap();
+        let left_out = materials
+            .iter()
+            .filter(|m| m["extras"]["trilux"]["glossy_left_out"] == true)
+            .count();
+        let sh2 = materials
+            .iter()
+            .filter(|m| m["extras"]["trilux"]["glossy"] == "sh2")
+            .count();
+        let with_sh = json["meshes"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .flat_map(|m| m["primitives"].as_array().unwrap())
+            .filter(|p| p["attributes"].get("_TRILUX_SH8").is_some())
+            .count();
+        let radiance: Vec<[f32; 3]> = prims.into_iter().flat_map(|p| p.radiance).collect();
+        (left_out, sh2, with_sh, radiance)
+    };
+    let (left_out, sh2, with_sh, diffuse) = marks(&plain);
+    assert!(left_out > 0, "without --glossy the glossy sides are marked");
+    assert_eq!((sh2, with_sh), (0, 0), "without --glossy no glossy light");
+    let (left_out, sh2, with_sh, diffuse_too) = marks(&glossy);
+    assert_eq!(left_out, 0, "with --glossy nothing is left out");
+    assert!(
+        sh2 > 0 && with_sh > 0,
+        "with --glossy the glossy sides carry it"
+    );
+    assert_eq!(diffuse, diffuse_too, "the diffuse light is the same");
+}
+
 /// Meshes as charts, with a textured floor and back wall (glTF): those
 /// sides carry albedo maps.
 #[test]

@@ -1,5 +1,7 @@
 // The viewer on real bakes, in headless Chromium (node's test runner):
-// walk mode in an interior, touch, the glossy notice, the compact overlay,
+// walk mode in an interior, touch, the glossy notice (never on a diffuse
+// bake), the baked glossy light of a --glossy bake and its toggle, the
+// compact overlay,
 // and `trilux view` serving a bake that the page loads.
 //
 //   TRILUX=target/release/trilux TRILUX_BAKES=target/viewer \
@@ -11,7 +13,10 @@
 // - crossing-room.glb (scenes/crossing-room.xml): a room x, z in [0, 4],
 //   floor y = 0, ceiling y = 3, the camera at (3.6, 1.9, 3.7) inside it; a
 //   glossy (roughconductor) box centred at (2.7, 0.45, 1.5), 0.6 × 0.9 ×
-//   0.6, rotated 25° about y; the red wall at x = 0.
+//   0.6, rotated 25° about y; the red wall at x = 0. Its glossy light is
+//   left out (the notice).
+// - crossing-room-glossy.glb: the same baked with `--glossy` (the glossy
+//   light as spherical harmonics, glossy.js).
 // - diffuse-textured.glb (tests/bake/diffuse-textured.xml): diffuse only, a
 //   box open towards its camera at (0, 1, 3.6), outside it.
 
@@ -205,6 +210,19 @@ const noticeLookingAt = (page, target) => page.evaluate((t) => new Promise((ok) 
 	}));
 }), target);
 
+/** The RGB bytes at the centre of the view looking at `target`, the baked glossy light on or off. */
+const centreLookingAt = (page, target, glossy) => page.evaluate(([t, g]) => {
+	const v = window.viewer;
+	v.camera.lookAt(...t);
+	v.camera.updateMatrixWorld();
+	v.setGlossy(g);
+	v.frameTime(1);
+	const gl = v.renderer.getContext();
+	const px = new Uint8Array(4);
+	gl.readPixels(gl.drawingBufferWidth >> 1, gl.drawingBufferHeight >> 1, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, px);
+	return [px[0], px[1], px[2]];
+}, [target, glossy]);
+
 test('glossy notice: on the glossy box of a bake, not on its diffuse walls', async () => {
 	const { page, context } = await open('crossing-room.glb');
 	const info = await page.evaluate(() => window.viewerInfo);
@@ -233,6 +251,43 @@ test('glossy notice: on the glossy box of a bake, not on its diffuse walls', asy
 	assert.deepEqual(await noticeLookingAt(page, [2.7, 0.45, 1.5]), { text: GLOSSY_NOTICE, shown: true });
 	assert.deepEqual(await noticeLookingAt(page, [0, 1.5, 2]), { text: null, shown: false });
 	assert.deepEqual(await noticeLookingAt(page, [2, 0, 3]), { text: null, shown: false });
+	await context.close();
+});
+
+test('glossy light: the glossy box of a --glossy bake carries it, G turns it off, no notice', async () => {
+	const { page, context } = await open('crossing-room-glossy.glb');
+	const info = await page.evaluate(() => window.viewerInfo);
+	assert.ok(info.glossyMeshes > 0, 'the bake has directional glossy light');
+	assert.deepEqual(info.glossyLeftOut, [], 'nothing is left out');
+	// Every mesh with glossy light is on the glossy box: within its bounds,
+	// x, z within 0.3 (cos 25° + sin 25°) = 0.399 of (2.7, 1.5), y in [0, 0.9].
+	const boxes = await page.evaluate(() => {
+		const out = [];
+		window.viewer.state.model.traverse((o) => {
+			if (!o.isMesh) return;
+			const ms = Array.isArray(o.material) ? o.material : [o.material];
+			if (!ms.some((m) => m.userData?.triluxGlossy === true)) return;
+			const b = new window.viewer.THREE.Box3().setFromObject(o);
+			out.push([b.min.toArray(), b.max.toArray()]);
+		});
+		return out;
+	});
+	assert.equal(boxes.length, info.glossyMeshes);
+	const half = 0.3 * (Math.cos(Math.PI * 25 / 180) + Math.sin(Math.PI * 25 / 180)) + 1e-3;
+	for (const [lo, hi] of boxes) {
+		assert.ok(lo[0] > 2.7 - half && hi[0] < 2.7 + half && lo[2] > 1.5 - half && hi[2] < 1.5 + half, `a glossy mesh in ${lo}..${hi}`);
+		assert.ok(lo[1] > -1e-3 && hi[1] < 0.9 + 1e-3, `a glossy mesh in ${lo}..${hi}`);
+	}
+	assert.equal(await page.evaluate(() => document.getElementById('glossy').hidden), false, 'the toggle shows');
+	// The box is a rough conductor: no diffuse light, all it shows is glossy.
+	const on = await centreLookingAt(page, [2.7, 0.45, 1.5], true);
+	const off = await centreLookingAt(page, [2.7, 0.45, 1.5], false);
+	assert.ok(on.some((c) => c > 10), `the box shows its glossy light: ${on}`);
+	assert.ok(off.every((c) => c <= 1), `diffuse only, the box is black: ${off}`);
+	// The walls have no glossy light: the toggle leaves them as they are.
+	const wallOn = await centreLookingAt(page, [0, 1.5, 2], true);
+	assert.deepEqual(await centreLookingAt(page, [0, 1.5, 2], false), wallOn);
+	assert.deepEqual(await noticeLookingAt(page, [2.7, 0.45, 1.5]), { text: null, shown: false });
 	await context.close();
 });
 

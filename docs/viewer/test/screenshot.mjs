@@ -5,7 +5,12 @@
 //
 //   node test/screenshot.mjs --glb FILE --width W --height H --out OUT.png
 //                            [--exposure STOPS] [--chromium PATH] [--timeout S]
-//                            [--info INFO.json] [--ui]
+//                            [--info INFO.json] [--ui] [--lookat CSV]
+//                            [--glossy 0|1] [--mask glossy]
+//
+// --lookat, --glossy and --mask pass the viewer's query parameters of the
+// same names (another view; the baked glossy light off; the mask of the
+// glossy sides).
 //
 // A static HTTP server on 127.0.0.1 (a free port) serves docs/viewer at / and
 // the model's directory at /model/; Debian's Chromium (/usr/bin/chromium, or
@@ -52,6 +57,9 @@ function parseArgs(argv) {
 		else if (a === '--timeout') o.timeout = val();
 		else if (a === '--info') o.info = val();
 		else if (a === '--ui') o.ui = true;
+		else if (a === '--lookat') o.lookat = val();
+		else if (a === '--glossy') o.glossy = val();
+		else if (a === '--mask') o.mask = val();
 		else usage(`unknown argument ${a}`);
 	}
 	if (!o.glb) usage('--glb is required');
@@ -99,6 +107,7 @@ async function main() {
 	const port = server.address().port;
 	const q = new URLSearchParams({ file: `/model/${basename(model)}`, ui: o.ui ? '1' : '0' });
 	if (o.exposure !== null) q.set('exposure', String(Number(o.exposure)));
+	for (const k of ['lookat', 'glossy', 'mask']) if (o[k] !== undefined) q.set(k, o[k]);
 	const url = `http://127.0.0.1:${port}/index.html?${q}`;
 
 	const userDataDir = mkdtempSync(join(tmpdir(), 'trilux-viewer-chromium-'));

@@ -1,0 +1,96 @@
+//! The renderer's estimate of glossy light, for directional bakes: a
+//! [`trilux_bake::GlossyLight`] that averages the link gather's own
+//! glossy estimate (`LinkGather::glossy_sample`: a light sample and a
+//! BSDF-sampled gather ray, MIS-combined, the gather hit read through its
+//! links and one more glossy level) over a fixed number of samples per
+//! direction. The bake's glossy light is thus the full render's, fitted.
+
+use glam::DVec3;
+use rayon::prelude::*;
+use trilux_bake::{GlossyLight, GlossyPoint};
+use trilux_render::gather::{ExtraBounce, FinalGather};
+use trilux_render::link_gather::{Caches, LinkGather};
+use trilux_render::solved::HitLocator;
+use trilux_render::{GatherStats, PixelSampler, SolvedScene, SurfacePoint};
+use trilux_solver::Solution;
+
+/// The render's glossy light over a solution.
+pub(crate) struct RenderedGlossy<'a, const N: usize> {
+    scene: SolvedScene<'a, N, Solution<N>>,
+}
+
+impl<'a, const N: usize> RenderedGlossy<'a, N> {
+    pub(crate) fn new(solution: &'a Solution<N>) -> Self {
+        RenderedGlossy {
+            scene: SolvedScene::new(solution),
+        }
+    }
+
+    /// Glossy radiance at `p` towards each of `dirs`.
+    fn at(
+        &self,
+        p: &GlossyPoint,
+        dirs: &[DVec3],
+        samples: u32,
+        caches: &mut Caches<N>,
+    ) -> Vec<[f64; 3]> {
+        let samples = samples.max(1);
+        let gather = LinkGather {
+            scene: &self.scene,
+            fallback: FinalGather {
+                scene: &self.scene,
+                extra: ExtraBounce::default(),
+            },
+            glossy_scene: true,
+        };
+        let x = SurfacePoint {
+            point: p.point,
+            normal: p.normal,
+            t: 0.0,
+            locator: HitLocator {
+                surface: p.surface,
+                coord: p.coord,
+                shading_normal: p.normal,
+                shape: p.shape,
+            },
+        };
+        let mut stats = GatherStats::default();
+        // The seed folds the point's key into the sampler's two indices.
+        let (lo, hi) = (p.key as u32, (p.key >> 32) as u32);
+        dirs.iter()
+            .enumerate()
+            .map(|(k, &wo)| {
+                let mut sampler =
+                    PixelSampler::new(hi ^ (k as u32).wrapping_mul(0x9e37_79b9), lo, k as u32);
+                let mut sum = trilux_color::Spectrum::<N>::zero();
+                for s in 0..samples {
+                    sampler.start_sample(s);
+                    sum += gather.glossy_sample(&x, wo, &sampler, caches, &mut stats);
+                }
+                (sum * (1.0 / f64::from(samples))).to_linear_srgb()
+            })
+            .collect()
+    }
+}
+
+impl<const N: usize> GlossyLight for RenderedGlossy<'_, N> {
+    fn outgoing(
+        &self,
+        points: &[GlossyPoint],
+        directions: &[DVec3],
+        samples: u32,
+    ) -> Vec<[f64; 3]> {
+        let per = directions.len().checked_div(points.len()).unwrap_or(0);
+        if per == 0 {
+            return Vec::new();
+        }
+        points
+            .par_iter()
+            .zip(directions.par_chunks(per))
+            .map_init(Caches::<N>::default, |caches, (p, dirs)| {
+                self.at(p, dirs, samples, caches)
+            })
+            .flatten_iter()
+            .collect()
+    }
+}
