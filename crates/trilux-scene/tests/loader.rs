@@ -466,7 +466,7 @@ fn blendbsdf_and_twosided() {
     assert!(e(r#"<bsdf type="blendbsdf"><float name="weight" value="1.5"/><bsdf type="diffuse"/><bsdf type="diffuse"/></bsdf>"#).contains("[0, 1]"));
     assert!(e(r#"<bsdf type="blendbsdf"><float name="weight" value="0.5"/><bsdf type="diffuse"/></bsdf>"#).contains("exactly two"));
     assert!(e(r#"<bsdf type="twosided"/>"#).contains("one or two"));
-    assert!(e(r#"<bsdf type="plastic"/>"#).contains("unknown bsdf plugin \"plastic\""));
+    assert!(e(r#"<bsdf type="dielectric"/>"#).contains("unknown bsdf plugin \"dielectric\""));
 }
 
 #[test]
