@@ -99,11 +99,32 @@ fn scenes_beyond_the_range_are_refused_at_their_place() {
     );
     let (out, _) = render(&dir, "huge", &scene(1e16, 0.0));
     let huge = s(&dir.join("huge.xml")).to_owned();
-    assert_refused(
-        &out,
-        &format!("{huge}:4:"),
-        "<lookat> origin: coordinate 8e15 is beyond the coordinate limit ±1e15",
-    );
+    // Three independent errors, each reported at its place in one run: the
+    // sensor's origin and the two shapes' transforms.
+    assert_eq!(out.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    let lines: Vec<&str> = stderr.lines().collect();
+    assert_eq!(lines.len(), 3, "three errors: {stderr}");
+    for (line, (place, what)) in lines.iter().zip([
+        (
+            4,
+            "<lookat> origin: coordinate 8e15 is beyond the coordinate limit ±1e15",
+        ),
+        (
+            9,
+            "to_world scales or moves by 1e16, beyond the coordinate limit ±1e15",
+        ),
+        (
+            14,
+            "to_world scales or moves by 5e15, beyond the coordinate limit ±1e15",
+        ),
+    ]) {
+        assert!(
+            line.starts_with(&format!("error: {huge}:{place}:")),
+            "{line}"
+        );
+        assert!(line.contains(what), "{line} should say {what}");
+    }
     let text = "<scene version=\"3.0.0\">\n  <shape type=\"rectangle\"><transform name=\"to_world\"><scale value=\"1e19\"/></transform></shape>\n</scene>\n";
     std::fs::write(&huge, text).unwrap();
     let out = trilux(&["info", &huge]);
