@@ -613,7 +613,10 @@ fn material_extension_error(ext: &str, body: Value) -> String {
     let m = json!({"name": "glass", "extensions": {ext: body}});
     let mut j = with_material(Some(m));
     j["extensionsUsed"] = json!([ext]);
-    let err = load(ext, &j).unwrap_err().to_string();
+    // A folder per call: two tests may ask for the same extension at once.
+    static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let err = load(&format!("{ext}-{call}"), &j).unwrap_err().to_string();
     assert_eq!(err.lines().count(), 1, "{err}");
     err
 }

@@ -13,8 +13,9 @@ proptest! {
     #![proptest_config(ProptestConfig::with_cases(256))]
 
     /// Cutting, deleting or replacing bytes anywhere in a valid scene gives
-    /// either a scene or an error, never a panic; an error displays on one
-    /// line starting with the file name.
+    /// either a scene or an error, never a panic; an error displays one
+    /// line per independent error (at most 20 and a count), each starting
+    /// with the file name.
     #[test]
     fn mutated_scenes_never_panic(at in 0usize..SCENE.len(), len in 0usize..40, with in "[<>\"=/a-z0-9 .,:$-]{0,6}") {
         let mut bytes = SCENE.as_bytes().to_vec();
@@ -23,8 +24,10 @@ proptest! {
         let text = String::from_utf8_lossy(&bytes);
         if let Err(e) = load_str(&text, "mutated.xml") {
             let msg = e.to_string();
-            prop_assert!(msg.starts_with("mutated.xml:"), "{}", msg);
-            prop_assert_eq!(msg.lines().count(), 1);
+            for line in msg.lines() {
+                prop_assert!(line.starts_with("mutated.xml:"), "{}", msg);
+            }
+            prop_assert!((1..=21).contains(&msg.lines().count()), "{}", msg);
         }
     }
 
