@@ -81,12 +81,7 @@ impl<S> ControlVariate<'_, S> {
         };
         let wo = -dir;
         let l = self.scene.emitted(&xs, wo) + self.reflected(&xs, wo, sampler, stats);
-        if l.is_finite() {
-            l
-        } else {
-            stats.dropped += 1;
-            Spectrum::zero()
-        }
+        stats.finite_or_dropped(l)
     }
 
     /// Reflected radiance leaving the camera hit `xs` towards `wo`: direct

@@ -108,12 +108,7 @@ impl<'a, S> FinalGather<'a, S> {
         let le = self.scene.emitted(&xs, wo);
         let lr = self.gather(&xs, wo, 0, sampler, stats);
         let l = le + lr;
-        if l.is_finite() {
-            l
-        } else {
-            stats.dropped += 1;
-            Spectrum::zero()
-        }
+        stats.finite_or_dropped(l)
     }
 
     /// Reflected radiance leaving `x` towards `wo`: light sample + gather

@@ -121,14 +121,14 @@ impl<S> LinkGather<'_, S> {
                 // No links here: the path gather serves the whole BSDF.
                 None => {
                     let lr = self.fallback.gather(&xs, wo, 0, sampler, w.stats);
-                    return finite_or_dropped(l + lr, w.stats);
+                    return w.stats.finite_or_dropped(l + lr);
                 }
             }
         }
         if scene.is_glossy(&xs, wo) {
             l += self.glossy(&xs, wo, 0, &mut w);
         }
-        finite_or_dropped(l, w.stats)
+        w.stats.finite_or_dropped(l)
     }
 
     /// One sample of the glossy part of the radiance leaving `x` towards
@@ -150,7 +150,8 @@ impl<S> LinkGather<'_, S> {
             caches,
             stats,
         };
-        finite_or_dropped(self.glossy(x, wo, 0, &mut w), w.stats)
+        let l = self.glossy(x, wo, 0, &mut w);
+        w.stats.finite_or_dropped(l)
     }
 
     /// The cosine ray's share of the irradiance at a Lambertian `x` at
@@ -330,7 +331,7 @@ impl<S> Preview<'_, S> {
                 l += albedo * reflected;
             }
         }
-        finite_or_dropped(l, stats)
+        stats.finite_or_dropped(l)
     }
 }
 
@@ -373,13 +374,4 @@ fn lambertian_at<S: SolutionGather<N>, const N: usize>(
     scene
         .solution_irradiance(xd, towards, LinkVisibility::Secondary, scratch, stats)
         .map(|e| rho * e)
-}
-
-fn finite_or_dropped<const N: usize>(l: Spectrum<N>, stats: &mut GatherStats) -> Spectrum<N> {
-    if l.is_finite() {
-        l
-    } else {
-        stats.dropped += 1;
-        Spectrum::zero()
-    }
 }

@@ -92,6 +92,17 @@ pub struct GatherStats {
 }
 
 impl GatherStats {
+    /// `l` if it is finite, else zero, counted as dropped (one sample's
+    /// NaN or infinity must not poison a pixel).
+    pub(crate) fn finite_or_dropped<const N: usize>(&mut self, l: Spectrum<N>) -> Spectrum<N> {
+        if l.is_finite() {
+            l
+        } else {
+            self.dropped += 1;
+            Spectrum::zero()
+        }
+    }
+
     /// Adds another set of counters.
     pub fn add(&mut self, o: &GatherStats) {
         self.camera_rays += o.camera_rays;
