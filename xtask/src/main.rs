@@ -10,6 +10,7 @@
 mod counting_alloc;
 mod deps;
 mod golden;
+mod package;
 mod rays;
 mod scale;
 mod scale_scenes;
@@ -106,7 +107,7 @@ fn ci() -> Result<()> {
     // debug assertions are on (the release pass below runs everything).
     run("cargo", &["test", "--workspace", "--lib", "--bins"])?;
     run("cargo", &["test", "--workspace", "--release"])?;
-    package()?;
+    package::main()?;
     color::color()?;
     // Every bundled scene against its stored Mitsuba 3 reference (the
     // golden test: relative RMSE ≤ 0.05, mean within 1 %).
@@ -127,30 +128,6 @@ fn ci() -> Result<()> {
     Ok(())
 }
 
-/// Every publishable crate packaged as crates.io would receive it, and
-/// each package built on its own from its `.crate` (cargo's verification:
-/// a file outside the crate, a path dependency without a version or a
-/// missing README fails here). Sibling crates resolve from cargo's local
-/// overlay of the packages just made. trilux-py (a Python extension module,
-/// published as a wheel) and xtask are `publish = false`; `--workspace`
-/// would package them too, so they are excluded by name. `--allow-dirty`:
-/// what is checked is the crates, not whether the work tree is committed
-/// (CI runs in a clean checkout; a local run may be mid-change).
-fn package() -> Result<()> {
-    run(
-        "cargo",
-        &[
-            "package",
-            "--workspace",
-            "--allow-dirty",
-            "--exclude",
-            "trilux-py",
-            "--exclude",
-            "xtask",
-        ],
-    )
-}
-
 fn main() -> Result<()> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     match args.first().map(String::as_str) {
@@ -159,7 +136,7 @@ fn main() -> Result<()> {
         Some("structure") => structure::main(),
         Some("deps") => deps::main(),
         Some("surface") => surface::main(&args[1..]),
-        Some("package") => package(),
+        Some("package") => package::main(),
         Some("golden") => golden::main(&args[1..]),
         Some("sweep") => sweep::main(&args[1..]),
         Some("rays") => rays::main(&args[1..]),
