@@ -25,11 +25,16 @@
 //! variance, never the mean. With M = 1 the estimator is the path tracer;
 //! each further lookup costs one ray and replaces the first bounce's
 //! directional noise by the solution's, 1/M of it.
+//!
+//! Being unbiased whatever L̃ is, it also honours a limit on path length
+//! (Mitsuba's `max_depth`) that the solution, which carries every bounce,
+//! cannot: the path and the direct terms stop at the limit and the lookups,
+//! added and subtracted alike, still cancel in the mean.
 
 use glam::{DVec2, DVec3};
 use trilux_color::Spectrum;
 
-use crate::mis::{hit_emission, light_sample};
+use crate::mis::{eye_hit, hit_emission, light_sample};
 use crate::records::{BsdfSample, GatherStats, SurfacePoint};
 use crate::sampler::{PixelSampler, dims};
 use crate::scene::GatherScene;
@@ -61,6 +66,12 @@ pub struct ControlVariate<'a, S> {
     pub scene: &'a S,
     /// M, the lookup rays per camera sample (1..=[`MAX_LOOKUPS`]).
     pub lookups: u32,
+    /// The longest path counted, in segments from the eye (Mitsuba's
+    /// `max_depth`); `None`: every length.
+    pub max_depth: Option<u32>,
+    /// Camera rays that meet an emitter count as misses
+    /// (`RenderSettings::hide_emitters`).
+    pub hide_emitters: bool,
 }
 
 impl<S> ControlVariate<'_, S> {
@@ -76,11 +87,17 @@ impl<S> ControlVariate<'_, S> {
         S: GatherScene<N>,
     {
         stats.camera_rays += 1;
-        let Some(xs) = self.scene.intersect(origin, dir) else {
+        if self.max_depth == Some(0) {
+            return Spectrum::zero();
+        }
+        let Some(xs) = eye_hit(self.scene, origin, dir, self.hide_emitters) else {
             return Spectrum::zero();
         };
         let wo = -dir;
-        let l = self.scene.emitted(&xs, wo) + self.reflected(&xs, wo, sampler, stats);
+        let mut l = self.scene.emitted(&xs, wo);
+        if self.max_depth.is_none_or(|d| d >= 2) {
+            l += self.reflected(&xs, wo, sampler, stats);
+        }
         stats.finite_or_dropped(l)
     }
 
@@ -149,7 +166,9 @@ impl<S> ControlVariate<'_, S> {
     /// β times the reflected radiance leaving `x` (vertex 2 of the path)
     /// towards `wo`, path-traced: at each vertex a light sample and a BSDF
     /// ray whose emission is MIS-weighted, Russian roulette from vertex
-    /// [`RR_DEPTH`] on.
+    /// [`RR_DEPTH`] on. Vertex k's light sample and the emission its BSDF
+    /// ray meets both end paths of k + 1 segments, so under a `max_depth` D
+    /// the walk stops before vertex D (as Mitsuba's path integrator does).
     fn path<const N: usize>(
         &self,
         mut x: SurfacePoint<S::Locator>,
@@ -163,7 +182,8 @@ impl<S> ControlVariate<'_, S> {
     {
         let scene = self.scene;
         let mut l = Spectrum::zero();
-        for vertex in 2..MAX_VERTICES {
+        let end = self.max_depth.map_or(MAX_VERTICES, |d| d.min(MAX_VERTICES));
+        for vertex in 2..end {
             let base = dims::PATH + (vertex - 2) * dims::PER_PATH_VERTEX;
             if vertex >= RR_DEPTH {
                 let q = beta.max_value().min(RR_MAX);

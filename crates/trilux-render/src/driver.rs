@@ -75,6 +75,15 @@ pub struct RenderSettings {
     /// Lookup rays per camera sample of the control variate
     /// ([`Estimator::Control`], `--lookups`).
     pub lookups: u32,
+    /// Mitsuba's `max_depth`: light is counted over paths of at most this
+    /// many segments from the eye (1: emitters seen directly, 2: direct
+    /// light, …); `None`: every length. Only [`Estimator::Control`] can
+    /// honour a limit (the solution the others read carries every bounce),
+    /// so [`Self::validate`] refuses one with them.
+    pub max_depth: Option<u32>,
+    /// Mitsuba's `hide_emitters`: a camera ray that meets an emitting
+    /// surface counts as a miss (black, as Mitsuba 3.9.1 renders it).
+    pub hide_emitters: bool,
 }
 
 /// Samples every pixel takes under adaptive sampling: its pilot's, which
@@ -92,6 +101,8 @@ impl Default for RenderSettings {
             target_error: None,
             tile_size: 16,
             lookups: DEFAULT_LOOKUPS,
+            max_depth: None,
+            hide_emitters: false,
         }
     }
 }
@@ -119,6 +130,14 @@ impl RenderSettings {
             return Err(RenderError::Settings(format!(
                 "lookups per sample {} must lie in 1..={MAX_LOOKUPS}",
                 self.lookups
+            )));
+        }
+        if let Some(depth) = self.max_depth
+            && self.estimator != Estimator::Control
+        {
+            return Err(RenderError::Settings(format!(
+                "max_depth {depth} is honoured by the control-variate estimator only: the solution the {:?} estimator reads carries light over paths of every length",
+                self.estimator
             )));
         }
         if self.tile_size == 0 {
@@ -162,15 +181,19 @@ impl<'a, S> Estimators<'a, S> {
     where
         S: SolutionGather<N>,
     {
+        let hide_emitters = settings.hide_emitters;
         let paths = || FinalGather {
             scene,
             extra: settings.extra_bounce,
+            hide_emitters,
         };
         Estimators {
             estimator: settings.estimator,
             control: ControlVariate {
                 scene,
                 lookups: settings.lookups,
+                max_depth: settings.max_depth,
+                hide_emitters,
             },
             paths: paths(),
             links: LinkGather {
@@ -178,7 +201,10 @@ impl<'a, S> Estimators<'a, S> {
                 fallback: paths(),
                 glossy_scene: scene.has_glossy_faces(),
             },
-            preview: Preview { scene },
+            preview: Preview {
+                scene,
+                hide_emitters,
+            },
         }
     }
 

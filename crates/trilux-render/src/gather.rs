@@ -38,7 +38,7 @@
 
 use glam::DVec3;
 
-use crate::mis::{hit_emission, light_sample};
+use crate::mis::{eye_hit, hit_emission, light_sample};
 use crate::records::{GatherStats, SurfacePoint};
 use crate::sampler::{PixelSampler, dims};
 use crate::scene::SolutionGather;
@@ -86,6 +86,9 @@ pub struct FinalGather<'a, S> {
     pub scene: &'a S,
     /// The extra-bounce rule.
     pub extra: ExtraBounce,
+    /// Camera rays that meet an emitter count as misses
+    /// (`RenderSettings::hide_emitters`).
+    pub hide_emitters: bool,
 }
 
 impl<'a, S> FinalGather<'a, S> {
@@ -101,7 +104,7 @@ impl<'a, S> FinalGather<'a, S> {
         S: SolutionGather<N>,
     {
         stats.camera_rays += 1;
-        let Some(xs) = self.scene.intersect(origin, dir) else {
+        let Some(xs) = eye_hit(self.scene, origin, dir, self.hide_emitters) else {
             return Spectrum::zero();
         };
         let wo = -dir;

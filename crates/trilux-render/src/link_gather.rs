@@ -41,7 +41,7 @@ use glam::DVec3;
 
 use crate::gather::FinalGather;
 use crate::link_sum::LinkCache;
-use crate::mis::{hit_emission, light_sample};
+use crate::mis::{eye_hit, hit_emission, light_sample};
 use crate::records::{GatherStats, LinkVisibility, SurfacePoint};
 use crate::sampler::{PixelSampler, dims, hammersley};
 use crate::scene::SolutionGather;
@@ -96,7 +96,7 @@ impl<S> LinkGather<'_, S> {
             return self.fallback.camera_sample(origin, dir, sampler, stats);
         }
         stats.camera_rays += 1;
-        let Some(xs) = self.scene.intersect(origin, dir) else {
+        let Some(xs) = eye_hit(self.scene, origin, dir, self.fallback.hide_emitters) else {
             return Spectrum::zero();
         };
         let wo = -dir;
@@ -288,6 +288,9 @@ impl<S> LinkGather<'_, S> {
 pub struct Preview<'a, S> {
     /// The scene and its solution.
     pub scene: &'a S,
+    /// Camera rays that meet an emitter count as misses
+    /// (`RenderSettings::hide_emitters`).
+    pub hide_emitters: bool,
 }
 
 impl<S> Preview<'_, S> {
@@ -305,7 +308,7 @@ impl<S> Preview<'_, S> {
     {
         stats.camera_rays += 1;
         let scene = self.scene;
-        let Some(xs) = scene.intersect(origin, dir) else {
+        let Some(xs) = eye_hit(scene, origin, dir, self.hide_emitters) else {
             return Spectrum::zero();
         };
         let wo = -dir;

@@ -78,6 +78,21 @@ pub fn light_sample<S: GatherScene<N>, const N: usize>(
     f * ls.radiance * (w / pdf_light)
 }
 
+/// Where a camera ray meets the scene. With `hide_emitters` (Mitsuba's
+/// parameter) a ray that meets an emitting surface counts as a miss:
+/// Mitsuba 3.9.1 renders it black, the light that surface reflects
+/// included (measured on its Cornell box, docs/results.md).
+pub(crate) fn eye_hit<S: GatherScene<N>, const N: usize>(
+    scene: &S,
+    origin: DVec3,
+    dir: DVec3,
+    hide_emitters: bool,
+) -> Option<SurfacePoint<S::Locator>> {
+    let xs = scene.intersect(origin, dir)?;
+    let hidden = hide_emitters && scene.light_pdf_area(&xs) > 0.0;
+    (!hidden).then_some(xs)
+}
+
 /// The emission a BSDF-sampled ray brings from its hit `xd` (seen from
 /// direction `back`): Le times the sample's `weight` (fr·cos/pdf, or a part
 /// of it), weighted by the power heuristic of the BSDF density `pdf`

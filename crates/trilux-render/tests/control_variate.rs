@@ -26,6 +26,19 @@ fn furnace_camera(w: u32, h: u32) -> Camera {
 /// `reflected` everywhere (the exact answer is 1: emission 1, albedo 0.5,
 /// L = 2).
 fn furnace_mean(reflected: f64, estimator: Estimator, lookups: u32) -> f64 {
+    furnace_mean_with(
+        reflected,
+        RenderSettings {
+            estimator,
+            lookups,
+            ..Default::default()
+        },
+    )
+}
+
+/// [`furnace_mean`] with more of the settings given (64 spp, seed 5 and
+/// no extra bounce always).
+fn furnace_mean_with(reflected: f64, settings: RenderSettings) -> f64 {
     let scene = Furnace {
         le: 1.0,
         rho: 0.5,
@@ -35,10 +48,8 @@ fn furnace_mean(reflected: f64, estimator: Estimator, lookups: u32) -> f64 {
     let settings = RenderSettings {
         spp: 64,
         seed: 5,
-        estimator,
-        lookups,
         extra_bounce: ExtraBounce::Never,
-        ..Default::default()
+        ..settings
     };
     let (img, stats) =
         render_image::<_, 3>(&scene, &furnace_camera(48, 32), &settings, rgb3, |_, _| {}).unwrap();
@@ -71,4 +82,69 @@ fn the_path_gather_with_a_wrong_solution_is_biased() {
     // walls, the solution for the rest).
     let m = furnace_mean(0.5, Estimator::Paths, 1);
     assert!((m - 1.75).abs() < 0.005, "mean {m}");
+}
+
+#[test]
+fn a_path_length_limit_counts_exactly_the_paths_mitsuba_counts() {
+    // Paths of at most D segments from the eye carry Le Σ_{k<D} ρ^k =
+    // 2 (1 − 0.5^D): 0, 1, 1.5, 1.75 for D = 0..3 (Mitsuba's `max_depth`,
+    // emission seen directly being the path of one segment), whatever the
+    // solution says (here 3× too bright), with one lookup or eight. Bound
+    // 0.5 % as above (D = 0 and 1 are exact).
+    for depth in 0..=3u32 {
+        let expected = 2.0 * (1.0 - 0.5f64.powi(depth as i32));
+        for lookups in [1, 8] {
+            let settings = RenderSettings {
+                estimator: Estimator::Control,
+                lookups,
+                max_depth: Some(depth),
+                ..Default::default()
+            };
+            let m = furnace_mean_with(3.0, settings);
+            assert!(
+                (m - expected).abs() <= 0.005 * expected,
+                "max_depth {depth}, {lookups} lookups: mean {m}, not {expected}"
+            );
+        }
+    }
+}
+
+#[test]
+fn only_the_control_variate_takes_a_path_length_limit() {
+    // The other estimators read a solution that carries every bounce.
+    for estimator in [Estimator::Paths, Estimator::Links, Estimator::Preview] {
+        let settings = RenderSettings {
+            estimator,
+            max_depth: Some(4),
+            ..Default::default()
+        };
+        let e = settings.validate().unwrap_err().to_string();
+        assert!(e.contains("max_depth 4"), "{e}");
+    }
+    let control = RenderSettings {
+        estimator: Estimator::Control,
+        max_depth: Some(4),
+        ..Default::default()
+    };
+    assert!(control.validate().is_ok());
+}
+
+#[test]
+fn hidden_emitters_leave_a_furnace_black() {
+    // Every wall of the furnace emits, so with `hide_emitters` every camera
+    // ray meets an emitter and counts as a miss (Mitsuba's meaning), for
+    // every estimator; without it the image is not black (the tests above).
+    for estimator in [
+        Estimator::Paths,
+        Estimator::Links,
+        Estimator::Preview,
+        Estimator::Control,
+    ] {
+        let settings = RenderSettings {
+            estimator,
+            hide_emitters: true,
+            ..Default::default()
+        };
+        assert_eq!(furnace_mean_with(1.0, settings), 0.0, "{estimator:?}");
+    }
 }

@@ -47,7 +47,7 @@ pub(crate) fn build(resolved: Resolved, path: &Path) -> Result<(Scene, Requests)
         camera: None,
         sensor: None,
         integrator: None,
-        max_depth: None,
+        params: None,
     };
     for (k, (e, &failed)) in scene_el.children.iter().zip(&failed).enumerate() {
         if e.tag == "shape" {
@@ -75,9 +75,10 @@ pub(crate) fn build(resolved: Resolved, path: &Path) -> Result<(Scene, Requests)
         requests,
         camera,
         integrator,
-        max_depth,
+        params,
         ..
     } = b;
+    let max_depth = params.as_ref().and_then(|p| p.max_depth);
     let spectral = shapes.iter().any(|s| {
         bsdf_is_sampled(&s.bsdf)
             || s.emitter
@@ -89,14 +90,14 @@ pub(crate) fn build(resolved: Resolved, path: &Path) -> Result<(Scene, Requests)
         shapes,
         camera,
         max_depth,
+        max_depth_location: integrator
+            .filter(|_| max_depth.is_some())
+            .map(crate::integrator::max_depth_location),
+        hide_emitters: params.is_some_and(|p| p.hide_emitters),
         spectral,
         bsdf_counts,
         camera_names: Vec::new(),
-        warnings: integrator
-            .zip(max_depth.filter(|d| *d >= 0))
-            .map(|(e, d)| crate::integrator::max_depth_warning(e, d))
-            .into_iter()
-            .collect(),
+        warnings: Vec::new(),
     };
     errors.or((scene, requests))
 }
@@ -113,7 +114,8 @@ struct Builder<'a> {
     /// The first `<sensor>` and `<integrator>`, built or not.
     sensor: Option<&'a Element>,
     integrator: Option<&'a Element>,
-    max_depth: Option<i64>,
+    /// What the integrator asks of the image.
+    params: Option<crate::integrator::IntegratorParams>,
 }
 
 impl<'a> Builder<'a> {
@@ -160,7 +162,7 @@ impl<'a> Builder<'a> {
                     ));
                 }
                 self.integrator = Some(e);
-                self.max_depth = crate::integrator::integrator(e)?.max_depth;
+                self.params = Some(crate::integrator::integrator(e)?);
             }
             "emitter" => top_level_emitter(e)?,
             "film" | "sampler" | "rfilter" if e.attr("id").is_some() => sensor_definition(e)?,

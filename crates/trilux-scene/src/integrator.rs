@@ -5,13 +5,12 @@
 //! for Mitsuba's unbiased global-illumination integrators (`path` and its
 //! relatives, which converge to the same image in a scene without media).
 //! Parameters that only change how Mitsuba samples (`rr_depth`, pass and
-//! block sizes, `timeout`) are read and ignored; `hide_emitters` and the
-//! integrators that compute something else (direct light only, AOVs,
-//! depth, …) change the image and are refused. `max_depth` is kept and
-//! warned about: Mitsuba's image with a finite limit lacks the light of
-//! longer paths, which the solution has.
+//! block sizes, `timeout`) are read and ignored; the integrators that
+//! compute something else (direct light only, AOVs, depth, …) are refused.
+//! `max_depth` and `hide_emitters` are kept for the renderer, which honours
+//! them (`trilux_render::RenderSettings`).
 
-use crate::error::{Result, SceneError};
+use crate::error::{Result, SceneError, SourceLocation};
 use crate::props::Props;
 use crate::xml::Element;
 
@@ -25,6 +24,8 @@ const GLOBAL_ILLUMINATION: [&str; 4] = ["path", "volpath", "volpathmis", "ptrace
 pub(crate) struct IntegratorParams {
     /// `max_depth` as written (-1: unlimited).
     pub max_depth: Option<i64>,
+    /// `hide_emitters` (false when not written).
+    pub hide_emitters: bool,
 }
 
 /// Reads an `<integrator>` as Mitsuba 3.9.1's integrator base class reads
@@ -54,12 +55,7 @@ pub(crate) fn integrator(e: &Element) -> Result<IntegratorParams> {
             format!("max_depth must be -1 (unlimited) or at least 0, found {d}"),
         ));
     }
-    if props.boolean("hide_emitters")?.unwrap_or(false) {
-        return Err(SceneError::at(
-            &props.loc("hide_emitters"),
-            "hide_emitters: trilux's images show the emitters the camera sees (set it to false or leave it out)",
-        ));
-    }
+    let hide_emitters = props.boolean("hide_emitters")?.unwrap_or(false);
     // Russian roulette's start, the samples of a pass, the image blocks and
     // a time limit change Mitsuba's noise and speed, not the image it
     // converges to.
@@ -72,18 +68,17 @@ pub(crate) fn integrator(e: &Element) -> Result<IntegratorParams> {
         props.boolean("use_spectral_mis")?;
     }
     props.finish()?;
-    Ok(IntegratorParams { max_depth })
+    Ok(IntegratorParams {
+        max_depth,
+        hide_emitters,
+    })
 }
 
-/// The warning for a finite `max_depth`, written at `at`: Mitsuba's image
-/// lacks the light of longer paths, trilux's does not.
-pub(crate) fn max_depth_warning(e: &Element, depth: i64) -> String {
-    let at = e
-        .children
+/// Where `e` writes its `max_depth`, else where `e` starts.
+pub(crate) fn max_depth_location(e: &Element) -> SourceLocation {
+    e.children
         .iter()
         .find(|c| c.attr("name").is_some_and(|n| n.value == "max_depth"))
-        .map_or(&e.loc, |c| &c.loc);
-    format!(
-        "{at}: max_depth {depth}: trilux's solution carries light over paths of every length (Mitsuba's max_depth -1); Mitsuba's image with this limit lacks the light of longer paths"
-    )
+        .map_or(&e.loc, |c| &c.loc)
+        .clone()
 }

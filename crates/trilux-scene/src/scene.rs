@@ -53,9 +53,16 @@ pub struct Scene {
     /// The camera, when the file has a `<sensor>` (Mitsuba 3 loads scenes
     /// without one too; solving needs none, rendering does).
     pub camera: Option<Camera>,
-    /// The integrator's `max_depth`, when the file gives one (noted in
-    /// stats; trilux's solver has its own stopping rule).
+    /// The integrator's `max_depth` (Mitsuba's longest path, -1 for no
+    /// limit), when the file gives one: the renderer honours a finite one
+    /// (`trilux::integrator_settings`).
     pub max_depth: Option<i64>,
+    /// Where the file writes `max_depth` (its warnings name the place).
+    #[serde(skip)]
+    pub max_depth_location: Option<SourceLocation>,
+    /// The integrator's `hide_emitters`: camera rays that meet an emitting
+    /// surface render black.
+    pub hide_emitters: bool,
     /// True when some `<spectrum>` in use gives wavelength:value pairs: the
     /// scene then solves in spectral bands by default.
     pub spectral: bool,

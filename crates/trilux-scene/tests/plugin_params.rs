@@ -125,10 +125,6 @@ fn bitmap_storage_parameters_are_ignored() {
 fn parameters_that_change_the_light_are_refused() {
     for (body, want) in [
         (
-            r#"<integrator type="path"><boolean name="hide_emitters" value="true"/></integrator>"#,
-            "hide_emitters",
-        ),
-        (
             r#"<integrator type="direct"/>"#,
             "\"direct\" does not compute global illumination",
         ),
@@ -173,16 +169,21 @@ fn an_emitter_without_a_bsdf_reflects_nothing() {
     assert_eq!(reflectance(1), ColorParam::Float(0.5));
 }
 
-/// A finite `max_depth` loads with one warning naming its place: the
-/// solution has every bounce, Mitsuba's image with the limit does not;
-/// -1 (unlimited, Mitsuba's default) warns about nothing.
+/// `max_depth` and `hide_emitters` are kept for the renderer, which
+/// honours them (crates/trilux/tests/mitsuba_cbox.rs checks the images
+/// against Mitsuba's), with the place `max_depth` is written for its
+/// warnings; loading warns about neither.
 #[test]
-fn a_finite_max_depth_is_warned_about() {
-    let s =
-        load("<integrator type=\"path\">\n<integer name=\"max_depth\" value=\"6\"/></integrator>");
-    assert_eq!(s.warnings.len(), 1, "{:?}", s.warnings);
-    assert!(s.warnings[0].contains("inline.xml:2:"), "{}", s.warnings[0]);
-    assert!(s.warnings[0].contains("max_depth 6"), "{}", s.warnings[0]);
-    let s = load(r#"<integrator type="path"><integer name="max_depth" value="-1"/></integrator>"#);
+fn max_depth_and_hide_emitters_are_kept_with_their_place() {
+    let s = load(
+        "<integrator type=\"path\">\n<integer name=\"max_depth\" value=\"6\"/><boolean name=\"hide_emitters\" value=\"true\"/></integrator>",
+    );
     assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+    assert_eq!(s.max_depth, Some(6));
+    assert!(s.hide_emitters);
+    let at = s.max_depth_location.expect("the place of max_depth");
+    assert_eq!(at.line, 2, "{at}");
+    let s = load(r#"<integrator type="path"/>"#);
+    assert_eq!((s.max_depth, s.hide_emitters), (None, false));
+    assert!(s.max_depth_location.is_none());
 }

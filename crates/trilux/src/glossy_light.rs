@@ -40,6 +40,7 @@ impl<'a, const N: usize> RenderedGlossy<'a, N> {
             fallback: FinalGather {
                 scene: &self.scene,
                 extra: ExtraBounce::default(),
+                hide_emitters: false,
             },
             glossy_scene: true,
         };

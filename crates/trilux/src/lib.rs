@@ -33,4 +33,4 @@ pub use oneshot::{
 pub use pipeline::{
     Observer, Outcome, Plan, RenderPlan, SolutionSource, check, prepare, run, scene_camera,
 };
-pub use view::{ViewOverrides, camera_of, filter_of, render_settings};
+pub use view::{ViewOverrides, apply_integrator, camera_of, filter_of, render_settings};

@@ -13,13 +13,13 @@
 use std::path::Path;
 
 use trilux_color::Mode;
-use trilux_render::{Estimator, ExtraBounce, Image};
+use trilux_render::{ExtraBounce, Image};
 use trilux_scene::Scene;
 use trilux_solver::{Quality, SolverSettings};
 
 use crate::error::PipelineError;
 use crate::pipeline::{Observer, Outcome, Plan, RenderPlan, SolutionSource, run};
-use crate::view::{ViewOverrides, render_settings};
+use crate::view::{ViewOverrides, apply_integrator, render_settings};
 
 /// How the light is solved: the command's `--quality`, `--convergence`
 /// and `--mode`. A saved solution must have been made with the same.
@@ -162,7 +162,9 @@ pub fn render_scene(
     let mut settings = render_settings(camera);
     settings.spp = view.spp.unwrap_or(settings.spp);
     settings.seed = view.seed;
-    settings.estimator = Estimator::Paths;
+    // The path gather, or the control variate where the file limits path
+    // length (no estimator is chosen here, so nothing to warn about).
+    let _ = apply_integrator(&mut settings, scene, None);
     settings.extra_bounce = ExtraBounce::Always;
     let mut plan = plan(scene, solve, saved);
     plan.render = Some(RenderPlan {

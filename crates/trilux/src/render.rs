@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
 use trilux::pipeline::RenderPlan;
-use trilux::view::{ViewOverrides, render_settings};
+use trilux::view::{ViewOverrides, apply_integrator, render_settings};
 use trilux_render::{Estimator, ExtraBounce};
 
 use crate::options::{
@@ -98,9 +98,11 @@ pub struct RenderArgs {
     /// Field of view in degrees along the scene's fov_axis.
     #[arg(long, allow_hyphen_values = true, value_parser = parse_fov)]
     pub fov: Option<f64>,
-    /// How a camera sample reads the solution.
-    #[arg(long, value_enum, default_value = "paths")]
-    pub gather: GatherArg,
+    /// How a camera sample reads the solution [default: paths; control
+    /// when the scene's integrator limits path length (max_depth), which
+    /// only the control variate honours].
+    #[arg(long, value_enum)]
+    pub gather: Option<GatherArg>,
     /// A noise-free preview for walkthroughs: the solution with its links'
     /// own visibility, no random rays (one sample a pixel unless --spp).
     #[arg(long, conflicts_with_all = ["gather", "target_error"])]
@@ -174,19 +176,27 @@ impl RenderArgs {
         Outputs::plan(&outputs, &inputs, folder)
     }
 
-    /// Samples, seed, filter and extra-bounce rule of this render.
-    fn render_plan(&self, camera: &trilux_scene::Camera) -> RenderPlan {
+    /// Samples, seed, filter, estimator and extra-bounce rule of this
+    /// render, and the warning when the estimator chosen cannot honour the
+    /// scene's `max_depth` (`apply_integrator`).
+    fn render_plan(
+        &self,
+        scene: &trilux_scene::Scene,
+        camera: &trilux_scene::Camera,
+    ) -> (RenderPlan, Option<String>) {
         let mut settings = render_settings(camera);
         settings.spp = self
             .spp
             .unwrap_or(if self.preview { 1 } else { settings.spp });
         settings.seed = self.seed;
-        settings.estimator = match (self.preview, self.gather) {
-            (true, _) => Estimator::Preview,
-            (false, GatherArg::Links) => Estimator::Links,
-            (false, GatherArg::Paths) => Estimator::Paths,
-            (false, GatherArg::Control) => Estimator::Control,
+        let chosen = match (self.preview, self.gather) {
+            (true, _) => Some(Estimator::Preview),
+            (false, Some(GatherArg::Links)) => Some(Estimator::Links),
+            (false, Some(GatherArg::Paths)) => Some(Estimator::Paths),
+            (false, Some(GatherArg::Control)) => Some(Estimator::Control),
+            (false, None) => None,
         };
+        let warning = apply_integrator(&mut settings, scene, chosen);
         settings.lookups = self.lookups;
         settings.target_error = self.target_error;
         settings.extra_bounce = match self.extra_bounce {
@@ -194,7 +204,7 @@ impl RenderArgs {
             ExtraBounceArg::Auto => ExtraBounce::Auto { close_factor: 1.0 },
             ExtraBounceArg::Never => ExtraBounce::Never,
         };
-        RenderPlan {
+        let plan = RenderPlan {
             view: ViewOverrides {
                 lookat: self.lookat,
                 fov: self.fov,
@@ -202,7 +212,8 @@ impl RenderArgs {
                 height: self.height,
             },
             settings,
-        }
+        };
+        (plan, warning)
     }
 }
 
@@ -232,7 +243,11 @@ pub fn run_into(args: &RenderArgs, in_out: bool) -> Result<()> {
             args.scene.display()
         )
     })?;
-    let render = Product::Render(args.render_plan(camera));
+    let (render, warning) = args.render_plan(pending.scene(), camera);
+    if let Some(w) = warning {
+        crate::streams::eprint_line(&format!("warning: {w}"));
+    }
+    let render = Product::Render(render);
     let plan = args
         .options
         .plan(pending.scene(), args.solution.as_deref(), render);

@@ -4,7 +4,7 @@
 
 use glam::{DVec2, DVec3};
 use trilux_geometry::look_at;
-use trilux_render::{Camera, ReconstructionFilter, RenderError, RenderSettings};
+use trilux_render::{Camera, Estimator, ReconstructionFilter, RenderError, RenderSettings};
 
 /// Changes to the scene's camera asked for on the command line.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -31,6 +31,41 @@ pub fn render_settings(camera: &trilux_scene::Camera) -> RenderSettings {
         filter: filter_of(camera),
         ..RenderSettings::default()
     }
+}
+
+/// Applies what the scene's integrator asks of the image (Mitsuba's
+/// `max_depth` and `hide_emitters`) to `settings`, whose estimator is
+/// `chosen` on the command line (`None`: none was). A finite `max_depth`
+/// makes the default estimator the control variate, the one that honours
+/// it; another chosen explicitly renders every bounce, and the returned
+/// warning (with the place the file sets the limit) says so.
+pub fn apply_integrator(
+    settings: &mut RenderSettings,
+    scene: &trilux_scene::Scene,
+    chosen: Option<Estimator>,
+) -> Option<String> {
+    settings.hide_emitters = scene.hide_emitters;
+    let limit = scene
+        .max_depth
+        .filter(|d| *d >= 0)
+        .map(|d| u32::try_from(d).unwrap_or(u32::MAX));
+    settings.estimator = match (chosen, limit) {
+        (Some(e), _) => e,
+        (None, Some(_)) => Estimator::Control,
+        (None, None) => Estimator::Paths,
+    };
+    let depth = limit?;
+    if settings.estimator == Estimator::Control {
+        settings.max_depth = Some(depth);
+        return None;
+    }
+    let at = scene
+        .max_depth_location
+        .as_ref()
+        .map_or_else(|| scene.path.display().to_string(), ToString::to_string);
+    Some(format!(
+        "{at}: max_depth {depth} is not honoured by this estimator: the solution it reads carries light over paths of every length (--gather control honours it)"
+    ))
 }
 
 /// The camera of the scene's sensor, with overrides applied.

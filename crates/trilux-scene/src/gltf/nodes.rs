@@ -118,6 +118,8 @@ pub(crate) fn build(
         shapes: walk.shapes,
         camera,
         max_depth: None,
+        max_depth_location: None,
+        hide_emitters: false,
         spectral: false,
         bsdf_counts: walk.bsdf_counts,
         camera_names,

@@ -47,7 +47,8 @@ pub fn of_plan(scene: &trilux_scene::Scene, plan: &trilux::Plan<'_>) -> Result<M
 }
 
 /// A render's settings: samples, seed, filter, estimator, extra bounce,
-/// adaptive target, tiles, and the view: the scene's camera and the
+/// adaptive target, tiles, the integrator's path-length limit and hidden
+/// emitters, and the view: the scene's camera and the
 /// command line's changes to it.
 fn render(scene: &trilux_scene::Scene, plan: &RenderPlan) -> Result<Value> {
     let s = &plan.settings;
@@ -78,6 +79,8 @@ fn render(scene: &trilux_scene::Scene, plan: &RenderPlan) -> Result<Value> {
         "target_error": s.target_error,
         "tile_size": s.tile_size,
         "lookups": s.lookups,
+        "max_depth": s.max_depth,
+        "hide_emitters": s.hide_emitters,
         "scene_camera": serde_json::to_value(&scene.camera)?,
         "view": { "lookat": lookat, "fov": v.fov, "width": v.width, "height": v.height },
     }))
