@@ -45,6 +45,9 @@ pub struct Camera {
     /// window, at `crop_offset`).
     film_size: DVec2,
     crop_offset: DVec2,
+    /// Pixels sampled beyond each edge of the image (Mitsuba's
+    /// `sample_border`; 0 without).
+    border: u32,
 }
 
 /// Mitsuba's `parse_fov`: the horizontal field of view (degrees) that
@@ -109,6 +112,7 @@ impl Camera {
             offset: DVec2::ZERO,
             film_size: DVec2::new(f64::from(width), f64::from(height)),
             crop_offset: DVec2::ZERO,
+            border: 0,
         })
     }
 
@@ -139,6 +143,34 @@ impl Camera {
         (self.width, self.height) = (size[0], size[1]);
         self.crop_offset = DVec2::new(f64::from(offset[0]), f64::from(offset[1]));
         Ok(self)
+    }
+
+    /// The camera that also samples `border` pixels beyond each edge of
+    /// its image (Mitsuba's `sample_border`, with the filter's
+    /// `border_size`): edge pixels then get what the filter spreads from
+    /// outside, as in Mitsuba. The image keeps its size.
+    pub fn with_sample_border(mut self, border: u32) -> Self {
+        self.border = border;
+        self
+    }
+
+    /// Pixels sampled beyond each edge ([`Self::with_sample_border`]).
+    pub fn sample_border(&self) -> u32 {
+        self.border
+    }
+
+    /// The image grown by the sample border on every side, its pixel
+    /// (i, j) the ray of this camera's (i − b, j − b): what a render with a
+    /// sample border samples before it keeps the inner image.
+    pub(crate) fn bordered(&self) -> Camera {
+        let b = self.border;
+        Camera {
+            width: self.width + 2 * b,
+            height: self.height + 2 * b,
+            crop_offset: self.crop_offset - DVec2::splat(f64::from(b)),
+            border: 0,
+            ..self.clone()
+        }
     }
 
     /// Width over height of the whole film (not of a crop window).

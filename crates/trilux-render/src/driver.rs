@@ -261,6 +261,16 @@ where
     S: SolutionGather<N>,
 {
     settings.validate()?;
+    // A sample border (Mitsuba's `sample_border`): render the image grown
+    // by it on every side, keep the inner part; its edge pixels have what
+    // the filter spread from the border's samples.
+    let b = camera.sample_border();
+    if b > 0 {
+        let bordered = camera.bordered();
+        let (image, stats) =
+            render_tiles(scene, &bordered, settings, to_rgb, progress, keep_pilot)?;
+        return Ok((image.window(b, b, camera.width(), camera.height()), stats));
+    }
     let start = Instant::now();
     let (w, h) = (camera.width(), camera.height());
     let ts = settings.tile_size;

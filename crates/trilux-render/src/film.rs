@@ -101,10 +101,10 @@ impl Film {
             &mut heap
         };
         for (k, w) in wx.iter_mut().enumerate() {
-            *w = self.filter.eval((lo_x + k as i64) as f64 - cx);
+            *w = self.filter.eval_discretized((lo_x + k as i64) as f64 - cx);
         }
         for j in lo_y..=hi_y {
-            let wy = self.filter.eval(j as f64 - cy) * weight;
+            let wy = self.filter.eval_discretized(j as f64 - cy) * weight;
             if wy == 0.0 {
                 continue;
             }
@@ -210,8 +210,9 @@ mod tests {
         let f = ReconstructionFilter::default();
         let mut film = Film::new(0, 0, 8, 8, f).unwrap();
         film.splat(3.5, 3.5, [1.0, 1.0, 1.0]);
-        assert!((film.weights[3 * 8 + 3] - f.eval(0.0).powi(2)).abs() < 1e-15);
-        assert!((film.weights[3 * 8 + 4] - f.eval(0.0) * f.eval(1.0)).abs() < 1e-15);
+        let w = |d| f.eval_discretized(d);
+        assert!((film.weights[3 * 8 + 3] - w(0.0).powi(2)).abs() < 1e-15);
+        assert!((film.weights[3 * 8 + 4] - w(0.0) * w(1.0)).abs() < 1e-15);
         assert_eq!(film.weights[3 * 8 + 5], 0.0); // d = 2: weight exactly zero
     }
 
@@ -220,7 +221,7 @@ mod tests {
         let f = ReconstructionFilter::default();
         let mut film = Film::new(0, 0, 8, 8, f).unwrap();
         film.splat_weighted(3.5, 3.5, [1.0; 3], 0.25);
-        assert!((film.weights[3 * 8 + 3] - 0.25 * f.eval(0.0).powi(2)).abs() < 1e-15);
+        assert!((film.weights[3 * 8 + 3] - 0.25 * f.eval_discretized(0.0).powi(2)).abs() < 1e-15);
         // Pixel 0 took one sample of 1, pixel 2 four of 3, each weighted
         // 1/n: pixel 1, as far from both, sees two equal units, mean 2.
         let mut row = Film::new(0, 0, 3, 1, f).unwrap();

@@ -56,6 +56,19 @@ impl Image {
         })
     }
 
+    /// The `w` × `h` pixels at (`x`, `y`), which must lie within.
+    pub(crate) fn window(&self, x: u32, y: u32, w: u32, h: u32) -> Self {
+        let row = |j: u32| {
+            let start = (y + j) as usize * self.width as usize + x as usize;
+            self.pixels[start..start + w as usize].iter().copied()
+        };
+        Self {
+            width: w,
+            height: h,
+            pixels: (0..h).flat_map(row).collect(),
+        }
+    }
+
     /// A black image.
     pub fn black(width: u32, height: u32) -> Self {
         Self {

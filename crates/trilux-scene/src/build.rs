@@ -361,6 +361,7 @@ fn sensor(e: &Element) -> Result<Camera> {
         far_clip,
         principal_point_offset,
         crop: children.film.crop,
+        sample_border: children.film.sample_border,
         location: e.loc.clone(),
     })
 }
@@ -527,6 +528,7 @@ fn sensor_children(props: &Props<'_>) -> Result<SensorChildren> {
         height: 576,
         rfilter: ReconstructionFilter::default(),
         crop: None,
+        sample_border: false,
     };
     let mut sample_count = 4;
     let mut seen_film = false;
@@ -602,6 +604,7 @@ struct FilmParams {
     height: u32,
     rfilter: ReconstructionFilter,
     crop: Option<Crop>,
+    sample_border: bool,
 }
 
 fn film(e: &Element) -> Result<FilmParams> {
@@ -635,12 +638,7 @@ fn film(e: &Element) -> Result<FilmParams> {
         "compensate",
         "banner",
     ]);
-    if props.boolean("sample_border")?.unwrap_or(false) {
-        return Err(SceneError::at(
-            &props.loc("sample_border"),
-            "sample_border: trilux samples the film only, so its border pixels would differ from Mitsuba's (leave it out or false)",
-        ));
-    }
+    let sample_border = props.boolean("sample_border")?.unwrap_or(false);
     let crop = crop_window(&props, width, height)?;
     let mut rfilter = ReconstructionFilter::default();
     for (i, o) in props.objects.iter().enumerate() {
@@ -658,6 +656,7 @@ fn film(e: &Element) -> Result<FilmParams> {
         height,
         rfilter,
         crop,
+        sample_border,
     })
 }
 

@@ -63,6 +63,10 @@ pub struct Camera {
     /// The part of the film rendered (Mitsuba's `crop_*`); the image has
     /// its size.
     pub crop: Option<Crop>,
+    /// Mitsuba's `sample_border`: the film is also sampled beyond its edge
+    /// (the filter's border), so edge pixels get what the filter spreads
+    /// from outside.
+    pub sample_border: bool,
     /// Where the `<sensor>` is written.
     #[serde(skip)]
     pub location: SourceLocation,

@@ -137,10 +137,6 @@ fn parameters_that_change_the_light_are_refused() {
             "unknown parameter \"use_spectral_mis\"",
         ),
         (
-            r#"<sensor type="perspective"><film type="hdrfilm"><boolean name="sample_border" value="true"/></film></sensor>"#,
-            "sample_border",
-        ),
-        (
             r#"<sensor type="perspective"><spectrum name="srf" value="400:1, 700:1"/></sensor>"#,
             "unknown parameter \"srf\"",
         ),
@@ -186,4 +182,19 @@ fn max_depth_and_hide_emitters_are_kept_with_their_place() {
     let s = load(r#"<integrator type="path"/>"#);
     assert_eq!((s.max_depth, s.hide_emitters), (None, false));
     assert!(s.max_depth_location.is_none());
+}
+
+/// `sample_border` is kept for the renderer, which samples the filter's
+/// border beyond the film (crates/trilux/tests/sample_border.rs checks the
+/// image against Mitsuba's).
+#[test]
+fn sample_border_is_kept() {
+    let film = |value: &str| {
+        format!(
+            r#"<sensor type="perspective"><film type="hdrfilm"><boolean name="sample_border" value="{value}"/></film></sensor>"#
+        )
+    };
+    let camera = |value| load(&film(value)).camera.expect("a camera");
+    assert!(camera("true").sample_border);
+    assert!(!camera("false").sample_border);
 }

@@ -90,6 +90,11 @@ pub fn camera_of(c: &trilux_scene::Camera, o: &ViewOverrides) -> Result<Camera, 
     )?
     .with_clip(c.near_clip, c.far_clip)?
     .with_principal_point_offset(DVec2::from(c.principal_point_offset));
+    let camera = if c.sample_border {
+        camera.with_sample_border(c.rfilter.border_size())
+    } else {
+        camera
+    };
     // A film size given on the command line is a new film: no crop.
     match c.crop {
         Some(crop) if o.width.is_none() && o.height.is_none() => {

@@ -470,6 +470,7 @@ fn camera(file: &Arc<Path>, c: &CameraNode) -> Result<Camera> {
         far_clip,
         principal_point_offset: [0.0; 2],
         crop: None,
+        sample_border: false,
         location,
     })
 }
