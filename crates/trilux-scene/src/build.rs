@@ -430,6 +430,12 @@ fn focal_length_fov(props: &Props<'_>) -> Result<(f64, FovAxis)> {
 /// checked) and ignored: `focus_distance` (only a lens has a focal plane)
 /// and the shutter interval (nothing in a trilux scene moves).
 fn ignored_sensor_params(props: &Props<'_>) -> Result<()> {
+    if props.has("srf") {
+        return Err(SceneError::at(
+            &props.loc("srf"),
+            "srf: a sensor's spectral response (which Mitsuba reads in its spectral variants only) is not supported: trilux's images are the CIE 1931 observer's colour in linear sRGB",
+        ));
+    }
     props.float("focus_distance")?;
     let open = props.float("shutter_open")?.unwrap_or(0.0);
     let close = props.float("shutter_close")?.unwrap_or(0.0);

@@ -138,7 +138,7 @@ fn parameters_that_change_the_light_are_refused() {
         ),
         (
             r#"<sensor type="perspective"><spectrum name="srf" value="400:1, 700:1"/></sensor>"#,
-            "unknown parameter \"srf\"",
+            "srf: a sensor's spectral response",
         ),
         (
             r#"<shape type="sphere"><boolean name="face_normals" value="true"/></shape>"#,
