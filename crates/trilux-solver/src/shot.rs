@@ -26,7 +26,7 @@ use trilux_geometry::{ElementId, FaceId, PerFace};
 use crate::cluster_transport::{FarField, far_links};
 use crate::interaction::Hierarchy;
 use crate::link::{NodeLink, PairLink, PairShot, Sender, Sent};
-use crate::refine::{Incidence, IncidenceMemo, RefineContext, TripleTask};
+use crate::refine::{Incidence, IncidenceMemo, Lateness, RefineContext, TripleTask};
 use crate::solver::{Solver, Source};
 
 /// The most a stored interaction's shot is scaled up to carry its whole
@@ -151,8 +151,8 @@ impl<const N: usize> Solver<N> {
             }
             Sending::Far { .. } => Vec::new(),
         };
-        let (pair_links, incidences, stage_two) = {
-            let (ctx, hierarchies) = self.split_for_shot();
+        let (pair_links, incidences, stage_two, late) = {
+            let (mut ctx, hierarchies) = self.split_for_shot();
             let sender = match &sending {
                 Sending::Radiosity(f) => Sender::Radiosity {
                     field: ctx.field,
@@ -177,8 +177,10 @@ impl<const N: usize> Solver<N> {
                 &pair_links,
                 &incidences,
             );
-            (pair_links, incidences, stage_two)
+            let late = std::mem::take(&mut ctx.refine.late);
+            (pair_links, incidences, stage_two, late)
         };
+        self.book_late(late);
         let scale = shot_scale(&pair_links, phi, matches!(source, Source::Stored(_)));
         let node_links = self.book_lost(stage_two);
         let group_scale = self.receive(&pair_links, &incidences, &node_links, scale, (phi, share));
@@ -249,13 +251,25 @@ impl<const N: usize> Solver<N> {
     /// The refinement context (the setup and the throughput cache) beside
     /// the stored hierarchies that stage 2 refines.
     fn split_for_shot(&mut self) -> (ShotContext<'_, N>, &mut Vec<Option<Hierarchy<N>>>) {
+        let deadline = self.deadline();
         let state = &mut self.state;
+        let mut refine = self.setup.refine_context(&state.cache);
+        refine.deadline = deadline;
         let ctx = ShotContext {
-            refine: self.setup.refine_context(&state.cache),
+            refine,
             field: &state.field,
             stored_from: &self.setup.stored_from,
         };
         (ctx, &mut state.hierarchies)
+    }
+
+    /// What the shot's refinement cut short at the deadline, into the
+    /// stats.
+    fn book_late(&mut self, late: Lateness) {
+        let stats = &mut self.state.stats;
+        stats.late_links += late.links.into_inner();
+        stats.late_root_throughputs += late.roots.into_inner();
+        stats.late_root_seconds += late.root_nanos.into_inner() as f64 * 1e-9;
     }
 
     /// Flux that a split could not keep leaves the residual (it is booked
@@ -444,7 +458,10 @@ fn stage_two<const N: usize>(
                 };
                 task.group = g;
                 for n in ctx.nodes_for(task.h, l.j, &mut task.lost) {
-                    ctx.refine_triple(&mut task, l.i, l.j, n, Some(incidence));
+                    // l.j, or past the deadline a stored node's coarser
+                    // sender element above it.
+                    let j = task.h.nodes[n as usize].from;
+                    ctx.refine_triple(&mut task, l.i, j, n, Some(incidence));
                 }
             }
             (task.out, h as u32, task.lost)

@@ -4,6 +4,8 @@
 //! and the point-to-disc form-factor estimates both stages use.
 
 use std::f64::consts::PI;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::Instant;
 
 use glam::DVec3;
 use trilux_brdf::{AlbedoTable, Bsdf};
@@ -64,6 +66,26 @@ pub(crate) struct RefineContext<'a, const N: usize> {
     pub clusters: &'a Clusters,
     /// Directional albedo per material (the sampled lobes' scale).
     pub albedo: &'a [AlbedoTable<N>],
+    /// When the solve's time budget runs out: refinement reached after it
+    /// links where it stands (docs/solver.md, "The deadline inside a
+    /// shot"). `None` without a budget.
+    pub deadline: Option<Instant>,
+    /// What refinement cut short because the deadline had passed.
+    pub late: Lateness,
+}
+
+/// What a shot's refinement did after the deadline (the stats' `late_*`
+/// fields), counted across its parallel tasks.
+#[derive(Debug, Default)]
+pub(crate) struct Lateness {
+    /// Links made where refinement would have split (or nodes used where
+    /// it would have split the stored hierarchy down to a pair link's
+    /// receiver).
+    pub links: AtomicU64,
+    /// Root throughputs made after the deadline.
+    pub roots: AtomicU64,
+    /// Their CPU time in nanoseconds, summed over threads.
+    pub root_nanos: AtomicU64,
 }
 
 impl<'a, const N: usize> RefineContext<'a, N> {
@@ -101,6 +123,17 @@ pub(super) fn disc_estimate(pa: DVec3, na: DVec3, pb: DVec3, nb: DVec3, area_b: 
 }
 
 impl<const N: usize> RefineContext<'_, N> {
+    /// True once the deadline has passed (one look at the clock; never
+    /// without a budget).
+    pub fn past_deadline(&self) -> bool {
+        self.deadline.is_some_and(|d| Instant::now() >= d)
+    }
+
+    /// Counts a link made coarser because the deadline had passed.
+    pub fn count_late_link(&self) {
+        self.late.links.fetch_add(1, Ordering::Relaxed);
+    }
+
     /// T through the cache, for `recv` receiving from `send` (T is
     /// symmetric; the spread is over the receiver).
     pub fn throughput(&self, recv: FaceElement, send: FaceElement) -> Throughput {
@@ -163,6 +196,9 @@ impl<const N: usize> RefineContext<'_, N> {
             pair,
             self.settings.visibility_samples,
         );
+        // Timed only after the deadline, to tell what a cut-short shot
+        // still spends on roots (docs/results.md, "Real interiors").
+        let late = self.past_deadline().then(Instant::now);
         h.make_root(compute_throughput(
             &self.visibility,
             pair[0],
@@ -170,6 +206,11 @@ impl<const N: usize> RefineContext<'_, N> {
             samples,
             false,
         ));
+        if let Some(start) = late {
+            let nanos = u64::try_from(start.elapsed().as_nanos()).unwrap_or(u64::MAX);
+            self.late.roots.fetch_add(1, Ordering::Relaxed);
+            self.late.root_nanos.fetch_add(nanos, Ordering::Relaxed);
+        }
     }
 
     /// Both point-to-disc estimates F̂_{a→b} and F̂_{b→a}.

@@ -35,6 +35,6 @@ mod narrow_lobe;
 mod pair;
 mod triple;
 
-pub(crate) use context::RefineContext;
+pub(crate) use context::{Lateness, RefineContext};
 pub(crate) use incidences::IncidenceMemo;
 pub(crate) use triple::{Incidence, TripleTask};

@@ -71,18 +71,25 @@ impl<const N: usize> RefineContext<'_, N> {
         // corners), the average is biased. Compare the transfer resolved
         // over the sender's children with the averaged one (point-to-disc
         // estimates) and split the sender when they differ.
-        if self.sender_varies(shot, i, j) {
-            self.split_sender(shot, i, j, budget, true, out);
-            return;
-        }
+        let varies = self.sender_varies(shot, i, j);
         // The transfer is accurate when the point form factor varies little
         // over the receiver (so that pushing it down unchanged is right).
         let partial = th.v > 0.0 && th.v < 1.0;
-        if th.spread <= budget && !partial {
+        if !varies && th.spread <= budget && !partial {
             out.push(link);
             return;
         }
-        if !self.split_pair(shot, i, j, budget, out) {
+        // Past the solve's deadline the pair is linked where it stands, as
+        // the photometric criterion links a small flux: the same light,
+        // carried coarser (docs/solver.md, "The deadline inside a shot").
+        if self.past_deadline() {
+            self.count_late_link();
+            out.push(link);
+            return;
+        }
+        if varies {
+            self.split_sender(shot, i, j, budget, true, out);
+        } else if !self.split_pair(shot, i, j, budget, out) {
             out.push(link);
         }
     }

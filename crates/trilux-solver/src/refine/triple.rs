@@ -33,6 +33,9 @@ pub(crate) struct Incidence<const N: usize> {
     tij: Throughput,
     /// δL sent from i towards j.
     unshot: Spectrum<N>,
+    /// j: after the deadline a stored node above j may receive the
+    /// pair's light (`nodes_for`), but the lobe still leaves j.
+    j: ElementId,
     /// The light's arrival at j's centre (`RefineContext::incident`);
     /// `None` when no part of i is on the receiving side.
     incoming: Option<Incoming>,
@@ -275,6 +278,7 @@ impl<const N: usize> RefineContext<'_, N> {
         Some(Incidence {
             tij,
             unshot,
+            j: j.element,
             incoming: self
                 .incident(&frame, i.element, j.element, j.side.sign())
                 .map(|wi| Incoming { frame, wi }),
@@ -336,7 +340,7 @@ impl<const N: usize> RefineContext<'_, N> {
         };
         // A lobe narrow against K: its sampled share that lands in K
         // (docs/solver.md, "Narrow lobes").
-        if let Some((share, inside)) = self.sampled_share(&known.lobe, (sj, i, j), task.h.to, k) {
+        if let Some((share, inside)) = self.sampled_share(&known.lobe, (sj, i, known.j), task.h.to, k) {
             self.link_sampled(task, (i, j, n), known, (share, &inside), straddle_k);
             return;
         }
@@ -465,6 +469,11 @@ impl<const N: usize> RefineContext<'_, N> {
         known: &Incidence<N>,
         straddle_k: bool,
     ) {
+        // Past the deadline this refinement is skipped: the group's glossy
+        // renormalisation scales its other links up for the part missed.
+        if self.past_deadline() {
+            return;
+        }
         let k = task.h.nodes[n as usize].to;
         let order = match (known.straddle_i, straddle_k) {
             (true, true) if self.forest.element(i).area >= self.forest.element(k).area => {
@@ -523,6 +532,12 @@ impl<const N: usize> RefineContext<'_, N> {
     ) {
         let accurate = e.brdf <= 1.0 && e.ff <= 1.0 && !e.partial;
         if accurate && !known.straddle_i {
+            task.push(link);
+            return;
+        }
+        // Past the deadline: linked where it stands (as in stage 1).
+        if self.past_deadline() {
+            self.count_late_link();
             task.push(link);
             return;
         }
@@ -632,7 +647,9 @@ impl<const N: usize> RefineContext<'_, N> {
 
     /// The nodes of `h` whose sender element is exactly `j`, splitting on
     /// the sender side down to `j` where needed and descending through
-    /// receiver-side splits (they keep the same sender element).
+    /// receiver-side splits (they keep the same sender element). Past the
+    /// deadline a leaf above `j` is not split: it is returned as it stands
+    /// (its sender element an ancestor of `j`), and counted late.
     pub fn nodes_for(
         &self,
         h: &mut Hierarchy<N>,
@@ -664,6 +681,10 @@ impl<const N: usize> RefineContext<'_, N> {
                     if let Some(c) = h.children(n) {
                         stack.extend(c.iter().map(|&c| (c, depth)));
                     }
+                }
+                Split::None if self.past_deadline() => {
+                    self.count_late_link();
+                    out.push(n);
                 }
                 Split::From | Split::None => {
                     if let Some(c) = self.node_children(h, n, Split::From, lost) {
