@@ -176,7 +176,7 @@ impl<const N: usize> Solver<N> {
     }
 
     /// The source with the greatest unshot flux (band sum), if any has some.
-    fn next_source(&self) -> Option<Source> {
+    pub(crate) fn next_source(&self) -> Option<Source> {
         let mut best: Option<(Source, f64)> = None;
         let mut consider = |s: Source, flux: f64| {
             if flux > 0.0 && best.is_none_or(|(_, f)| flux > f) {

@@ -31,6 +31,8 @@
 
 mod context;
 mod incidences;
+#[cfg(test)]
+mod late_tests;
 mod narrow_lobe;
 mod pair;
 mod triple;

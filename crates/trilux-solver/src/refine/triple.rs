@@ -33,8 +33,7 @@ pub(crate) struct Incidence<const N: usize> {
     tij: Throughput,
     /// δL sent from i towards j.
     unshot: Spectrum<N>,
-    /// j: after the deadline a stored node above j may receive the
-    /// pair's light (`nodes_for`), but the lobe still leaves j.
+    /// j (a node above j may receive the pair's light after the deadline).
     j: ElementId,
     /// The light's arrival at j's centre (`RefineContext::incident`);
     /// `None` when no part of i is on the receiving side.
@@ -361,6 +360,12 @@ impl<const N: usize> RefineContext<'_, N> {
             task.push(link);
             return;
         }
+        // Past the deadline: linked as it stands, before the costly oracle.
+        if self.past_deadline() {
+            self.count_late_link();
+            task.push(link);
+            return;
+        }
         let (spread, driver) = self.fr_variation(bsdf, i, j, k);
         // fr's spread over the three elements, and over j the texture's.
         let spread = match self.textures {
@@ -416,6 +421,11 @@ impl<const N: usize> RefineContext<'_, N> {
             task.push(link);
             return;
         }
+        if self.past_deadline() {
+            self.count_late_link();
+            task.push(link);
+            return;
+        }
         let errors = TripleErrors {
             // Where in K the lobe lands, not fr's variation, decides.
             brdf: if self.footprint_uneven(k, inside) {
@@ -433,7 +443,7 @@ impl<const N: usize> RefineContext<'_, N> {
     /// A node whose elements were found not to see each other: as in stage
     /// 1, near the roots a few shadow rays may miss a gap, so look one
     /// level further (splitting the larger of J and K) before giving the
-    /// pair up.
+    /// pair up, unless the deadline has passed.
     fn retry_unseen_node(
         &self,
         task: &mut TripleTask<'_, N>,
@@ -444,7 +454,9 @@ impl<const N: usize> RefineContext<'_, N> {
     ) {
         let k = task.h.nodes[n as usize].to;
         let (ej, ek) = (self.forest.element(j), self.forest.element(k));
-        if ej.depth + ek.depth < 2 && self.throughput(task.h.to.of(k), task.h.from.of(j)).f > 0.0 {
+        if ej.depth + ek.depth < 2
+            && !self.past_deadline()
+            && self.throughput(task.h.to.of(k), task.h.from.of(j)).f > 0.0 {
             let side = if ej.area >= ek.area {
                 Driver::J
             } else {
@@ -469,8 +481,7 @@ impl<const N: usize> RefineContext<'_, N> {
         known: &Incidence<N>,
         straddle_k: bool,
     ) {
-        // Past the deadline this refinement is skipped: the group's glossy
-        // renormalisation scales its other links up for the part missed.
+        // Not past the deadline: the group's renormalisation makes up.
         if self.past_deadline() {
             return;
         }
@@ -532,12 +543,6 @@ impl<const N: usize> RefineContext<'_, N> {
     ) {
         let accurate = e.brdf <= 1.0 && e.ff <= 1.0 && !e.partial;
         if accurate && !known.straddle_i {
-            task.push(link);
-            return;
-        }
-        // Past the deadline: linked where it stands (as in stage 1).
-        if self.past_deadline() {
-            self.count_late_link();
             task.push(link);
             return;
         }
@@ -649,7 +654,7 @@ impl<const N: usize> RefineContext<'_, N> {
     /// the sender side down to `j` where needed and descending through
     /// receiver-side splits (they keep the same sender element). Past the
     /// deadline a leaf above `j` is not split: it is returned as it stands
-    /// (its sender element an ancestor of `j`), and counted late.
+    /// (its sender element above `j`), and counted late.
     pub fn nodes_for(
         &self,
         h: &mut Hierarchy<N>,
