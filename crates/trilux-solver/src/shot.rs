@@ -550,7 +550,9 @@ impl<const N: usize> Solver<N> {
             // What an element reflects may not exceed what arrived there.
             let room = (arrived - diffuse).max(Spectrum::zero());
             let (glossy, sampled) = (glossy_flux[g], sampled_flux[g]);
-            let target = self.glossy_target(l, incidences[g].as_ref(), arrived, glossy);
+            let late = self.past_deadline();
+            let target = self.glossy_target(l, incidences[g].as_ref(), arrived, (glossy, late));
+            self.state.stats.late_groups += u64::from(late && target.is_some());
             let scale = crate::glossy::group_scale(target, glossy, sampled, room);
             group_scale[g] = scale;
             let absorbed_g = arrived - diffuse - glossy * scale.0 - sampled * scale.1;

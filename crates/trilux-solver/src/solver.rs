@@ -118,6 +118,11 @@ impl<const N: usize> Solver<N> {
         self.time_budget.map(|b| self.started + b)
     }
 
+    /// True once the deadline has passed (never without a budget).
+    pub(crate) fn past_deadline(&self) -> bool {
+        self.deadline().is_some_and(|d| Instant::now() >= d)
+    }
+
     /// Stops the shooting loop, between shots, once `flag` is set: the
     /// solve then ends as with a spent time budget, with stop reason
     /// `interrupted` (a Ctrl-C or a scheduler's SIGTERM in the command).

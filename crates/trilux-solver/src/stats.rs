@@ -53,6 +53,12 @@ pub struct SolveStats {
     /// deadline inside a shot"). 0 without a budget or within it.
     #[serde(default)]
     pub late_links: u64,
+    /// Pair links into glossy faces received after the time budget ran
+    /// out, whose glossy renormalisation took the face's mean hemisphere
+    /// coverage instead of their element's (docs/solver.md, "The deadline
+    /// inside a shot").
+    #[serde(default)]
+    pub late_groups: u64,
     /// Root throughputs the shots made after the time budget ran out (the
     /// part of a cut-short shot that refinement does not bound).
     #[serde(default)]
