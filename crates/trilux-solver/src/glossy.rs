@@ -182,7 +182,7 @@ impl<const N: usize> Solver<N> {
     /// root throughputs the hierarchies already hold, instead of a new
     /// throughput to every stored receiver per element (docs/solver.md,
     /// "The deadline inside a shot").
-    fn hemisphere_coverage(&self, face: FaceId, j: ElementId, late: bool) -> f64 {
+    pub(crate) fn hemisphere_coverage(&self, face: FaceId, j: ElementId, late: bool) -> f64 {
         let j = if late {
             self.setup.forest().root(face.surface())
         } else {

@@ -762,6 +762,7 @@ mod tests {
         for budget in [None, Some(0.0)] {
             let s = first_shot(budget, &scene);
             assert_eq!(s.state.stats.late_links > 0, budget.is_some());
+            assert_eq!(s.state.stats.late_groups > 0, budget.is_some());
             assert_ledger(&s);
             let glossy: f64 = s
                 .state
@@ -774,5 +775,27 @@ mod tests {
             // At most the emitter's flux arrives on the floor.
             assert!(glossy <= 3.0 * PI, "{glossy}");
         }
+    }
+
+    /// Past the deadline a glossy face's hemisphere coverage is its
+    /// root's, summed from the root throughputs its hierarchies hold: with
+    /// nothing in the way (visibility exactly 1) the same sum of the same
+    /// form factors as the root coverage made afresh, for any element j.
+    #[test]
+    fn the_late_coverage_is_the_roots_from_the_stored_throughputs() {
+        let scene = [
+            (DVec3::new(0.5, 0.0, 0.0), false, ts::glossy(0.3)),
+            (DVec3::new(1.5, 0.0, 1.0), true, ts::diffuse(0.5)),
+        ];
+        let s = first_shot(None, &scene);
+        let floor = ts::front(1);
+        let root = s.setup.forest().root(floor.surface());
+        let leaf = *ts::leaves(s.setup.forest(), root).last().unwrap();
+        assert!(s.state.hierarchies.iter().flatten().any(|h| h.from == floor && !h.pending));
+        let fresh = s.hemisphere_coverage(floor, root, false);
+        s.state.coverage.lock().unwrap().clear();
+        let late = s.hemisphere_coverage(floor, leaf, true);
+        assert!(fresh > 0.0 && fresh < 1.0, "{fresh}");
+        assert!((late - fresh).abs() <= 1e-12 * fresh, "{late} {fresh}");
     }
 }

@@ -16,7 +16,7 @@ use crate::faces::TransportFace;
 use crate::interaction::Hierarchy;
 use crate::settings::SolverSettings;
 use crate::textures::ElementTextures;
-use crate::throughput::{Throughput, ThroughputCache, compute_throughput};
+use crate::throughput::{Throughput, ThroughputCache, compute_throughput, throughput_with_rays};
 
 /// How many times the rays a pair with a partly buried or cut-off element
 /// gets (see `RefineContext::throughput`).
@@ -184,7 +184,9 @@ impl<const N: usize> RefineContext<'_, N> {
 
     /// Makes the root throughput of a pending hierarchy (light is about to
     /// arrive at its sender face): the same T the setup used to make for
-    /// every root pair, with the root pair's shadow rays.
+    /// every root pair, with the root pair's shadow rays; past the deadline
+    /// with the base rays only (docs/solver.md, "The deadline inside a
+    /// shot").
     pub fn make_root(&self, h: &mut Hierarchy<N>) {
         if !h.pending {
             return;
@@ -196,16 +198,14 @@ impl<const N: usize> RefineContext<'_, N> {
             pair,
             self.settings.visibility_samples,
         );
-        // Timed only after the deadline, to tell what a cut-short shot
-        // still spends on roots (docs/results.md, "Real interiors").
+        // Past the deadline, the base rays (not ×16): the root throughputs
+        // were most of what a cut-short shot still spent (docs/results.md,
+        // "Real interiors"); timed there.
         let late = self.past_deadline().then(Instant::now);
-        h.make_root(compute_throughput(
-            &self.visibility,
-            pair[0],
-            pair[1],
-            samples,
-            false,
-        ));
+        h.make_root(match late {
+            None => compute_throughput(&self.visibility, pair[0], pair[1], samples, false),
+            Some(_) => throughput_with_rays(&self.visibility, pair[0], pair[1], samples, false),
+        });
         if let Some(start) = late {
             let nanos = u64::try_from(start.elapsed().as_nanos()).unwrap_or(u64::MAX);
             self.late.roots.fetch_add(1, Ordering::Relaxed);

@@ -149,3 +149,32 @@ fn after_the_deadline_a_hierarchy_is_not_split_down_to_the_receiver() {
     let (h, found, from, late) = nodes(Some(Instant::now()));
     assert_eq!((h.nodes.len(), found, from, late), (1, vec![0], vec![root], 1));
 }
+
+/// A root throughput made after the deadline takes the base rays, not
+/// ×16: with nothing in the way (visibility exactly 1 either way) it is
+/// the full root's T, from the same form factor; it is counted.
+#[test]
+fn a_root_made_after_the_deadline_takes_the_base_rays() {
+    let (setup, state) = mirror_scene();
+    let cache = ThroughputCache::new(1 << 16);
+    let (r, k) = (ts::front(1), ts::front(2));
+    let pending = state
+        .hierarchies
+        .iter()
+        .flatten()
+        .find(|h| (h.from, h.to) == (r, k))
+        .expect("R stores an interaction towards K");
+    assert!(pending.pending);
+    let root = |deadline| {
+        let mut ctx = setup.refine_context(&cache);
+        ctx.deadline = deadline;
+        let mut h = pending.clone();
+        ctx.make_root(&mut h);
+        (h.nodes[0].t, ctx.late.roots.load(Ordering::Relaxed))
+    };
+    let (full, early) = root(None);
+    let (cheap, late) = root(Some(Instant::now()));
+    assert_eq!((early, late), (0, 1));
+    assert!(full > 0.0 && full.is_finite());
+    assert_eq!(cheap, full);
+}

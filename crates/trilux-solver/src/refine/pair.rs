@@ -36,7 +36,8 @@ impl<const N: usize> RefineContext<'_, N> {
         let (ei, ej) = (self.forest.element(i), self.forest.element(j));
         if th.t <= 0.0 {
             // Fully occluded or facing away. Near the roots a handful of
-            // shadow rays may miss a gap: look one level further there.
+            // shadow rays may miss a gap: look one level further there
+            // (not past the deadline).
             if ei.depth + ej.depth < 2
                 && th.v == 0.0
                 && !self.past_deadline()
