@@ -717,7 +717,11 @@ mod tests {
             assert!((sum - ledger.emitted[b]).abs() <= 1e-9 * ledger.emitted[b]);
         }
         assert!(residual.is_finite() && residual.is_non_negative());
-        assert!(ledger.min_shot_escaped >= -1e-9, "{}", ledger.min_shot_escaped);
+        assert!(
+            ledger.min_shot_escaped >= -1e-9,
+            "{}",
+            ledger.min_shot_escaped
+        );
         assert!(ledger.min_element_absorbed >= -1e-9);
     }
 
@@ -778,9 +782,10 @@ mod tests {
     }
 
     /// Past the deadline a glossy face's hemisphere coverage is its
-    /// root's, summed from the root throughputs its hierarchies hold: with
-    /// nothing in the way (visibility exactly 1) the same sum of the same
-    /// form factors as the root coverage made afresh, for any element j.
+    /// root's, summed from the root throughputs its hierarchies hold, for
+    /// any element j: the same form factors as the root coverage made
+    /// afresh, the visibility from other shadow rays (hundreds per root
+    /// pair, nearly all unblocked here: within 1 %).
     #[test]
     fn the_late_coverage_is_the_roots_from_the_stored_throughputs() {
         let scene = [
@@ -791,11 +796,21 @@ mod tests {
         let floor = ts::front(1);
         let root = s.setup.forest().root(floor.surface());
         let leaf = *ts::leaves(s.setup.forest(), root).last().unwrap();
-        assert!(s.state.hierarchies.iter().flatten().any(|h| h.from == floor && !h.pending));
+        assert!(
+            s.state
+                .hierarchies
+                .iter()
+                .flatten()
+                .any(|h| h.from == floor && !h.pending)
+        );
         let fresh = s.hemisphere_coverage(floor, root, false);
         s.state.coverage.lock().unwrap().clear();
         let late = s.hemisphere_coverage(floor, leaf, true);
         assert!(fresh > 0.0 && fresh < 1.0, "{fresh}");
-        assert!((late - fresh).abs() <= 1e-12 * fresh, "{late} {fresh}");
+        assert!((late - fresh).abs() <= 0.01 * fresh, "{late} {fresh}");
+        // Not j's own: the leaf's coverage made afresh differs.
+        s.state.coverage.lock().unwrap().clear();
+        let own = s.hemisphere_coverage(floor, leaf, false);
+        assert!((own - fresh).abs() > 0.05 * fresh, "{own} {fresh}");
     }
 }

@@ -134,6 +134,16 @@ impl<const N: usize> RefineContext<'_, N> {
         self.late.links.fetch_add(1, Ordering::Relaxed);
     }
 
+    /// True, and counted, once the deadline has passed: the caller links
+    /// where it stands instead of refining.
+    pub fn cut_short(&self) -> bool {
+        let late = self.past_deadline();
+        if late {
+            self.count_late_link();
+        }
+        late
+    }
+
     /// T through the cache, for `recv` receiving from `send` (T is
     /// symmetric; the spread is over the receiver).
     pub fn throughput(&self, recv: FaceElement, send: FaceElement) -> Throughput {

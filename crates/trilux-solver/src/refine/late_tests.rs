@@ -147,7 +147,10 @@ fn after_the_deadline_a_hierarchy_is_not_split_down_to_the_receiver() {
     assert!(!found.is_empty() && from.iter().all(|&f| f == leaf));
     assert_eq!(late, 0);
     let (h, found, from, late) = nodes(Some(Instant::now()));
-    assert_eq!((h.nodes.len(), found, from, late), (1, vec![0], vec![root], 1));
+    assert_eq!(
+        (h.nodes.len(), found, from, late),
+        (1, vec![0], vec![root], 1)
+    );
 }
 
 /// A root throughput made after the deadline takes the base rays, not

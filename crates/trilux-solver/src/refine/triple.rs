@@ -339,7 +339,9 @@ impl<const N: usize> RefineContext<'_, N> {
         };
         // A lobe narrow against K: its sampled share that lands in K
         // (docs/solver.md, "Narrow lobes").
-        if let Some((share, inside)) = self.sampled_share(&known.lobe, (sj, i, known.j), task.h.to, k) {
+        if let Some((share, inside)) =
+            self.sampled_share(&known.lobe, (sj, i, known.j), task.h.to, k)
+        {
             self.link_sampled(task, (i, j, n), known, (share, &inside), straddle_k);
             return;
         }
@@ -356,13 +358,10 @@ impl<const N: usize> RefineContext<'_, N> {
             gathered,
             sampled: false,
         };
-        if self.below_photometric(bsdf, known, j, &task.h.nodes[n as usize], aj, gathered) {
-            task.push(link);
-            return;
-        }
         // Past the deadline: linked as it stands, before the costly oracle.
-        if self.past_deadline() {
-            self.count_late_link();
+        if self.below_photometric(bsdf, known, j, &task.h.nodes[n as usize], aj, gathered)
+            || self.cut_short()
+        {
             task.push(link);
             return;
         }
@@ -417,12 +416,7 @@ impl<const N: usize> RefineContext<'_, N> {
             gathered,
             sampled: true,
         };
-        if PI * tjk * gathered.sum() < self.flux_threshold {
-            task.push(link);
-            return;
-        }
-        if self.past_deadline() {
-            self.count_late_link();
+        if PI * tjk * gathered.sum() < self.flux_threshold || self.cut_short() {
             task.push(link);
             return;
         }
@@ -454,9 +448,8 @@ impl<const N: usize> RefineContext<'_, N> {
     ) {
         let k = task.h.nodes[n as usize].to;
         let (ej, ek) = (self.forest.element(j), self.forest.element(k));
-        if ej.depth + ek.depth < 2
-            && !self.past_deadline()
-            && self.throughput(task.h.to.of(k), task.h.from.of(j)).f > 0.0 {
+        let near_roots = ej.depth + ek.depth < 2 && !self.past_deadline();
+        if near_roots && self.throughput(task.h.to.of(k), task.h.from.of(j)).f > 0.0 {
             let side = if ej.area >= ek.area {
                 Driver::J
             } else {
