@@ -75,8 +75,9 @@ pub(crate) fn group_scale<const N: usize>(
 impl<const N: usize> Solver<N> {
     /// The glossy flux a group should reflect (module docs), for the flux
     /// `arrived` through pair link `l`, `late` past the solve's deadline;
-    /// `None` where no renormalisation applies. The light arrives from the part of i in front of j (the
-    /// same direction the group's area reflectances used).
+    /// `None` where no renormalisation applies. The light arrives from the
+    /// part of i in front of j (the same direction the group's area
+    /// reflectances used).
     pub(crate) fn glossy_target(
         &self,
         l: &PairLink<N>,
