@@ -74,15 +74,16 @@ pub(crate) fn group_scale<const N: usize>(
 
 impl<const N: usize> Solver<N> {
     /// The glossy flux a group should reflect (module docs), for the flux
-    /// `arrived` through pair link `l`; `None` where no renormalisation
-    /// applies. The light arrives from the part of i in front of j (the
-    /// same direction the group's area reflectances used).
+    /// `arrived` through pair link `l`, `late` past the solve's deadline;
+    /// `None` where no renormalisation applies. The light arrives from the
+    /// part of i in front of j (the same direction the group's area
+    /// reflectances used).
     pub(crate) fn glossy_target(
         &self,
         l: &PairLink<N>,
         incidence: Option<&Incidence<N>>,
         arrived: Spectrum<N>,
-        glossy: Spectrum<N>,
+        (glossy, late): (Spectrum<N>, bool),
     ) -> Option<Spectrum<N>> {
         let face = &self.setup.faces[l.face];
         if !face.stored || glossy.is_black() || self.setup.settings.transport != Transport::TwoPoint
@@ -90,7 +91,7 @@ impl<const N: usize> Solver<N> {
             return None;
         }
         let to_light = incidence.and_then(Incidence::direction)?;
-        let covered = self.hemisphere_coverage(l.face, l.j);
+        let covered = self.hemisphere_coverage(l.face, l.j, late);
         // A textured j reflects g(j) times the nominal glossy part.
         let g = self
             .setup
@@ -177,8 +178,17 @@ impl<const N: usize> Solver<N> {
 
     /// Σ over the face's stored hierarchies of T(j, K) / A_j: the
     /// cosine-weighted share of j's hemisphere that stored receivers cover
-    /// (1 in a closed room). Cached per (face, element).
-    fn hemisphere_coverage(&self, face: FaceId, j: ElementId) -> f64 {
+    /// (1 in a closed room). Cached per (face, element). Past the deadline
+    /// (`late`) the face's mean stands in for j's: its root's, from the
+    /// root throughputs the hierarchies already hold, instead of a new
+    /// throughput to every stored receiver per element (docs/solver.md,
+    /// "The deadline inside a shot").
+    pub(crate) fn hemisphere_coverage(&self, face: FaceId, j: ElementId, late: bool) -> f64 {
+        let j = if late {
+            self.setup.forest().root(face.surface())
+        } else {
+            j
+        };
         if let Ok(cache) = self.state.coverage.lock()
             && let Some(&c) = cache.get(&(face, j))
         {
@@ -194,6 +204,10 @@ impl<const N: usize> Solver<N> {
             .iter()
             .flatten()
         {
+            if late && !h.pending {
+                t += h.nodes[0].t;
+                continue;
+            }
             let k = h.to.of(h.nodes[0].to);
             t += compute_throughput(
                 &vis,

@@ -184,6 +184,8 @@ impl<const N: usize> Setup<N> {
             textures: self.textures.as_ref(),
             clusters: &self.clusters,
             albedo: &self.albedo,
+            deadline: None,
+            late: Default::default(),
         }
     }
 }

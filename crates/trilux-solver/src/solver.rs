@@ -111,6 +111,18 @@ impl<const N: usize> Solver<N> {
         })
     }
 
+    /// When the time budget runs out (`None` without one): shots reached
+    /// after it stop refining (docs/solver.md, "The deadline inside a
+    /// shot").
+    pub(crate) fn deadline(&self) -> Option<Instant> {
+        self.time_budget.map(|b| self.started + b)
+    }
+
+    /// True once the deadline has passed (never without a budget).
+    pub(crate) fn past_deadline(&self) -> bool {
+        self.deadline().is_some_and(|d| Instant::now() >= d)
+    }
+
     /// Stops the shooting loop, between shots, once `flag` is set: the
     /// solve then ends as with a spent time budget, with stop reason
     /// `interrupted` (a Ctrl-C or a scheduler's SIGTERM in the command).
@@ -169,7 +181,7 @@ impl<const N: usize> Solver<N> {
     }
 
     /// The source with the greatest unshot flux (band sum), if any has some.
-    fn next_source(&self) -> Option<Source> {
+    pub(crate) fn next_source(&self) -> Option<Source> {
         let mut best: Option<(Source, f64)> = None;
         let mut consider = |s: Source, flux: f64| {
             if flux > 0.0 && best.is_none_or(|(_, f)| flux > f) {
@@ -331,13 +343,26 @@ impl<const N: usize> Solver<N> {
             });
         }
         let target = self.setup.settings.convergence;
+        let late = self.state.stats.late_links;
+        // A shot that ran into the deadline linked coarser from there on.
+        let cut_short = if late > 0 {
+            format!(
+                "; the last shot was cut short at the budget: {late} links were made coarser than refinement asked (the light is all carried, at a lower resolution)"
+            )
+        } else {
+            String::new()
+        };
         let warning = match reason {
-            StopReason::Converged | StopReason::NothingUnshot => return,
+            StopReason::Converged | StopReason::NothingUnshot if late == 0 => return,
+            StopReason::Converged | StopReason::NothingUnshot => format!(
+                "the solve reached its target convergence ratio {target}, but its last shot ran past its time budget of {} s{cut_short}",
+                self.time_budget.map_or(0.0, |b| b.as_secs_f64())
+            ),
             StopReason::ShotCap => format!(
                 "the solve stopped at its cap of {shots} shots with convergence ratio {cr:.4}, short of its target {target} (surfaces that reflect nearly all light converge slowly: lower a reflectance, or ask for less with --convergence)"
             ),
             StopReason::TimeBudget => format!(
-                "the solve stopped at its time budget of {} s after {shots} shots with convergence ratio {cr:.4}, short of its target {target}: the solution is the best so far",
+                "the solve stopped at its time budget of {} s after {shots} shots with convergence ratio {cr:.4}, short of its target {target}: the solution is the best so far{cut_short}",
                 self.time_budget.map_or(0.0, |b| b.as_secs_f64())
             ),
             StopReason::Interrupted => format!(
@@ -349,6 +374,7 @@ impl<const N: usize> Solver<N> {
 
     /// Final push-pull of everything, statistics, and the solution.
     fn finish(mut self, seconds: f64) -> Solution<N> {
+        let deadline = self.deadline();
         let (setup, state) = (&self.setup, &mut self.state);
         let forest = setup.forest();
         for (face, _) in setup.faces.iter() {
@@ -372,7 +398,6 @@ impl<const N: usize> Solver<N> {
             }
         }
         let gather_start = Instant::now();
-        let deadline = self.time_budget.map(|b| self.started + b);
         let (links, report) = gather_links(setup, &state.field, &state.cache, deadline);
         state.stats.gather_seconds = gather_start.elapsed().as_secs_f64();
         state.stats.gather_senders = report.senders;

@@ -46,6 +46,26 @@ pub struct SolveStats {
     /// photometric threshold.
     #[serde(default)]
     pub gather_bounded_pairs: u64,
+    /// Links the shots made coarser because the time budget ran out
+    /// during a shot: pairs and three-point links linked where they stood
+    /// instead of split, and stored nodes used above a pair link's
+    /// receiver instead of split down to it (docs/solver.md, "The
+    /// deadline inside a shot"). 0 without a budget or within it.
+    #[serde(default)]
+    pub late_links: u64,
+    /// Pair links into glossy faces received after the time budget ran
+    /// out, whose glossy renormalisation took the face's mean hemisphere
+    /// coverage instead of their element's (docs/solver.md, "The deadline
+    /// inside a shot").
+    #[serde(default)]
+    pub late_groups: u64,
+    /// Root throughputs the shots made after the time budget ran out (the
+    /// part of a cut-short shot that refinement does not bound).
+    #[serde(default)]
+    pub late_root_throughputs: u64,
+    /// Their CPU seconds, summed over threads.
+    #[serde(default)]
+    pub late_root_seconds: f64,
     /// Seconds spent preparing (before the first shot) and in the final
     /// gather; `solve_seconds` counts the shots, push-pull and gather.
     #[serde(default)]

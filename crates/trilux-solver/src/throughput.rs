@@ -144,25 +144,39 @@ pub(crate) fn compute_throughput(
     visibility_samples: u32,
     visible: bool,
 ) -> Throughput {
-    let forest = vis.forest();
-    let ff = form_factor(forest, i, j, &FORM_FACTOR_OPTIONS);
-    let (f, spread) = (ff.value, ff.spread);
-    if !(f.is_finite() && f > 0.0) {
-        return Throughput::default();
-    }
     // Coarse pairs decide a lot of transport from one number: give them
     // more shadow rays (×16 for whole input surfaces, ×4 one or two levels
     // down).
+    let forest = vis.forest();
     let depth = forest.element(i.element).depth + forest.element(j.element).depth;
     let samples = match depth {
         0 | 1 => visibility_samples * 16,
         2 | 3 => visibility_samples * 4,
         _ => visibility_samples,
     };
+    throughput_with_rays(vis, i, j, samples, visible)
+}
+
+/// [`compute_throughput`] with exactly `rays` shadow rays, whatever the
+/// pair's depth (a root pair reached after the solve's deadline:
+/// docs/solver.md, "The deadline inside a shot").
+pub(crate) fn throughput_with_rays(
+    vis: &Visibility<'_>,
+    i: FaceElement,
+    j: FaceElement,
+    rays: u32,
+    visible: bool,
+) -> Throughput {
+    let forest = vis.forest();
+    let ff = form_factor(forest, i, j, &FORM_FACTOR_OPTIONS);
+    let (f, spread) = (ff.value, ff.spread);
+    if !(f.is_finite() && f > 0.0) {
+        return Throughput::default();
+    }
     let v = if visible {
         1.0
     } else {
-        vis.weighted(i, j, samples)
+        vis.weighted(i, j, rays)
     };
     let area = forest.element(i.element).area;
     let t = area * f * v;

@@ -4,6 +4,8 @@
 //! and the point-to-disc form-factor estimates both stages use.
 
 use std::f64::consts::PI;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::Instant;
 
 use glam::DVec3;
 use trilux_brdf::{AlbedoTable, Bsdf};
@@ -14,7 +16,7 @@ use crate::faces::TransportFace;
 use crate::interaction::Hierarchy;
 use crate::settings::SolverSettings;
 use crate::textures::ElementTextures;
-use crate::throughput::{Throughput, ThroughputCache, compute_throughput};
+use crate::throughput::{Throughput, ThroughputCache, compute_throughput, throughput_with_rays};
 
 /// How many times the rays a pair with a partly buried or cut-off element
 /// gets (see `RefineContext::throughput`).
@@ -64,6 +66,26 @@ pub(crate) struct RefineContext<'a, const N: usize> {
     pub clusters: &'a Clusters,
     /// Directional albedo per material (the sampled lobes' scale).
     pub albedo: &'a [AlbedoTable<N>],
+    /// When the solve's time budget runs out: refinement reached after it
+    /// links where it stands (docs/solver.md, "The deadline inside a
+    /// shot"). `None` without a budget.
+    pub deadline: Option<Instant>,
+    /// What refinement cut short because the deadline had passed.
+    pub late: Lateness,
+}
+
+/// What a shot's refinement did after the deadline (the stats' `late_*`
+/// fields), counted across its parallel tasks.
+#[derive(Debug, Default)]
+pub(crate) struct Lateness {
+    /// Links made where refinement would have split (or nodes used where
+    /// it would have split the stored hierarchy down to a pair link's
+    /// receiver).
+    pub links: AtomicU64,
+    /// Root throughputs made after the deadline.
+    pub roots: AtomicU64,
+    /// Their CPU time in nanoseconds, summed over threads.
+    pub root_nanos: AtomicU64,
 }
 
 impl<'a, const N: usize> RefineContext<'a, N> {
@@ -101,6 +123,27 @@ pub(super) fn disc_estimate(pa: DVec3, na: DVec3, pb: DVec3, nb: DVec3, area_b: 
 }
 
 impl<const N: usize> RefineContext<'_, N> {
+    /// True once the deadline has passed (one look at the clock; never
+    /// without a budget).
+    pub fn past_deadline(&self) -> bool {
+        self.deadline.is_some_and(|d| Instant::now() >= d)
+    }
+
+    /// Counts a link made coarser because the deadline had passed.
+    pub fn count_late_link(&self) {
+        self.late.links.fetch_add(1, Ordering::Relaxed);
+    }
+
+    /// True, and counted, once the deadline has passed: the caller links
+    /// where it stands instead of refining.
+    pub fn cut_short(&self) -> bool {
+        let late = self.past_deadline();
+        if late {
+            self.count_late_link();
+        }
+        late
+    }
+
     /// T through the cache, for `recv` receiving from `send` (T is
     /// symmetric; the spread is over the receiver).
     pub fn throughput(&self, recv: FaceElement, send: FaceElement) -> Throughput {
@@ -151,7 +194,9 @@ impl<const N: usize> RefineContext<'_, N> {
 
     /// Makes the root throughput of a pending hierarchy (light is about to
     /// arrive at its sender face): the same T the setup used to make for
-    /// every root pair, with the root pair's shadow rays.
+    /// every root pair, with the root pair's shadow rays; past the deadline
+    /// with the base rays only (docs/solver.md, "The deadline inside a
+    /// shot").
     pub fn make_root(&self, h: &mut Hierarchy<N>) {
         if !h.pending {
             return;
@@ -163,13 +208,19 @@ impl<const N: usize> RefineContext<'_, N> {
             pair,
             self.settings.visibility_samples,
         );
-        h.make_root(compute_throughput(
-            &self.visibility,
-            pair[0],
-            pair[1],
-            samples,
-            false,
-        ));
+        // Past the deadline, the base rays (not ×16): the root throughputs
+        // were most of what a cut-short shot still spent (docs/results.md,
+        // "Real interiors"); timed there.
+        let late = self.past_deadline().then(Instant::now);
+        h.make_root(match late {
+            None => compute_throughput(&self.visibility, pair[0], pair[1], samples, false),
+            Some(_) => throughput_with_rays(&self.visibility, pair[0], pair[1], samples, false),
+        });
+        if let Some(start) = late {
+            let nanos = u64::try_from(start.elapsed().as_nanos()).unwrap_or(u64::MAX);
+            self.late.roots.fetch_add(1, Ordering::Relaxed);
+            self.late.root_nanos.fetch_add(nanos, Ordering::Relaxed);
+        }
     }
 
     /// Both point-to-disc estimates F̂_{a→b} and F̂_{b→a}.

@@ -31,10 +31,12 @@
 
 mod context;
 mod incidences;
+#[cfg(test)]
+mod late_tests;
 mod narrow_lobe;
 mod pair;
 mod triple;
 
-pub(crate) use context::RefineContext;
+pub(crate) use context::{Lateness, RefineContext};
 pub(crate) use incidences::IncidenceMemo;
 pub(crate) use triple::{Incidence, TripleTask};

@@ -36,9 +36,11 @@ impl<const N: usize> RefineContext<'_, N> {
         let (ei, ej) = (self.forest.element(i), self.forest.element(j));
         if th.t <= 0.0 {
             // Fully occluded or facing away. Near the roots a handful of
-            // shadow rays may miss a gap: look one level further there.
+            // shadow rays may miss a gap: look one level further there
+            // (not past the deadline).
             if ei.depth + ej.depth < 2
                 && th.v == 0.0
+                && !self.past_deadline()
                 && self.unoccluded_positive(si.of(i), sj.of(j))
             {
                 self.split_pair(shot, i, j, budget, out);
@@ -71,18 +73,25 @@ impl<const N: usize> RefineContext<'_, N> {
         // corners), the average is biased. Compare the transfer resolved
         // over the sender's children with the averaged one (point-to-disc
         // estimates) and split the sender when they differ.
-        if self.sender_varies(shot, i, j) {
-            self.split_sender(shot, i, j, budget, true, out);
-            return;
-        }
+        let varies = self.sender_varies(shot, i, j);
         // The transfer is accurate when the point form factor varies little
         // over the receiver (so that pushing it down unchanged is right).
         let partial = th.v > 0.0 && th.v < 1.0;
-        if th.spread <= budget && !partial {
+        if !varies && th.spread <= budget && !partial {
             out.push(link);
             return;
         }
-        if !self.split_pair(shot, i, j, budget, out) {
+        // Past the solve's deadline the pair is linked where it stands, as
+        // the photometric criterion links a small flux: the same light,
+        // carried coarser (docs/solver.md, "The deadline inside a shot").
+        if self.past_deadline() {
+            self.count_late_link();
+            out.push(link);
+            return;
+        }
+        if varies {
+            self.split_sender(shot, i, j, budget, true, out);
+        } else if !self.split_pair(shot, i, j, budget, out) {
             out.push(link);
         }
     }
@@ -226,8 +235,21 @@ mod tests {
         threshold: impl Fn(f64) -> f64,
         budget: f64,
     ) -> (Vec<PairLink<3>>, f64) {
+        let (links, flux, _) = refine_by(setup, state, threshold, budget, None);
+        (links, flux)
+    }
+
+    /// [`refine`] with a deadline; also the links counted late.
+    fn refine_by(
+        setup: &Setup<3>,
+        state: &ShotState<3>,
+        threshold: impl Fn(f64) -> f64,
+        budget: f64,
+        deadline: Option<std::time::Instant>,
+    ) -> (Vec<PairLink<3>>, f64, u64) {
         let cache = ThroughputCache::new(1 << 16);
         let mut ctx = setup.refine_context(&cache);
+        ctx.deadline = deadline;
         let (si, sj) = (ts::front(0), ts::front(1));
         let (ri, rj) = (ts::root(ctx.forest, si), ts::root(ctx.forest, sj));
         let root_flux = PI * ctx.throughput(rj, ri).t * 3.0;
@@ -245,7 +267,36 @@ mod tests {
         };
         let mut out = Vec::new();
         ctx.refine_pair(shot, ri.element, rj.element, budget, &mut out);
-        (out, root_flux)
+        let late = ctx.late.links.load(std::sync::atomic::Ordering::Relaxed);
+        (out, root_flux, late)
+    }
+
+    /// A pair reached after the solve's deadline is linked where it
+    /// stands: with no photometric threshold and no form-factor budget
+    /// (which refine it to the depth limit before the deadline), the one
+    /// link made is the root link the photometric criterion makes, the
+    /// same T and δL (the same light, coarser), and it is counted late. A
+    /// deadline still ahead changes nothing.
+    #[test]
+    fn a_pair_reached_after_the_deadline_is_linked_where_it_stands() {
+        use std::time::{Duration, Instant};
+        let (setup, state) = plates(1.0, 1.0, 2);
+        let (coarse, _) = refine(&setup, &state, |_| f64::INFINITY, 0.0);
+        let (late, _, count) = refine_by(&setup, &state, |_| 0.0, 0.0, Some(Instant::now()));
+        assert_eq!(late.len(), 1);
+        assert_eq!(count, 1);
+        let (a, b) = (&late[0], &coarse[0]);
+        assert_eq!((a.i, a.j, a.t, a.unshot), (b.i, b.j, b.t, b.unshot));
+        let ahead = Instant::now() + Duration::from_secs(365 * 24 * 3600);
+        let (fine, _, count) = refine_by(&setup, &state, |_| 0.0, 0.0, Some(ahead));
+        let (free, _) = refine(&setup, &state, |_| 0.0, 0.0);
+        assert_eq!(count, 0);
+        assert_eq!(fine.len(), 16 * 16, "every pair of leaves");
+        let key = |l: &PairLink<3>| (l.i, l.j, l.t.to_bits());
+        assert_eq!(
+            fine.iter().map(key).collect::<Vec<_>>(),
+            free.iter().map(key).collect::<Vec<_>>()
+        );
     }
 
     /// Parallel, directly opposed unit squares at distance 1 exchange

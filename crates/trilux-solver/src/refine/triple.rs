@@ -33,6 +33,8 @@ pub(crate) struct Incidence<const N: usize> {
     tij: Throughput,
     /// δL sent from i towards j.
     unshot: Spectrum<N>,
+    /// j (a node above j may receive the pair's light after the deadline).
+    j: ElementId,
     /// The light's arrival at j's centre (`RefineContext::incident`);
     /// `None` when no part of i is on the receiving side.
     incoming: Option<Incoming>,
@@ -275,6 +277,7 @@ impl<const N: usize> RefineContext<'_, N> {
         Some(Incidence {
             tij,
             unshot,
+            j: j.element,
             incoming: self
                 .incident(&frame, i.element, j.element, j.side.sign())
                 .map(|wi| Incoming { frame, wi }),
@@ -336,7 +339,9 @@ impl<const N: usize> RefineContext<'_, N> {
         };
         // A lobe narrow against K: its sampled share that lands in K
         // (docs/solver.md, "Narrow lobes").
-        if let Some((share, inside)) = self.sampled_share(&known.lobe, (sj, i, j), task.h.to, k) {
+        if let Some((share, inside)) =
+            self.sampled_share(&known.lobe, (sj, i, known.j), task.h.to, k)
+        {
             self.link_sampled(task, (i, j, n), known, (share, &inside), straddle_k);
             return;
         }
@@ -353,7 +358,10 @@ impl<const N: usize> RefineContext<'_, N> {
             gathered,
             sampled: false,
         };
-        if self.below_photometric(bsdf, known, j, &task.h.nodes[n as usize], aj, gathered) {
+        // Past the deadline: linked as it stands, before the costly oracle.
+        if self.below_photometric(bsdf, known, j, &task.h.nodes[n as usize], aj, gathered)
+            || self.cut_short()
+        {
             task.push(link);
             return;
         }
@@ -408,7 +416,7 @@ impl<const N: usize> RefineContext<'_, N> {
             gathered,
             sampled: true,
         };
-        if PI * tjk * gathered.sum() < self.flux_threshold {
+        if PI * tjk * gathered.sum() < self.flux_threshold || self.cut_short() {
             task.push(link);
             return;
         }
@@ -429,7 +437,7 @@ impl<const N: usize> RefineContext<'_, N> {
     /// A node whose elements were found not to see each other: as in stage
     /// 1, near the roots a few shadow rays may miss a gap, so look one
     /// level further (splitting the larger of J and K) before giving the
-    /// pair up.
+    /// pair up, unless the deadline has passed.
     fn retry_unseen_node(
         &self,
         task: &mut TripleTask<'_, N>,
@@ -440,7 +448,8 @@ impl<const N: usize> RefineContext<'_, N> {
     ) {
         let k = task.h.nodes[n as usize].to;
         let (ej, ek) = (self.forest.element(j), self.forest.element(k));
-        if ej.depth + ek.depth < 2 && self.throughput(task.h.to.of(k), task.h.from.of(j)).f > 0.0 {
+        let near_roots = ej.depth + ek.depth < 2 && !self.past_deadline();
+        if near_roots && self.throughput(task.h.to.of(k), task.h.from.of(j)).f > 0.0 {
             let side = if ej.area >= ek.area {
                 Driver::J
             } else {
@@ -465,6 +474,10 @@ impl<const N: usize> RefineContext<'_, N> {
         known: &Incidence<N>,
         straddle_k: bool,
     ) {
+        // Not past the deadline: the group's renormalisation makes up.
+        if self.past_deadline() {
+            return;
+        }
         let k = task.h.nodes[n as usize].to;
         let order = match (known.straddle_i, straddle_k) {
             (true, true) if self.forest.element(i).area >= self.forest.element(k).area => {
@@ -632,7 +645,9 @@ impl<const N: usize> RefineContext<'_, N> {
 
     /// The nodes of `h` whose sender element is exactly `j`, splitting on
     /// the sender side down to `j` where needed and descending through
-    /// receiver-side splits (they keep the same sender element).
+    /// receiver-side splits (they keep the same sender element). Past the
+    /// deadline a leaf above `j` is not split: it is returned as it stands
+    /// (its sender element above `j`), and counted late.
     pub fn nodes_for(
         &self,
         h: &mut Hierarchy<N>,
@@ -664,6 +679,10 @@ impl<const N: usize> RefineContext<'_, N> {
                     if let Some(c) = h.children(n) {
                         stack.extend(c.iter().map(|&c| (c, depth)));
                     }
+                }
+                Split::None if self.past_deadline() => {
+                    self.count_late_link();
+                    out.push(n);
                 }
                 Split::From | Split::None => {
                     if let Some(c) = self.node_children(h, n, Split::From, lost) {

@@ -1,0 +1,183 @@
+//! Stage 2 after the solve's deadline (docs/solver.md, "The deadline
+//! inside a shot"): a three-point link is linked where it stands, and a
+//! stored hierarchy is not split down to a pair link's receiver. Answers
+//! from the definition: the link made is the one the photometric
+//! criterion makes.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests may panic
+
+use std::sync::atomic::Ordering;
+use std::time::Instant;
+
+use glam::DVec3;
+use trilux_color::Spectrum;
+
+use super::{IncidenceMemo, RefineContext, TripleTask};
+use crate::interaction::{Hierarchy, Split};
+use crate::link::{NodeLink, Sender, Sent};
+use crate::setup::Setup;
+use crate::state::ShotState;
+use crate::test_scenes as ts;
+use crate::throughput::ThroughputCache;
+
+/// An emitter E facing down at (−1, 0, 1), a glossy floor R at the origin
+/// facing up and a grey plate K facing down at (1, 0, 1), in R's mirror
+/// direction from E; every error bound (nearly) zero, so that only the
+/// photometric criterion or the deadline stops refinement.
+fn mirror_scene() -> (Setup<3>, ShotState<3>) {
+    let shapes = [
+        ts::square(DVec3::new(-1.0, 0.0, 1.0), 1.0, true),
+        ts::square(DVec3::ZERO, 1.0, false),
+        ts::square(DVec3::new(1.0, 0.0, 1.0), 1.0, true),
+    ];
+    let mut settings = ts::settings(2);
+    settings.ff_eps = 1e-12;
+    settings.fr_eps = 1e-12;
+    let setup = ts::setup(
+        &shapes,
+        &[ts::diffuse(0.0), ts::glossy(0.3), ts::diffuse(0.5)],
+        &[Some(1.0), None, None],
+        settings,
+    );
+    let state = ShotState::new(&setup);
+    (setup, state)
+}
+
+/// E's shot into hierarchy R → K with photometric threshold `threshold`
+/// and `deadline`: runs `f` with the context, the task and R's root, and
+/// returns the hierarchy, the links and the count of late links.
+fn stage_two(
+    threshold: f64,
+    deadline: Option<Instant>,
+    f: impl FnOnce(&RefineContext<'_, 3>, &mut TripleTask<'_, 3>),
+) -> (Hierarchy<3>, Vec<NodeLink<3>>, u64) {
+    let (setup, mut state) = mirror_scene();
+    let cache = ThroughputCache::new(1 << 16);
+    let mut ctx = setup.refine_context(&cache);
+    ctx.flux_threshold = threshold;
+    ctx.deadline = deadline;
+    let (e, r, k) = (ts::front(0), ts::front(1), ts::front(2));
+    let h_index = state
+        .hierarchies
+        .iter()
+        .position(|h| h.as_ref().is_some_and(|h| (h.from, h.to) == (r, k)))
+        .expect("R stores an interaction towards K");
+    let mut h = state.hierarchies[h_index].take().unwrap();
+    ctx.make_root(&mut h);
+    let sender = Sender::Radiosity {
+        field: &state.field,
+        side: e.side(),
+        sent: Sent::Unshot,
+        emission: Spectrum::zero(),
+    };
+    let memo = IncidenceMemo::new();
+    let mut task = TripleTask {
+        sender: &sender,
+        si: e,
+        h: &mut h,
+        h_index: h_index as u32,
+        group: 0,
+        lost: Spectrum::zero(),
+        out: Vec::new(),
+        memo: &memo,
+    };
+    f(&ctx, &mut task);
+    let out = std::mem::take(&mut task.out);
+    let late = ctx.late.links.load(Ordering::Relaxed);
+    (h, out, late)
+}
+
+/// The roots of E and R.
+fn roots() -> (trilux_geometry::ElementId, trilux_geometry::ElementId) {
+    let (setup, _) = mirror_scene();
+    let forest = setup.forest();
+    (
+        forest.root(ts::front(0).surface()),
+        forest.root(ts::front(1).surface()),
+    )
+}
+
+/// With no threshold and zero error bounds a link is refined to the depth
+/// limit; after the deadline it is made at the root node as it stands,
+/// the very link an infinite threshold makes, and the hierarchy does not
+/// grow.
+#[test]
+fn a_three_point_link_reached_after_the_deadline_is_linked_where_it_stands() {
+    let (i, j) = roots();
+    let root_link = |threshold, deadline| {
+        stage_two(threshold, deadline, |ctx, task| {
+            let inc = ctx
+                .incidence(task.sender, task.si.of(i), task.h.from.of(j))
+                .expect("light passes from E to R");
+            ctx.refine_triple(task, i, j, 0, Some(&inc));
+        })
+    };
+    let (h, photometric, late) = root_link(f64::INFINITY, None);
+    assert_eq!((h.nodes.len(), photometric.len(), late), (1, 1, 0));
+    let (h, links, late) = root_link(0.0, Some(Instant::now()));
+    assert_eq!(h.nodes.len(), 1, "the hierarchy did not grow");
+    assert_eq!(late, 1);
+    assert_eq!(links.len(), 1);
+    assert_eq!(links[0].node, 0);
+    assert_eq!(links[0].gathered, photometric[0].gathered);
+    assert!(!links[0].gathered.is_black(), "light reflects towards K");
+    let (h, links, late) = root_link(0.0, None);
+    assert!(h.nodes.len() > 1 && links.len() > 1, "refined without one");
+    assert_eq!(late, 0);
+}
+
+/// A pair link into a leaf j of R: before the deadline the hierarchy is
+/// split on its sender side down to j; after it, the root node is
+/// returned as it stands (its sender element R's root, above j).
+#[test]
+fn after_the_deadline_a_hierarchy_is_not_split_down_to_the_receiver() {
+    let (_, root) = roots();
+    let (setup, _) = mirror_scene();
+    let leaf = *ts::leaves(setup.forest(), root).first().unwrap();
+    assert_eq!(setup.forest().element(leaf).depth, 2);
+    let nodes = |deadline| {
+        let mut found = Vec::new();
+        let (h, _, late) = stage_two(0.0, deadline, |ctx, task| {
+            found = ctx.nodes_for(task.h, leaf, &mut task.lost);
+        });
+        let from: Vec<_> = found.iter().map(|&n| h.nodes[n as usize].from).collect();
+        (h, found, from, late)
+    };
+    let (h, found, from, late) = nodes(None);
+    assert!(h.nodes.len() > 1 && h.nodes[0].split == Split::From);
+    assert!(!found.is_empty() && from.iter().all(|&f| f == leaf));
+    assert_eq!(late, 0);
+    let (h, found, from, late) = nodes(Some(Instant::now()));
+    assert_eq!(
+        (h.nodes.len(), found, from, late),
+        (1, vec![0], vec![root], 1)
+    );
+}
+
+/// A root throughput made after the deadline takes the base rays, not
+/// ×16: with nothing in the way (visibility exactly 1 either way) it is
+/// the full root's T, from the same form factor; it is counted.
+#[test]
+fn a_root_made_after_the_deadline_takes_the_base_rays() {
+    let (setup, state) = mirror_scene();
+    let cache = ThroughputCache::new(1 << 16);
+    let (r, k) = (ts::front(1), ts::front(2));
+    let pending = state
+        .hierarchies
+        .iter()
+        .flatten()
+        .find(|h| (h.from, h.to) == (r, k))
+        .expect("R stores an interaction towards K");
+    assert!(pending.pending);
+    let root = |deadline| {
+        let mut ctx = setup.refine_context(&cache);
+        ctx.deadline = deadline;
+        let mut h = pending.clone();
+        ctx.make_root(&mut h);
+        (h.nodes[0].t, ctx.late.roots.load(Ordering::Relaxed))
+    };
+    let (full, early) = root(None);
+    let (cheap, late) = root(Some(Instant::now()));
+    assert_eq!((early, late), (0, 1));
+    assert!(full > 0.0 && full.is_finite());
+    assert_eq!(cheap, full);
+}
