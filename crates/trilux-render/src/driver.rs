@@ -550,6 +550,22 @@ pub fn render<const N: usize, S: RadianceSolution<N>>(
     render_image::<_, N>(&solved, camera, settings, |l| l.to_linear_srgb(), progress)
 }
 
+/// [`render`] through a sensor with a spectral `response` (per band, Mitsuba's
+/// `srf`): each sample's radiance is multiplied by it before the CIE
+/// observer turns it into colour, so the image is ∫ L srf x̄ȳz̄ dλ in
+/// linear sRGB.
+pub fn render_with_response<const N: usize, S: RadianceSolution<N>>(
+    solution: &S,
+    camera: &Camera,
+    settings: &RenderSettings,
+    response: Spectrum<N>,
+    progress: impl Fn(usize, usize) + Sync,
+) -> Result<(Image, RenderStats), RenderError> {
+    let solved = SolvedScene::new(solution);
+    let seen = |l: &Spectrum<N>| (*l * response).to_linear_srgb();
+    render_image::<_, N>(&solved, camera, settings, seen, progress)
+}
+
 #[cfg(test)]
 mod tests {
     use glam::DVec3;

@@ -72,7 +72,9 @@ pub mod solved;
 
 pub use camera::{Camera, FovAxis, Ray};
 pub use compare::{Comparison, compare};
-pub use driver::{Estimator, RenderSettings, RenderStats, render, render_image};
+pub use driver::{
+    Estimator, RenderSettings, RenderStats, render, render_image, render_with_response,
+};
 pub use error::RenderError;
 pub use film::Film;
 pub use filter::ReconstructionFilter;

@@ -84,7 +84,10 @@ pub(crate) fn build(resolved: Resolved, path: &Path) -> Result<(Scene, Requests)
             || s.emitter
                 .as_ref()
                 .is_some_and(|em| em.radiance.is_sampled())
-    });
+    }) || camera
+        .as_ref()
+        .and_then(|c| c.response.as_ref())
+        .is_some_and(ColorParam::is_sampled);
     let scene = Scene {
         path: path.to_path_buf(),
         shapes,
@@ -344,6 +347,7 @@ fn sensor(e: &Element) -> Result<Camera> {
     let (near_clip, far_clip) = clip_planes(&props)?;
     let principal_point_offset = principal_point_offset(&props)?;
     let children = sensor_children(&props)?;
+    let response = sensor_response(&props)?;
     ignored_sensor_params(&props)?;
     props.finish()?;
     Ok(Camera {
@@ -362,6 +366,7 @@ fn sensor(e: &Element) -> Result<Camera> {
         principal_point_offset,
         crop: children.film.crop,
         sample_border: children.film.sample_border,
+        response,
         location: e.loc.clone(),
     })
 }
@@ -430,12 +435,6 @@ fn focal_length_fov(props: &Props<'_>) -> Result<(f64, FovAxis)> {
 /// checked) and ignored: `focus_distance` (only a lens has a focal plane)
 /// and the shutter interval (nothing in a trilux scene moves).
 fn ignored_sensor_params(props: &Props<'_>) -> Result<()> {
-    if props.has("srf") {
-        return Err(SceneError::at(
-            &props.loc("srf"),
-            "srf: a sensor's spectral response (which Mitsuba reads in its spectral variants only) is not supported: trilux's images are the CIE 1931 observer's colour in linear sRGB",
-        ));
-    }
     props.float("focus_distance")?;
     let open = props.float("shutter_open")?.unwrap_or(0.0);
     let close = props.float("shutter_close")?.unwrap_or(0.0);
@@ -448,6 +447,37 @@ fn ignored_sensor_params(props: &Props<'_>) -> Result<()> {
         ));
     }
     Ok(())
+}
+
+/// The sensor's `srf` (Mitsuba's spectral response, read in its spectral
+/// variants): a spectrum or a constant, finite and non-negative. An
+/// `<rgb>` response has no spectral meaning Mitsuba gives it here.
+fn sensor_response(props: &Props<'_>) -> Result<Option<ColorParam>> {
+    let Some(srf) = props.color("srf")? else {
+        return Ok(None);
+    };
+    let at = || props.loc("srf");
+    if matches!(srf, ColorParam::Rgb(_)) {
+        return Err(SceneError::at(
+            &at(),
+            "srf: give the sensor's spectral response as a <spectrum> or <float>, not <rgb>",
+        ));
+    }
+    if let Some(v) = srf
+        .values()
+        .into_iter()
+        .find(|v| !(v.is_finite() && *v >= 0.0))
+    {
+        return Err(SceneError::at(
+            &at(),
+            format!("srf: the spectral response must be finite and non-negative, found {v}"),
+        ));
+    }
+    // A malformed spectrum (wavelengths not ascending) is refused here,
+    // before any work, not when the render converts it.
+    srf.to_spectrum::<3>(trilux_color::Role::Unbounded)
+        .map_err(|e| SceneError::at(&at(), format!("srf: {e}")))?;
+    Ok(Some(srf))
 }
 
 /// Where the sensor stands and looks: its `to_world` (a rigid motion) and

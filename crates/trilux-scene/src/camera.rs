@@ -9,6 +9,7 @@
 
 use glam::{DMat4, DVec3};
 use serde::Serialize;
+use trilux_color::ColorParam;
 
 use crate::error::SourceLocation;
 pub use trilux_geometry::sensor::{FovAxis, ReconstructionFilter};
@@ -67,6 +68,10 @@ pub struct Camera {
     /// (the filter's border), so edge pixels get what the filter spreads
     /// from outside.
     pub sample_border: bool,
+    /// Mitsuba's `srf`: the sensor's spectral response, multiplying the
+    /// radiance before the CIE observer sees it (a sampled one makes the
+    /// scene spectral, as Mitsuba reads it in spectral variants only).
+    pub response: Option<ColorParam>,
     /// Where the `<sensor>` is written.
     #[serde(skip)]
     pub location: SourceLocation,

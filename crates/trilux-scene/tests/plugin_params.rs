@@ -137,8 +137,8 @@ fn parameters_that_change_the_light_are_refused() {
             "unknown parameter \"use_spectral_mis\"",
         ),
         (
-            r#"<sensor type="perspective"><spectrum name="srf" value="400:1, 700:1"/></sensor>"#,
-            "srf: a sensor's spectral response",
+            r#"<sensor type="perspective"><rgb name="srf" value="1, 0, 0"/></sensor>"#,
+            "srf: give the sensor's spectral response as a <spectrum>",
         ),
         (
             r#"<shape type="sphere"><boolean name="face_normals" value="true"/></shape>"#,
@@ -197,4 +197,21 @@ fn sample_border_is_kept() {
     let camera = |value| load(&film(value)).camera.expect("a camera");
     assert!(camera("true").sample_border);
     assert!(!camera("false").sample_border);
+}
+
+/// A sensor's `srf` is kept (crates/trilux/tests/mitsuba_cbox.rs checks
+/// the image against Mitsuba's) and, sampled, makes the scene spectral as
+/// Mitsuba reads it in spectral variants only.
+#[test]
+fn a_sensor_response_is_kept_and_makes_the_scene_spectral() {
+    let s =
+        load(r#"<sensor type="perspective"><spectrum name="srf" value="400:1, 700:1"/></sensor>"#);
+    let camera = s.camera.as_ref().expect("a camera");
+    assert_eq!(
+        camera.response,
+        Some(ColorParam::Sampled(vec![(400.0, 1.0), (700.0, 1.0)]))
+    );
+    assert!(s.spectral);
+    let s = load(r#"<sensor type="perspective"/>"#);
+    assert!(s.camera.expect("a camera").response.is_none());
 }

@@ -19,7 +19,9 @@ use trilux_solver::{
     SolverError, SolverSettings,
 };
 
-use trilux_render::{Camera, Image, RenderError, RenderSettings, RenderStats, render};
+use trilux_render::{
+    Camera, Image, RenderError, RenderSettings, RenderStats, render, render_with_response,
+};
 
 use crate::error::PipelineError;
 use crate::view::{ViewOverrides, camera_of};
@@ -290,7 +292,11 @@ impl WithBands for Run<'_, '_> {
         let start = Instant::now();
         let rendered = match &self.view {
             Some((camera, settings)) => {
-                Some(render(&solution, camera, settings, self.observer.render)?)
+                let progress = self.observer.render;
+                Some(match sensor_response::<N>(self.scene)? {
+                    Some(r) => render_with_response(&solution, camera, settings, r, progress)?,
+                    None => render(&solution, camera, settings, progress)?,
+                })
             }
             None => None,
         };
@@ -335,4 +341,20 @@ fn bake<const N: usize>(
             .then_some(&glossy as &dyn trilux_bake::GlossyLight),
     };
     Ok(trilux_bake::bake(&input, options)?)
+}
+
+/// The scene's sensor response (`srf`) in `N` bands, if it has one.
+fn sensor_response<const N: usize>(
+    scene: &Scene,
+) -> Result<Option<trilux_color::Spectrum<N>>, PipelineError> {
+    let Some(camera) = &scene.camera else {
+        return Ok(None);
+    };
+    let Some(srf) = &camera.response else {
+        return Ok(None);
+    };
+    let spectrum = srf
+        .to_spectrum::<N>(trilux_color::Role::Unbounded)
+        .map_err(|e| SceneError::at(&camera.location, format!("srf: {e}")))?;
+    Ok(Some(spectrum))
 }

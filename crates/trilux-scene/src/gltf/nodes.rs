@@ -471,6 +471,7 @@ fn camera(file: &Arc<Path>, c: &CameraNode) -> Result<Camera> {
         principal_point_offset: [0.0; 2],
         crop: None,
         sample_border: false,
+        response: None,
         location,
     })
 }
