@@ -8,7 +8,6 @@
 use std::sync::atomic::Ordering;
 use std::time::Instant;
 
-use glam::DVec3;
 use trilux_color::Spectrum;
 
 use super::{IncidenceMemo, RefineContext, TripleTask};
@@ -19,27 +18,12 @@ use crate::state::ShotState;
 use crate::test_scenes as ts;
 use crate::throughput::ThroughputCache;
 
-/// An emitter E facing down at (−1, 0, 1), a glossy floor R at the origin
-/// facing up and a grey plate K facing down at (1, 0, 1), in R's mirror
-/// direction from E; every error bound (nearly) zero, so that only the
-/// photometric criterion or the deadline stops refinement.
+/// The triple tests' scene (an emitter E, a glossy floor R, a grey plate
+/// K in R's mirror direction from E) with every error bound (nearly) zero,
+/// so that only the photometric criterion or the deadline stops
+/// refinement.
 fn mirror_scene() -> (Setup<3>, ShotState<3>) {
-    let shapes = [
-        ts::square(DVec3::new(-1.0, 0.0, 1.0), 1.0, true),
-        ts::square(DVec3::ZERO, 1.0, false),
-        ts::square(DVec3::new(1.0, 0.0, 1.0), 1.0, true),
-    ];
-    let mut settings = ts::settings(2);
-    settings.ff_eps = 1e-12;
-    settings.fr_eps = 1e-12;
-    let setup = ts::setup(
-        &shapes,
-        &[ts::diffuse(0.0), ts::glossy(0.3), ts::diffuse(0.5)],
-        &[Some(1.0), None, None],
-        settings,
-    );
-    let state = ShotState::new(&setup);
-    (setup, state)
+    super::triple::tests::mirror_scene(1.0, 1.0, 2, 1e-12)
 }
 
 /// E's shot into hierarchy R → K with photometric threshold `threshold`

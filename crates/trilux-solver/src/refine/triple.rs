@@ -696,7 +696,7 @@ impl<const N: usize> RefineContext<'_, N> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     //! The stage-2 oracle against answers that follow from its definition:
     //! the photometric criterion, refinement down to the depth limit, and
     //! which element a link that is not accurate splits.
@@ -715,7 +715,12 @@ mod tests {
     /// R (surface 1, side `floor`) at the origin facing up, and a grey
     /// plate K (surface 2, side `plate`) facing down at (1, 0, 1), in R's
     /// mirror direction from E.
-    fn mirror_scene(floor: f64, plate: f64, depth: u32, eps: f64) -> (Setup<3>, ShotState<3>) {
+    pub(in crate::refine) fn mirror_scene(
+        floor: f64,
+        plate: f64,
+        depth: u32,
+        eps: f64,
+    ) -> (Setup<3>, ShotState<3>) {
         let shapes = [
             ts::square(DVec3::new(-1.0, 0.0, 1.0), 1.0, true),
             ts::square(DVec3::ZERO, floor, false),
