@@ -109,9 +109,10 @@ fn mitsubas_cornell_box_renders_unedited_and_matches_mitsuba() {
     assert!(!failed, "{}", report.join("\n"));
 }
 
-/// Copies scenes/mitsuba-cbox into `to` with `hide_emitters` set in its
-/// path integrator; returns the copy of cbox-rgb.xml.
-fn with_hidden_emitters(to: &Path) -> PathBuf {
+/// Copies scenes/mitsuba-cbox's `file`, its `fragments/` and `meshes/`
+/// into `to`, with `edit` applied to the text of `edited` (a path in the
+/// folder); returns the copy of `file`.
+fn edited_copy(to: &Path, file: &str, edited: &str, edit: impl Fn(&str) -> String) -> PathBuf {
     let from = PathBuf::from(scene("mitsuba-cbox"));
     for sub in ["fragments", "meshes"] {
         std::fs::create_dir_all(to.join(sub)).unwrap();
@@ -120,15 +121,21 @@ fn with_hidden_emitters(to: &Path) -> PathBuf {
             std::fs::copy(&path, to.join(sub).join(path.file_name().unwrap())).unwrap();
         }
     }
-    let base = to.join("fragments/base.xml");
-    let text = std::fs::read_to_string(&base).unwrap();
+    std::fs::copy(from.join(file), to.join(file)).unwrap();
+    let text = std::fs::read_to_string(to.join(edited)).unwrap();
+    let changed = edit(&text);
+    assert_ne!(changed, text, "{edited} unchanged");
+    std::fs::write(to.join(edited), changed).unwrap();
+    to.join(file)
+}
+
+/// cbox-rgb.xml with `hide_emitters` set in its path integrator.
+fn with_hidden_emitters(to: &Path) -> PathBuf {
     let depth = r#"<integer name="max_depth" value="$max_depth"/>"#;
-    assert!(text.contains(depth));
     let hidden = format!(r#"{depth}<boolean name="hide_emitters" value="true"/>"#);
-    std::fs::write(&base, text.replace(depth, &hidden)).unwrap();
-    let file = to.join("cbox-rgb.xml");
-    std::fs::copy(from.join("cbox-rgb.xml"), &file).unwrap();
-    file
+    edited_copy(to, "cbox-rgb.xml", "fragments/base.xml", |t| {
+        t.replace(depth, &hidden)
+    })
 }
 
 /// The path integrator's `max_depth` 1, 2 and 3 (emitters alone, direct
@@ -193,23 +200,17 @@ fn an_estimator_that_cannot_honour_max_depth_says_so() {
     assert!(warnings[0].contains("--gather control"), "{stderr}");
 }
 
-/// cbox.xml with `<spectrum name="srf" value="SRF"/>` first in its sensor,
-/// written into `to` beside a copy of the meshes; returns the file.
+/// cbox.xml with `<spectrum name="srf" value="SRF"/>` first in its sensor.
 fn with_response(to: &Path, srf: &str) -> PathBuf {
-    let from = PathBuf::from(scene("mitsuba-cbox"));
-    std::fs::create_dir_all(to.join("meshes")).unwrap();
-    for entry in std::fs::read_dir(from.join("meshes")).unwrap() {
-        let path = entry.unwrap().path();
-        std::fs::copy(&path, to.join("meshes").join(path.file_name().unwrap())).unwrap();
-    }
-    let text = std::fs::read_to_string(from.join("cbox.xml")).unwrap();
-    let at = text[text.find("<sensor").unwrap()..].find('>').unwrap()
-        + text.find("<sensor").unwrap()
-        + 1;
-    let file = to.join("cbox.xml");
-    let srf = format!("\n<spectrum name=\"srf\" value=\"{srf}\"/>");
-    std::fs::write(&file, format!("{}{srf}{}", &text[..at], &text[at..])).unwrap();
-    file
+    edited_copy(to, "cbox.xml", "cbox.xml", |text| {
+        let sensor = text.find("<sensor").unwrap();
+        let at = sensor + text[sensor..].find('>').unwrap() + 1;
+        format!(
+            "{}\n<spectrum name=\"srf\" value=\"{srf}\"/>{}",
+            &text[..at],
+            &text[at..]
+        )
+    })
 }
 
 /// A sensor's spectral response (`srf`) multiplies the light before the
