@@ -17,14 +17,13 @@ mean and its relative standard error. Only means are kept (the test
 compares image means; the images themselves add nothing to check them).
 """
 import argparse
-import json
 import os
 import sys
 import time
 
-import numpy as np
-
 HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+from image_means import mean_over_passes, rounded, write  # noqa: E402
 
 CASES = [
     ("max_depth_1", 1, False),
@@ -39,14 +38,7 @@ def case_mean(mi, max_depth, hide, spp, passes):
     integrator = mi.load_dict(
         {"type": "path", "max_depth": max_depth, "hide_emitters": hide}
     )
-    means = []
-    for k in range(passes):
-        img = mi.render(scene, integrator=integrator, spp=spp // passes, seed=k)
-        means.append(np.array(img, dtype=np.float64).reshape(-1, 3).mean(axis=0))
-    means = np.array(means)
-    mean = means.mean(axis=0)
-    stderr = means.std(axis=0, ddof=1) / np.sqrt(passes) / np.maximum(mean, 1e-30)
-    return mean, stderr
+    return mean_over_passes(mi, scene, spp, passes, integrator)
 
 
 def main():
@@ -72,20 +64,12 @@ def main():
     }
     for name, depth, hide in CASES:
         mean, stderr = case_mean(mi, depth, hide, a.spp, a.passes)
-        rec["cases"][name] = {
-            "max_depth": depth,
-            "hide_emitters": hide,
-            "mean_rgb": [round(float(x), 7) for x in mean],
-            "mean_rel_stderr": [round(float(x), 6) for x in stderr],
-        }
+        rec["cases"][name] = {"max_depth": depth, "hide_emitters": hide, **rounded(mean, stderr)}
     rec["seconds"] = round(time.time() - t0, 1)
     rec["command"] = "python3 scenes/mitsuba-cbox/make_integrator_references.py " + " ".join(
         sys.argv[1:]
     )
-    with open(os.path.join(HERE, "integrator.json"), "w", encoding="utf-8") as f:
-        json.dump(rec, f, indent=2)
-        f.write("\n")
-    print(json.dumps(rec))
+    write(os.path.join(HERE, "integrator.json"), rec)
 
 
 if __name__ == "__main__":

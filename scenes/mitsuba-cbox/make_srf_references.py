@@ -13,13 +13,12 @@ srf.json beside this script: per case the srf, the per-channel image mean
 and its relative standard error (the passes' spread / sqrt(K) / |mean|).
 """
 import argparse
-import json
 import os
 import sys
 
-import numpy as np
-
 HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+from image_means import mean_over_passes, rounded, write  # noqa: E402
 
 CASES = {
     "red_box": "600:1, 700:1",
@@ -34,15 +33,7 @@ def with_srf(srf):
 
 
 def case_mean(mi, srf, spp, passes):
-    scene = mi.load_string(with_srf(srf))
-    means = []
-    for k in range(passes):
-        img = mi.render(scene, spp=spp // passes, seed=k)
-        means.append(np.array(img, dtype=np.float64).reshape(-1, 3).mean(axis=0))
-    means = np.array(means)
-    mean = means.mean(axis=0)
-    stderr = means.std(axis=0, ddof=1) / np.sqrt(passes) / np.maximum(np.abs(mean), 1e-30)
-    return mean, stderr
+    return mean_over_passes(mi, mi.load_string(with_srf(srf)), spp, passes)
 
 
 def main():
@@ -62,16 +53,9 @@ def main():
            "variant": mi.variant(), "spp": a.spp, "passes": a.passes, "cases": {}}
     for name, srf in CASES.items():
         mean, stderr = case_mean(mi, srf, a.spp, a.passes)
-        rec["cases"][name] = {
-            "srf": srf,
-            "mean_rgb": [round(float(x), 7) for x in mean],
-            "mean_rel_stderr": [round(float(x), 6) for x in stderr],
-        }
+        rec["cases"][name] = {"srf": srf, **rounded(mean, stderr)}
     rec["command"] = "python3 scenes/mitsuba-cbox/make_srf_references.py " + " ".join(sys.argv[1:])
-    with open(os.path.join(HERE, "srf.json"), "w", encoding="utf-8") as f:
-        json.dump(rec, f, indent=2)
-        f.write("\n")
-    print(json.dumps(rec))
+    write(os.path.join(HERE, "srf.json"), rec)
 
 
 if __name__ == "__main__":
