@@ -22,7 +22,8 @@
 //!   (Christensen et al. 1997).
 //! - `divergence`: scenes with no finite solution (light never absorbed
 //!   and never escaping), refused before the solve.
-//! - `throughput`: T = A F V per element pair, cached (paper §4.6).
+//! - `throughput`: T = A F V per element pair, cached (paper §4.6);
+//!   `shards`: the shared tables' shards, each on its own cache lines.
 //! - `radiosity`: two-point radiance of Lambertian parts, push-pull.
 //! - `textures`: each element's texture average (ρ_d and the glossy
 //!   ratio g of textured materials), pushed as irradiance.
@@ -68,6 +69,7 @@ mod radiosity;
 mod refine;
 pub mod settings;
 mod setup;
+mod shards;
 mod shot;
 pub mod solution;
 pub mod solver;

@@ -450,6 +450,7 @@ fn stage_two<const N: usize>(
                 lost: Spectrum::zero(),
                 out: Vec::new(),
                 memo: &memo,
+                local: Default::default(),
             };
             for &g in &groups_of_face[&from] {
                 let l = &pair_links[g as usize];

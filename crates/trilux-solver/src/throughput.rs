@@ -13,6 +13,8 @@ use std::sync::RwLock;
 
 use trilux_geometry::{FaceElement, FormFactorOptions, Visibility, form_factor};
 
+use crate::shards::Padded;
+
 /// A throughput with the visible fraction it was made with.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub(crate) struct Throughput {
@@ -77,7 +79,7 @@ type KeyMap = HashMap<u64, Throughput, BuildKeyHasher>;
 
 /// A bounded, thread-safe cache of throughputs keyed by ordered sided pairs.
 pub(crate) struct ThroughputCache {
-    shards: Vec<RwLock<KeyMap>>,
+    shards: Vec<Padded<RwLock<KeyMap>>>,
     per_shard_cap: usize,
 }
 
@@ -86,7 +88,7 @@ impl ThroughputCache {
     pub fn new(capacity: usize) -> Self {
         ThroughputCache {
             shards: (0..SHARDS)
-                .map(|_| RwLock::new(KeyMap::default()))
+                .map(|_| Padded(RwLock::new(KeyMap::default())))
                 .collect(),
             per_shard_cap: (capacity / SHARDS).max(16),
         }

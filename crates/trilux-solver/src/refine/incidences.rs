@@ -15,11 +15,12 @@ use std::sync::{Arc, Mutex};
 
 use trilux_geometry::{ElementId, FaceElement};
 
+use crate::shards::Padded;
 use crate::throughput::BuildKeyHasher;
 
 /// Shards of the table: enough that two to a few dozen threads rarely
-/// wait on one another.
-const SHARDS: usize = 32;
+/// want the same one at once (each on its own cache lines).
+const SHARDS: usize = 128;
 
 /// One shard: incidences by i · 2³³ + j's key (2 × element + side;
 /// element ids stay far below 2³¹, whose forest would need hundreds of
@@ -29,28 +30,43 @@ type Table<T> = HashMap<u64, Option<Arc<T>>, BuildKeyHasher>;
 /// One shot's incidences `T` (stage 2's `Incidence`) by (i, j and j's
 /// side); `None` records a sub-pair that carries no light.
 pub(crate) struct IncidenceMemo<T> {
-    shards: Vec<Mutex<Table<T>>>,
+    shards: Vec<Padded<Mutex<Table<T>>>>,
 }
 
 impl<T> IncidenceMemo<T> {
     /// An empty table.
     pub fn new() -> Self {
         IncidenceMemo {
-            shards: (0..SHARDS).map(|_| Mutex::new(Table::default())).collect(),
+            shards: (0..SHARDS)
+                .map(|_| Padded(Mutex::new(Table::default())))
+                .collect(),
         }
     }
 
     /// The incidence of (i, j), made by `make` the first time it is asked
-    /// for. (Two threads asking at once may both make it; they make the
-    /// same value, and the first stored is kept.)
+    /// for, looked up in the task's `local` front first (a hierarchy asks
+    /// for the same (i, j) once per receiver node of j, and the shared
+    /// table's lock and reference count are atomics that both cores
+    /// write). (Two threads asking at once may both make it; they make
+    /// the same value, and the first stored is kept.)
     pub fn get_or_make(
         &self,
+        local: &mut LocalMemo<T>,
         i: ElementId,
         j: FaceElement,
         make: impl FnOnce() -> Option<T>,
     ) -> Option<Arc<T>> {
         let key = (u64::from(i.0) << 33) | j.key();
-        let shard = &self.shards[(key.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 59) as usize % SHARDS];
+        if let Some(found) = local.0.get(&key) {
+            return found.clone();
+        }
+        let got = self.shared(key, make);
+        local.0.insert(key, got.clone());
+        got
+    }
+
+    fn shared(&self, key: u64, make: impl FnOnce() -> Option<T>) -> Option<Arc<T>> {
+        let shard = &self.shards[(key.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 57) as usize % SHARDS];
         if let Some(found) = shard.lock().ok().and_then(|m| m.get(&key).cloned()) {
             return found;
         }
@@ -59,5 +75,48 @@ impl<T> IncidenceMemo<T> {
             Ok(mut m) => m.entry(key).or_insert(made).clone(),
             Err(_) => made,
         }
+    }
+}
+
+/// One task's incidences already asked for (lives as long as the task).
+pub(crate) struct LocalMemo<T>(Table<T>);
+
+impl<T> Default for LocalMemo<T> {
+    fn default() -> Self {
+        LocalMemo(Table::default())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::cell::Cell;
+
+    use trilux_geometry::{ElementId, FaceElement, Side};
+
+    use super::{IncidenceMemo, LocalMemo};
+
+    #[test]
+    fn each_incidence_is_made_once_per_shot_whichever_task_asks() {
+        let memo = IncidenceMemo::new();
+        let (mut first, mut second) = (LocalMemo::default(), LocalMemo::default());
+        let made = Cell::new(0);
+        let make = |v: u32| {
+            made.set(made.get() + 1);
+            Some(v)
+        };
+        let j = FaceElement::new(ElementId(7), Side::Back);
+        let a = memo.get_or_make(&mut first, ElementId(3), j, || make(30));
+        let again = memo.get_or_make(&mut first, ElementId(3), j, || make(99));
+        let other_task = memo.get_or_make(&mut second, ElementId(3), j, || make(98));
+        assert_eq!((a.as_deref(), again.as_deref(), other_task.as_deref()), (Some(&30), Some(&30), Some(&30)));
+        assert_eq!(made.get(), 1);
+        // The other side of j, and another i, are other incidences.
+        let front = FaceElement::new(ElementId(7), Side::Front);
+        assert_eq!(memo.get_or_make(&mut first, ElementId(3), front, || make(31)).as_deref(), Some(&31));
+        assert_eq!(memo.get_or_make(&mut second, ElementId(4), j, || make(40)).as_deref(), Some(&40));
+        // A sub-pair that carries no light is remembered as such.
+        assert_eq!(memo.get_or_make(&mut first, ElementId(5), j, || None), None);
+        assert_eq!(memo.get_or_make(&mut second, ElementId(5), j, || make(50)), None);
+        assert_eq!(made.get(), 3);
     }
 }

@@ -63,6 +63,7 @@ fn stage_two(
         lost: Spectrum::zero(),
         out: Vec::new(),
         memo: &memo,
+        local: Default::default(),
     };
     f(&ctx, &mut task);
     let out = std::mem::take(&mut task.out);

@@ -17,7 +17,7 @@ use trilux_color::Spectrum;
 use trilux_geometry::{ElementId, FaceElement, FaceId};
 
 use super::context::RefineContext;
-use super::incidences::IncidenceMemo;
+use super::incidences::{IncidenceMemo, LocalMemo};
 use super::narrow_lobe::LobeHit;
 use crate::interaction::{Hierarchy, Node, Split};
 use crate::link::{NodeLink, Sender};
@@ -98,6 +98,8 @@ pub(crate) struct TripleTask<'t, const N: usize> {
     pub out: Vec<NodeLink<N>>,
     /// The shot's sub-pair incidences, shared with its other tasks.
     pub memo: &'t IncidenceMemo<Incidence<N>>,
+    /// The incidences this task has already asked the shared table for.
+    pub local: LocalMemo<Incidence<N>>,
 }
 
 impl<const N: usize> TripleTask<'_, N> {
@@ -307,7 +309,9 @@ impl<const N: usize> RefineContext<'_, N> {
                 let sender = task.sender;
                 let made = task
                     .memo
-                    .get_or_make(i, sj.of(j), || self.incidence(sender, si.of(i), sj.of(j)));
+                    .get_or_make(&mut task.local, i, sj.of(j), || {
+                        self.incidence(sender, si.of(i), sj.of(j))
+                    });
                 let Some(k) = made else {
                     return;
                 };
@@ -778,6 +782,7 @@ pub(super) mod tests {
             lost: Spectrum::zero(),
             out: Vec::new(),
             memo: &memo,
+            local: Default::default(),
         };
         f(&ctx, &mut task, &incidence);
         let out = std::mem::take(&mut task.out);
