@@ -14,6 +14,7 @@ use trilux_brdf::BsdfParams;
 use trilux_color::ColorParam;
 
 use crate::camera::{Camera, Crop, FovAxis, ReconstructionFilter, default_fov};
+use crate::environment::Environment;
 use crate::error::{Result, SceneError};
 use crate::limits::MAX_SHAPES;
 use crate::material::{TextureCollector, build_bsdf, check_color};
@@ -48,6 +49,7 @@ pub(crate) fn build(resolved: Resolved, path: &Path) -> Result<(Scene, Requests)
         sensor: None,
         integrator: None,
         params: None,
+        environment: None,
     };
     for (k, (e, &failed)) in scene_el.children.iter().zip(&failed).enumerate() {
         if e.tag == "shape" {
@@ -76,6 +78,7 @@ pub(crate) fn build(resolved: Resolved, path: &Path) -> Result<(Scene, Requests)
         camera,
         integrator,
         params,
+        environment,
         ..
     } = b;
     let max_depth = params.as_ref().and_then(|p| p.max_depth);
@@ -84,7 +87,8 @@ pub(crate) fn build(resolved: Resolved, path: &Path) -> Result<(Scene, Requests)
             || s.emitter
                 .as_ref()
                 .is_some_and(|em| em.radiance.is_sampled())
-    }) || camera
+    }) || environment.as_ref().is_some_and(|e| e.radiance.is_sampled())
+        || camera
         .as_ref()
         .and_then(|c| c.response.as_ref())
         .is_some_and(ColorParam::is_sampled);
@@ -100,6 +104,7 @@ pub(crate) fn build(resolved: Resolved, path: &Path) -> Result<(Scene, Requests)
         spectral,
         bsdf_counts,
         camera_names: Vec::new(),
+        environment,
         warnings: Vec::new(),
     };
     errors.or((scene, requests))
@@ -119,6 +124,8 @@ struct Builder<'a> {
     integrator: Option<&'a Element>,
     /// What the integrator asks of the image.
     params: Option<crate::integrator::IntegratorParams>,
+    /// The `constant` emitter, if any.
+    environment: Option<Environment>,
 }
 
 impl<'a> Builder<'a> {
@@ -167,6 +174,13 @@ impl<'a> Builder<'a> {
                 self.integrator = Some(e);
                 self.params = Some(crate::integrator::integrator(e)?);
             }
+            "emitter" if e.attr("type").is_some_and(|t| t.value == "constant") => {
+                let env = crate::environment::constant(e)?;
+                if let Some(first) = &self.environment {
+                    return Err(crate::environment::second(e, first));
+                }
+                self.environment = Some(env);
+            }
             "emitter" => top_level_emitter(e)?,
             "film" | "sampler" | "rfilter" if e.attr("id").is_some() => sensor_definition(e)?,
             other => {
@@ -202,7 +216,7 @@ fn top_level_emitter(e: &Element) -> Result<()> {
         "area" if e.attr("id").is_some() => return area_emitter(e).map(|_| ()),
         "area" => "an area <emitter> must be placed inside a <shape> (or given an id and named there by a <ref>)".to_string(),
         _ => format!(
-            "unknown emitter plugin \"{t}\" (only area emitters inside shapes are supported)"
+            "unknown emitter plugin \"{t}\" (supported: area inside a shape, constant)"
         ),
     };
     Err(SceneError::at(&e.loc, message))
@@ -295,21 +309,9 @@ fn scene_shape(e: &Element, folder: &Path) -> Result<ShapeRequests> {
     Ok((shape, request, textures.requests))
 }
 
-fn area_emitter(e: &Element) -> Result<AreaEmitter> {
-    e.check_attrs(&["type", "id", "name"])?;
-    let t = e.plugin_type()?;
-    if t != "area" {
-        return Err(SceneError::at(
-            &e.required("type")?.loc,
-            format!("unknown emitter plugin \"{t}\" (only \"area\" inside a shape)"),
-        ));
-    }
-    let props = Props::new(e)?;
-    props.no_objects()?;
-    // How often Mitsuba's light sampling picks this emitter: its noise, not
-    // its image.
-    props.float("sampling_weight")?;
-    // Mitsuba's default radiance is 1.
+/// An emitter's `radiance` (Mitsuba's default 1), checked: finite, not
+/// negative, within the limit.
+pub(crate) fn emitted_radiance(props: &Props<'_>) -> Result<ColorParam> {
     let radiance = props.color("radiance")?.unwrap_or(ColorParam::Float(1.0));
     check_color(&radiance, &props.loc("radiance"), "radiance", None)?;
     if let Some(v) = radiance
@@ -325,6 +327,24 @@ fn area_emitter(e: &Element) -> Result<AreaEmitter> {
             ),
         ));
     }
+    Ok(radiance)
+}
+
+fn area_emitter(e: &Element) -> Result<AreaEmitter> {
+    e.check_attrs(&["type", "id", "name"])?;
+    let t = e.plugin_type()?;
+    if t != "area" {
+        return Err(SceneError::at(
+            &e.required("type")?.loc,
+            format!("unknown emitter plugin \"{t}\" (only \"area\" inside a shape)"),
+        ));
+    }
+    let props = Props::new(e)?;
+    props.no_objects()?;
+    // How often Mitsuba's light sampling picks this emitter: its noise, not
+    // its image.
+    props.float("sampling_weight")?;
+    let radiance = emitted_radiance(&props)?;
     props.finish()?;
     Ok(AreaEmitter {
         radiance,

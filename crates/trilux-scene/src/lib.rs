@@ -44,6 +44,7 @@
 
 mod build;
 pub mod camera;
+pub mod environment;
 pub mod error;
 pub mod gltf;
 pub mod image;
@@ -72,6 +73,7 @@ use std::path::Path;
 use std::sync::Arc;
 
 pub use camera::{Camera, FovAxis, ReconstructionFilter};
+pub use environment::Environment;
 pub use error::{SceneError, SourceLocation};
 pub use meshes::Pending;
 pub use scene::{AreaEmitter, Scene, SceneShape};

@@ -130,6 +130,7 @@ impl Pending {
             index += 1;
             !flat.contains(&(index - 1))
         });
+        crate::environment::enclose(&mut self.scene);
         errors.or(self.scene)
     }
 }

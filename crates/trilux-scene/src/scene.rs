@@ -74,6 +74,9 @@ pub struct Scene {
     /// camera's name, else its node's, `None` when neither is named.
     /// Empty for an XML scene (its one `<sensor>` is `camera`).
     pub camera_names: Vec<Option<String>>,
+    /// The `constant` environment emitter, if any; its enclosure is the
+    /// last of [`Scene::shapes`] (`crate::environment`).
+    pub environment: Option<crate::environment::Environment>,
     /// What loading left out, one line each with its place (zero-area
     /// triangles and meshes): the command prints them as warnings.
     #[serde(skip)]

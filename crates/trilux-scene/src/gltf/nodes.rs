@@ -123,6 +123,7 @@ pub(crate) fn build(
         spectral: false,
         bsdf_counts: walk.bsdf_counts,
         camera_names,
+        environment: None,
         warnings: Vec::new(),
     };
     let meshes = GltfMeshes {

@@ -1,0 +1,148 @@
+//! Mitsuba's `constant` emitter: light of one radiance arriving from every
+//! direction at infinity (a uniform sky).
+//!
+//! Radiance does not change along a ray, so a closed surface around the
+//! whole scene that emits that radiance inward, and absorbs what reaches
+//! it, is the same light for every point and direction inside it: a ray
+//! that leaves the scene meets it and brings back exactly the radiance it
+//! would have brought from infinity, and light that leaves the scene is
+//! lost either way. The loader therefore stands the environment in as such
+//! an *enclosure*: a box 2 % beyond the scene's bounds and the camera's
+//! position, black, emitting inward. The solver shoots from it and the
+//! renderer samples it as it does any area light, with no code of their
+//! own. It must be a tight box: the solver's smallest element (MinArea)
+//! is a fraction of the scene's diagonal, which a distant sphere would
+//! enlarge. Its one limit: a view from outside the box (a camera moved
+//! there after loading) sees the box's black back. docs/scene-format.md,
+//! "Environment".
+
+use glam::{DMat4, DVec3};
+use trilux_brdf::BsdfParams;
+use trilux_color::ColorParam;
+use trilux_geometry::{Shape, ShapeKind};
+
+use crate::error::{Result, SceneError, SourceLocation};
+use crate::props::Props;
+use crate::scene::{AreaEmitter, Scene, SceneShape};
+use crate::xml::Element;
+
+/// A `constant` environment emitter.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Environment {
+    /// Radiance arriving from every direction (`radiance`, Mitsuba's
+    /// default 1).
+    pub radiance: ColorParam,
+    /// The index in [`Scene::shapes`] of the enclosure standing for it
+    /// (set when the scene's meshes are read: its size needs them).
+    pub shape: Option<usize>,
+    /// Where the `<emitter>` is written.
+    #[serde(skip)]
+    pub location: SourceLocation,
+}
+
+/// Builds a top-level `<emitter type="constant">`.
+pub(crate) fn constant(e: &Element) -> Result<Environment> {
+    e.check_attrs(&["type", "id", "name"])?;
+    let props = Props::new(e)?;
+    props.no_objects()?;
+    props.float("sampling_weight")?;
+    let radiance = crate::build::emitted_radiance(&props)?;
+    props.finish()?;
+    Ok(Environment {
+        radiance,
+        shape: None,
+        location: e.loc.clone(),
+    })
+}
+
+/// The error for a second environment (Mitsuba 3 allows one).
+pub(crate) fn second(e: &Element, first: &Environment) -> SceneError {
+    SceneError::at(
+        &e.loc,
+        format!(
+            "only one environment emitter is allowed (the first is at line {})",
+            first.location.line
+        ),
+    )
+}
+
+/// Appends the enclosure of the scene's environment, if it has one (module
+/// docs); every mesh must be read already.
+pub(crate) fn enclose(scene: &mut Scene) {
+    let Some(env) = &scene.environment else {
+        return;
+    };
+    let mut lo = DVec3::splat(f64::INFINITY);
+    let mut hi = DVec3::splat(f64::NEG_INFINITY);
+    for s in &scene.shapes {
+        let (a, b) = world_bounds(&s.shape);
+        (lo, hi) = (lo.min(a), hi.max(b));
+    }
+    if let Some(c) = &scene.camera {
+        (lo, hi) = (lo.min(c.origin), hi.max(c.origin));
+    }
+    if !(lo.is_finite() && hi.is_finite()) {
+        // No shape and no camera: a unit box around the origin.
+        (lo, hi) = (DVec3::splat(-1.0), DVec3::splat(1.0));
+    }
+    let centre = 0.5 * (lo + hi);
+    let diagonal = (hi - lo).length().max(1e-3);
+    // 2 % beyond the bounds on each axis, and at least 0.1 % of the
+    // diagonal (a flat scene still gets a box with volume).
+    let half = 0.5 * (hi - lo) * 1.02 + DVec3::splat(1e-3 * diagonal);
+    let shape = SceneShape {
+        id: None,
+        shape: Shape {
+            kind: ShapeKind::Cube,
+            world_from_object: DMat4::from_translation(centre) * DMat4::from_scale(half),
+            flip_normals: true,
+        },
+        bsdf: BsdfParams::Diffuse {
+            reflectance: ColorParam::Float(0.0),
+        },
+        emitter: Some(AreaEmitter {
+            radiance: env.radiance.clone(),
+            location: env.location.clone(),
+        }),
+        textures: Vec::new(),
+        location: env.location.clone(),
+    };
+    let index = scene.shapes.len();
+    scene.shapes.push(shape);
+    if let Some(env) = &mut scene.environment {
+        env.shape = Some(index);
+    }
+}
+
+/// A box holding the shape in world space: the world images of its object
+/// box's corners (exact for meshes' vertices' box up to the transform).
+fn world_bounds(shape: &Shape) -> (DVec3, DVec3) {
+    let (a, b) = match &shape.kind {
+        ShapeKind::Rectangle => (DVec3::new(-1.0, -1.0, 0.0), DVec3::new(1.0, 1.0, 0.0)),
+        ShapeKind::Disk => (DVec3::new(-1.0, -1.0, 0.0), DVec3::new(1.0, 1.0, 0.0)),
+        ShapeKind::Cube => (DVec3::splat(-1.0), DVec3::splat(1.0)),
+        ShapeKind::Sphere { center, radius } => (*center - *radius, *center + *radius),
+        ShapeKind::Cylinder { p0, p1, radius } => {
+            (p0.min(*p1) - *radius, p0.max(*p1) + *radius)
+        }
+        ShapeKind::Mesh(m) => m.positions.iter().fold(
+            (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+            |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+        ),
+    };
+    if !(a.is_finite() && b.is_finite()) {
+        return (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+    }
+    (0..8).fold(
+        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+        |(lo, hi), k| {
+            let corner = DVec3::new(
+                if k & 1 == 0 { a.x } else { b.x },
+                if k & 2 == 0 { a.y } else { b.y },
+                if k & 4 == 0 { a.z } else { b.z },
+            );
+            let w = shape.world_from_object.transform_point3(corner);
+            (lo.min(w), hi.max(w))
+        },
+    )
+}

@@ -1,0 +1,48 @@
+#!/usr/bin/env python3
+"""Mitsuba 3.9.1's image means of tests/environment/courtyard.xml (a
+`constant` sky), with the sky seen and with `hide_emitters`, for
+crates/trilux/tests/environment.rs.
+
+Usage (from anywhere):
+    python3 tests/environment/make_reference.py [--spp N] [--passes P]
+
+Writes reference.json beside this script.
+"""
+import argparse
+import os
+import sys
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(HERE, "..", "..", "scenes", "mitsuba-cbox"))
+import image_means  # noqa: E402
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--spp", type=int, default=8192)
+    ap.add_argument("--passes", type=int, default=8)
+    a = ap.parse_args()
+    import mitsuba as mi
+
+    mi.set_variant("llvm_ad_rgb")
+    cases = {}
+    for name, hide in (("sky_seen", "false"), ("sky_hidden", "true")):
+        scene = mi.load_file(os.path.join(HERE, "courtyard.xml"), hide=hide)
+        mean, stderr = image_means.mean_over_passes(mi, scene, a.spp, a.passes)
+        cases[name] = image_means.rounded(mean, stderr)
+    image_means.write(
+        os.path.join(HERE, "reference.json"),
+        {
+            "scene": "tests/environment/courtyard.xml",
+            "mitsuba": mi.__version__,
+            "variant": mi.variant(),
+            "spp": a.spp,
+            "passes": a.passes,
+            "cases": cases,
+            "command": "python3 tests/environment/make_reference.py " + " ".join(sys.argv[1:]),
+        },
+    )
+
+
+if __name__ == "__main__":
+    main()
