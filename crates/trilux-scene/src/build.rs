@@ -14,13 +14,13 @@ use trilux_brdf::BsdfParams;
 use trilux_color::ColorParam;
 
 use crate::camera::{Camera, Crop, FovAxis, ReconstructionFilter, default_fov};
-use crate::environment::Environment;
 use crate::error::{Result, SceneError};
 use crate::limits::MAX_SHAPES;
-use crate::material::{TextureCollector, build_bsdf, check_color};
+use crate::material::{TextureCollector, build_bsdf};
 use crate::meshes::Requests;
 use crate::props::Props;
 use crate::resolve::Resolved;
+use crate::scene::Environment;
 use crate::scene::{AreaEmitter, Scene, SceneShape};
 use crate::shape::{MeshRequest, build_shape};
 use crate::textures::TextureRequest;
@@ -87,11 +87,13 @@ pub(crate) fn build(resolved: Resolved, path: &Path) -> Result<(Scene, Requests)
             || s.emitter
                 .as_ref()
                 .is_some_and(|em| em.radiance.is_sampled())
-    }) || environment.as_ref().is_some_and(|e| e.radiance.is_sampled())
-        || camera
+    }) || environment
         .as_ref()
-        .and_then(|c| c.response.as_ref())
-        .is_some_and(ColorParam::is_sampled);
+        .is_some_and(|e| e.radiance.is_sampled())
+        || camera
+            .as_ref()
+            .and_then(|c| c.response.as_ref())
+            .is_some_and(ColorParam::is_sampled);
     let scene = Scene {
         path: path.to_path_buf(),
         shapes,
@@ -309,27 +311,6 @@ fn scene_shape(e: &Element, folder: &Path) -> Result<ShapeRequests> {
     Ok((shape, request, textures.requests))
 }
 
-/// An emitter's `radiance` (Mitsuba's default 1), checked: finite, not
-/// negative, within the limit.
-pub(crate) fn emitted_radiance(props: &Props<'_>) -> Result<ColorParam> {
-    let radiance = props.color("radiance")?.unwrap_or(ColorParam::Float(1.0));
-    check_color(&radiance, &props.loc("radiance"), "radiance", None)?;
-    if let Some(v) = radiance
-        .values()
-        .into_iter()
-        .find(|v| *v > crate::limits::MAX_RADIANCE)
-    {
-        return Err(SceneError::at(
-            &props.loc("radiance"),
-            format!(
-                "radiance {v:e} is beyond the limit {:e} (docs/limits.md)",
-                crate::limits::MAX_RADIANCE
-            ),
-        ));
-    }
-    Ok(radiance)
-}
-
 fn area_emitter(e: &Element) -> Result<AreaEmitter> {
     e.check_attrs(&["type", "id", "name"])?;
     let t = e.plugin_type()?;
@@ -344,7 +325,7 @@ fn area_emitter(e: &Element) -> Result<AreaEmitter> {
     // How often Mitsuba's light sampling picks this emitter: its noise, not
     // its image.
     props.float("sampling_weight")?;
-    let radiance = emitted_radiance(&props)?;
+    let radiance = crate::material::emitted_radiance(&props)?;
     props.finish()?;
     Ok(AreaEmitter {
         radiance,

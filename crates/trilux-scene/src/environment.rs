@@ -21,24 +21,10 @@ use trilux_brdf::BsdfParams;
 use trilux_color::ColorParam;
 use trilux_geometry::{Shape, ShapeKind};
 
-use crate::error::{Result, SceneError, SourceLocation};
+use crate::error::{Result, SceneError};
 use crate::props::Props;
-use crate::scene::{AreaEmitter, Scene, SceneShape};
+use crate::scene::{AreaEmitter, Environment, Scene, SceneShape};
 use crate::xml::Element;
-
-/// A `constant` environment emitter.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
-pub struct Environment {
-    /// Radiance arriving from every direction (`radiance`, Mitsuba's
-    /// default 1).
-    pub radiance: ColorParam,
-    /// The index in [`Scene::shapes`] of the enclosure standing for it
-    /// (set when the scene's meshes are read: its size needs them).
-    pub shape: Option<usize>,
-    /// Where the `<emitter>` is written.
-    #[serde(skip)]
-    pub location: SourceLocation,
-}
 
 /// Builds a top-level `<emitter type="constant">`.
 pub(crate) fn constant(e: &Element) -> Result<Environment> {
@@ -46,7 +32,7 @@ pub(crate) fn constant(e: &Element) -> Result<Environment> {
     let props = Props::new(e)?;
     props.no_objects()?;
     props.float("sampling_weight")?;
-    let radiance = crate::build::emitted_radiance(&props)?;
+    let radiance = crate::material::emitted_radiance(&props)?;
     props.finish()?;
     Ok(Environment {
         radiance,
@@ -122,9 +108,7 @@ fn world_bounds(shape: &Shape) -> (DVec3, DVec3) {
         ShapeKind::Disk => (DVec3::new(-1.0, -1.0, 0.0), DVec3::new(1.0, 1.0, 0.0)),
         ShapeKind::Cube => (DVec3::splat(-1.0), DVec3::splat(1.0)),
         ShapeKind::Sphere { center, radius } => (*center - *radius, *center + *radius),
-        ShapeKind::Cylinder { p0, p1, radius } => {
-            (p0.min(*p1) - *radius, p0.max(*p1) + *radius)
-        }
+        ShapeKind::Cylinder { p0, p1, radius } => (p0.min(*p1) - *radius, p0.max(*p1) + *radius),
         ShapeKind::Mesh(m) => m.positions.iter().fold(
             (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
             |(lo, hi), p| (lo.min(*p), hi.max(*p)),

@@ -44,7 +44,7 @@
 
 mod build;
 pub mod camera;
-pub mod environment;
+mod environment;
 pub mod error;
 pub mod gltf;
 pub mod image;
@@ -73,10 +73,9 @@ use std::path::Path;
 use std::sync::Arc;
 
 pub use camera::{Camera, FovAxis, ReconstructionFilter};
-pub use environment::Environment;
 pub use error::{SceneError, SourceLocation};
 pub use meshes::Pending;
-pub use scene::{AreaEmitter, Scene, SceneShape};
+pub use scene::{AreaEmitter, Environment, Scene, SceneShape};
 pub use shape::surface_area;
 pub use transform::LookAt;
 

@@ -23,6 +23,21 @@ pub struct AreaEmitter {
     pub location: SourceLocation,
 }
 
+/// A `constant` environment emitter.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Environment {
+    /// Radiance arriving from every direction (`radiance`, Mitsuba's
+    /// default 1).
+    pub radiance: ColorParam,
+    /// The index in [`Scene::shapes`] of the enclosure standing for it
+    /// (set when the scene's meshes are read: its size needs them;
+    /// `crate::environment` says why an enclosure).
+    pub shape: Option<usize>,
+    /// Where the `<emitter>` is written.
+    #[serde(skip)]
+    pub location: SourceLocation,
+}
+
 /// One `<shape>` with its material and optional area light.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct SceneShape {
@@ -76,7 +91,7 @@ pub struct Scene {
     pub camera_names: Vec<Option<String>>,
     /// The `constant` environment emitter, if any; its enclosure is the
     /// last of [`Scene::shapes`] (`crate::environment`).
-    pub environment: Option<crate::environment::Environment>,
+    pub environment: Option<Environment>,
     /// What loading left out, one line each with its place (zero-area
     /// triangles and meshes): the command prints them as warnings.
     #[serde(skip)]

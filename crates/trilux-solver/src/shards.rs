@@ -32,7 +32,7 @@ mod tests {
         for pair in shards.windows(2) {
             let a = &*pair[0] as *const Mutex<u64> as usize;
             let b = &*pair[1] as *const Mutex<u64> as usize;
-            assert!(b - a >= 128 && a % 128 == 0 && b % 128 == 0);
+            assert!(b - a >= 128 && a.is_multiple_of(128) && b.is_multiple_of(128));
         }
     }
 }

@@ -25,7 +25,11 @@ fn render(file: &str, extra: &[&str], out: &Path) -> Image {
     let mut args = vec!["render", file, "-o", out.to_str().unwrap()];
     args.extend_from_slice(extra);
     let run = trilux(&args);
-    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
     Image::read_exr(out).unwrap()
 }
 
@@ -49,7 +53,8 @@ fn a_convex_sphere_under_a_uniform_sky_reflects_its_albedo_times_the_sky() {
     let (mut sphere, mut sky) = ((0.0, [0.0; 3]), (0.0, [0.0; 3]));
     for y in 0..h {
         for x in 0..w {
-            let d = (f64::from(x) + 0.5 - f64::from(w) / 2.0).hypot(f64::from(y) + 0.5 - f64::from(h) / 2.0);
+            let d = (f64::from(x) + 0.5 - f64::from(w) / 2.0)
+                .hypot(f64::from(y) + 0.5 - f64::from(h) / 2.0);
             let acc = if d < r - 3.0 {
                 &mut sphere
             } else if d > r + 3.0 {
@@ -63,13 +68,19 @@ fn a_convex_sphere_under_a_uniform_sky_reflects_its_albedo_times_the_sky() {
             }
         }
     }
-    for c in 0..3 {
-        let (s, k) = (sphere.1[c] / sphere.0 / SKY[c], sky.1[c] / sky.0 / SKY[c]);
+    for (c, sky_c) in SKY.iter().enumerate() {
+        let (s, k) = (sphere.1[c] / sphere.0 / sky_c, sky.1[c] / sky.0 / sky_c);
         // 0.5 % for the solve's form factors from the enclosure (cubature
         // at relative tolerance 1e-2) and the render's noise; the sky seen
         // directly is the enclosure's radiance exactly.
-        assert!((s - 0.5).abs() < 0.0025, "channel {c}: sphere {s} of the sky, closed form 0.5");
-        assert!((k - 1.0).abs() < 1e-5, "channel {c}: sky {k} of its radiance");
+        assert!(
+            (s - 0.5).abs() < 0.0025,
+            "channel {c}: sphere {s} of the sky, closed form 0.5"
+        );
+        assert!(
+            (k - 1.0).abs() < 1e-5,
+            "channel {c}: sky {k} of its radiance"
+        );
     }
 }
 
@@ -81,7 +92,11 @@ fn a_uniform_sky_lights_a_courtyard_as_in_mitsuba() {
     for (case, hide) in [("sky_seen", "false"), ("sky_hidden", "true")] {
         let define = format!("hide={hide}");
         let out = dir.join(format!("{case}.exr"));
-        let image = render(&scene("courtyard.xml"), &["-D", &define, "--spp", "64"], &out);
+        let image = render(
+            &scene("courtyard.xml"),
+            &["-D", &define, "--spp", "64"],
+            &out,
+        );
         let n = f64::from(image.width() * image.height());
         for c in 0..3 {
             let ours: f64 = (0..image.height())
@@ -109,7 +124,12 @@ fn refused(text: &str, name: &str) -> String {
     let file = dir.join("scene.xml");
     std::fs::write(&file, text).unwrap();
     let run = trilux(&["info", file.to_str().unwrap()]);
-    assert_eq!(run.status.code(), Some(1), "{}", String::from_utf8_lossy(&run.stderr));
+    assert_eq!(
+        run.status.code(),
+        Some(1),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
     String::from_utf8_lossy(&run.stderr).into_owned()
 }
 
@@ -119,18 +139,26 @@ fn bad_skies_are_one_located_line_each() {
         "<scene version=\"3.0.0\">\n<emitter type=\"constant\"><rgb name=\"radiance\" value=\"1, -1, 1\"/></emitter>\n</scene>\n",
         "negative",
     );
-    assert!(negative.contains("scene.xml:2:") && negative.contains("radiance"), "{negative}");
+    assert!(
+        negative.contains("scene.xml:2:") && negative.contains("radiance"),
+        "{negative}"
+    );
     let two = refused(
         "<scene version=\"3.0.0\">\n<emitter type=\"constant\"/>\n<emitter type=\"constant\"/>\n</scene>\n",
         "two",
     );
     assert!(
-        two.contains("scene.xml:3:") && two.contains("only one environment emitter") && two.contains("line 2"),
+        two.contains("scene.xml:3:")
+            && two.contains("only one environment emitter")
+            && two.contains("line 2"),
         "{two}"
     );
     let unknown = refused(
         "<scene version=\"3.0.0\">\n<emitter type=\"constant\"><float name=\"scale\" value=\"2\"/></emitter>\n</scene>\n",
         "unknown",
     );
-    assert!(unknown.contains("scene.xml:2:") && unknown.contains("scale"), "{unknown}");
+    assert!(
+        unknown.contains("scene.xml:2:") && unknown.contains("scale"),
+        "{unknown}"
+    );
 }

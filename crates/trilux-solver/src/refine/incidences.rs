@@ -108,15 +108,29 @@ mod tests {
         let a = memo.get_or_make(&mut first, ElementId(3), j, || make(30));
         let again = memo.get_or_make(&mut first, ElementId(3), j, || make(99));
         let other_task = memo.get_or_make(&mut second, ElementId(3), j, || make(98));
-        assert_eq!((a.as_deref(), again.as_deref(), other_task.as_deref()), (Some(&30), Some(&30), Some(&30)));
+        assert_eq!(
+            (a.as_deref(), again.as_deref(), other_task.as_deref()),
+            (Some(&30), Some(&30), Some(&30))
+        );
         assert_eq!(made.get(), 1);
         // The other side of j, and another i, are other incidences.
         let front = FaceElement::new(ElementId(7), Side::Front);
-        assert_eq!(memo.get_or_make(&mut first, ElementId(3), front, || make(31)).as_deref(), Some(&31));
-        assert_eq!(memo.get_or_make(&mut second, ElementId(4), j, || make(40)).as_deref(), Some(&40));
+        assert_eq!(
+            memo.get_or_make(&mut first, ElementId(3), front, || make(31))
+                .as_deref(),
+            Some(&31)
+        );
+        assert_eq!(
+            memo.get_or_make(&mut second, ElementId(4), j, || make(40))
+                .as_deref(),
+            Some(&40)
+        );
         // A sub-pair that carries no light is remembered as such.
         assert_eq!(memo.get_or_make(&mut first, ElementId(5), j, || None), None);
-        assert_eq!(memo.get_or_make(&mut second, ElementId(5), j, || make(50)), None);
+        assert_eq!(
+            memo.get_or_make(&mut second, ElementId(5), j, || make(50)),
+            None
+        );
         assert_eq!(made.get(), 3);
     }
 }

@@ -307,11 +307,9 @@ impl<const N: usize> RefineContext<'_, N> {
             Some(k) => k,
             None => {
                 let sender = task.sender;
-                let made = task
-                    .memo
-                    .get_or_make(&mut task.local, i, sj.of(j), || {
-                        self.incidence(sender, si.of(i), sj.of(j))
-                    });
+                let made = task.memo.get_or_make(&mut task.local, i, sj.of(j), || {
+                    self.incidence(sender, si.of(i), sj.of(j))
+                });
                 let Some(k) = made else {
                     return;
                 };
