@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
-"""Mitsuba 3.9.1's image means of tests/environment/courtyard.xml (a
-`constant` sky), with the sky seen and with `hide_emitters`, for
-crates/trilux/tests/environment.rs.
+"""Mitsuba 3.9.1's image means of the scenes lit by a `constant` sky in
+tests/environment/ (courtyard.xml with the sky seen and with
+`hide_emitters`; daylight-room.xml, a closed room lit through one window),
+for crates/trilux/tests/environment.rs.
 
 Usage (from anywhere):
     python3 tests/environment/make_reference.py [--spp N] [--passes P]
@@ -26,14 +27,18 @@ def main():
 
     mi.set_variant("llvm_ad_rgb")
     cases = {}
-    for name, hide in (("sky_seen", "false"), ("sky_hidden", "true")):
-        scene = mi.load_file(os.path.join(HERE, "courtyard.xml"), hide=hide)
+    for name, file, hide in (
+        ("sky_seen", "courtyard.xml", "false"),
+        ("sky_hidden", "courtyard.xml", "true"),
+        ("daylight_room", "daylight-room.xml", "false"),
+    ):
+        scene = mi.load_file(os.path.join(HERE, file), hide=hide)
         mean, stderr = image_means.mean_over_passes(mi, scene, a.spp, a.passes)
         cases[name] = image_means.rounded(mean, stderr)
     image_means.write(
         os.path.join(HERE, "reference.json"),
         {
-            "scene": "tests/environment/courtyard.xml",
+            "scenes": "tests/environment/{courtyard,daylight-room}.xml",
             "mitsuba": mi.__version__,
             "variant": mi.variant(),
             "spp": a.spp,
