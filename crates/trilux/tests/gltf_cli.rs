@@ -220,11 +220,11 @@ fn unsupported_primitive_mode() {
 }
 
 #[test]
-fn punctual_lights_are_refused_by_name() {
+fn a_punctual_light_with_a_negative_intensity_is_refused_by_name() {
     let j = triangle(|j| {
         j["extensionsUsed"] = serde_json::json!(["KHR_lights_punctual"]);
         j["extensions"] = serde_json::json!({"KHR_lights_punctual": {"lights": [
-            {"name": "Desk lamp", "type": "point", "color": [1.0, 1.0, 1.0], "intensity": 10.0}
+            {"name": "Desk lamp", "type": "point", "color": [1.0, 1.0, 1.0], "intensity": -10.0}
         ]}});
         j["nodes"] = serde_json::json!([
             {"name": "tri", "mesh": 0, "children": [2]},
@@ -236,7 +236,7 @@ fn punctual_lights_are_refused_by_name() {
         "light",
         &j,
         "/nodes/2/extensions/KHR_lights_punctual",
-        "point light \"Desk lamp\"",
+        "light \"Desk lamp\": intensity must be finite and not negative",
     );
 }
 
@@ -251,7 +251,8 @@ fn refused_material_features() {
 
 /// Three meshes placed by three nodes, each with its own bad material
 /// (alpha blending, an extension that changes the light, a double-sided
-/// emitter), and a fourth node with a point light: all four reported in
+/// emitter), and a fourth node with a spot whose inner cone is wider than
+/// its outer one: all four reported in
 /// one run, one line each at its JSON path, exit 1.
 #[test]
 fn several_bad_materials_are_reported_in_one_run() {
@@ -268,8 +269,8 @@ fn several_bad_materials_are_reported_in_one_run() {
             {"extensions": {"KHR_materials_clearcoat": {"clearcoatFactor": 1.0}}},
             {"emissiveFactor": [1.0, 1.0, 1.0], "doubleSided": true}
         ]);
-        j["extensions"] =
-            serde_json::json!({"KHR_lights_punctual": {"lights": [{"type": "point"}]}});
+        j["extensions"] = serde_json::json!({"KHR_lights_punctual": {"lights": [{"type": "spot",
+                "spot": {"innerConeAngle": 0.6, "outerConeAngle": 0.5}}]}});
         j["nodes"] = serde_json::json!([
             {"mesh": 0},
             {"mesh": 1, "translation": [2.0, 0.0, 0.0]},
@@ -295,7 +296,7 @@ fn several_bad_materials_are_reported_in_one_run() {
             "extension KHR_materials_clearcoat is refused",
         ),
         ("/materials/2/doubleSided", "double-sided emissive"),
-        ("/nodes/4/extensions/KHR_lights_punctual", "point light"),
+        ("/nodes/4/extensions/KHR_lights_punctual", "spot light #0"),
     ];
     for (line, (pointer, what)) in lines.iter().zip(expected) {
         assert!(
