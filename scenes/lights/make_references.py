@@ -1,5 +1,5 @@
 """Mitsuba 3.9.1 references of the scenes beside this script (lights
-without area: point-box, spot-box, sun-room): NAME.exr (64 x 64, the
+without area: point-box, spot-box, sun-room, point-glossy): NAME.exr (64 x 64, the
 final pass-averaged image) and NAME.json (the image mean per channel and
 its relative standard error over 16 passes).
 
@@ -14,7 +14,7 @@ import mitsuba as mi
 
 mi.set_variant("llvm_ad_rgb")
 HERE = os.path.dirname(os.path.abspath(__file__))
-SCENES = ["point-box", "spot-box", "sun-room"]
+SCENES = ["point-box", "spot-box", "sun-room", "point-glossy"]
 
 
 def main():

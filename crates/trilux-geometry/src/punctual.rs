@@ -170,7 +170,7 @@ impl Punctual {
 fn towards(position: DVec3, x: DVec3, f: f64) -> Option<Arrival> {
     let d = position - x;
     let r2 = d.length_squared();
-    if !(r2 > 0.0) || !r2.is_finite() {
+    if r2 <= 0.0 || !r2.is_finite() {
         return None;
     }
     let r = r2.sqrt();

@@ -120,7 +120,7 @@ fn spot(props: &Props<'_>) -> Result<Punctual> {
     }
     let m = to_world(props)?.unwrap_or(DMat4::IDENTITY);
     let cutoff = props.float("cutoff_angle")?.unwrap_or(20.0);
-    if !(cutoff > 0.0 && cutoff < 180.0) {
+    if cutoff <= 0.0 || cutoff >= 180.0 {
         return Err(SceneError::at(
             &props.loc("cutoff_angle"),
             format!("cutoff_angle must be in (0, 180) degrees, found {cutoff}"),

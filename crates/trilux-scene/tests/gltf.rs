@@ -549,7 +549,7 @@ fn punctual_lights_load_with_their_units_and_directions() {
         // points along +y.
         json!([
             {"translation": [1.0, 2.0, 3.0]},
-            {"rotation": [0.70710678, 0.0, 0.0, 0.70710678]},
+            {"rotation": [std::f64::consts::FRAC_1_SQRT_2, 0.0, 0.0, std::f64::consts::FRAC_1_SQRT_2]},
             {"translation": [0.0, 1.0, 0.0]}
         ]),
     );

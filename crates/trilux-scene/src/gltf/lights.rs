@@ -27,12 +27,12 @@ pub(super) fn light(
         .map_or(format!("#{}", light.index()), |n| format!("\"{n}\""));
     let intensity = f64::from(light.intensity());
     let color = light.color().map(f64::from);
-    if !(intensity >= 0.0) || !intensity.is_finite() {
+    if intensity < 0.0 || !intensity.is_finite() {
         return Err(format!(
             "light {name}: intensity must be finite and not negative, found {intensity}"
         ));
     }
-    if color.iter().any(|c| !(*c >= 0.0) || !c.is_finite()) {
+    if color.iter().any(|c| *c < 0.0 || !c.is_finite()) {
         return Err(format!(
             "light {name}: color must be finite and not negative, found {color:?}"
         ));
@@ -54,7 +54,10 @@ pub(super) fn light(
             outer_cone_angle,
         } => {
             let (inner, outer) = (f64::from(inner_cone_angle), f64::from(outer_cone_angle));
-            if !(0.0..outer).contains(&inner) || !(outer <= std::f64::consts::FRAC_PI_2) {
+            if !(0.0..outer).contains(&inner)
+                || outer > std::f64::consts::FRAC_PI_2
+                || outer.is_nan()
+            {
                 return Err(format!(
                     "spot light {name}: glTF needs 0 ≤ innerConeAngle < outerConeAngle ≤ π/2, found {inner} and {outer}"
                 ));
