@@ -14,7 +14,7 @@
 //! the gather links' piecewise-constant senders is 0.5–2 % on any scene
 //! (docs/rendering.md). The preview is not checked on the glossy floor: it
 //! reads a glossy part's indirect light in the mirror direction only, and
-//! is -10.5 % there (-5.4 % with a small sphere light of the same
+//! is -7.3 % there (-5.4 % with a small sphere light of the same
 //! intensity instead of the point: docs/results.md, "Lights without
 //! area").
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
