@@ -165,3 +165,47 @@ fn a_negative_intensity_is_refused() {
     assert_eq!(e.index, 0);
     assert!(e.problem.contains("negative"), "{e}");
 }
+
+mod common;
+
+/// The ledger closes on whole solves of the bundled light scenes
+/// (`scenes/lights/`, point, spot, sun and a glossy floor): emitted =
+/// absorbed + escaped + residual per band, no shot creates energy and no
+/// element reflects more than arrived; the lights' flux is the emitted
+/// flux (none of these scenes has an area emitter).
+#[test]
+fn the_ledger_closes_with_lights() {
+    for name in ["point-box", "spot-box", "sun-room", "point-glossy"] {
+        let path = format!(
+            "{}/../../scenes/lights/{name}.xml",
+            env!("CARGO_MANIFEST_DIR")
+        );
+        let scene = common::prepare::<3>(&path);
+        assert_eq!(scene.lights().len(), 1);
+        let radius = trilux_solver::lights::scene_radius(scene.geometry());
+        let flux = scene.lights()[0].flux(radius);
+        let mut settings = SolverSettings::preset(Quality::Draft);
+        settings.max_shots = 200;
+        let s = Solver::new(scene, settings).unwrap().solve(|_| {});
+        let st = s.stats();
+        for b in 0..3 {
+            let e = st.emitted_flux[b];
+            assert!((e / flux[b] - 1.0).abs() < 1e-12, "{name}");
+            let sum = st.absorbed_flux[b] + st.escaped_flux[b] + st.residual_flux[b];
+            assert!(
+                (sum / e - 1.0).abs() < 1e-9,
+                "{name} band {b}: {sum} of {e}"
+            );
+        }
+        assert!(
+            st.min_shot_escaped >= -1e-9,
+            "{name}: {}",
+            st.min_shot_escaped
+        );
+        assert!(
+            st.min_element_absorbed >= -1e-9,
+            "{name}: {}",
+            st.min_element_absorbed
+        );
+    }
+}
