@@ -1,7 +1,9 @@
 //! Lights without area through the binary against Mitsuba 3.9.1
 //! (scenes/lights: a closed diffuse box under a point light, the same box
 //! under a spot, a room lit by the sun through an opening in its ceiling,
-//! the point-lit box with a glossy floor;
+//! the point-lit box with a glossy floor, and the glTF Cornell box with its
+//! ceiling light replaced by a `KHR_lights_punctual` point light (its
+//! reference made through `scripts/gltf_to_mitsuba.py`);
 //! references by `scenes/lights/make_references.py`, 4096 spp in 16
 //! passes, whose image means have a relative standard error of at most
 //! 0.03 %).
@@ -45,8 +47,20 @@ fn lights_without_area_match_mitsuba_in_every_estimator() {
     let dir = folder("lights");
     let mut report = Vec::new();
     let mut ok = true;
-    for name in ["point-box", "spot-box", "sun-room", "point-glossy"] {
-        let file = scene(&format!("lights/{name}.xml"));
+    let names = [
+        "point-box",
+        "spot-box",
+        "sun-room",
+        "point-glossy",
+        "cornell-point",
+    ];
+    for name in names {
+        // The glTF Cornell box's film is 768 wide; its reference is at 64.
+        let gltf = name == "cornell-point";
+        let file = scene(&format!(
+            "lights/{name}.{}",
+            if gltf { "gltf" } else { "xml" }
+        ));
         let sol = dir.join(format!("{name}.sol"));
         let run = trilux(&["solve", &file, "-o", sol.to_str().unwrap()]);
         assert!(
@@ -67,6 +81,9 @@ fn lights_without_area_match_mitsuba_in_every_estimator() {
             let out = dir.join(format!("{name}-{gather}.exr"));
             let mut args = vec!["render", &file, "--solution", sol.to_str().unwrap()];
             args.extend(["--spp", "16", "-o", out.to_str().unwrap()]);
+            if gltf {
+                args.extend(["--width", "64", "--height", "64"]);
+            }
             if gather == "preview" {
                 args.push("--preview");
             } else {
