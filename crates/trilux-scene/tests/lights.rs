@@ -173,7 +173,10 @@ fn bad_lights_are_located() {
             r#"<emitter type="spot"><texture type="bitmap" name="texture"><string name="filename" value="a.png"/></texture></emitter>"#,
             "projected image) is not supported",
         ),
-        (r#"<emitter type="sky"/>"#, "unknown emitter plugin \"sky\""),
+        (
+            r#"<emitter type="projector"/>"#,
+            "unknown emitter plugin \"projector\"",
+        ),
         (
             r#"<shape type="rectangle"><emitter type="point"/></shape>"#,
             "a shape's emitter must be \"area\"",

@@ -515,7 +515,7 @@ fn area_emitters() {
         s.shapes[1].emitter.as_ref().map(|e| e.radiance.clone()),
         Some(ColorParam::Float(1.0))
     );
-    assert!(err(r#"<emitter type="constant"/>"#).contains("unknown emitter plugin \"constant\""));
+    assert!(err(r#"<emitter type="projector"/>"#).contains("unknown emitter plugin \"projector\""));
     assert!(err(r#"<emitter type="area"/>"#).contains("inside a <shape>"));
     assert!(
         err(r#"<shape type="rectangle"><emitter type="spot"/></shape>"#)
