@@ -239,6 +239,27 @@ class Converter:
         emitter = ('<emitter type="area">' + rgb("radiance", e) + "</emitter>") if e.max() > 0 else ""
         return bsdf, emitter
 
+    def light(self, i, node, world):
+        """A KHR_lights_punctual light as Mitsuba's emitter, in trilux's
+        units (docs/gltf.md: candela as W/sr, lux as W/m^2, times color);
+        it shines along the node's -z. A spot is refused: glTF's falloff
+        (quadratic in the cosine) has no Mitsuba equivalent."""
+        light = self.j["extensions"]["KHR_lights_punctual"]["lights"][
+            node["extensions"]["KHR_lights_punctual"]["light"]]
+        c = np.array(light.get("color", [1.0, 1.0, 1.0])) * light.get("intensity", 1.0)
+        rgb = ", ".join(f"{v:.12g}" for v in c)
+        kind = light["type"]
+        if kind == "point":
+            p = ", ".join(f"{v:.12g}" for v in world[:3, 3])
+            return (f'<emitter type="point"><point name="position" value="{p}"/>'
+                    f'<rgb name="intensity" value="{rgb}"/></emitter>')
+        if kind == "directional":
+            d = world[:3, :3] @ np.array([0.0, 0.0, -1.0])
+            d = ", ".join(f"{v:.12g}" for v in d / np.linalg.norm(d))
+            return (f'<emitter type="directional"><vector name="direction" value="{d}"/>'
+                    f'<rgb name="irradiance" value="{rgb}"/></emitter>')
+        raise SystemExit(f"node {i}: a {kind} light has no Mitsuba equivalent (glTF's spot falloff)")
+
     def convert(self, camera_name=None):
         j = self.j
         required = set(j.get("extensionsRequired", [])) - {"KHR_materials_specular", "KHR_materials_emissive_strength"}
@@ -257,7 +278,7 @@ class Converter:
             stack[:0] = [(c, world) for c in node.get("children", [])]
         for i, node, world in order:
             if "KHR_lights_punctual" in node.get("extensions", {}):
-                raise SystemExit(f"node {i}: punctual lights are refused")
+                shapes.append(self.light(i, node, world))
             if "camera" in node:
                 cam = j["cameras"][node["camera"]]
                 names = {cam.get("name"), node.get("name")}

@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Mitsuba 3.9.1's image means of the scenes lit by a `constant` sky in
 tests/environment/ (courtyard.xml with the sky seen and with
-`hide_emitters`; daylight-room.xml, a closed room lit through one window),
+`hide_emitters`; daylight-room.xml, a closed room lit through one window,
+under the sky alone and with a sun),
 for crates/trilux/tests/environment.rs.
 
 Usage (from anywhere):
@@ -14,6 +15,9 @@ import os
 import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+# The sun of the daylight room's sunlit case (its irradiance, W m^-2);
+# crates/trilux/tests/environment.rs passes the same.
+SUN = "40, 38, 34"
 sys.path.insert(0, os.path.join(HERE, "..", "..", "scenes", "mitsuba-cbox"))
 import image_means  # noqa: E402
 
@@ -27,12 +31,13 @@ def main():
 
     mi.set_variant("llvm_ad_rgb")
     cases = {}
-    for name, file, hide in (
-        ("sky_seen", "courtyard.xml", "false"),
-        ("sky_hidden", "courtyard.xml", "true"),
-        ("daylight_room", "daylight-room.xml", "false"),
+    for name, file, params in (
+        ("sky_seen", "courtyard.xml", {"hide": "false"}),
+        ("sky_hidden", "courtyard.xml", {"hide": "true"}),
+        ("daylight_room", "daylight-room.xml", {}),
+        ("daylight_room_sun", "daylight-room.xml", {"sun": SUN}),
     ):
-        scene = mi.load_file(os.path.join(HERE, file), hide=hide)
+        scene = mi.load_file(os.path.join(HERE, file), **params)
         mean, stderr = image_means.mean_over_passes(mi, scene, a.spp, a.passes)
         cases[name] = image_means.rounded(mean, stderr)
     image_means.write(

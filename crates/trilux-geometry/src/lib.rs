@@ -94,6 +94,9 @@
 //! - [`coordinate_system`]: the orthonormal basis around a unit vector
 //!   (Duff et al.), the one tangent frame every crate builds on
 //!   (`trilux-frame`'s, re-exported).
+//! - [`punctual`]: lights without area ([`Punctual`]: point, spot with
+//!   its [`SpotFalloff`], directional) and the light they bring to a point
+//!   ([`Arrival`]), shared by the loader, the solver and the renderer.
 //! - [`sensor`]: the camera's plain data shared by the scene loader and
 //!   the renderer: Mitsuba's `look_at` ([`look_at`]), the field of view's
 //!   axis ([`FovAxis`]) and the film's reconstruction filters
@@ -117,6 +120,7 @@ pub mod geometry;
 pub mod ids;
 pub mod limits;
 mod patch;
+pub mod punctual;
 mod quadrature;
 pub mod sampling;
 pub mod sensor;
@@ -143,6 +147,7 @@ pub use form_factor::{
 };
 pub use geometry::{BvhStats, Geometry, Hit, RAY_EPSILON, Ray};
 pub use ids::{ElementId, SurfaceId};
+pub use punctual::{Arrival, Punctual, SpotFalloff};
 pub use sampling::SurfaceSample;
 pub use sensor::{FovAxis, LookAtError, ReconstructionFilter, look_at};
 pub use shape::{Shape, ShapeKind, TriangleMesh};

@@ -15,7 +15,9 @@ use trilux_color::Spectrum;
 use trilux_geometry::FaceElement;
 
 use crate::link_sum::LinkCache;
-use crate::records::{BsdfSample, GatherStats, LightSample, LinkVisibility, SurfacePoint};
+use crate::records::{
+    BsdfSample, GatherStats, LightSample, LinkVisibility, PunctualSample, SurfacePoint,
+};
 use crate::scene::{GatherScene, SolutionGather};
 
 /// [`SolutionGather`] for an analytic scene with no links, no glossy part
@@ -188,6 +190,18 @@ impl<const N: usize> GatherScene<N> for Furnace {
             locator: face,
         })
     }
+    fn punctual_count(&self) -> usize {
+        0
+    }
+
+    fn punctual_at(
+        &self,
+        _k: usize,
+        _reference: &SurfacePoint<Self::Locator>,
+    ) -> Option<PunctualSample<N>> {
+        None
+    }
+
     fn unoccluded(&self, _from: &SurfacePoint<usize>, _to: DVec3) -> bool {
         true // convex: nothing inside
     }
@@ -325,6 +339,18 @@ impl<const N: usize> GatherScene<N> for LitFloor {
     fn intersect(&self, o: DVec3, d: DVec3) -> Option<SurfacePoint<u8>> {
         floor_and_square_light(o, d, self.h, self.s)
     }
+    fn punctual_count(&self) -> usize {
+        0
+    }
+
+    fn punctual_at(
+        &self,
+        _k: usize,
+        _reference: &SurfacePoint<Self::Locator>,
+    ) -> Option<PunctualSample<N>> {
+        None
+    }
+
     fn unoccluded(&self, _from: &SurfacePoint<u8>, _to: DVec3) -> bool {
         true
     }

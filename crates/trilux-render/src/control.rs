@@ -34,7 +34,7 @@
 use glam::{DVec2, DVec3};
 use trilux_color::Spectrum;
 
-use crate::mis::{eye_hit, hit_emission, light_sample};
+use crate::mis::{eye_hit, hit_emission, light_sample, punctual_direct};
 use crate::records::{BsdfSample, GatherStats, SurfacePoint};
 use crate::sampler::{PixelSampler, dims};
 use crate::scene::GatherScene;
@@ -118,6 +118,7 @@ impl<S> ControlVariate<'_, S> {
         let (pick, u) = (sampler.get1(base), sampler.get2(base + 1));
         let fr = |wi| scene.bsdf_cos(xs, wi, wo);
         let mut l = light_sample(scene, xs, wo, pick, u, fr, true, stats);
+        l += punctual_direct(scene, xs, fr, stats);
         let m = self.lookups.clamp(1, MAX_LOOKUPS);
         // Lookups 1..M: the control's other terms, w L̃ each.
         let mut control = Spectrum::zero();
@@ -195,6 +196,7 @@ impl<S> ControlVariate<'_, S> {
             let (pick, u) = (sampler.get1(base), sampler.get2(base + 1));
             let fr = |wi| scene.bsdf_cos(&x, wi, wo);
             l += beta * light_sample(scene, &x, wo, pick, u, fr, true, stats);
+            l += beta * punctual_direct(scene, &x, fr, stats);
             let Some((bs, xn)) = self.gather_ray(&x, wo, sampler.get2(base + 3), stats) else {
                 break;
             };

@@ -38,7 +38,7 @@
 
 use glam::DVec3;
 
-use crate::mis::{eye_hit, hit_emission, light_sample};
+use crate::mis::{eye_hit, hit_emission, light_sample, punctual_direct};
 use crate::records::{GatherStats, SurfacePoint};
 use crate::sampler::{PixelSampler, dims};
 use crate::scene::SolutionGather;
@@ -138,6 +138,7 @@ impl<'a, S> FinalGather<'a, S> {
         let (pick, u) = (sampler.get1(base), sampler.get2(base + 1));
         let fr = |wi| scene.bsdf_cos(x, wi, wo);
         let mut l = light_sample(scene, x, wo, pick, u, fr, true, stats);
+        l += punctual_direct(scene, x, fr, stats);
 
         // 2. A gather ray sampled from the BSDF.
         let Some(bs) = scene.sample_bsdf(x, wo, sampler.get2(base + 3)) else {

@@ -80,8 +80,10 @@ pub use film::Film;
 pub use filter::ReconstructionFilter;
 pub use gather::ExtraBounce;
 pub use image::Image;
-pub use mis::power_heuristic;
-pub use records::{BsdfSample, GatherStats, LightSample, LinkVisibility, SurfacePoint};
+pub use mis::{power_heuristic, punctual_direct};
+pub use records::{
+    BsdfSample, GatherStats, LightSample, LinkVisibility, PunctualSample, SurfacePoint,
+};
 pub use sampler::PixelSampler;
 pub use scene::{GatherScene, SolutionGather};
 pub use solution::{DirectOnly, RadianceSolution};

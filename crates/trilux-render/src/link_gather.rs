@@ -41,7 +41,7 @@ use glam::DVec3;
 
 use crate::gather::FinalGather;
 use crate::link_sum::LinkCache;
-use crate::mis::{eye_hit, hit_emission, light_sample};
+use crate::mis::{eye_hit, hit_emission, light_sample, punctual_direct};
 use crate::records::{GatherStats, LinkVisibility, SurfacePoint};
 use crate::sampler::{PixelSampler, dims, hammersley};
 use crate::scene::SolutionGather;
@@ -223,6 +223,7 @@ impl<S> LinkGather<'_, S> {
         let (pick, u) = (w.sampler.get1(base), w.sampler.get2(base + 1));
         let fr = |wi| scene.glossy_cos(x, wi, wo);
         let mut l = light_sample(scene, x, wo, pick, u, fr, true, w.stats);
+        l += punctual_direct(scene, x, fr, w.stats);
         let Some(bs) = scene.sample_bsdf(x, wo, w.sampler.get2(base + 3)) else {
             return l;
         };
@@ -358,7 +359,8 @@ fn preview_direct<S: SolutionGather<N>, const N: usize>(
         let fr = |wi| scene.glossy_cos(x, wi, wo);
         sum += light_sample(scene, x, wo, pick, u, fr, false, stats);
     }
-    sum * (1.0 / f64::from(PREVIEW_LIGHT_POINTS))
+    let fr = |wi| scene.glossy_cos(x, wi, wo);
+    sum * (1.0 / f64::from(PREVIEW_LIGHT_POINTS)) + punctual_direct(scene, x, fr, stats)
 }
 
 /// ρ_d(xd) times the link sum at `xd` with the links' own visibility

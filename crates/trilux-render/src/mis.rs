@@ -5,6 +5,8 @@
 //! - [`light_sample`]: a point sampled on an emitter with a shadow ray,
 //!   fr·cos·Le / p_light weighted by the power heuristic against the BSDF's
 //!   density (Veach 1997, §9.2);
+//! - [`punctual_direct`]: the lights without area, by one shadow ray
+//!   each (a delta light needs no MIS weight);
 //! - [`hit_emission`]: the emission met by a BSDF-sampled ray, weighted by
 //!   the power heuristic against light sampling's density at the hit.
 
@@ -76,6 +78,33 @@ pub fn light_sample<S: GatherScene<N>, const N: usize>(
         1.0
     };
     f * ls.radiance * (w / pdf_light)
+}
+
+/// The direct light of every light without area at `x`: Σ fr(ω_i) E⊥ V
+/// over the lights, `fr` the BSDF's fr·|cos θ_i| (or a part of it), one
+/// shadow ray each. No MIS weight: a delta light has no density a BSDF
+/// sample could share, and no ray ever meets it.
+pub fn punctual_direct<S: GatherScene<N>, const N: usize>(
+    scene: &S,
+    x: &SurfacePoint<S::Locator>,
+    fr: impl Fn(DVec3) -> Spectrum<N>,
+    stats: &mut GatherStats,
+) -> Spectrum<N> {
+    let mut sum = Spectrum::zero();
+    for k in 0..scene.punctual_count() {
+        let Some(p) = scene.punctual_at(k, x) else {
+            continue;
+        };
+        let f = fr(p.wi);
+        if f.is_black() || p.irradiance.is_black() {
+            continue;
+        }
+        stats.shadow_rays += 1;
+        if scene.unoccluded(x, p.end) {
+            sum += f * p.irradiance;
+        }
+    }
+    sum
 }
 
 /// Where a camera ray meets the scene. With `hide_emitters` (Mitsuba's

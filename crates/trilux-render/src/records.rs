@@ -41,6 +41,19 @@ pub struct LightSample<const N: usize> {
     pub pdf_area: f64,
 }
 
+/// The light a light without area brings to a point (a delta: it is
+/// never sampled by density nor met by a ray).
+#[derive(Clone, Copy, Debug)]
+pub struct PunctualSample<const N: usize> {
+    /// Unit direction from the point towards the light.
+    pub wi: DVec3,
+    /// Where a shadow ray towards it ends (the light, or beyond the scene
+    /// for a directional light).
+    pub end: DVec3,
+    /// Irradiance on a plane facing the light (I falloff / r², or E).
+    pub irradiance: Spectrum<N>,
+}
+
 /// A direction sampled from a BSDF at a surface point.
 #[derive(Clone, Copy, Debug)]
 pub struct BsdfSample<const N: usize> {

@@ -21,7 +21,9 @@ use trilux_color::Spectrum;
 use trilux_geometry::FaceElement;
 
 use crate::link_sum::LinkCache;
-use crate::records::{BsdfSample, GatherStats, LightSample, LinkVisibility, SurfacePoint};
+use crate::records::{
+    BsdfSample, GatherStats, LightSample, LinkVisibility, PunctualSample, SurfacePoint,
+};
 
 /// Everything the path gather needs from a scene and its solution.
 pub trait GatherScene<const N: usize>: Sync {
@@ -50,6 +52,17 @@ pub trait GatherScene<const N: usize>: Sync {
         pick: f64,
         u: DVec2,
     ) -> Option<LightSample<N>>;
+
+    /// The number of lights without area (point, spot, directional).
+    fn punctual_count(&self) -> usize;
+
+    /// The light that light `k` without area brings to `reference`
+    /// (`None` where it brings none, as outside a spot's cone).
+    fn punctual_at(
+        &self,
+        k: usize,
+        reference: &SurfacePoint<Self::Locator>,
+    ) -> Option<PunctualSample<N>>;
 
     /// The area density [`GatherScene::sample_light`] has at `at` (zero when
     /// `at` is not on an emitter).

@@ -34,7 +34,9 @@ use trilux_geometry::{
 use trilux_solver::{PreparedScene, SurfaceSite};
 
 use crate::link_sum::{LinkCache, LinkField, Receiver, link_sum};
-use crate::records::{BsdfSample, GatherStats, LightSample, LinkVisibility, SurfacePoint};
+use crate::records::{
+    BsdfSample, GatherStats, LightSample, LinkVisibility, PunctualSample, SurfacePoint,
+};
 use crate::sampler::hammersley;
 use crate::scene::{GatherScene, SolutionGather};
 use crate::solution::RadianceSolution;
@@ -165,6 +167,33 @@ impl<'a, const N: usize, S: RadianceSolution<N>> SolvedScene<'a, N, S> {
         (Self::site(from, from_side), Self::site(towards, to_side))
     }
 
+    /// The lights without area's part of the link sum at `at` seen from
+    /// `side`: Σ E⊥ cos θ / π V (cos about the shading normal, as the
+    /// Lambertian BSDF takes it), one shadow ray per light; they have no
+    /// gather links.
+    fn punctual_irradiance(
+        &self,
+        at: &SurfacePoint<HitLocator>,
+        side: Side,
+        stats: &mut GatherStats,
+    ) -> Spectrum<N> {
+        let mut e = Spectrum::zero();
+        for k in 0..self.punctual_count() {
+            let Some(p) = self.punctual_at(k, at) else {
+                continue;
+            };
+            let cos = side.sign() * at.locator.shading_normal.dot(p.wi);
+            if cos <= 0.0 || side.sign() * at.normal.dot(p.wi) <= 0.0 {
+                continue;
+            }
+            stats.shadow_rays += 1;
+            if self.unoccluded(at, p.end) {
+                e += p.irradiance * (cos / std::f64::consts::PI);
+            }
+        }
+        e
+    }
+
     /// The link sum at `at`, seen from `side`, in the leaf `leaf`.
     fn link_sum_at(
         &self,
@@ -209,6 +238,23 @@ impl<const N: usize, S: RadianceSolution<N>> GatherScene<N> for SolvedScene<'_, 
                 shading_normal: hit.shading_normal,
                 shape,
             },
+        })
+    }
+
+    fn punctual_count(&self) -> usize {
+        self.scene.lights().len()
+    }
+
+    fn punctual_at(
+        &self,
+        k: usize,
+        reference: &SurfacePoint<HitLocator>,
+    ) -> Option<PunctualSample<N>> {
+        let (a, irradiance) = self.scene.lights().get(k)?.at(reference.point)?;
+        Some(PunctualSample {
+            wi: a.wi,
+            end: self.scene.shadow_end(reference.point, &a)?,
+            irradiance,
         })
     }
 
@@ -333,7 +379,8 @@ impl<const N: usize, S: RadianceSolution<N>> SolutionGather<N> for SolvedScene<'
             .solution
             .forest()
             .locate(at.locator.surface, at.locator.coord);
-        Some(self.link_sum_at(at, side, leaf, visibility, cache, stats))
+        let sum = self.link_sum_at(at, side, leaf, visibility, cache, stats);
+        Some(sum + self.punctual_irradiance(at, side, stats))
     }
 
     fn near_correction(

@@ -74,6 +74,18 @@ impl GatherScene<3> for GlossyFloor {
     fn intersect(&self, o: DVec3, d: DVec3) -> Option<SurfacePoint<u8>> {
         trilux_render::analytic::floor_and_square_light(o, d, self.h, self.s)
     }
+    fn punctual_count(&self) -> usize {
+        0
+    }
+
+    fn punctual_at(
+        &self,
+        _k: usize,
+        _reference: &SurfacePoint<Self::Locator>,
+    ) -> Option<trilux_render::PunctualSample<3>> {
+        None
+    }
+
     fn unoccluded(&self, _: &SurfacePoint<u8>, _: DVec3) -> bool {
         true
     }

@@ -20,8 +20,7 @@ use crate::material::{TextureCollector, build_bsdf};
 use crate::meshes::Requests;
 use crate::props::Props;
 use crate::resolve::Resolved;
-use crate::scene::Environment;
-use crate::scene::{AreaEmitter, Scene, SceneShape};
+use crate::scene::{AreaEmitter, Environment, Light, Scene, SceneShape};
 use crate::shape::{MeshRequest, build_shape};
 use crate::textures::TextureRequest;
 use crate::xml::Element;
@@ -43,6 +42,7 @@ pub(crate) fn build(resolved: Resolved, path: &Path) -> Result<(Scene, Requests)
     let mut b = Builder {
         folder: path.parent().unwrap_or(Path::new(".")),
         shapes: Vec::new(),
+        lights: Vec::new(),
         shape_elements: 0,
         requests: Requests::default(),
         camera: None,
@@ -74,6 +74,7 @@ pub(crate) fn build(resolved: Resolved, path: &Path) -> Result<(Scene, Requests)
     }
     let Builder {
         shapes,
+        lights,
         requests,
         camera,
         integrator,
@@ -90,6 +91,7 @@ pub(crate) fn build(resolved: Resolved, path: &Path) -> Result<(Scene, Requests)
     }) || environment
         .as_ref()
         .is_some_and(|e| e.radiance.is_sampled())
+        || lights.iter().any(|l| l.intensity.is_sampled())
         || camera
             .as_ref()
             .and_then(|c| c.response.as_ref())
@@ -97,6 +99,7 @@ pub(crate) fn build(resolved: Resolved, path: &Path) -> Result<(Scene, Requests)
     let scene = Scene {
         path: path.to_path_buf(),
         shapes,
+        lights,
         camera,
         max_depth,
         max_depth_location: integrator
@@ -117,6 +120,8 @@ struct Builder<'a> {
     /// The scene file's folder (relative file names start there).
     folder: &'a Path,
     shapes: Vec<SceneShape>,
+    /// The lights without area (`crate::light`).
+    lights: Vec<Light>,
     /// `<shape>` elements met, built or not (the limit counts them).
     shape_elements: usize,
     requests: Requests,
@@ -183,6 +188,9 @@ impl<'a> Builder<'a> {
                 }
                 self.environment = Some(env);
             }
+            "emitter" if matches!(e.plugin_type()?, "point" | "spot" | "directional") => {
+                self.lights.push(crate::light::light(e)?);
+            }
             "emitter" => top_level_emitter(e)?,
             "film" | "sampler" | "rfilter" if e.attr("id").is_some() => sensor_definition(e)?,
             other => {
@@ -218,7 +226,7 @@ fn top_level_emitter(e: &Element) -> Result<()> {
         "area" if e.attr("id").is_some() => return area_emitter(e).map(|_| ()),
         "area" => "an area <emitter> must be placed inside a <shape> (or given an id and named there by a <ref>)".to_string(),
         _ => format!(
-            "unknown emitter plugin \"{t}\" (supported: area inside a shape, constant)"
+            "unknown emitter plugin \"{t}\" (supported: area inside a shape; point, spot, directional, constant)"
         ),
     };
     Err(SceneError::at(&e.loc, message))
@@ -317,7 +325,9 @@ fn area_emitter(e: &Element) -> Result<AreaEmitter> {
     if t != "area" {
         return Err(SceneError::at(
             &e.required("type")?.loc,
-            format!("unknown emitter plugin \"{t}\" (only \"area\" inside a shape)"),
+            format!(
+                "a shape's emitter must be \"area\", found \"{t}\" (point, spot and directional emitters stand at the top level of the scene)"
+            ),
         ));
     }
     let props = Props::new(e)?;

@@ -20,7 +20,8 @@
 //!    texture, emitter, film, sampler or filter).
 //! 3. `build`: typed parameters (`props`, `value`, [`transform`], their
 //!    numbers read by `numbers`) → the
-//!    model: shapes ([`shape`]), materials (`material`), area lights and the
+//!    model: shapes ([`shape`]), materials (`material`), area lights,
+//!    lights without area (`light`: point, spot, directional) and the
 //!    camera ([`camera`], its film's filter in [`rfilter`]), and the
 //!    `integrator` a solve stands for.
 //! 4. [`meshes`]: the OBJ, PLY and serialized files the shapes name
@@ -49,6 +50,7 @@ pub mod error;
 pub mod gltf;
 pub mod image;
 mod integrator;
+mod light;
 pub mod limits;
 mod material;
 pub mod meshes;
@@ -75,7 +77,7 @@ use std::sync::Arc;
 pub use camera::{Camera, FovAxis, ReconstructionFilter};
 pub use error::{SceneError, SourceLocation};
 pub use meshes::Pending;
-pub use scene::{AreaEmitter, Environment, Scene, SceneShape};
+pub use scene::{AreaEmitter, Environment, Light, Scene, SceneShape};
 pub use shape::surface_area;
 pub use transform::LookAt;
 

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use serde::Serialize;
 use trilux_brdf::{BsdfParams, TextureSlot};
 use trilux_color::{ColorParam, Mode};
-use trilux_geometry::{Geometry, Shape};
+use trilux_geometry::{Bounds, Geometry, Punctual, Shape};
 
 use crate::camera::Camera;
 use crate::error::{SceneError, SourceLocation};
@@ -34,6 +34,23 @@ pub struct Environment {
     /// `crate::environment` says why an enclosure).
     pub shape: Option<usize>,
     /// Where the `<emitter>` is written.
+    #[serde(skip)]
+    pub location: SourceLocation,
+}
+
+/// A light without area: Mitsuba's `point`, `spot` and `directional`
+/// emitters, glTF's `KHR_lights_punctual` lights. A delta in position or
+/// direction: no ray meets it, the solve shoots from it and the render
+/// samples it by next-event estimation.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Light {
+    /// Where it is and how its intensity varies with direction.
+    pub punctual: Punctual,
+    /// The radiant intensity (W sr⁻¹) of a point or spot light at full
+    /// strength, or the irradiance (W m⁻²) of a directional light on a
+    /// plane facing it (Mitsuba's `intensity` and `irradiance`).
+    pub intensity: ColorParam,
+    /// Where the light is written.
     #[serde(skip)]
     pub location: SourceLocation,
 }
@@ -65,6 +82,8 @@ pub struct Scene {
     pub path: PathBuf,
     /// The shapes, in file order (index i is shape i of the geometry layer).
     pub shapes: Vec<SceneShape>,
+    /// The lights without area, in file order.
+    pub lights: Vec<Light>,
     /// The camera, when the file has a `<sensor>` (Mitsuba 3 loads scenes
     /// without one too; solving needs none, rendering does).
     pub camera: Option<Camera>,
@@ -131,6 +150,30 @@ impl Scene {
         self.shapes
             .iter()
             .map(|s| s.emitter.as_ref().map(|e| e.radiance.clone()))
+            .collect()
+    }
+
+    /// The box standing for the `constant` environment, if any (its
+    /// lower and upper corners; `crate::environment`).
+    pub fn enclosure(&self) -> Option<Bounds> {
+        let shape = &self.shapes.get(self.environment.as_ref()?.shape?)?.shape;
+        let m = shape.world_from_object;
+        let (a, b) = (
+            m.transform_point3(glam::DVec3::splat(-1.0)),
+            m.transform_point3(glam::DVec3::splat(1.0)),
+        );
+        Some(Bounds {
+            min: a.min(b),
+            max: a.max(b),
+        })
+    }
+
+    /// Every light without area as the solver takes it (where it is, its
+    /// intensity), in file order.
+    pub fn light_params(&self) -> Vec<(Punctual, ColorParam)> {
+        self.lights
+            .iter()
+            .map(|l| (l.punctual, l.intensity.clone()))
             .collect()
     }
 

@@ -515,26 +515,127 @@ fn texture_transforms_map_the_texture_coordinates() {
     );
 }
 
-#[test]
-fn punctual_lights_are_refused_naming_the_light() {
+/// A scene of `lights` placed by nodes 1.. (node k + 1 carries light k,
+/// with the node's own fields from `nodes`).
+fn with_lights(lights: Value, nodes: Value) -> Value {
     let mut j = with_material(None);
     j["extensionsUsed"] = json!(["KHR_lights_punctual"]);
-    j["extensions"] = json!({"KHR_lights_punctual": {"lights": [
-        {"type": "directional", "color": [1.0, 1.0, 1.0]},
-        {"name": "Sun", "type": "spot", "spot": {}}
-    ]}});
-    j["nodes"] = json!([{"mesh": 0}, {"extensions": {"KHR_lights_punctual": {"light": 1}}}]);
-    j["scenes"] = json!([{"nodes": [0, 1]}]);
-    let err = load("light", &j).unwrap_err().to_string();
-    assert!(
-        err.contains("/nodes/1/extensions/KHR_lights_punctual"),
-        "{err}"
+    j["extensions"] = json!({"KHR_lights_punctual": {"lights": lights}});
+    let mut all = vec![json!({"mesh": 0})];
+    for (k, n) in nodes.as_array().unwrap().iter().enumerate() {
+        let mut n = n.clone();
+        n["extensions"] = json!({"KHR_lights_punctual": {"light": k}});
+        all.push(n);
+    }
+    j["scenes"] = json!([{"nodes": (0..all.len()).collect::<Vec<_>>()}]);
+    j["nodes"] = Value::Array(all);
+    j
+}
+
+/// glTF's units as trilux reads glTF's emission (one for one): candela →
+/// W sr⁻¹ for point and spot, lux → W m⁻² for directional, times
+/// `color`; a light shines along its node's −z; a spot keeps glTF's
+/// falloff; `range` is ignored with a warning naming the light.
+#[test]
+fn punctual_lights_load_with_their_units_and_directions() {
+    use trilux_geometry::{Punctual, SpotFalloff};
+    let j = with_lights(
+        json!([
+            {"type": "point", "color": [1.0, 0.5, 0.25], "intensity": 8.0, "range": 3.0},
+            {"type": "directional", "intensity": 2.0},
+            {"name": "Sun", "type": "spot", "spot": {"innerConeAngle": 0.2, "outerConeAngle": 0.5}}
+        ]),
+        // The directional light's node turned +90° about x: its −z
+        // points along +y.
+        json!([
+            {"translation": [1.0, 2.0, 3.0]},
+            {"rotation": [std::f64::consts::FRAC_1_SQRT_2, 0.0, 0.0, std::f64::consts::FRAC_1_SQRT_2]},
+            {"translation": [0.0, 1.0, 0.0]}
+        ]),
     );
-    assert!(
-        err.contains("spot light \"Sun\"") && err.contains("emissive"),
-        "{err}"
+    let s = load("lights", &j).unwrap();
+    assert_eq!(s.lights.len(), 3);
+    assert_eq!(
+        s.lights[0].punctual,
+        Punctual::Point {
+            position: DVec3::new(1.0, 2.0, 3.0)
+        }
     );
-    assert_eq!(err.lines().count(), 1);
+    assert!(near3(rgb(&s.lights[0].intensity), [8.0, 4.0, 2.0]));
+    match s.lights[1].punctual {
+        Punctual::Directional { direction } => {
+            assert!(close(direction, DVec3::new(0.0, 1.0, 0.0)), "{direction}")
+        }
+        other => panic!("{other:?}"),
+    }
+    assert!(near3(rgb(&s.lights[1].intensity), [2.0, 2.0, 2.0]));
+    match s.lights[2].punctual {
+        Punctual::Spot {
+            position,
+            light_from_world,
+            falloff,
+        } => {
+            assert!(close(position, DVec3::Y));
+            // The node's −z (world −z here) is the spot's axis.
+            assert!(close(light_from_world * -DVec3::Z, DVec3::Z));
+            assert_eq!(
+                falloff,
+                SpotFalloff::Gltf {
+                    inner_cone_angle: f64::from(0.2f32),
+                    outer_cone_angle: f64::from(0.5f32)
+                }
+            );
+        }
+        other => panic!("{other:?}"),
+    }
+    assert_eq!(s.warnings.len(), 1, "{:?}", s.warnings);
+    assert!(
+        s.warnings[0].contains("/nodes/1/extensions/KHR_lights_punctual")
+            && s.warnings[0].contains("range 3 is ignored"),
+        "{}",
+        s.warnings[0]
+    );
+}
+
+/// Bad values of a punctual light: one line at the node's light, naming
+/// the light and the problem.
+#[test]
+fn bad_punctual_lights_are_located() {
+    let cases = [
+        (
+            json!({"type": "point", "intensity": -1.0}),
+            "intensity must be finite and not negative",
+        ),
+        (
+            json!({"type": "point", "color": [1.0, -0.5, 1.0]}),
+            "color must be finite and not negative",
+        ),
+        (
+            json!({"type": "spot", "spot": {"innerConeAngle": 0.5, "outerConeAngle": 0.5}}),
+            "0 ≤ innerConeAngle < outerConeAngle ≤ π/2",
+        ),
+        (
+            json!({"type": "spot", "spot": {"outerConeAngle": 2.0}}),
+            "0 ≤ innerConeAngle < outerConeAngle ≤ π/2",
+        ),
+    ];
+    for (k, (light, what)) in cases.into_iter().enumerate() {
+        let j = with_lights(json!([light]), json!([{}]));
+        let err = load(&format!("bad-light-{k}"), &j).unwrap_err().to_string();
+        assert!(
+            err.contains("/nodes/1/extensions/KHR_lights_punctual"),
+            "{err}"
+        );
+        assert!(err.contains(what), "{err}");
+        assert_eq!(err.lines().count(), 1, "{err}");
+    }
+    // A directional light on a node scaled to nothing has no direction.
+    let j = with_lights(
+        json!([{"type": "directional"}]),
+        json!([{"scale": [0.0, 0.0, 0.0]}]),
+    );
+    let err = load("bad-light-scale", &j).unwrap_err().to_string();
+    assert!(err.contains("has no direction"), "{err}");
 }
 
 /// The `gltf` crate's validation indexes a primitive's POSITION accessor

@@ -515,11 +515,11 @@ fn area_emitters() {
         s.shapes[1].emitter.as_ref().map(|e| e.radiance.clone()),
         Some(ColorParam::Float(1.0))
     );
-    assert!(err(r#"<emitter type="point"/>"#).contains("unknown emitter plugin \"point\""));
+    assert!(err(r#"<emitter type="projector"/>"#).contains("unknown emitter plugin \"projector\""));
     assert!(err(r#"<emitter type="area"/>"#).contains("inside a <shape>"));
     assert!(
         err(r#"<shape type="rectangle"><emitter type="spot"/></shape>"#)
-            .contains("unknown emitter plugin")
+            .contains("a shape's emitter must be \"area\"")
     );
     assert!(err(r#"<shape type="rectangle"><emitter type="area"><float name="radiance" value="-1"/></emitter></shape>"#).contains("radiance must not be negative"));
 }

@@ -64,10 +64,13 @@ pub(crate) fn gather_links<const N: usize>(
 ) -> (GatherLinks, GatherReport) {
     let ctx = setup.refine_context(cache);
     let forest = setup.forest();
+    // A glossy face without a Lambertian part holds two-point radiance
+    // only from lights without area (their glossy share, `light_shot`).
+    let lights = !setup.scene.lights().is_empty();
     let mut faces: Vec<(usize, FaceId, &TransportFace<N>, f64)> = setup
         .faces
         .iter()
-        .filter(|(_, f)| !(f.rho_d.is_black() && f.emission.is_black()))
+        .filter(|(_, f)| !(f.rho_d.is_black() && f.emission.is_black()) || (lights && f.stored))
         .filter(|&(face, f)| !sent(setup, field, face, f).is_black())
         .enumerate()
         .map(|(k, (face, f))| {

@@ -38,6 +38,9 @@
 //! - `setup`: what a solve fixes before its first shot (scene,
 //!   discretisation, faces, buried parts, clusters, partners);
 //!   `state`: what the shots change (unshot radiance, hierarchies, ledger).
+//! - [`lights`]: lights without area (point, spot, directional) in
+//!   bands, with their flux; `light_shot`: their shot, a point-to-element
+//!   transfer into every leaf.
 //! - [`solver`]: the progressive loop (§4, Fig. 7 and 9); `shot`: one
 //!   shot's phases; `glossy`: the glossy renormalisation.
 //! - [`gather_links`]: the final gather's links, kept for rendering;
@@ -63,6 +66,8 @@ pub mod gather_links;
 mod glossy;
 mod interaction;
 pub mod ledger;
+mod light_shot;
+pub mod lights;
 mod link;
 pub mod prepared;
 mod radiosity;
@@ -86,6 +91,7 @@ pub use error::SolverError;
 pub use gather_links::{GatherLink, GatherLinks, LinkSource};
 pub use interaction::Split;
 pub use ledger::Ledger;
+pub use lights::{LightError, PreparedLight};
 pub use prepared::{PrepareError, PreparedScene, SceneDescription};
 pub use settings::{Quality, SolverSettings, Transport};
 pub use solution::{FORMAT_VERSION, Solution, SurfaceSite, solve_hash};

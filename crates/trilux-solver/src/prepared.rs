@@ -13,7 +13,9 @@ use std::sync::Arc;
 use thiserror::Error;
 use trilux_brdf::{BrdfError, Bsdf, BsdfParams, Shading, TextureSlot, TexturedBsdf};
 use trilux_color::{ColorError, ColorParam, Spectrum};
-use trilux_geometry::{Geometry, GeometryError, Shape, SurfaceCoord, SurfaceId};
+use trilux_geometry::{Bounds, Geometry, GeometryError, Punctual, Shape, SurfaceCoord, SurfaceId};
+
+use crate::lights::{LightError, PreparedLight};
 
 /// What light transport needs of a scene, as plain data: per shape its
 /// geometry, its material and its area emitter's radiance (if any).
@@ -142,6 +144,10 @@ pub struct PreparedScene<const N: usize> {
     /// The textured materials, by shape (`None` for uniform ones).
     textured: Vec<Option<TexturedBsdf<N>>>,
     emission: Vec<Spectrum<N>>,
+    /// The lights without area (`lights`).
+    lights: Vec<PreparedLight<N>>,
+    /// The box standing for a `constant` sky, if any (`with_enclosure`).
+    enclosure: Option<Bounds>,
     hash: u64,
 }
 
@@ -201,6 +207,8 @@ impl<const N: usize> PreparedScene<N> {
             materials,
             textured,
             emission,
+            lights: Vec::new(),
+            enclosure: None,
             hash: content_hash(desc, textures, N)?,
         })
     }
@@ -237,6 +245,44 @@ impl<const N: usize> PreparedScene<N> {
     /// The material of one shape.
     pub fn material(&self, shape: usize) -> &Bsdf<N> {
         &self.materials[shape]
+    }
+
+    /// The scene with lights without area (`lights`: each with its
+    /// intensity as written); they enter the content hash.
+    pub fn with_lights(mut self, lights: &[(Punctual, ColorParam)]) -> Result<Self, LightError> {
+        self.lights = lights
+            .iter()
+            .enumerate()
+            .map(|(k, (p, c))| PreparedLight::new(k, *p, c))
+            .collect::<Result<_, _>>()?;
+        if !lights.is_empty() {
+            let mut h = Fnv1a(self.hash);
+            serde_json::to_writer(&mut h, lights).map_err(|e| LightError {
+                index: 0,
+                problem: e.to_string(),
+            })?;
+            self.hash = h.0;
+        }
+        Ok(self)
+    }
+
+    /// The lights without area.
+    pub fn lights(&self) -> &[PreparedLight<N>] {
+        &self.lights
+    }
+
+    /// The scene whose shapes include `enclosure`, the box standing for a
+    /// `constant` sky (trilux-scene's `Scene::enclosure`): shadow rays
+    /// towards directional lights end inside it.
+    pub fn with_enclosure(mut self, enclosure: Option<Bounds>) -> Self {
+        self.enclosure = enclosure;
+        self
+    }
+
+    /// Where a shadow ray from `x` towards the light of `a` ends, `None`
+    /// where no light arrives ([`crate::lights::shadow_end`]).
+    pub fn shadow_end(&self, x: glam::DVec3, a: &trilux_geometry::Arrival) -> Option<glam::DVec3> {
+        crate::lights::shadow_end(&self.geometry, self.enclosure.as_ref(), x, a)
     }
 
     /// The emitted radiance of every shape (zero where it does not emit).

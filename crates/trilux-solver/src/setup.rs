@@ -72,8 +72,10 @@ pub(crate) struct Setup<const N: usize> {
     /// ρ_d and g of the elements of textured faces (`None` without
     /// textures).
     pub textures: Option<ElementTextures<N>>,
-    /// The emitted flux IF per band (paper §6).
+    /// The emitted flux IF per band (paper §6), the lights' included.
     pub emitted: Spectrum<N>,
+    /// The flux of every light without area (`lights`).
+    pub light_flux: Vec<Spectrum<N>>,
     /// Warnings of the preparation (clamped reflectances).
     pub warnings: Vec<String>,
 }
@@ -122,6 +124,11 @@ impl<const N: usize> Setup<N> {
                 emitted += emitted_flux(forest, face, f, &exposed_area);
             }
         }
+        let radius = crate::lights::scene_radius(scene.geometry());
+        let light_flux: Vec<Spectrum<N>> = scene.lights().iter().map(|l| l.flux(radius)).collect();
+        for f in &light_flux {
+            emitted += *f;
+        }
         let count = forest.element_count() as u32;
         let points = (0..count)
             .map(|e| forest.element_points(ElementId(e)))
@@ -154,6 +161,7 @@ impl<const N: usize> Setup<N> {
             interior,
             textures,
             emitted,
+            light_flux,
             warnings,
         })
     }

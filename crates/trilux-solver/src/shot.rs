@@ -128,6 +128,9 @@ impl<const N: usize> Solver<N> {
     /// One shot from `source` (module docs); returns the number of links it
     /// made.
     pub(crate) fn shoot(&mut self, source: Source) -> usize {
+        if let Source::Light(k) = source {
+            return self.shoot_light(k as usize);
+        }
         let Some((phi, sending)) = self.take_source(source) else {
             return 0;
         };
@@ -245,6 +248,8 @@ impl<const N: usize> Solver<N> {
                 }
                 Some((phi, Sending::Far { field, by_surface }))
             }
+            // Shot by `shoot_light`.
+            Source::Light(_) => None,
         }
     }
 

@@ -73,6 +73,8 @@ pub(crate) enum Source {
     Stored(u32),
     /// A glossy face's far field (`cluster_transport`).
     Far(FaceId),
+    /// A light without area (`lights`), by its index.
+    Light(u32),
 }
 
 /// A prepared solve: its setup, fixed before the first shot, and the state
@@ -155,6 +157,7 @@ impl<const N: usize> Solver<N> {
             .flatten()
             .map(|f| f.unshot_flux)
             .sum::<Spectrum<N>>();
+        r += state.light_flux.iter().copied().sum::<Spectrum<N>>();
         r
     }
 
@@ -188,6 +191,9 @@ impl<const N: usize> Solver<N> {
                 best = Some((s, flux));
             }
         };
+        for (k, f) in self.state.light_flux.iter().enumerate() {
+            consider(Source::Light(k as u32), f.sum());
+        }
         for (face, f) in self.state.face_flux.iter() {
             consider(Source::Radiosity(face), f.sum());
         }

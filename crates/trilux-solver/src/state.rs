@@ -50,6 +50,8 @@ pub(crate) struct ShotState<const N: usize> {
     pub stats: SolveStats,
     /// Elements that a link or a stored node has used.
     pub used: Vec<bool>,
+    /// Unshot flux of every light without area (`lights`).
+    pub light_flux: Vec<Spectrum<N>>,
 }
 
 impl<const N: usize> ShotState<N> {
@@ -75,6 +77,7 @@ impl<const N: usize> ShotState<N> {
             field,
             face_flux,
             stats,
+            light_flux: setup.light_flux.clone(),
         }
     }
 }

@@ -40,6 +40,8 @@ struct InfoJson {
     shapes: usize,
     input_surfaces: usize,
     emitters: usize,
+    /// Lights without area (point, spot, directional).
+    lights: usize,
     bsdfs: BTreeMap<String, usize>,
     emitted_power: Vec<f64>,
     mode: &'static str,
@@ -98,6 +100,7 @@ pub fn run(args: &InfoArgs) -> Result<()> {
         shapes: scene.shapes.len(),
         input_surfaces: scene.build_geometry()?.surfaces().len(),
         emitters: scene.emitters().count(),
+        lights: scene.lights.len(),
         bsdfs: scene.bsdf_counts.clone(),
         emitted_power: emitted_power(&scene, mode)?,
         mode: mode.name(),
@@ -133,6 +136,7 @@ fn text(scene: &Scene, info: &InfoJson) -> Result<String, std::fmt::Error> {
     writeln!(out, "shapes         {}", info.shapes)?;
     writeln!(out, "input surfaces {}", info.input_surfaces)?;
     writeln!(out, "emitters       {}", info.emitters)?;
+    writeln!(out, "lights         {}", info.lights)?;
     let bsdfs: Vec<String> = info.bsdfs.iter().map(|(k, v)| format!("{k} {v}")).collect();
     writeln!(out, "bsdfs          {}", bsdfs.join(", "))?;
     let power: Vec<String> = info

@@ -118,9 +118,9 @@ pub fn warn_loading(scene: &trilux_scene::Scene) {
 /// harmless (and quick: there is no light to shoot), and a user who forgot
 /// the light is told so instead of being left with a black image.
 pub fn warn_if_dark(scene: &trilux_scene::Scene) {
-    if scene.shapes.iter().all(|s| s.emitter.is_none()) {
+    if scene.shapes.iter().all(|s| s.emitter.is_none()) && scene.lights.is_empty() {
         streams::eprint_line(&format!(
-            "warning: {}: the scene has no emitter: no light reaches any surface (an area emitter on a shape, or an emissive glTF material, lights it)",
+            "warning: {}: the scene has no emitter: no light reaches any surface (an area emitter on a shape, a point, spot or directional emitter, an emissive glTF material or a KHR_lights_punctual light lights it)",
             scene.path.display()
         ));
     }

@@ -149,9 +149,19 @@ pub fn prepare<const N: usize>(scene: &Scene) -> Result<Arc<PreparedScene<N>>, P
         bsdfs: &bsdfs,
         emission: &emission,
     };
-    PreparedScene::new_textured(&desc, &scene.texture_slots())
+    let prepared = PreparedScene::new_textured(&desc, &scene.texture_slots())
+        .map_err(|e| PipelineError::from(located(scene, &e)))?;
+    prepared
+        .with_enclosure(scene.enclosure())
+        .with_lights(&scene.light_params())
         .map(Arc::new)
-        .map_err(|e| located(scene, &e).into())
+        .map_err(|e| {
+            let at = scene
+                .lights
+                .get(e.index)
+                .map_or_else(|| scene.shape_location(usize::MAX), |l| l.location.clone());
+            SceneError::at(&at, e.problem).into()
+        })
 }
 
 /// A preparation error at its place in the scene file.

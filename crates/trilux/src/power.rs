@@ -1,5 +1,6 @@
 //! Emitted power per band, P = π · L · A for each one-sided Lambertian area
-//! emitter (radiance L in each band, area A), summed over the emitters.
+//! emitter (radiance L in each band, area A), summed over the emitters,
+//! plus I · ∫ falloff dω for each point (4π I) and spot light.
 //!
 //! L comes from trilux-color's emission conversion
 //! ([`ColorParam::emission`](trilux_color::ColorParam::emission)), exactly as
@@ -30,6 +31,17 @@ impl WithBands for Power<'_> {
             let radiance = radiance::<N>(&emitter.radiance)
                 .map_err(|e| anyhow!("{}: emitted radiance: {e}", emitter.location))?;
             total += radiance * (std::f64::consts::PI * surface_area(&s.shape));
+        }
+        // Point and spot lights send I · ∫ falloff dω; a directional
+        // light's power depends on the scene's bounding sphere (the
+        // solve's `emitted_flux` counts it).
+        for l in &self.0.lights {
+            if matches!(l.punctual, trilux_geometry::Punctual::Directional { .. }) {
+                continue;
+            }
+            let i = radiance::<N>(&l.intensity)
+                .map_err(|e| anyhow!("{}: intensity: {e}", l.location))?;
+            total += i * l.punctual.flux_factor(0.0);
         }
         Ok(total.0.to_vec())
     }

@@ -252,6 +252,7 @@ fn info_json_has_exactly_the_design_keys() {
             "emitted_power",
             "emitters",
             "input_surfaces",
+            "lights",
             "mode",
             "shape_list",
             "shapes"

@@ -220,11 +220,11 @@ fn unsupported_primitive_mode() {
 }
 
 #[test]
-fn punctual_lights_are_refused_by_name() {
+fn a_punctual_light_with_a_negative_intensity_is_refused_by_name() {
     let j = triangle(|j| {
         j["extensionsUsed"] = serde_json::json!(["KHR_lights_punctual"]);
         j["extensions"] = serde_json::json!({"KHR_lights_punctual": {"lights": [
-            {"name": "Desk lamp", "type": "point", "color": [1.0, 1.0, 1.0], "intensity": 10.0}
+            {"name": "Desk lamp", "type": "point", "color": [1.0, 1.0, 1.0], "intensity": -10.0}
         ]}});
         j["nodes"] = serde_json::json!([
             {"name": "tri", "mesh": 0, "children": [2]},
@@ -236,7 +236,60 @@ fn punctual_lights_are_refused_by_name() {
         "light",
         &j,
         "/nodes/2/extensions/KHR_lights_punctual",
-        "point light \"Desk lamp\"",
+        "light \"Desk lamp\": intensity must be finite and not negative",
+    );
+}
+
+/// A point light of 10 cd with colour (1, 0.5, 0.25) and a spot: `info`
+/// counts them, and the point's power is 4π · 10 · colour W (candela read
+/// as W sr⁻¹, docs/gltf.md); its `range` is a warning, and the scene
+/// solves and renders lit by the light alone.
+#[test]
+fn punctual_lights_load_solve_and_render() {
+    let j = triangle(|j| {
+        j["extensionsUsed"] = serde_json::json!(["KHR_lights_punctual"]);
+        j["extensions"] = serde_json::json!({"KHR_lights_punctual": {"lights": [
+            {"name": "lamp", "type": "point", "color": [1.0, 0.5, 0.25], "intensity": 10.0, "range": 5.0}
+        ]}});
+        j["nodes"] = serde_json::json!([
+            {"name": "tri", "mesh": 0, "children": [2]},
+            {"name": "eye", "camera": 0, "translation": [0.2, 0.2, 2.0]},
+            {"name": "lamp", "translation": [0.3, 0.3, 1.0], "extensions": {"KHR_lights_punctual": {"light": 0}}}
+        ]);
+    });
+    let dir = folder("gltf-lights");
+    let path = dir.join("lit.gltf");
+    std::fs::write(&path, serde_json::to_vec(&j).unwrap()).unwrap();
+    let v = info_json(&path, &[]);
+    assert_eq!(v["lights"], 1);
+    assert_eq!(v["emitters"], 0);
+    let four_pi_i = 4.0 * std::f64::consts::PI * 10.0;
+    for (c, want) in [1.0, 0.5, 0.25].into_iter().enumerate() {
+        let got = v["emitted_power"][c].as_f64().unwrap();
+        assert!((got / (four_pi_i * want) - 1.0).abs() < 1e-9, "{v}");
+    }
+    let exr = dir.join("lit.exr");
+    let out = trilux(&[
+        "render",
+        path.to_str().unwrap(),
+        "--spp",
+        "4",
+        "-o",
+        exr.to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(
+        stderr.contains(
+            "/nodes/2/extensions/KHR_lights_punctual: light \"lamp\": range 5 is ignored"
+        ),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("no emitter"), "{stderr}");
+    let image = trilux_render::Image::read_exr(&exr).unwrap();
+    assert!(
+        image.pixels().iter().any(|p| p[0] > 0.0),
+        "the light lights the triangle"
     );
 }
 
@@ -251,7 +304,8 @@ fn refused_material_features() {
 
 /// Three meshes placed by three nodes, each with its own bad material
 /// (alpha blending, an extension that changes the light, a double-sided
-/// emitter), and a fourth node with a point light: all four reported in
+/// emitter), and a fourth node with a spot whose inner cone is wider than
+/// its outer one: all four reported in
 /// one run, one line each at its JSON path, exit 1.
 #[test]
 fn several_bad_materials_are_reported_in_one_run() {
@@ -268,8 +322,8 @@ fn several_bad_materials_are_reported_in_one_run() {
             {"extensions": {"KHR_materials_clearcoat": {"clearcoatFactor": 1.0}}},
             {"emissiveFactor": [1.0, 1.0, 1.0], "doubleSided": true}
         ]);
-        j["extensions"] =
-            serde_json::json!({"KHR_lights_punctual": {"lights": [{"type": "point"}]}});
+        j["extensions"] = serde_json::json!({"KHR_lights_punctual": {"lights": [{"type": "spot",
+                "spot": {"innerConeAngle": 0.6, "outerConeAngle": 0.5}}]}});
         j["nodes"] = serde_json::json!([
             {"mesh": 0},
             {"mesh": 1, "translation": [2.0, 0.0, 0.0]},
@@ -295,7 +349,7 @@ fn several_bad_materials_are_reported_in_one_run() {
             "extension KHR_materials_clearcoat is refused",
         ),
         ("/materials/2/doubleSided", "double-sided emissive"),
-        ("/nodes/4/extensions/KHR_lights_punctual", "point light"),
+        ("/nodes/4/extensions/KHR_lights_punctual", "spot light #0"),
     ];
     for (line, (pointer, what)) in lines.iter().zip(expected) {
         assert!(

@@ -19,6 +19,7 @@
 
 mod accessor;
 mod buffers;
+mod lights;
 mod material;
 mod nodes;
 

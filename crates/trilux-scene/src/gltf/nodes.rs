@@ -16,11 +16,9 @@
 //!   world transform is the node's (its scale removed) times diag(−1, 1,
 //!   −1). `yfov` is the vertical field of view; the film is 768 pixels wide
 //!   and as high as `aspectRatio` makes it (576 without one).
-//! - **Lights** (`KHR_lights_punctual`): refused, naming the light. A point,
-//!   spot or directional light is a delta: the hierarchical solve shoots
-//!   from surfaces, and a sphere small enough to stand in for it would
-//!   need a radiance millions of times any surface's, whose flux no
-//!   element-sized link resolves (model the lamp as an emissive mesh).
+//! - **Lights** (`KHR_lights_punctual`): point, spot and directional
+//!   lights, placed by their nodes (`super::lights`: units, falloff and
+//!   what is ignored).
 
 use std::collections::{BTreeMap, HashMap, HashSet};
 use std::fmt;
@@ -41,7 +39,7 @@ use crate::limits::{
     MAX_GLTF_NODES, MAX_GLTF_TRIANGLES, MAX_MESH_TRIANGLES, MAX_MESH_VERTICES, MAX_NODE_DEPTH,
     MAX_SHAPES,
 };
-use crate::scene::{AreaEmitter, Scene, SceneShape};
+use crate::scene::{AreaEmitter, Light, Scene, SceneShape};
 use crate::shape::check_area;
 use crate::textures::{ImageSource, TextureRequest};
 
@@ -100,6 +98,8 @@ pub(crate) fn build(
         bsdf_counts: BTreeMap::new(),
         seen: HashSet::new(),
         triangles: 0,
+        lights: Vec::new(),
+        warnings: Vec::new(),
     };
     for node in root.nodes() {
         walk.node(&node, DMat4::IDENTITY, 1)?;
@@ -116,6 +116,7 @@ pub(crate) fn build(
     let scene = Scene {
         path: file.to_path_buf(),
         shapes: walk.shapes,
+        lights: walk.lights,
         camera,
         max_depth: None,
         max_depth_location: None,
@@ -124,7 +125,7 @@ pub(crate) fn build(
         bsdf_counts: walk.bsdf_counts,
         camera_names,
         environment: None,
-        warnings: Vec::new(),
+        warnings: walk.warnings,
     };
     let meshes = GltfMeshes {
         file: Arc::clone(file),
@@ -152,6 +153,10 @@ struct Walk<'f> {
     bsdf_counts: BTreeMap<String, usize>,
     seen: HashSet<usize>,
     triangles: usize,
+    /// The punctual lights (`super::lights`).
+    lights: Vec<Light>,
+    /// What loading left out (a light's `range`).
+    warnings: Vec<String>,
 }
 
 struct CameraNode {
@@ -220,18 +225,15 @@ impl Walk<'_> {
     /// notes its perspective camera.
     fn check_node(&mut self, node: &gltf::Node<'_>, here: &str, world: DMat4) -> Result<()> {
         if let Some(light) = node.light() {
-            let kind = match light.kind() {
-                gltf::khr_lights_punctual::Kind::Directional => "directional",
-                gltf::khr_lights_punctual::Kind::Point => "point",
-                gltf::khr_lights_punctual::Kind::Spot { .. } => "spot",
-            };
-            return Err(self.at(
-                format!("{here}/extensions/KHR_lights_punctual"),
-                format!(
-                    "{kind} light {} (KHR_lights_punctual) is refused: trilux solves light between surfaces, and a punctual light has none (model the lamp as a mesh with an emissive material)",
-                    light.name().map_or(format!("#{}", light.index()), |n| format!("\"{n}\""))
-                ),
-            ));
+            let place = format!("{here}/extensions/KHR_lights_punctual");
+            let loc = SourceLocation::json(self.file, place.clone());
+            match super::lights::light(&light, world, loc.clone()) {
+                Ok((l, warning)) => {
+                    self.lights.push(l);
+                    self.warnings.extend(warning.map(|w| format!("{loc}: {w}")));
+                }
+                Err(m) => return Err(self.at(place, m)),
+            }
         }
         if let Some(name) = node.extensions().and_then(|e| {
             e.keys()

@@ -23,5 +23,10 @@ pub fn prepare_scene<const N: usize>(scene: &trilux_scene::Scene) -> Arc<Prepare
         bsdfs: &bsdfs,
         emission: &emission,
     };
-    Arc::new(PreparedScene::new(&desc).unwrap_or_else(|e| panic!("{e}")))
+    let prepared = PreparedScene::new(&desc).unwrap_or_else(|e| panic!("{e}"));
+    Arc::new(
+        prepared
+            .with_lights(&scene.light_params())
+            .unwrap_or_else(|e| panic!("{e}")),
+    )
 }

@@ -1,0 +1,168 @@
+//! The shot of a light without area (docs/solver.md, "Lights without
+//! area"): a source like a face, shot once, first (it is the largest). A
+//! point-to-element transfer into every leaf element of every face: the
+//! flux ∫ E dA over the element's exposed part, E = I cos θ / r² (E cos θ
+//! for a directional light) with a shadow ray per point, 16 stratified
+//! points per leaf. The Lambertian share ρ_d goes into the two-point
+//! radiance as for a pair link; the glossy share (the directional albedo
+//! for the light's direction less ρ_d) joins it, its energy kept and its
+//! direction lost (a smooth plastic's coat is carried the same way); the
+//! rest is absorbed, and what misses every element escapes.
+
+use glam::{DVec2, DVec3};
+use rayon::prelude::*;
+use trilux_brdf::Frame;
+use trilux_color::Spectrum;
+use trilux_geometry::{ElementId, FaceId};
+
+use crate::lights::PreparedLight;
+use crate::solver::Solver;
+
+/// Stratified points per leaf element and light (4 × 4).
+const POINTS_PER_SIDE: u32 = 4;
+
+/// What one leaf element of one face receives from a light.
+struct Deposit<const N: usize> {
+    face: FaceId,
+    leaf: ElementId,
+    /// ∫ E dA over the leaf's exposed part.
+    arrived: Spectrum<N>,
+    /// Unit direction towards the light from the leaf's centre.
+    wi: DVec3,
+}
+
+impl<const N: usize> Solver<N> {
+    /// Shoots light `k` (module docs); returns the number of elements it
+    /// lit.
+    pub(crate) fn shoot_light(&mut self, k: usize) -> usize {
+        let phi = std::mem::take(&mut self.state.light_flux[k]);
+        // Every watt a light shoots is emission.
+        self.state.interreflection.book_shot(phi, Spectrum::zero());
+        let light = self.setup.scene.lights()[k].clone();
+        let faces: Vec<FaceId> = self.setup.faces.iter().map(|(f, _)| f).collect();
+        let deposits: Vec<Deposit<N>> = faces
+            .par_iter()
+            .flat_map_iter(|&f| self.light_deposits(&light, f))
+            .collect();
+        let mut total = Spectrum::<N>::zero();
+        let mut absorbed = Spectrum::<N>::zero();
+        for d in &deposits {
+            let reflected = self.receive_light(d);
+            total += d.arrived;
+            absorbed += d.arrived - reflected;
+            self.state
+                .interreflection
+                .book_group(d.face, d.arrived, reflected, Spectrum::zero());
+        }
+        let escaped = phi - total;
+        for b in 0..N {
+            self.state.ledger.escaped[b] += escaped[b];
+            self.state.ledger.absorbed[b] += absorbed[b];
+        }
+        let rel = escaped.min_value() / phi.max_value().max(1e-300);
+        self.state.ledger.min_shot_escaped = self.state.ledger.min_shot_escaped.min(rel);
+        deposits.len()
+    }
+
+    /// What light `light` brings to each leaf of face `f` (leaves it
+    /// does not reach are left out).
+    fn light_deposits(&self, light: &PreparedLight<N>, f: FaceId) -> Vec<Deposit<N>> {
+        let forest = self.setup.forest();
+        let geometry = forest.geometry();
+        let sign = f.side().sign();
+        let n = POINTS_PER_SIDE;
+        let mut out = Vec::new();
+        for leaf in forest.leaves(forest.root(f.surface())) {
+            if self.setup.exposed_area[f.side()][leaf.index()] <= 0.0 {
+                continue;
+            }
+            let mut arrived = Spectrum::<N>::zero();
+            for s in 0..n * n {
+                let u = DVec2::new(
+                    (f64::from(s % n) + 0.5) / f64::from(n),
+                    (f64::from(s / n) + 0.5) / f64::from(n),
+                );
+                let y = forest.sample_element(leaf, u);
+                if y.pdf_area <= 0.0
+                    || self
+                        .setup
+                        .burial
+                        .as_ref()
+                        .is_some_and(|m| m.is_buried(f, y.coord))
+                {
+                    continue;
+                }
+                let Some((a, e)) = light.at(y.point) else {
+                    continue;
+                };
+                let cos = sign * y.normal.dot(a.wi);
+                let end = self.setup.scene.shadow_end(y.point, &a);
+                if cos <= 0.0 || end.is_none_or(|end| geometry.occluded(y.point, end)) {
+                    continue;
+                }
+                arrived += e * (cos / y.pdf_area);
+            }
+            if arrived.max_value() > 0.0 {
+                let centre = forest.element(leaf).centre;
+                let wi = light
+                    .punctual
+                    .arrival(centre)
+                    .map_or(sign * forest.element(leaf).normal, |a| a.wi);
+                out.push(Deposit {
+                    face: f,
+                    leaf,
+                    arrived: arrived * (1.0 / f64::from(n * n)),
+                    wi,
+                });
+            }
+        }
+        out
+    }
+
+    /// Puts what deposit `d` reflects into its face's two-point radiance
+    /// (the Lambertian share, and the glossy share as Lambertian light);
+    /// returns the flux reflected.
+    fn receive_light(&mut self, d: &Deposit<N>) -> Spectrum<N> {
+        let face = &self.setup.faces[d.face];
+        let (rho, g) = match &self.setup.textures {
+            Some(t) => (
+                t.rho(d.face, d.leaf).unwrap_or(face.rho_d),
+                t.glossy(d.face, d.leaf),
+            ),
+            None => (face.rho_d, Spectrum::splat(1.0)),
+        };
+        let rho_d = (rho * self.light_shading_factor(d.leaf, d.wi)).min(Spectrum::splat(1.0));
+        let glossy = if face.stored {
+            let normal = self.setup.forest().element(d.leaf).normal * d.face.side().sign();
+            let wi = Frame::from_normal(normal).to_local(d.wi);
+            (self.setup.albedo[face.shape].albedo(wi) - face.rho_d).max(Spectrum::zero()) * g
+        } else {
+            Spectrum::zero()
+        };
+        let reflected = (d.arrived * (rho_d + glossy)).min(d.arrived);
+        let side = d.face.side();
+        let aj = self.setup.exposed_area[side][d.leaf.index()];
+        if !reflected.is_black() && aj > 0.0 {
+            let dl = reflected * (1.0 / (std::f64::consts::PI * aj));
+            self.state.field.gathered[side][d.leaf.index()] += dl;
+            self.state.face_flux[d.face] += reflected;
+        }
+        self.state.used[d.leaf.index()] = true;
+        let min = (d.arrived - reflected).min_value() / d.arrived.max_value().max(1e-300);
+        self.state.ledger.min_element_absorbed = self.state.ledger.min_element_absorbed.min(min);
+        reflected
+    }
+
+    /// The shading-normal factor of a chart element for light from `wi`
+    /// (docs/solver.md, "Shading normals of smooth meshes").
+    fn light_shading_factor(&self, j: ElementId, wi: DVec3) -> f64 {
+        let Some((s, g)) = self.setup.shading[j.index()] else {
+            return 1.0;
+        };
+        let (ds, dg) = (s.dot(wi), g.dot(wi));
+        if dg.abs() <= 1e-12 * g.length() || ds * dg <= 0.0 {
+            return 1.0;
+        }
+        (ds / dg).clamp(0.25, 4.0)
+    }
+}
