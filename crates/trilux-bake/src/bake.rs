@@ -29,7 +29,7 @@ use trilux_solver::{ElementTextures, Solution};
 
 use crate::albedo::{AlbedoMap, albedo_map};
 use crate::camera::BakeCamera;
-use crate::directional::{GlossyLight, GlossyPoint, SH_COEFFICIENTS, fit_vertices};
+use crate::directional::{GlossyLight, GlossyPoint, GlossySamples, SH_COEFFICIENTS, fit_vertices};
 use crate::error::BakeError;
 use crate::glb::Document;
 use crate::reconstruct::{baked_flux, vertex_values};
@@ -64,23 +64,25 @@ pub struct BakeOptions {
     /// (smaller files, texture detail finer than the leaves lost).
     pub albedo_maps: bool,
     /// Fit the glossy light of glossy sides as spherical harmonics
-    /// (module `directional`; slow on large scenes, so off by default:
-    /// the glossy light is then left out and its materials marked).
+    /// (module `directional`; on by default: without, the glossy light is
+    /// left out and its materials marked).
     pub glossy: bool,
     /// Directions per vertex over which the glossy light is fitted
-    /// (module `directional`; at least 9).
+    /// (module `directional`; at least [`MIN_GLOSSY_DIRECTIONS`]). Cheap:
+    /// every direction reuses the vertex's incident samples.
     pub glossy_directions: u32,
-    /// Estimates of the glossy light per direction and vertex (0: leave
-    /// glossy light out).
+    /// BSDF-sampled gather rays per vertex, shared by its directions (0:
+    /// leave glossy light out).
     pub glossy_samples: u32,
-    /// Most estimates of glossy light in one bake (vertices × directions
-    /// × samples): a larger bake takes fewer samples per direction, then
-    /// fewer directions, down to [`MIN_GLOSSY_DIRECTIONS`] and one sample.
+    /// Light samples per vertex, shared by its directions.
+    pub glossy_light_samples: u32,
+    /// Most incident samples of glossy light in one bake (vertices ×
+    /// (gather rays + light samples)): a larger bake takes fewer per
+    /// vertex, down to a quarter of each (at least one).
     pub glossy_budget: u64,
 }
 
-/// Fewest directions a vertex's glossy light is fitted over (a budget
-/// stops lowering them here).
+/// Fewest directions a vertex's glossy light is fitted over.
 pub const MIN_GLOSSY_DIRECTIONS: u32 = 16;
 
 impl Default for BakeOptions {
@@ -88,9 +90,10 @@ impl Default for BakeOptions {
         BakeOptions {
             exposure: 0.0,
             albedo_maps: true,
-            glossy: false,
+            glossy: true,
             glossy_directions: 48,
-            glossy_samples: 4,
+            glossy_samples: 16,
+            glossy_light_samples: 8,
             glossy_budget: 8_000_000,
         }
     }
@@ -257,13 +260,13 @@ impl<'t, const N: usize> SideLight<'t, N> {
 /// The glossy light's fits: directions and samples per vertex, counted.
 struct GlossyCount {
     directions: usize,
-    samples: u32,
+    samples: GlossySamples,
     vertices: usize,
     seconds: f64,
 }
 
 impl GlossyCount {
-    /// Directions and samples within `options.glossy_budget` for every
+    /// Directions and incident samples within `options.glossy_budget` for every
     /// used vertex of every glossy side of `meshes`.
     fn new<const N: usize>(
         input: &BakeInput<'_, N>,
@@ -287,12 +290,21 @@ impl GlossyCount {
             }
         }
         let per_vertex = options.glossy_budget.checked_div(total).unwrap_or(u64::MAX);
-        let wanted = u64::from(options.glossy_directions.max(MIN_GLOSSY_DIRECTIONS));
-        let directions = wanted.min(per_vertex.max(u64::from(MIN_GLOSSY_DIRECTIONS)));
-        let samples = (per_vertex / directions).clamp(1, u64::from(options.glossy_samples.max(1)));
+        let (gather, light) = (
+            u64::from(options.glossy_samples),
+            u64::from(options.glossy_light_samples),
+        );
+        // Within the budget, both counts scaled alike, to a quarter at least.
+        let scale = |n: u64| {
+            let fit = (n * per_vertex).checked_div(gather + light).unwrap_or(n);
+            fit.clamp(n.div_ceil(4).max(1), n.max(1)) as u32
+        };
         GlossyCount {
-            directions: directions as usize,
-            samples: samples as u32,
+            directions: options.glossy_directions.max(MIN_GLOSSY_DIRECTIONS) as usize,
+            samples: GlossySamples {
+                gather: scale(gather),
+                light: scale(light),
+            },
             vertices: 0,
             seconds: 0.0,
         }

@@ -37,6 +37,6 @@ mod tessellate;
 
 pub use bake::{BakeInput, BakeOptions, BakeStats, Baked, MIN_GLOSSY_DIRECTIONS, bake};
 pub use camera::BakeCamera;
-pub use directional::{GlossyLight, GlossyPoint};
+pub use directional::{GlossyLight, GlossyPoint, GlossySamples};
 pub use error::BakeError;
 pub use tessellate::ShapeMesh;

@@ -249,7 +249,7 @@ impl trilux_bake::GlossyLight for Quadratic {
         &self,
         points: &[trilux_bake::GlossyPoint],
         directions: &[DVec3],
-        _samples: u32,
+        _samples: trilux_bake::GlossySamples,
     ) -> Vec<[f64; 3]> {
         let per = directions.len() / points.len();
         directions
