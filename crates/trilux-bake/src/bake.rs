@@ -76,6 +76,9 @@ pub struct BakeOptions {
     pub glossy_samples: u32,
     /// Light samples per vertex, shared by its directions.
     pub glossy_light_samples: u32,
+    /// Gather hits read through their links, as the full render does
+    /// (slower); without, the solution's radiance there.
+    pub glossy_links: bool,
     /// Most incident samples of glossy light in one bake (vertices ×
     /// (gather rays + light samples)): a larger bake takes fewer per
     /// vertex, down to a quarter of each (at least one).
@@ -94,6 +97,7 @@ impl Default for BakeOptions {
             glossy_directions: 48,
             glossy_samples: 16,
             glossy_light_samples: 8,
+            glossy_links: false,
             glossy_budget: 8_000_000,
         }
     }
@@ -304,6 +308,7 @@ impl GlossyCount {
             samples: GlossySamples {
                 gather: scale(gather),
                 light: scale(light),
+                links: options.glossy_links,
             },
             vertices: 0,
             seconds: 0.0,

@@ -51,6 +51,9 @@ pub struct GlossySamples {
     pub gather: u32,
     /// Light samples.
     pub light: u32,
+    /// Gather hits read through their links, as the full render reads
+    /// them; without, the solution's radiance there (much cheaper).
+    pub links: bool,
 }
 
 /// The glossy part of the radiance leaving surface points.

@@ -163,7 +163,8 @@ impl<S> LinkGather<'_, S> {
     /// weighted by the balance heuristic over the lobe mixture and light
     /// sampling (Veach's multi-sample estimator, unbiased): what a sample
     /// brings (the gather hit read as [`LinkGather::glossy_sample`] reads
-    /// it) is paid for once, not once per direction.
+    /// it, or from the solution: `counts.links`) is paid for once, not
+    /// once per direction.
     pub fn glossy_directions<const N: usize>(
         &self,
         x: &SurfacePoint<S::Locator>,
@@ -182,10 +183,10 @@ impl<S> LinkGather<'_, S> {
         }
         let (ng, nl) = (f64::from(counts.gather), f64::from(counts.light));
         let scene = self.scene;
-        let mixture = |wi| wos.iter().map(|&wo| scene.bsdf_pdf(x, wo, wi)).sum::<f64>() / wos.len() as f64;
-        let mut add = |wi: DVec3, l: Spectrum<N>| {
-            for (o, &wo) in out.iter_mut().zip(wos) {
-                *o += scene.glossy_cos(x, wi, wo) * l;
+        let mut fan = Vec::with_capacity(wos.len());
+        let mut add = |fan: &[Spectrum<N>], l: Spectrum<N>| {
+            for (o, f) in out.iter_mut().zip(fan) {
+                *o += *f * l;
             }
         };
         for k in 0..counts.gather {
@@ -195,8 +196,11 @@ impl<S> LinkGather<'_, S> {
             let Some(bs) = scene.sample_bsdf(x, wos[j], sampler.get2(dims::GATHER + 1)) else {
                 continue;
             };
-            let p_mix = mixture(bs.wi);
-            if !(bs.pdf.is_finite() && bs.pdf > 0.0 && p_mix > 0.0) {
+            if !(bs.pdf.is_finite() && bs.pdf > 0.0) {
+                continue;
+            }
+            let p_mix = scene.glossy_fan(x, bs.wi, wos, &mut fan);
+            if p_mix <= 0.0 {
                 continue;
             }
             stats.gather_rays += 1;
@@ -209,19 +213,21 @@ impl<S> LinkGather<'_, S> {
                 caches: &mut *caches,
                 stats: &mut *stats,
             };
-            let mut l = self.reflected_at(&xd, x, back, 1, &mut w) * (1.0 / (ng * p_mix));
+            let level = if counts.links { 1 } else { LINK_LEVELS + 1 };
+            let mut l = self.reflected_at(&xd, x, back, level, &mut w) * (1.0 / (ng * p_mix));
             let le = scene.emitted(&xd, back);
             if !le.is_black() {
                 let p_light = light_density(scene, &xd, back);
                 l += le * (1.0 / (ng * p_mix + nl * p_light));
             }
-            add(bs.wi, l);
+            add(&fan, l);
         }
         for k in 0..counts.light {
             sampler.start_sample(counts.gather + k);
             let (pick, u) = (sampler.get1(dims::GATHER + 3), sampler.get2(dims::GATHER + 4));
             if let Some((wi, le, p_light)) = unoccluded_light(scene, x, pick, u, stats) {
-                add(wi, le * (1.0 / (nl * p_light + ng * mixture(wi))));
+                let p_mix = scene.glossy_fan(x, wi, wos, &mut fan);
+                add(&fan, le * (1.0 / (nl * p_light + ng * p_mix)));
             }
         }
         out.iter()
@@ -366,6 +372,11 @@ pub struct IncidentSamples {
     pub gather: u32,
     /// Light samples (shadow rays).
     pub light: u32,
+    /// Read a gather hit's reflected light through its links (the full
+    /// render's reading, one glossy level deeper); without, the solution's
+    /// own radiance there (no link sum: many times cheaper, element-sized
+    /// detail in reflections lost).
+    pub links: bool,
 }
 
 /// The solid-angle density with which light sampling reaches the emitting

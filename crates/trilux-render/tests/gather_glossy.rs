@@ -325,6 +325,7 @@ fn shared_incident_samples_match_brute_force_in_every_direction() {
         let counts = IncidentSamples {
             gather: 8192,
             light: 8192,
+            links: true,
         };
         let mut sampler = trilux_render::PixelSampler::new(3, 1, 2);
         let (mut caches, mut stats) = (Caches::<3>::default(), GatherStats::default());

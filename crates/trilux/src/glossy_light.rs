@@ -63,6 +63,7 @@ impl<'a, const N: usize> RenderedGlossy<'a, N> {
         let counts = IncidentSamples {
             gather: samples.gather,
             light: samples.light,
+            links: samples.links,
         };
         gather
             .glossy_directions(&x, dirs, counts, &mut sampler, caches, &mut stats)
