@@ -29,7 +29,9 @@ use trilux_solver::{ElementTextures, Solution};
 
 use crate::albedo::{AlbedoMap, albedo_map};
 use crate::camera::BakeCamera;
-use crate::directional::{GlossyLight, GlossyPoint, GlossySamples, SH_COEFFICIENTS, fit_vertices};
+use crate::directional::{
+    GlossyForm, GlossyLight, GlossyPoint, GlossyRecord, GlossySamples, fit_vertices,
+};
 use crate::error::BakeError;
 use crate::glb::Document;
 use crate::reconstruct::{baked_flux, vertex_values};
@@ -63,10 +65,13 @@ pub struct BakeOptions {
     /// without, their radiance goes into the vertex colours like any other
     /// (smaller files, texture detail finer than the leaves lost).
     pub albedo_maps: bool,
-    /// Fit the glossy light of glossy sides as spherical harmonics
-    /// (module `directional`; on by default: without, the glossy light is
-    /// left out and its materials marked).
+    /// Fit the glossy light of glossy sides per vertex (module
+    /// `directional`; on by default: without, the glossy light is left out
+    /// and its materials marked).
     pub glossy: bool,
+    /// The glossy light's form (order-1 harmonics and a lobe, or order-2
+    /// harmonics).
+    pub glossy_form: GlossyForm,
     /// Directions per vertex over which the glossy light is fitted
     /// (module `directional`; at least [`MIN_GLOSSY_DIRECTIONS`]). Cheap:
     /// every direction reuses the vertex's incident samples.
@@ -94,7 +99,8 @@ impl Default for BakeOptions {
             exposure: 0.0,
             albedo_maps: true,
             glossy: true,
-            glossy_directions: 48,
+            glossy_form: GlossyForm::Lobe,
+            glossy_directions: 96,
             glossy_samples: 16,
             glossy_light_samples: 8,
             glossy_links: false,
@@ -159,7 +165,13 @@ pub fn bake<const N: usize>(
             light.sh = glossy.fit(input, options, mesh, side, vertices);
             light
         });
-        write_shape(&mut doc, input, mesh, &sides, options.exposure.exp2())?;
+        write_shape(
+            &mut doc,
+            input,
+            mesh,
+            &sides,
+            (options.exposure.exp2(), options.glossy_form),
+        )?;
         vertices += mesh.positions.len();
         triangles += 2 * mesh.triangles.len();
     }
@@ -206,7 +218,7 @@ struct SideLight<'t, const N: usize> {
     textures: Option<&'t ElementTextures<N>>,
     /// The glossy light's SH coefficients per vertex (module
     /// `directional`), on a glossy side when the bake has them.
-    sh: Option<Vec<[[f64; 3]; SH_COEFFICIENTS]>>,
+    sh: Option<Vec<GlossyRecord>>,
 }
 
 impl<'t, const N: usize> SideLight<'t, N> {
@@ -263,6 +275,7 @@ impl<'t, const N: usize> SideLight<'t, N> {
 
 /// The glossy light's fits: directions and samples per vertex, counted.
 struct GlossyCount {
+    form: GlossyForm,
     directions: usize,
     samples: GlossySamples,
     vertices: usize,
@@ -304,6 +317,7 @@ impl GlossyCount {
             fit.clamp(n.div_ceil(4).max(1), n.max(1)) as u32
         };
         GlossyCount {
+            form: options.glossy_form,
             directions: options.glossy_directions.max(MIN_GLOSSY_DIRECTIONS) as usize,
             samples: GlossySamples {
                 gather: scale(gather),
@@ -326,7 +340,7 @@ impl GlossyCount {
         mesh: &ShapeMesh,
         side: Side,
         first: usize,
-    ) -> Option<Vec<[[f64; 3]; SH_COEFFICIENTS]>> {
+    ) -> Option<Vec<GlossyRecord>> {
         let light = input.glossy.filter(|_| options.glossy)?;
         let scene = input.solution.scene();
         if !scene.material(mesh.shape as usize).has_glossy(side) {
@@ -357,7 +371,7 @@ impl GlossyCount {
         if options.glossy_samples == 0 {
             return None;
         }
-        let sizes = (self.directions, self.samples);
+        let sizes = (self.form, self.directions, self.samples);
         let sh = fit_vertices(light, &points, mesh.positions.len(), sizes);
         self.vertices += points.len();
         self.seconds += start.elapsed().as_secs_f64();
@@ -371,7 +385,7 @@ fn write_shape<const N: usize>(
     input: &BakeInput<'_, N>,
     mesh: &ShapeMesh,
     sides: &[SideLight<'_, N>; 2],
-    scale: f64,
+    scale: (f64, GlossyForm),
 ) -> Result<(), BakeError> {
     for light in sides {
         let sh = light.sh.iter().flatten().flatten().flatten();
@@ -450,7 +464,7 @@ fn side_primitives<const N: usize>(
     shape: u32,
     light: &SideLight<'_, N>,
     (shared, surfaces): (&SharedAttributes, &[SurfaceTriangles]),
-    scale: f64,
+    (scale, form): (f64, GlossyForm),
 ) -> Result<Vec<Value>, BakeError> {
     let side = light.side;
     let radiance: Vec<[f32; 3]> = light.values.iter().map(|c| c.map(|x| x as f32)).collect();
@@ -465,7 +479,7 @@ fn side_primitives<const N: usize>(
     m["extras"]["trilux"]["glossy_left_out"] =
         json!(light.sh.is_none() && glossy_side(input, shape, side));
     if light.sh.is_some() {
-        m["extras"]["trilux"]["glossy"] = json!("sh2");
+        m["extras"]["trilux"]["glossy"] = json!(form.name());
     }
     if let Some(map) = &light.map {
         let png = map.png().map_err(|e| BakeError::Image(e.to_string()))?;
@@ -484,9 +498,9 @@ fn side_primitives<const N: usize>(
         attributes["TEXCOORD_0"] = json!(uv);
     }
     if let Some(sh) = &light.sh {
-        for j in 0..SH_COEFFICIENTS {
+        for (j, name) in form.attributes().iter().enumerate() {
             let c: Vec<[f32; 3]> = sh.iter().map(|v| v[j].map(|x| x as f32)).collect();
-            attributes[format!("_TRILUX_SH{j}")] = json!(doc.vec3(&c, false));
+            attributes[*name] = json!(doc.vec3(&c, false));
         }
     }
     let mut primitives = Vec::new();
@@ -595,7 +609,7 @@ fn asset(options: &BakeOptions) -> Value {
             "colour": "_RADIANCE is linear Rec. 709 radiance (W sr^-1 m^-2 per channel); COLOR_0 is it times 2^exposure, clamped to [0, 1]",
             "baked": "the view-independent (Lambertian) light of the solution, emission included",
             "left_out": "the glossy (view-dependent) reflection of materials marked glossy_left_out",
-            "glossy": "on materials marked glossy: \"sh2\", the glossy outgoing radiance towards a world direction w is max(0, sum_j _TRILUX_SHj * Y_j(w)), Y the order-2 real spherical harmonics (Y_0 = 0.282095, Y_1..3 = 0.488603 (y, z, x), Y_4 = 1.092548 xy, Y_5 = 1.092548 yz, Y_6 = 0.315392 (3z^2 - 1), Y_7 = 1.092548 xz, Y_8 = 0.546274 (x^2 - y^2)), added to _RADIANCE",
+            "glossy": "on materials marked glossy, the glossy outgoing radiance towards a world direction w (unit, from the point to the eye), added to _RADIANCE: \"sh2+lobe\": max(0, sum_{j<9} _TRILUX_SHj * Y_j(w) + _TRILUX_LOBE_RGB * exp(dot(v, w) - |v|)), v = _TRILUX_LOBE; \"sh2\": max(0, sum_{j<9} _TRILUX_SHj * Y_j(w)); Y the real spherical harmonics Y_0 = 0.282095, Y_1..3 = 0.488603 (y, z, x), Y_4 = 1.092548 xy, Y_5 = 1.092548 yz, Y_6 = 0.315392 (3z^2 - 1), Y_7 = 1.092548 xz, Y_8 = 0.546274 (x^2 - y^2)",
         } },
     })
 }

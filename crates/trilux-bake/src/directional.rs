@@ -19,10 +19,18 @@
 //! clamped at zero, and adds it to the diffuse vertex colour.
 
 use glam::DVec3;
+use rayon::prelude::*;
 use trilux_geometry::{Side, SurfaceCoord, SurfaceId};
 
 /// Coefficients of order-2 real spherical harmonics.
 pub const SH_COEFFICIENTS: usize = 9;
+
+/// RGB slots of a vertex's glossy record: the order-2 harmonics, then
+/// (form [`GlossyForm::Lobe`]) the lobe's axis × sharpness and amplitude.
+pub const SLOTS: usize = SH_COEFFICIENTS + 2;
+
+/// A vertex's glossy light in its form's slots.
+pub type GlossyRecord = [[f64; 3]; SLOTS];
 
 /// Where the bake asks for glossy light: a vertex of a glossy side.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -88,6 +96,11 @@ pub fn sh_basis(d: DVec3) -> [f64; SH_COEFFICIENTS] {
     ]
 }
 
+/// The order-2 harmonics of a record.
+fn sh_part(c: &GlossyRecord) -> [[f64; 3]; SH_COEFFICIENTS] {
+    std::array::from_fn(|j| c[j])
+}
+
 /// The SH expansion `c` evaluated towards `d`, per channel.
 pub fn sh_eval(c: &[[f64; 3]; SH_COEFFICIENTS], d: DVec3) -> [f64; 3] {
     let y = sh_basis(d);
@@ -139,57 +152,66 @@ pub fn fit_sh(directions: &[DVec3], values: &[[f64; 3]]) -> Option<[[f64; 3]; SH
     cholesky_solve(a, rhs)
 }
 
-/// The fit `c` made non-negative over the hemisphere about `normal`
-/// without changing its mean there: per channel, c blended towards the
-/// constant m (the mean of `values`, which the least-squares fit keeps over
-/// `directions`) by the largest t ≤ 1 with m + t (c·Y(ω) − m) ≥ 0 at all
-/// of [`CHECK_DIRECTIONS`] directions and a quarter as many on the
-/// horizon. A viewer's max(0, ·) then clips
-/// nothing, where a raw fit's negative ringing, clipped, adds light (+27 %
-/// at GGX α = 0.1, docs/results.md); the price is a flatter lobe where it
-/// rang.
-pub fn nonnegative(
-    mut c: [[f64; 3]; SH_COEFFICIENTS],
-    normal: DVec3,
-    values: &[[f64; 3]],
-) -> [[f64; 3]; SH_COEFFICIENTS] {
-    if values.is_empty() {
-        return c;
-    }
-    let mut check = hemisphere_directions(normal, CHECK_DIRECTIONS);
-    // The horizon too: a quadratic's least may lie on the boundary.
-    let (t, b) = normal.any_orthonormal_pair();
-    check.extend((0..CHECK_DIRECTIONS / 4).map(|k| {
-        let phi = std::f64::consts::TAU * k as f64 / (CHECK_DIRECTIONS / 4) as f64;
-        t * phi.cos() + b * phi.sin()
-    }));
-    let y0 = sh_basis(normal)[0];
-    for ch in 0..3 {
-        let m = (values.iter().map(|v| v[ch]).sum::<f64>() / values.len() as f64).max(0.0);
-        let lowest = check
-            .iter()
-            .map(|&d| sh_eval(&c, d)[ch])
-            .fold(f64::INFINITY, f64::min);
-        if lowest >= 0.0 {
-            continue;
-        }
-        let t = if m > 0.0 { m / (m - lowest) } else { 0.0 };
-        for (j, cj) in c.iter_mut().enumerate() {
-            cj[ch] *= t;
-            if j == 0 {
-                cj[ch] += (1.0 - t) * m / y0;
-            }
-        }
-    }
-    c
+/// How a vertex's glossy light is written ([`SLOTS`] RGB slots).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum GlossyForm {
+    /// Order-2 real spherical harmonics alone, slots 0..9 (`_TRILUX_SH0..8`).
+    Sh2,
+    /// Order-2 harmonics plus one spherical Gaussian (module `lobe`):
+    /// slots 0..9 (`_TRILUX_SH0..8`), the lobe's axis × sharpness
+    /// (`_TRILUX_LOBE`) and its RGB amplitude (`_TRILUX_LOBE_RGB`).
+    #[default]
+    Lobe,
 }
 
-/// Directions over the hemisphere at which [`nonnegative`] checks a fit.
-pub const CHECK_DIRECTIONS: usize = 256;
+impl GlossyForm {
+    /// The form's value towards unit `d`, per channel.
+    pub fn eval(self, c: &GlossyRecord, d: DVec3) -> [f64; 3] {
+        match self {
+            GlossyForm::Sh2 => sh_eval(&sh_part(c), d),
+            GlossyForm::Lobe => crate::lobe::lobe_eval(c, d),
+        }
+    }
+
+    /// The least-squares fit to `values` towards `directions`.
+    pub fn fit(self, directions: &[DVec3], values: &[[f64; 3]]) -> Option<GlossyRecord> {
+        match self {
+            GlossyForm::Sh2 => fit_sh(directions, values).map(|c| {
+                let mut r = [[0.0; 3]; SLOTS];
+                r[..SH_COEFFICIENTS].copy_from_slice(&c);
+                r
+            }),
+            GlossyForm::Lobe => crate::lobe::fit_lobe(directions, values),
+        }
+    }
+
+    /// The glTF attribute of each slot used.
+    pub fn attributes(self) -> &'static [&'static str] {
+        match self {
+            GlossyForm::Sh2 => &[
+                "_TRILUX_SH0", "_TRILUX_SH1", "_TRILUX_SH2", "_TRILUX_SH3", "_TRILUX_SH4",
+                "_TRILUX_SH5", "_TRILUX_SH6", "_TRILUX_SH7", "_TRILUX_SH8",
+            ],
+            GlossyForm::Lobe => &[
+                "_TRILUX_SH0", "_TRILUX_SH1", "_TRILUX_SH2", "_TRILUX_SH3", "_TRILUX_SH4",
+                "_TRILUX_SH5", "_TRILUX_SH6", "_TRILUX_SH7", "_TRILUX_SH8", "_TRILUX_LOBE",
+                "_TRILUX_LOBE_RGB",
+            ],
+        }
+    }
+
+    /// The name the materials' `extras.trilux.glossy` gives it.
+    pub fn name(self) -> &'static str {
+        match self {
+            GlossyForm::Sh2 => "sh2",
+            GlossyForm::Lobe => "sh2+lobe",
+        }
+    }
+}
 
 /// Solves A x = b (A symmetric positive definite) by Cholesky, three
 /// right-hand sides at once.
-fn cholesky_solve<const M: usize>(a: [[f64; M]; M], b: [[f64; 3]; M]) -> Option<[[f64; 3]; M]> {
+pub(crate) fn cholesky_solve<const M: usize>(a: [[f64; M]; M], b: [[f64; 3]; M]) -> Option<[[f64; 3]; M]> {
     let mut l = [[0.0; M]; M];
     for j in 0..M {
         let d = a[j][j] - (0..j).map(|k| l[j][k] * l[j][k]).sum::<f64>();
@@ -219,29 +241,34 @@ fn cholesky_solve<const M: usize>(a: [[f64; M]; M], b: [[f64; 3]; M]) -> Option<
     Some(x)
 }
 
-/// The fitted coefficients of every vertex of `points`' side (zero for
-/// vertices not in `points`), each made [`nonnegative`]: asks `light` in
+/// The fitted `form` of every vertex of `points`' side (zero for
+/// vertices not in `points`): asks `light` in
 /// batches of [`BATCH_POINTS`] points, `n_dir` directions each.
 pub(crate) fn fit_vertices(
     light: &dyn GlossyLight,
     points: &[(usize, GlossyPoint)],
     vertices: usize,
-    (n_dir, samples): (usize, GlossySamples),
-) -> Vec<[[f64; 3]; SH_COEFFICIENTS]> {
-    let mut out = vec![[[0.0; 3]; SH_COEFFICIENTS]; vertices];
+    (form, n_dir, samples): (GlossyForm, usize, GlossySamples),
+) -> Vec<GlossyRecord> {
+    let mut out = vec![[[0.0; 3]; SLOTS]; vertices];
     for batch in points.chunks(BATCH_POINTS) {
-        let normals: Vec<DVec3> = batch.iter().map(|(_, p)| p.normal * p.side.sign()).collect();
-        let dirs: Vec<Vec<DVec3>> = normals
+        let dirs: Vec<Vec<DVec3>> = batch
             .iter()
-            .map(|&n| hemisphere_directions(n, n_dir))
+            .map(|(_, p)| hemisphere_directions(p.normal * p.side.sign(), n_dir))
             .collect();
         let flat: Vec<DVec3> = dirs.iter().flatten().copied().collect();
         let only: Vec<GlossyPoint> = batch.iter().map(|(_, p)| *p).collect();
         let values = light.outgoing(&only, &flat, samples);
-        for (k, ((v, _), d)) in batch.iter().zip(&dirs).enumerate() {
-            let measured = values.get(k * n_dir..(k + 1) * n_dir).unwrap_or(&[]);
-            if let Some(c) = fit_sh(d, measured) {
-                out[*v] = nonnegative(c, normals[k], measured);
+        let fits: Vec<Option<GlossyRecord>> = (0..batch.len())
+            .into_par_iter()
+            .map(|k| {
+                let measured = values.get(k * n_dir..(k + 1) * n_dir).unwrap_or(&[]);
+                form.fit(&dirs[k], measured)
+            })
+            .collect();
+        for ((v, _), fit) in batch.iter().zip(fits) {
+            if let Some(c) = fit {
+                out[*v] = c;
             }
         }
     }
@@ -330,40 +357,5 @@ mod tests {
         let fit = mean(&|d| sh_eval(&c, d)[0]);
         assert!(data > 0.0);
         assert!((fit - data).abs() < 1e-9 * data.max(1.0), "{fit} vs {data}");
-    }
-
-    /// A narrow lobe (cos⁴⁰ about a grazing axis) rings below zero when
-    /// fitted; [`nonnegative`] lifts it to ≥ 0 over a hemisphere finer
-    /// than its own check set (1000 directions) while the mean over the
-    /// sample directions stays the data's; a lobe the fit follows without
-    /// ringing (a quadratic ≥ 0.2) is left as it was.
-    #[test]
-    fn nonnegative_fits_keep_the_mean() {
-        let n = DVec3::new(0.0, 0.0, 1.0);
-        let axis = DVec3::new(0.8, 0.0, 0.6);
-        let dirs = hemisphere_directions(n, 48);
-        let vals: Vec<[f64; 3]> = dirs
-            .iter()
-            .map(|d| [d.dot(axis).max(0.0).powi(40), 0.2 + d.x * d.x, 0.0])
-            .collect();
-        let raw = fit_sh(&dirs, &vals).unwrap();
-        let fine = hemisphere_directions(n, 1000);
-        let lowest = |c: &[[f64; 3]; 9], ch: usize| {
-            fine.iter()
-                .map(|&d| sh_eval(c, d)[ch])
-                .fold(f64::INFINITY, f64::min)
-        };
-        assert!(lowest(&raw, 0) < -0.01, "the raw fit rings: {}", lowest(&raw, 0));
-        let c = nonnegative(raw, n, &vals);
-        assert!(lowest(&c, 0) > -1e-3 * sh_eval(&c, axis)[0], "{}", lowest(&c, 0));
-        for ch in 0..3 {
-            let data = vals.iter().map(|v| v[ch]).sum::<f64>() / 48.0;
-            let fit = dirs.iter().map(|&d| sh_eval(&c, d)[ch]).sum::<f64>() / 48.0;
-            assert!((fit - data).abs() <= 1e-6 * data.max(1e-3), "{ch}: {fit} vs {data}");
-        }
-        for d in &fine {
-            let (a, b) = (sh_eval(&raw, *d)[1], sh_eval(&c, *d)[1]);
-            assert!((a - b).abs() < 1e-12, "the quadratic changed: {a} vs {b}");
-        }
     }
 }
