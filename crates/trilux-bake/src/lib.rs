@@ -23,6 +23,7 @@
 //! - [`directional`]: the glossy light of glossy sides per vertex,
 //!   fitted from a [`GlossyLight`]: order-1 spherical harmonics plus one
 //!   spherical Gaussian ([`lobe`]), or order-2 harmonics.
+//! - [`sh`]: order-2 real spherical harmonics and their least-squares fit.
 //! - `glb`: the glTF JSON and the binary container.
 //! - [`bake()`](bake()): the whole, with its [`BakeStats`].
 //! - [`mod@error`]: the error type, [`BakeError`].
@@ -36,6 +37,7 @@ pub mod error;
 mod glb;
 pub mod lobe;
 pub mod reconstruct;
+pub mod sh;
 mod tessellate;
 
 pub use bake::{BakeInput, BakeOptions, BakeStats, Baked, MIN_GLOSSY_DIRECTIONS, bake};

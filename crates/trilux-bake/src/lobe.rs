@@ -18,19 +18,28 @@
 
 use glam::DVec3;
 
-use crate::directional::{GlossyRecord, SH_COEFFICIENTS, SLOTS, cholesky_solve, sh_basis};
+use crate::sh::{GlossyRecord, SH_COEFFICIENTS, SLOTS, cholesky_solve, sh_basis};
 
 /// Coefficients of the harmonics beside the lobe (order 2).
 const BASE: usize = SH_COEFFICIENTS;
 /// Sharpnesses tried for the lobe (half width at half maximum
-/// acos(1 − ln 2 / λ): 49° down to 6°).
-pub const SHARPNESS: [f64; 7] = [2.0, 4.0, 8.0, 16.0, 32.0, 64.0, 128.0];
+/// acos(1 − ln 2 / λ): 49° down to 8.5°).
+pub const SHARPNESS: [f64; 6] = [2.0, 4.0, 8.0, 16.0, 32.0, MAX_SHARPNESS];
+/// The sharpest lobe: 8.5° half width, about half the spacing of 96
+/// directions over a hemisphere (15°); a sharper one would follow one
+/// direction's noise, not a highlight the directions resolve.
+pub const MAX_SHARPNESS: f64 = 64.0;
+/// The share of the harmonics' squared residual a lobe must remove to be
+/// kept. The estimates' noise is itself lobe-shaped (each incident
+/// sample adds a BSDF lobe about its mirror direction), and a lobe fitted
+/// to it would take its energy from the directions a camera mostly sees.
+pub const SIGNIFICANCE: f64 = 0.25;
 /// Directions with the largest residual tried as the lobe's axis.
 const AXIS_CANDIDATES: usize = 8;
 /// Refinements of the best candidate (centroid step and finer sharpness).
 const REFINE_STEPS: usize = 4;
 
-/// Where the fit stores the lobe in a vertex record (`directional`):
+/// Where the fit stores the lobe in a vertex record (`sh::GlossyRecord`):
 /// slots 0..9 the harmonics, then v, then a.
 pub const LOBE_AXIS_SLOT: usize = SH_COEFFICIENTS;
 /// The slot of the lobe's amplitude a.
@@ -132,10 +141,7 @@ fn best_lobe(
 /// The lobe form's fit to the `values` measured towards `directions`
 /// (module docs), in the nine slots of a vertex record; `None` for fewer
 /// directions than unknowns.
-pub fn fit_lobe(
-    directions: &[DVec3],
-    values: &[[f64; 3]],
-) -> Option<GlossyRecord> {
+pub fn fit_lobe(directions: &[DVec3], values: &[[f64; 3]]) -> Option<GlossyRecord> {
     if directions.len() < BASE + 2 || directions.len() != values.len() {
         return None;
     }
@@ -169,23 +175,22 @@ pub fn fit_lobe(
             .map(|(&d, &x)| d * (x.max(0.0) * (lambda * (axis.dot(d) - 1.0)).exp()))
             .sum();
         let axis = centroid.try_normalize().unwrap_or(axis);
-        let ladder: Vec<f64> = (-4..=4).map(|k| lambda * (f64::from(k) / 8.0).exp2()).collect();
+        let ladder: Vec<f64> = (-4..=4)
+            .map(|k| lambda * (f64::from(k) / 8.0).exp2())
+            .collect();
         match best_lobe(&o1, directions, &r, &[axis], &ladder) {
             Some(better) if better.2 > gain => lobe = Some(better),
             _ => break,
         }
     }
+    let lobe = lobe.filter(|l| l.2 >= SIGNIFICANCE * left);
     Some(colours(directions, values, lobe.map(|(a, l, _)| a * l)))
 }
 
 /// The harmonics' and the lobe's RGB weights by least squares, with the
 /// lobe `v` (axis × sharpness) fixed; a channel whose amplitude comes out
 /// negative is fitted by the harmonics alone.
-fn colours(
-    directions: &[DVec3],
-    values: &[[f64; 3]],
-    v: Option<DVec3>,
-) -> GlossyRecord {
+fn colours(directions: &[DVec3], values: &[[f64; 3]], v: Option<DVec3>) -> GlossyRecord {
     const M: usize = BASE + 1;
     let v = v.unwrap_or(DVec3::ZERO);
     let row = |d: DVec3| {
@@ -216,7 +221,11 @@ fn colours(
     let without = solve(BASE);
     let mut out = [[0.0; 3]; SLOTS];
     for ch in 0..3 {
-        let pick = if with[BASE][ch] >= 0.0 { &with } else { &without };
+        let pick = if with[BASE][ch] >= 0.0 {
+            &with
+        } else {
+            &without
+        };
         for j in 0..BASE {
             out[j][ch] = pick[j][ch];
         }
@@ -229,7 +238,7 @@ fn colours(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::directional::{fit_sh, hemisphere_directions, sh_eval};
+    use crate::sh::{fit_sh, hemisphere_directions, sh_eval};
 
     /// A constant plus a spherical Gaussian whose axis lies between the
     /// sample directions is fitted back: the fitted form matches the data
@@ -244,7 +253,10 @@ mod tests {
             [0.2 + g, 0.1 + 0.5 * g, 0.05 * d.y + 0.8 * g]
         };
         let dirs = hemisphere_directions(n, 96);
-        assert!(dirs.iter().all(|d| d.dot(axis) < 0.995), "no sample on the axis");
+        assert!(
+            dirs.iter().all(|d| d.dot(axis) < 0.995),
+            "no sample on the axis"
+        );
         let vals: Vec<[f64; 3]> = dirs.iter().map(|&d| truth(d)).collect();
         let c = fit_lobe(&dirs, &vals).unwrap();
         let sh = fit_sh(&dirs, &vals).unwrap();

@@ -224,15 +224,16 @@ impl<S> LinkGather<'_, S> {
         }
         for k in 0..counts.light {
             sampler.start_sample(counts.gather + k);
-            let (pick, u) = (sampler.get1(dims::GATHER + 3), sampler.get2(dims::GATHER + 4));
+            let (pick, u) = (
+                sampler.get1(dims::GATHER + 3),
+                sampler.get2(dims::GATHER + 4),
+            );
             if let Some((wi, le, p_light)) = unoccluded_light(scene, x, pick, u, stats) {
                 let p_mix = scene.glossy_fan(x, wi, wos, &mut fan);
                 add(&fan, le * (1.0 / (nl * p_light + ng * p_mix)));
             }
         }
-        out.iter()
-            .map(|&l| stats.finite_or_dropped(l))
-            .collect()
+        out.iter().map(|&l| stats.finite_or_dropped(l)).collect()
     }
 
     /// The cosine ray's share of the irradiance at a Lambertian `x` at

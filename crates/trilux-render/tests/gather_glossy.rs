@@ -329,7 +329,8 @@ fn shared_incident_samples_match_brute_force_in_every_direction() {
         };
         let mut sampler = trilux_render::PixelSampler::new(3, 1, 2);
         let (mut caches, mut stats) = (Caches::<3>::default(), GatherStats::default());
-        let got = gather.glossy_directions(&point, &wos, counts, &mut sampler, &mut caches, &mut stats);
+        let got =
+            gather.glossy_directions(&point, &wos, counts, &mut sampler, &mut caches, &mut stats);
         let expected: Vec<f64> = wos.iter().map(|&wo| scene.brute_force(x, wo)).collect();
         let top = expected.iter().copied().fold(0.0, f64::max);
         assert!(top > 0.1, "{dist:?} α={alpha}: {top} too dark to test");
@@ -340,7 +341,10 @@ fn shared_incident_samples_match_brute_force_in_every_direction() {
             } else {
                 (g - e).abs() < 0.03 * e
             };
-            assert!(ok, "{dist:?} α={alpha} towards {wo}: {g} against brute force {e}");
+            assert!(
+                ok,
+                "{dist:?} α={alpha} towards {wo}: {g} against brute force {e}"
+            );
         }
     }
 }

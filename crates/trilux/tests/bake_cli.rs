@@ -454,7 +454,7 @@ fn glossy_tube_bakes_to_its_solution() {
 }
 
 /// The glossy tube's glossy light: left out and marked with
-/// `--no-glossy`, as spherical harmonics on the glossy sides by default
+/// `--no-glossy`, as harmonics and a lobe on the glossy sides by default
 /// (the same solution, the same diffuse light).
 #[test]
 fn glossy_light_is_baked_unless_left_out() {
@@ -485,14 +485,17 @@ fn glossy_light_is_baked_unless_left_out() {
             .count();
         let sh2 = materials
             .iter()
-            .filter(|m| m["extras"]["trilux"]["glossy"] == "sh2")
+            .filter(|m| m["extras"]["trilux"]["glossy"] == "sh2+lobe")
             .count();
         let with_sh = json["meshes"]
             .as_array()
             .unwrap()
             .iter()
             .flat_map(|m| m["primitives"].as_array().unwrap())
-            .filter(|p| p["attributes"].get("_TRILUX_SH8").is_some())
+            .filter(|p| {
+                let a = &p["attributes"];
+                a.get("_TRILUX_SH8").is_some() && a.get("_TRILUX_LOBE_RGB").is_some()
+            })
             .count();
         let radiance: Vec<[f32; 3]> = prims.into_iter().flat_map(|p| p.radiance).collect();
         (left_out, sh2, with_sh, radiance)
