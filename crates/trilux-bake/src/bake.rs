@@ -29,7 +29,9 @@ use trilux_solver::{ElementTextures, Solution};
 
 use crate::albedo::{AlbedoMap, albedo_map};
 use crate::camera::BakeCamera;
-use crate::directional::{GlossyLight, GlossyPoint, SH_COEFFICIENTS, fit_vertices};
+use crate::directional::{
+    GlossyForm, GlossyLight, GlossyPoint, GlossyRecord, GlossySamples, fit_vertices,
+};
 use crate::error::BakeError;
 use crate::glb::Document;
 use crate::reconstruct::{baked_flux, vertex_values};
@@ -63,24 +65,32 @@ pub struct BakeOptions {
     /// without, their radiance goes into the vertex colours like any other
     /// (smaller files, texture detail finer than the leaves lost).
     pub albedo_maps: bool,
-    /// Fit the glossy light of glossy sides as spherical harmonics
-    /// (module `directional`; slow on large scenes, so off by default:
-    /// the glossy light is then left out and its materials marked).
+    /// Fit the glossy light of glossy sides per vertex (module
+    /// `directional`; on by default: without, the glossy light is left out
+    /// and its materials marked).
     pub glossy: bool,
+    /// The glossy light's form (order-1 harmonics and a lobe, or order-2
+    /// harmonics).
+    pub glossy_form: GlossyForm,
     /// Directions per vertex over which the glossy light is fitted
-    /// (module `directional`; at least 9).
+    /// (module `directional`; at least [`MIN_GLOSSY_DIRECTIONS`]). Cheap:
+    /// every direction reuses the vertex's incident samples.
     pub glossy_directions: u32,
-    /// Estimates of the glossy light per direction and vertex (0: leave
-    /// glossy light out).
+    /// BSDF-sampled gather rays per vertex, shared by its directions (0:
+    /// leave glossy light out).
     pub glossy_samples: u32,
-    /// Most estimates of glossy light in one bake (vertices × directions
-    /// × samples): a larger bake takes fewer samples per direction, then
-    /// fewer directions, down to [`MIN_GLOSSY_DIRECTIONS`] and one sample.
+    /// Light samples per vertex, shared by its directions.
+    pub glossy_light_samples: u32,
+    /// Gather hits read through their links, as the full render does
+    /// (slower); without, the solution's radiance there.
+    pub glossy_links: bool,
+    /// Most incident samples of glossy light in one bake (vertices ×
+    /// (gather rays + light samples)): a larger bake takes fewer per
+    /// vertex, down to a quarter of each (at least one).
     pub glossy_budget: u64,
 }
 
-/// Fewest directions a vertex's glossy light is fitted over (a budget
-/// stops lowering them here).
+/// Fewest directions a vertex's glossy light is fitted over.
 pub const MIN_GLOSSY_DIRECTIONS: u32 = 16;
 
 impl Default for BakeOptions {
@@ -88,9 +98,12 @@ impl Default for BakeOptions {
         BakeOptions {
             exposure: 0.0,
             albedo_maps: true,
-            glossy: false,
-            glossy_directions: 48,
-            glossy_samples: 4,
+            glossy: true,
+            glossy_form: GlossyForm::Lobe,
+            glossy_directions: 96,
+            glossy_samples: 16,
+            glossy_light_samples: 8,
+            glossy_links: false,
             glossy_budget: 8_000_000,
         }
     }
@@ -152,7 +165,13 @@ pub fn bake<const N: usize>(
             light.sh = glossy.fit(input, options, mesh, side, vertices);
             light
         });
-        write_shape(&mut doc, input, mesh, &sides, options.exposure.exp2())?;
+        write_shape(
+            &mut doc,
+            input,
+            mesh,
+            &sides,
+            (options.exposure.exp2(), options.glossy_form),
+        )?;
         vertices += mesh.positions.len();
         triangles += 2 * mesh.triangles.len();
     }
@@ -199,7 +218,7 @@ struct SideLight<'t, const N: usize> {
     textures: Option<&'t ElementTextures<N>>,
     /// The glossy light's SH coefficients per vertex (module
     /// `directional`), on a glossy side when the bake has them.
-    sh: Option<Vec<[[f64; 3]; SH_COEFFICIENTS]>>,
+    sh: Option<Vec<GlossyRecord>>,
 }
 
 impl<'t, const N: usize> SideLight<'t, N> {
@@ -256,14 +275,15 @@ impl<'t, const N: usize> SideLight<'t, N> {
 
 /// The glossy light's fits: directions and samples per vertex, counted.
 struct GlossyCount {
+    form: GlossyForm,
     directions: usize,
-    samples: u32,
+    samples: GlossySamples,
     vertices: usize,
     seconds: f64,
 }
 
 impl GlossyCount {
-    /// Directions and samples within `options.glossy_budget` for every
+    /// Directions and incident samples within `options.glossy_budget` for every
     /// used vertex of every glossy side of `meshes`.
     fn new<const N: usize>(
         input: &BakeInput<'_, N>,
@@ -287,12 +307,23 @@ impl GlossyCount {
             }
         }
         let per_vertex = options.glossy_budget.checked_div(total).unwrap_or(u64::MAX);
-        let wanted = u64::from(options.glossy_directions.max(MIN_GLOSSY_DIRECTIONS));
-        let directions = wanted.min(per_vertex.max(u64::from(MIN_GLOSSY_DIRECTIONS)));
-        let samples = (per_vertex / directions).clamp(1, u64::from(options.glossy_samples.max(1)));
+        let (gather, light) = (
+            u64::from(options.glossy_samples),
+            u64::from(options.glossy_light_samples),
+        );
+        // Within the budget, both counts scaled alike, to a quarter at least.
+        let scale = |n: u64| {
+            let fit = (n * per_vertex).checked_div(gather + light).unwrap_or(n);
+            fit.clamp(n.div_ceil(4).max(1), n.max(1)) as u32
+        };
         GlossyCount {
-            directions: directions as usize,
-            samples: samples as u32,
+            form: options.glossy_form,
+            directions: options.glossy_directions.max(MIN_GLOSSY_DIRECTIONS) as usize,
+            samples: GlossySamples {
+                gather: scale(gather),
+                light: scale(light),
+                links: options.glossy_links,
+            },
             vertices: 0,
             seconds: 0.0,
         }
@@ -309,7 +340,7 @@ impl GlossyCount {
         mesh: &ShapeMesh,
         side: Side,
         first: usize,
-    ) -> Option<Vec<[[f64; 3]; SH_COEFFICIENTS]>> {
+    ) -> Option<Vec<GlossyRecord>> {
         let light = input.glossy.filter(|_| options.glossy)?;
         let scene = input.solution.scene();
         if !scene.material(mesh.shape as usize).has_glossy(side) {
@@ -340,7 +371,7 @@ impl GlossyCount {
         if options.glossy_samples == 0 {
             return None;
         }
-        let sizes = (self.directions, self.samples);
+        let sizes = (self.form, self.directions, self.samples);
         let sh = fit_vertices(light, &points, mesh.positions.len(), sizes);
         self.vertices += points.len();
         self.seconds += start.elapsed().as_secs_f64();
@@ -354,7 +385,7 @@ fn write_shape<const N: usize>(
     input: &BakeInput<'_, N>,
     mesh: &ShapeMesh,
     sides: &[SideLight<'_, N>; 2],
-    scale: f64,
+    scale: (f64, GlossyForm),
 ) -> Result<(), BakeError> {
     for light in sides {
         let sh = light.sh.iter().flatten().flatten().flatten();
@@ -433,7 +464,7 @@ fn side_primitives<const N: usize>(
     shape: u32,
     light: &SideLight<'_, N>,
     (shared, surfaces): (&SharedAttributes, &[SurfaceTriangles]),
-    scale: f64,
+    (scale, form): (f64, GlossyForm),
 ) -> Result<Vec<Value>, BakeError> {
     let side = light.side;
     let radiance: Vec<[f32; 3]> = light.values.iter().map(|c| c.map(|x| x as f32)).collect();
@@ -448,7 +479,7 @@ fn side_primitives<const N: usize>(
     m["extras"]["trilux"]["glossy_left_out"] =
         json!(light.sh.is_none() && glossy_side(input, shape, side));
     if light.sh.is_some() {
-        m["extras"]["trilux"]["glossy"] = json!("sh2");
+        m["extras"]["trilux"]["glossy"] = json!(form.name());
     }
     if let Some(map) = &light.map {
         let png = map.png().map_err(|e| BakeError::Image(e.to_string()))?;
@@ -467,9 +498,9 @@ fn side_primitives<const N: usize>(
         attributes["TEXCOORD_0"] = json!(uv);
     }
     if let Some(sh) = &light.sh {
-        for j in 0..SH_COEFFICIENTS {
+        for (j, name) in form.attributes().iter().enumerate() {
             let c: Vec<[f32; 3]> = sh.iter().map(|v| v[j].map(|x| x as f32)).collect();
-            attributes[format!("_TRILUX_SH{j}")] = json!(doc.vec3(&c, false));
+            attributes[*name] = json!(doc.vec3(&c, false));
         }
     }
     let mut primitives = Vec::new();
@@ -578,7 +609,7 @@ fn asset(options: &BakeOptions) -> Value {
             "colour": "_RADIANCE is linear Rec. 709 radiance (W sr^-1 m^-2 per channel); COLOR_0 is it times 2^exposure, clamped to [0, 1]",
             "baked": "the view-independent (Lambertian) light of the solution, emission included",
             "left_out": "the glossy (view-dependent) reflection of materials marked glossy_left_out",
-            "glossy": "on materials marked glossy: \"sh2\", the glossy outgoing radiance towards a world direction w is max(0, sum_j _TRILUX_SHj * Y_j(w)), Y the order-2 real spherical harmonics (Y_0 = 0.282095, Y_1..3 = 0.488603 (y, z, x), Y_4 = 1.092548 xy, Y_5 = 1.092548 yz, Y_6 = 0.315392 (3z^2 - 1), Y_7 = 1.092548 xz, Y_8 = 0.546274 (x^2 - y^2)), added to _RADIANCE",
+            "glossy": "on materials marked glossy, the glossy outgoing radiance towards a world direction w (unit, from the point to the eye), added to _RADIANCE: \"sh2+lobe\": max(0, sum_{j<9} _TRILUX_SHj * Y_j(w) + _TRILUX_LOBE_RGB * exp(dot(v, w) - |v|)), v = _TRILUX_LOBE; \"sh2\": max(0, sum_{j<9} _TRILUX_SHj * Y_j(w)); Y the real spherical harmonics Y_0 = 0.282095, Y_1..3 = 0.488603 (y, z, x), Y_4 = 1.092548 xy, Y_5 = 1.092548 yz, Y_6 = 0.315392 (3z^2 - 1), Y_7 = 1.092548 xz, Y_8 = 0.546274 (x^2 - y^2)",
         } },
     })
 }

@@ -2,7 +2,8 @@
 //!
 //! Layer: above `trilux-solver` (it reads a [`trilux_solver::Solution`])
 //! and beside `trilux-render`; the `trilux` crate's pipeline calls it. Depends on
-//! `trilux-color`, `trilux-geometry`, `trilux-brdf` and `trilux-solver`.
+//! `trilux-color`, `trilux-geometry`, `trilux-brdf` and `trilux-solver`
+//! (and rayon, to fit vertices in parallel).
 //!
 //! A view-independent solution is what a walkthrough needs: solve once,
 //! look around freely. [`bake()`](bake()) writes the solution's view-independent
@@ -19,8 +20,10 @@
 //!   flux-conserving averaging (the rule and its error bound are there).
 //! - `albedo`: textured materials as an albedo map times the light.
 //! - `camera`: the scene's camera ([`BakeCamera`]) as a glTF camera node.
-//! - [`directional`]: the glossy light of glossy sides as spherical
-//!   harmonics per vertex, fitted from a [`GlossyLight`].
+//! - [`directional`]: the glossy light of glossy sides per vertex,
+//!   fitted from a [`GlossyLight`]: order-1 spherical harmonics plus one
+//!   spherical Gaussian ([`lobe`]), or order-2 harmonics.
+//! - [`sh`]: order-2 real spherical harmonics and their least-squares fit.
 //! - `glb`: the glTF JSON and the binary container.
 //! - [`bake()`](bake()): the whole, with its [`BakeStats`].
 //! - [`mod@error`]: the error type, [`BakeError`].
@@ -32,11 +35,13 @@ mod camera;
 pub mod directional;
 pub mod error;
 mod glb;
+pub mod lobe;
 pub mod reconstruct;
+pub mod sh;
 mod tessellate;
 
 pub use bake::{BakeInput, BakeOptions, BakeStats, Baked, MIN_GLOSSY_DIRECTIONS, bake};
 pub use camera::BakeCamera;
-pub use directional::{GlossyLight, GlossyPoint};
+pub use directional::{GlossyForm, GlossyLight, GlossyPoint, GlossySamples};
 pub use error::BakeError;
 pub use tessellate::ShapeMesh;

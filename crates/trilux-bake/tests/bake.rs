@@ -249,7 +249,7 @@ impl trilux_bake::GlossyLight for Quadratic {
         &self,
         points: &[trilux_bake::GlossyPoint],
         directions: &[DVec3],
-        _samples: u32,
+        _samples: trilux_bake::GlossySamples,
     ) -> Vec<[f64; 3]> {
         let per = directions.len() / points.len();
         directions
@@ -280,7 +280,7 @@ fn sh(w: DVec3) -> [f64; 9] {
 }
 
 #[test]
-fn a_glossy_floor_carries_its_glossy_light_as_spherical_harmonics() {
+fn a_glossy_floor_carries_its_glossy_light_as_harmonics_and_a_lobe() {
     let shapes = box_shapes();
     let mut bsdfs = vec![
         BsdfParams::Diffuse {
@@ -314,8 +314,10 @@ fn a_glossy_floor_carries_its_glossy_light_as_spherical_harmonics() {
         camera: None,
         glossy: Some(&Quadratic),
     };
-    // Off by default: the glossy light is left out and the floor marked.
-    let plain = bake(&input, &BakeOptions::default()).expect("the box bakes");
+    // Without: the glossy light is left out and the floor marked.
+    let mut without = BakeOptions::default();
+    without.glossy = false;
+    let plain = bake(&input, &without).expect("the box bakes");
     let (json, _) = chunks(&plain.glb);
     assert!(!String::from_utf8_lossy(&plain.glb).contains("_TRILUX_SH0"));
     let left_out = json["materials"]
@@ -326,9 +328,8 @@ fn a_glossy_floor_carries_its_glossy_light_as_spherical_harmonics() {
         .count();
     assert_eq!(left_out, 1, "the floor's front is marked");
     assert_eq!(plain.stats.glossy_vertices, 0);
-    let mut options = BakeOptions::default();
-    options.glossy = true;
-    let baked = bake(&input, &options).expect("the box bakes");
+    // On by default.
+    let baked = bake(&input, &BakeOptions::default()).expect("the box bakes");
     let (json, bin) = chunks(&baked.glb);
     gltf::Gltf::from_slice(&baked.glb).expect("the gltf crate reads the file");
     let mut glossy_primitives = 0;
@@ -345,7 +346,9 @@ fn a_glossy_floor_carries_its_glossy_light_as_spherical_harmonics() {
                 continue;
             }
             glossy_primitives += 1;
-            assert_eq!(material["extras"]["trilux"]["glossy"], "sh2");
+            assert_eq!(material["extras"]["trilux"]["glossy"], "sh2+lobe");
+            let lobe = vec3s(&json, bin, &attrs["_TRILUX_LOBE"]);
+            let amplitude = vec3s(&json, bin, &attrs["_TRILUX_LOBE_RGB"]);
             let positions = vec3s(&json, bin, &attrs["POSITION"]);
             let normals = vec3s(&json, bin, &attrs["NORMAL"]);
             let c: Vec<Vec<DVec3>> = (0..9)
@@ -359,7 +362,10 @@ fn a_glossy_floor_carries_its_glossy_light_as_spherical_harmonics() {
                     (n - 0.9 * DVec3::Y).normalize(),
                 ] {
                     let y = sh(w);
-                    let got: DVec3 = (0..9).map(|j| c[j][v] * y[j]).sum();
+                    // The lobe adds nothing the harmonics span.
+                    let g = (lobe[v].dot(w) - lobe[v].length()).exp();
+                    let got: DVec3 =
+                        (0..9).map(|j| c[j][v] * y[j]).sum::<DVec3>() + amplitude[v] * g;
                     let want = DVec3::from_array(quadratic(p, w));
                     assert!(
                         (got - want).abs().max_element() < 1e-4,

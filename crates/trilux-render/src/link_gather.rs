@@ -154,6 +154,100 @@ impl<S> LinkGather<'_, S> {
         w.stats.finite_or_dropped(l)
     }
 
+    /// The glossy part of the radiance leaving `x` towards each of `wos`
+    /// (unit vectors), from one set of incident samples shared by all of
+    /// them (for directional bakes): `counts.gather` BSDF-sampled gather
+    /// rays, sample k drawn from the lobe of direction ⌊(k + u)·D/K⌋ (the
+    /// strata together draw from the mixture of all D lobes), and
+    /// `counts.light` light samples. Every sample serves every direction,
+    /// weighted by the balance heuristic over the lobe mixture and light
+    /// sampling (Veach's multi-sample estimator, unbiased): what a sample
+    /// brings (the gather hit read as [`LinkGather::glossy_sample`] reads
+    /// it, or from the solution: `counts.links`) is paid for once, not
+    /// once per direction.
+    pub fn glossy_directions<const N: usize>(
+        &self,
+        x: &SurfacePoint<S::Locator>,
+        wos: &[DVec3],
+        counts: IncidentSamples,
+        sampler: &mut PixelSampler,
+        caches: &mut Caches<N>,
+        stats: &mut GatherStats,
+    ) -> Vec<Spectrum<N>>
+    where
+        S: SolutionGather<N>,
+    {
+        let mut out = vec![Spectrum::zero(); wos.len()];
+        if wos.is_empty() {
+            return out;
+        }
+        let (ng, nl) = (f64::from(counts.gather), f64::from(counts.light));
+        let scene = self.scene;
+        let mut fan = Vec::with_capacity(wos.len());
+        let mut add = |fan: &[Spectrum<N>], l: Spectrum<N>| {
+            for (o, f) in out.iter_mut().zip(fan) {
+                *o += *f * l;
+            }
+        };
+        for k in 0..counts.gather {
+            sampler.start_sample(k);
+            let stratum = (f64::from(k) + sampler.get1(dims::GATHER)) / ng;
+            let j = ((stratum * wos.len() as f64) as usize).min(wos.len() - 1);
+            let Some(bs) = scene.sample_bsdf(x, wos[j], sampler.get2(dims::GATHER + 1)) else {
+                continue;
+            };
+            if !(bs.pdf.is_finite() && bs.pdf > 0.0) {
+                continue;
+            }
+            let p_mix = scene.glossy_fan(x, bs.wi, wos, &mut fan);
+            if p_mix <= 0.0 {
+                continue;
+            }
+            stats.gather_rays += 1;
+            let Some(xd) = scene.intersect(x.point, bs.wi) else {
+                continue;
+            };
+            let back = -bs.wi;
+            let mut w = Walk {
+                sampler: &*sampler,
+                caches: &mut *caches,
+                stats: &mut *stats,
+            };
+            let level = if counts.links { 1 } else { LINK_LEVELS + 1 };
+            let mut l = self.reflected_at(&xd, x, back, level, &mut w) * (1.0 / (ng * p_mix));
+            let le = scene.emitted(&xd, back);
+            if !le.is_black() {
+                let p_light = light_density(scene, &xd, back);
+                l += le * (1.0 / (ng * p_mix + nl * p_light));
+            }
+            add(&fan, l);
+        }
+        for k in 0..counts.light {
+            sampler.start_sample(counts.gather + k);
+            let (pick, u) = (
+                sampler.get1(dims::GATHER + 3),
+                sampler.get2(dims::GATHER + 4),
+            );
+            if let Some((wi, le, p_light)) = unoccluded_light(scene, x, pick, u, stats) {
+                let p_mix = scene.glossy_fan(x, wi, wos, &mut fan);
+                add(&fan, le * (1.0 / (nl * p_light + ng * p_mix)));
+            }
+        }
+        // Lights without area: one shadow ray each, no MIS (no ray meets
+        // them), as `punctual_direct` for a single direction.
+        for k in 0..scene.punctual_count() {
+            let Some(p) = scene.punctual_at(k, x) else {
+                continue;
+            };
+            stats.shadow_rays += 1;
+            if !p.irradiance.is_black() && scene.unoccluded(x, p.end) {
+                scene.glossy_fan(x, p.wi, wos, &mut fan);
+                add(&fan, p.irradiance);
+            }
+        }
+        out.iter().map(|&l| stats.finite_or_dropped(l)).collect()
+    }
+
     /// The cosine ray's share of the irradiance at a Lambertian `x` at
     /// gather `level` (module docs): E_g, the glossy radiance it brings,
     /// and at the camera hit the near-field correction where it meets a
@@ -283,6 +377,63 @@ impl<S> LinkGather<'_, S> {
         };
         lambertian + glossy
     }
+}
+
+/// Incident samples per point of [`LinkGather::glossy_directions`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct IncidentSamples {
+    /// BSDF-sampled gather rays.
+    pub gather: u32,
+    /// Light samples (shadow rays).
+    pub light: u32,
+    /// Read a gather hit's reflected light through its links (the full
+    /// render's reading, one glossy level deeper); without, the solution's
+    /// own radiance there (no link sum: many times cheaper, element-sized
+    /// detail in reflections lost).
+    pub links: bool,
+}
+
+/// The solid-angle density with which light sampling reaches the emitting
+/// `xd` seen from direction `back` (0 where it cannot).
+fn light_density<S: SolutionGather<N>, const N: usize>(
+    scene: &S,
+    xd: &SurfacePoint<S::Locator>,
+    back: DVec3,
+) -> f64 {
+    let cos_d = xd.normal.dot(back).abs();
+    let pdf_area = scene.light_pdf_area(xd);
+    if pdf_area > 0.0 && cos_d > 0.0 {
+        pdf_area * xd.t * xd.t / cos_d
+    } else {
+        0.0
+    }
+}
+
+/// A point sampled on an emitter from `x` and visible from it: the unit
+/// direction to it, its radiance and the solid-angle density.
+fn unoccluded_light<S: SolutionGather<N>, const N: usize>(
+    scene: &S,
+    x: &SurfacePoint<S::Locator>,
+    pick: f64,
+    u: glam::DVec2,
+    stats: &mut GatherStats,
+) -> Option<(DVec3, Spectrum<N>, f64)> {
+    let ls = scene.sample_light(x, pick, u)?;
+    let d = ls.point - x.point;
+    let dist2 = d.length_squared();
+    let dist = dist2.sqrt();
+    if dist <= 0.0 || ls.radiance.is_black() {
+        return None;
+    }
+    let cos_light = ls.normal.dot(-d / dist);
+    if !(cos_light > 0.0 && ls.pdf_area > 0.0) {
+        return None;
+    }
+    stats.shadow_rays += 1;
+    if !scene.unoccluded(x, ls.point) {
+        return None;
+    }
+    Some((d / dist, ls.radiance, ls.pdf_area * dist2 / cos_light))
 }
 
 /// The preview estimator: no random rays (module docs).

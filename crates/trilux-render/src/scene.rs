@@ -156,6 +156,23 @@ pub trait SolutionGather<const N: usize>: GatherScene<N> {
     /// base term's departure from Lambertian (which may be negative).
     fn glossy_cos(&self, at: &SurfacePoint<Self::Locator>, wi: DVec3, wo: DVec3) -> Spectrum<N>;
 
+    /// For one incident `wi` at `at` and every one of `wos`:
+    /// [`SolutionGather::glossy_cos`] into `glossy`, and the mean over
+    /// `wos` of [`GatherScene::bsdf_pdf`] returned. A scene may resolve
+    /// the material (its textures) once for all of them.
+    fn glossy_fan(
+        &self,
+        at: &SurfacePoint<Self::Locator>,
+        wi: DVec3,
+        wos: &[DVec3],
+        glossy: &mut Vec<Spectrum<N>>,
+    ) -> f64 {
+        glossy.clear();
+        glossy.extend(wos.iter().map(|&wo| self.glossy_cos(at, wi, wo)));
+        let sum: f64 = wos.iter().map(|&wo| self.bsdf_pdf(at, wo, wi)).sum();
+        sum / wos.len().max(1) as f64
+    }
+
     /// The solution's reflected radiance at `from` towards `towards`
     /// without its Lambertian part (the stored glossy radiance).
     fn reflected_glossy(

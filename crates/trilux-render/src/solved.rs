@@ -425,6 +425,26 @@ impl<const N: usize, S: RadianceSolution<N>> SolutionGather<N> for SolvedScene<'
         self.bsdf(at).eval_non_lambertian(wi, wo) * wi.z.abs()
     }
 
+    fn glossy_fan(
+        &self,
+        at: &SurfacePoint<HitLocator>,
+        wi: DVec3,
+        wos: &[DVec3],
+        glossy: &mut Vec<Spectrum<N>>,
+    ) -> f64 {
+        let frame = Frame::from_normal(at.locator.shading_normal);
+        let bsdf = self.bsdf(at);
+        let wi = frame.to_local(wi);
+        glossy.clear();
+        let mut pdf = 0.0;
+        for &wo in wos {
+            let wo = frame.to_local(wo);
+            glossy.push(bsdf.eval_non_lambertian(wi, wo) * wi.z.abs());
+            pdf += bsdf.pdf(wo, wi);
+        }
+        pdf / wos.len().max(1) as f64
+    }
+
     fn reflected_glossy(
         &self,
         from: &SurfacePoint<HitLocator>,

@@ -146,3 +146,76 @@ fn a_directional_light_gives_e_cos() {
         "sun",
     );
 }
+
+/// The directional bake's estimator (`LinkGather::glossy_directions`)
+/// takes a point light's glossy reflection too: on an open glossy floor
+/// (no area light, nothing for a gather ray to meet) it is exactly, in
+/// every outgoing direction, the light's one term glossy_cos · I / r² —
+/// the same term `punctual_direct` adds for a single direction.
+#[test]
+fn the_bakes_glossy_estimate_reflects_a_point_light_in_every_direction() {
+    use trilux_brdf::{Distribution, RoughConductorParams};
+    use trilux_render::link_gather::{Caches, IncidentSamples, LinkGather};
+    use trilux_render::{GatherScene, SolutionGather};
+    let (p, i) = (DVec3::new(0.3, -0.2, 1.0), 2.0);
+    let shapes = vec![square(DVec3::ZERO, 4.0, false)];
+    let bsdfs = vec![BsdfParams::RoughConductor(RoughConductorParams {
+        distribution: Distribution::Ggx,
+        alpha: 0.3,
+        eta_k: None,
+        specular_reflectance: ColorParam::Float(0.8),
+    })];
+    let desc = SceneDescription {
+        shapes: &shapes,
+        bsdfs: &bsdfs,
+        emission: &[None],
+    };
+    let scene = Arc::new(
+        PreparedScene::<3>::new(&desc)
+            .unwrap()
+            .with_lights(&[(Punctual::Point { position: p }, ColorParam::Float(i))])
+            .unwrap(),
+    );
+    let solution = DirectOnly::new(Arc::clone(&scene));
+    let solved = SolvedScene::new(&solution);
+    let gather = LinkGather {
+        scene: &solved,
+        fallback: FinalGather {
+            scene: &solved,
+            extra: ExtraBounce::Never,
+            hide_emitters: false,
+        },
+        glossy_scene: true,
+    };
+    let x = solved
+        .intersect(DVec3::new(-0.2, 0.1, 2.0), -DVec3::Z)
+        .unwrap();
+    let wos: Vec<DVec3> = [(0.0, 0.0), (0.5, 0.2), (-0.6, 0.3), (0.1, -0.8)]
+        .iter()
+        .map(|&(a, b): &(f64, f64)| DVec3::new(a, b, (1.0 - a * a - b * b).sqrt()))
+        .collect();
+    let counts = IncidentSamples {
+        gather: 4,
+        light: 4,
+        links: false,
+    };
+    let mut sampler = PixelSampler::new(0, 0, 0);
+    let (mut caches, mut stats) = (Caches::<3>::default(), GatherStats::default());
+    let got = gather.glossy_directions(&x, &wos, counts, &mut sampler, &mut caches, &mut stats);
+    let d = p - x.point;
+    let wi = d.normalize();
+    let mut brightest = 0.0f64;
+    for (wo, g) in wos.iter().zip(&got) {
+        let want = solved.glossy_cos(&x, wi, *wo).0[0] * i / d.length_squared();
+        brightest = brightest.max(want);
+        assert!(
+            (g.0[0] - want).abs() <= 1e-12 * want.max(1e-300),
+            "towards {wo}: {} against {want}",
+            g.0[0]
+        );
+    }
+    assert!(
+        brightest > 0.01,
+        "the lobe must face some direction: {brightest}"
+    );
+}

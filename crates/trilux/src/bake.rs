@@ -1,4 +1,4 @@
-//! `trilux bake SCENE [-o OUT.glb] [--glossy] [--open]`: the solution's view-independent
+//! `trilux bake SCENE [-o OUT.glb] [--no-glossy] [--open]`: the solution's view-independent
 //! light as a glTF 2.0 binary, for walkthroughs in any glTF viewer
 //! (docs/bake.md; the file's layout is `trilux_bake`'s), and with `--open`
 //! in trilux's own viewer on localhost (`serve`).
@@ -36,11 +36,29 @@ pub struct BakeArgs {
     #[arg(long)]
     pub no_albedo_maps: bool,
     /// Bake the glossy (view-dependent) light of glossy materials too, as
-    /// order-2 spherical harmonics per vertex that trilux's viewer shows
-    /// (docs/bake.md; slower to bake). Default: left out, the materials
-    /// marked glossy_left_out.
-    #[arg(long)]
+    /// spherical harmonics per vertex that trilux's viewer shows
+    /// (docs/bake.md). The default; kept for scripts that ask for it.
+    #[arg(long, conflicts_with = "no_glossy")]
     pub glossy: bool,
+    /// Leave the glossy light out (the materials marked glossy_left_out;
+    /// a faster bake and a smaller file).
+    #[arg(long)]
+    pub no_glossy: bool,
+    /// Directions per vertex the glossy light is fitted over (at least 16).
+    #[arg(long, default_value_t = BakeOptions::default().glossy_directions)]
+    pub glossy_directions: u32,
+    /// BSDF-sampled gather rays per vertex for the glossy light, shared by
+    /// its directions.
+    #[arg(long, default_value_t = BakeOptions::default().glossy_samples)]
+    pub glossy_samples: u32,
+    /// Light samples per vertex for the glossy light, shared by its
+    /// directions.
+    #[arg(long, default_value_t = BakeOptions::default().glossy_light_samples)]
+    pub glossy_light_samples: u32,
+    /// Read the glossy light's gather hits through their links, as the
+    /// full render does (slower), instead of the solution's radiance there.
+    #[arg(long)]
+    pub glossy_links: bool,
     /// Write solve and bake statistics (file size, vertices, triangles) as
     /// JSON.
     #[arg(long)]
@@ -86,7 +104,11 @@ pub fn run(args: &BakeArgs) -> Result<()> {
     let mut options = BakeOptions::default();
     options.exposure = args.exposure;
     options.albedo_maps = !args.no_albedo_maps;
-    options.glossy = args.glossy;
+    options.glossy = !args.no_glossy;
+    options.glossy_directions = args.glossy_directions;
+    options.glossy_samples = args.glossy_samples;
+    options.glossy_light_samples = args.glossy_light_samples;
+    options.glossy_links = args.glossy_links;
     let bake = Product::Bake(options);
     let plan = args
         .options

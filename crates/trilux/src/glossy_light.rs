@@ -1,15 +1,17 @@
 //! The renderer's estimate of glossy light, for directional bakes: a
-//! [`trilux_bake::GlossyLight`] that averages the link gather's own
-//! glossy estimate (`LinkGather::glossy_sample`: a light sample and a
-//! BSDF-sampled gather ray, MIS-combined, the gather hit read through its
-//! links and one more glossy level) over a fixed number of samples per
-//! direction. The bake's glossy light is thus the full render's, fitted.
+//! [`trilux_bake::GlossyLight`] that asks the link gather for the glossy
+//! light of every direction of a point from one set of incident samples
+//! (`LinkGather::glossy_directions`: BSDF-sampled gather rays from the
+//! mixture of the directions' lobes and light samples, each gather hit
+//! read as the full render reads it, through its links and one more
+//! glossy level). The bake's glossy light is thus the full render's,
+//! fitted; each sample's cost is paid once per point, not per direction.
 
 use glam::DVec3;
 use rayon::prelude::*;
-use trilux_bake::{GlossyLight, GlossyPoint};
+use trilux_bake::{GlossyLight, GlossyPoint, GlossySamples};
 use trilux_render::gather::{ExtraBounce, FinalGather};
-use trilux_render::link_gather::{Caches, LinkGather};
+use trilux_render::link_gather::{Caches, IncidentSamples, LinkGather};
 use trilux_render::solved::HitLocator;
 use trilux_render::{GatherStats, PixelSampler, SolvedScene, SurfacePoint};
 use trilux_solver::Solution;
@@ -31,10 +33,9 @@ impl<'a, const N: usize> RenderedGlossy<'a, N> {
         &self,
         p: &GlossyPoint,
         dirs: &[DVec3],
-        samples: u32,
+        samples: GlossySamples,
         caches: &mut Caches<N>,
     ) -> Vec<[f64; 3]> {
-        let samples = samples.max(1);
         let gather = LinkGather {
             scene: &self.scene,
             fallback: FinalGather {
@@ -58,18 +59,16 @@ impl<'a, const N: usize> RenderedGlossy<'a, N> {
         let mut stats = GatherStats::default();
         // The seed folds the point's key into the sampler's two indices.
         let (lo, hi) = (p.key as u32, (p.key >> 32) as u32);
-        dirs.iter()
-            .enumerate()
-            .map(|(k, &wo)| {
-                let mut sampler =
-                    PixelSampler::new(hi ^ (k as u32).wrapping_mul(0x9e37_79b9), lo, k as u32);
-                let mut sum = trilux_color::Spectrum::<N>::zero();
-                for s in 0..samples {
-                    sampler.start_sample(s);
-                    sum += gather.glossy_sample(&x, wo, &sampler, caches, &mut stats);
-                }
-                (sum * (1.0 / f64::from(samples))).to_linear_srgb()
-            })
+        let mut sampler = PixelSampler::new(hi ^ 0x9e37_79b9, lo, 0);
+        let counts = IncidentSamples {
+            gather: samples.gather,
+            light: samples.light,
+            links: samples.links,
+        };
+        gather
+            .glossy_directions(&x, dirs, counts, &mut sampler, caches, &mut stats)
+            .iter()
+            .map(|l| l.to_linear_srgb())
             .collect()
     }
 }
@@ -79,7 +78,7 @@ impl<const N: usize> GlossyLight for RenderedGlossy<'_, N> {
         &self,
         points: &[GlossyPoint],
         directions: &[DVec3],
-        samples: u32,
+        samples: GlossySamples,
     ) -> Vec<[f64; 3]> {
         let per = directions.len().checked_div(points.len()).unwrap_or(0);
         if per == 0 {

@@ -446,20 +446,20 @@ fn cornell_box_bakes_to_its_solution() {
     assert_eq!(check_scene(&repo("scenes/cornell-box.xml"), "cornell"), 0);
 }
 
-/// Curved pieces: a cylinder (the glossy tube; its glossy part is left out
-/// of the bake, its diffuse part is what is checked).
+/// Curved pieces: a cylinder (the glossy tube; its glossy light is in
+/// attributes of its own, its diffuse part is what is checked).
 #[test]
 fn glossy_tube_bakes_to_its_solution() {
     assert_eq!(check_scene(&repo("scenes/glossy-tube.xml"), "tube"), 0);
 }
 
-/// The glossy tube's glossy light: left out and marked by default, as
-/// spherical harmonics on the glossy sides with `--glossy` (the same
-/// solution, the same diffuse light).
+/// The glossy tube's glossy light: left out and marked with
+/// `--no-glossy`, as harmonics and a lobe on the glossy sides by default
+/// (the same solution, the same diffuse light).
 #[test]
-fn glossy_light_is_baked_only_with_the_glossy_flag() {
+fn glossy_light_is_baked_unless_left_out() {
     let dir = folder("bake-glossy-flag");
-    let (sol, plain) = solve_and_bake(&repo("scenes/glossy-tube.xml"), &dir, &[]);
+    let (sol, plain) = solve_and_bake(&repo("scenes/glossy-tube.xml"), &dir, &["--no-glossy"]);
     let glossy = dir.join("glossy.glb");
     let out = trilux(&[
         "bake",
@@ -470,7 +470,6 @@ fn glossy_light_is_baked_only_with_the_glossy_flag() {
         sol.to_str().unwrap(),
         "-o",
         glossy.to_str().unwrap(),
-        "--glossy",
     ]);
     assert!(
         out.status.success(),
@@ -486,26 +485,29 @@ fn glossy_light_is_baked_only_with_the_glossy_flag() {
             .count();
         let sh2 = materials
             .iter()
-            .filter(|m| m["extras"]["trilux"]["glossy"] == "sh2")
+            .filter(|m| m["extras"]["trilux"]["glossy"] == "sh2+lobe")
             .count();
         let with_sh = json["meshes"]
             .as_array()
             .unwrap()
             .iter()
             .flat_map(|m| m["primitives"].as_array().unwrap())
-            .filter(|p| p["attributes"].get("_TRILUX_SH8").is_some())
+            .filter(|p| {
+                let a = &p["attributes"];
+                a.get("_TRILUX_SH8").is_some() && a.get("_TRILUX_LOBE_RGB").is_some()
+            })
             .count();
         let radiance: Vec<[f32; 3]> = prims.into_iter().flat_map(|p| p.radiance).collect();
         (left_out, sh2, with_sh, radiance)
     };
     let (left_out, sh2, with_sh, diffuse) = marks(&plain);
-    assert!(left_out > 0, "without --glossy the glossy sides are marked");
-    assert_eq!((sh2, with_sh), (0, 0), "without --glossy no glossy light");
+    assert!(left_out > 0, "with --no-glossy the glossy sides are marked");
+    assert_eq!((sh2, with_sh), (0, 0), "with --no-glossy no glossy light");
     let (left_out, sh2, with_sh, diffuse_too) = marks(&glossy);
-    assert_eq!(left_out, 0, "with --glossy nothing is left out");
+    assert_eq!(left_out, 0, "by default nothing is left out");
     assert!(
         sh2 > 0 && with_sh > 0,
-        "with --glossy the glossy sides carry it"
+        "by default the glossy sides carry it"
     );
     assert_eq!(diffuse, diffuse_too, "the diffuse light is the same");
 }
