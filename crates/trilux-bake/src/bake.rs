@@ -306,22 +306,18 @@ impl GlossyCount {
                 total += (sides * used.iter().filter(|&&u| u).count()) as u64;
             }
         }
-        let per_vertex = options.glossy_budget.checked_div(total).unwrap_or(u64::MAX);
-        let (gather, light) = (
-            u64::from(options.glossy_samples),
-            u64::from(options.glossy_light_samples),
+        let (gather, light) = within_budget(
+            options.glossy_budget,
+            total,
+            options.glossy_samples,
+            options.glossy_light_samples,
         );
-        // Within the budget, both counts scaled alike, to a quarter at least.
-        let scale = |n: u64| {
-            let fit = (n * per_vertex).checked_div(gather + light).unwrap_or(n);
-            fit.clamp(n.div_ceil(4).max(1), n.max(1)) as u32
-        };
         GlossyCount {
             form: options.glossy_form,
             directions: options.glossy_directions.max(MIN_GLOSSY_DIRECTIONS) as usize,
             samples: GlossySamples {
-                gather: scale(gather),
-                light: scale(light),
+                gather,
+                light,
                 links: options.glossy_links,
             },
             vertices: 0,
@@ -656,5 +652,38 @@ impl FluxCheck {
             .filter(|(_, exact)| *exact > 1e-6 * largest)
             .map(|(baked, exact)| (baked - exact).abs() / exact)
             .fold(0.0, f64::max)
+    }
+}
+
+/// The gather and light samples per glossy vertex (`gather`, `light`
+/// asked) that keep `vertices` within `budget` estimates, both scaled
+/// alike and to a quarter at least; as asked when there is no glossy
+/// vertex.
+fn within_budget(budget: u64, vertices: u64, gather: u32, light: u32) -> (u32, u32) {
+    let per_vertex = budget.checked_div(vertices).unwrap_or(u64::MAX);
+    let (g, l) = (u64::from(gather), u64::from(light));
+    let scale = |n: u64| {
+        // Saturating: with no glossy vertex per_vertex is u64::MAX.
+        let fit = n.saturating_mul(per_vertex).checked_div(g + l).unwrap_or(n);
+        fit.clamp(n.div_ceil(4).max(1), n.max(1)) as u32
+    };
+    (scale(g), scale(l))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::within_budget;
+
+    #[test]
+    fn sample_counts_stay_within_the_budget_and_are_asked_without_glossy_vertices() {
+        // No glossy vertex (a diffuse scene baked with glossy light on):
+        // the counts asked, no overflow.
+        assert_eq!(within_budget(8_000_000, 0, 16, 8), (16, 8));
+        // Room for all: as asked.
+        assert_eq!(within_budget(8_000_000, 1_000, 16, 8), (16, 8));
+        // 24 estimates a vertex asked, 12 allowed: both halved.
+        assert_eq!(within_budget(12_000, 1_000, 16, 8), (8, 4));
+        // Far over: a quarter at least.
+        assert_eq!(within_budget(1, 1_000_000, 16, 8), (4, 2));
     }
 }

@@ -109,33 +109,25 @@ impl GlossyForm {
         }
     }
 
-    /// The glTF attribute of each slot used.
+    /// The glTF attribute of each slot used (the harmonics first, so that
+    /// `Sh2` uses the first nine).
     pub fn attributes(self) -> &'static [&'static str] {
+        const ALL: [&str; SLOTS] = [
+            "_TRILUX_SH0",
+            "_TRILUX_SH1",
+            "_TRILUX_SH2",
+            "_TRILUX_SH3",
+            "_TRILUX_SH4",
+            "_TRILUX_SH5",
+            "_TRILUX_SH6",
+            "_TRILUX_SH7",
+            "_TRILUX_SH8",
+            "_TRILUX_LOBE",
+            "_TRILUX_LOBE_RGB",
+        ];
         match self {
-            GlossyForm::Sh2 => &[
-                "_TRILUX_SH0",
-                "_TRILUX_SH1",
-                "_TRILUX_SH2",
-                "_TRILUX_SH3",
-                "_TRILUX_SH4",
-                "_TRILUX_SH5",
-                "_TRILUX_SH6",
-                "_TRILUX_SH7",
-                "_TRILUX_SH8",
-            ],
-            GlossyForm::Lobe => &[
-                "_TRILUX_SH0",
-                "_TRILUX_SH1",
-                "_TRILUX_SH2",
-                "_TRILUX_SH3",
-                "_TRILUX_SH4",
-                "_TRILUX_SH5",
-                "_TRILUX_SH6",
-                "_TRILUX_SH7",
-                "_TRILUX_SH8",
-                "_TRILUX_LOBE",
-                "_TRILUX_LOBE_RGB",
-            ],
+            GlossyForm::Sh2 => &ALL[..SH_COEFFICIENTS],
+            GlossyForm::Lobe => &ALL,
         }
     }
 
