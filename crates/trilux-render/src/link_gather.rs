@@ -239,8 +239,11 @@ impl<S> LinkGather<'_, S> {
             let Some(p) = scene.punctual_at(k, x) else {
                 continue;
             };
+            if p.irradiance.is_black() {
+                continue;
+            }
             stats.shadow_rays += 1;
-            if !p.irradiance.is_black() && scene.unoccluded(x, p.end) {
+            if scene.unoccluded(x, p.end) {
                 scene.glossy_fan(x, p.wi, wos, &mut fan);
                 add(&fan, p.irradiance);
             }

@@ -177,21 +177,16 @@ impl<'a, const N: usize, S: RadianceSolution<N>> SolvedScene<'a, N, S> {
         side: Side,
         stats: &mut GatherStats,
     ) -> Spectrum<N> {
-        let mut e = Spectrum::zero();
-        for k in 0..self.punctual_count() {
-            let Some(p) = self.punctual_at(k, at) else {
-                continue;
-            };
-            let cos = side.sign() * at.locator.shading_normal.dot(p.wi);
-            if cos <= 0.0 || side.sign() * at.normal.dot(p.wi) <= 0.0 {
-                continue;
+        let sign = side.sign();
+        let lambert = |wi: DVec3| {
+            let cos = sign * at.locator.shading_normal.dot(wi);
+            if cos <= 0.0 || sign * at.normal.dot(wi) <= 0.0 {
+                Spectrum::zero()
+            } else {
+                Spectrum::splat(cos / std::f64::consts::PI)
             }
-            stats.shadow_rays += 1;
-            if self.unoccluded(at, p.end) {
-                e += p.irradiance * (cos / std::f64::consts::PI);
-            }
-        }
-        e
+        };
+        crate::mis::punctual_direct(self, at, lambert, stats)
     }
 
     /// The link sum at `at`, seen from `side`, in the leaf `leaf`.

@@ -335,7 +335,7 @@ fn area_emitter(e: &Element) -> Result<AreaEmitter> {
     // How often Mitsuba's light sampling picks this emitter: its noise, not
     // its image.
     props.float("sampling_weight")?;
-    let radiance = crate::material::emitted_radiance(&props)?;
+    let radiance = crate::material::emitted_strength(&props, "radiance")?;
     props.finish()?;
     Ok(AreaEmitter {
         radiance,

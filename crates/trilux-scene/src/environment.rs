@@ -19,7 +19,7 @@
 use glam::{DMat4, DVec3};
 use trilux_brdf::BsdfParams;
 use trilux_color::ColorParam;
-use trilux_geometry::{Shape, ShapeKind};
+use trilux_geometry::{Bounds, Shape, ShapeKind};
 
 use crate::error::{Result, SceneError};
 use crate::props::Props;
@@ -32,7 +32,7 @@ pub(crate) fn constant(e: &Element) -> Result<Environment> {
     let props = Props::new(e)?;
     props.no_objects()?;
     props.float("sampling_weight")?;
-    let radiance = crate::material::emitted_radiance(&props)?;
+    let radiance = crate::material::emitted_strength(&props, "radiance")?;
     props.finish()?;
     Ok(Environment {
         radiance,
@@ -58,19 +58,18 @@ pub(crate) fn enclose(scene: &mut Scene) {
     let Some(env) = &scene.environment else {
         return;
     };
-    let mut lo = DVec3::splat(f64::INFINITY);
-    let mut hi = DVec3::splat(f64::NEG_INFINITY);
-    for s in &scene.shapes {
-        let (a, b) = world_bounds(&s.shape);
-        (lo, hi) = (lo.min(a), hi.max(b));
-    }
+    let mut bounds = scene
+        .shapes
+        .iter()
+        .fold(Bounds::EMPTY, |b, s| b.union(world_bounds(&s.shape)));
     if let Some(c) = &scene.camera {
-        (lo, hi) = (lo.min(c.origin), hi.max(c.origin));
+        bounds = bounds.with_point(c.origin);
     }
-    if !(lo.is_finite() && hi.is_finite()) {
+    if bounds.is_empty() {
         // No shape and no camera: a unit box around the origin.
-        (lo, hi) = (DVec3::splat(-1.0), DVec3::splat(1.0));
+        bounds = Bounds::from_points([DVec3::splat(-1.0), DVec3::splat(1.0)]);
     }
+    let (lo, hi) = (bounds.min, bounds.max);
     let centre = 0.5 * (lo + hi);
     let diagonal = (hi - lo).length().max(1e-3);
     // 2 % beyond the bounds on each axis, and at least 0.1 % of the
@@ -102,31 +101,30 @@ pub(crate) fn enclose(scene: &mut Scene) {
 
 /// A box holding the shape in world space: the world images of its object
 /// box's corners (exact for meshes' vertices' box up to the transform).
-fn world_bounds(shape: &Shape) -> (DVec3, DVec3) {
-    let (a, b) = match &shape.kind {
-        ShapeKind::Rectangle => (DVec3::new(-1.0, -1.0, 0.0), DVec3::new(1.0, 1.0, 0.0)),
-        ShapeKind::Disk => (DVec3::new(-1.0, -1.0, 0.0), DVec3::new(1.0, 1.0, 0.0)),
-        ShapeKind::Cube => (DVec3::splat(-1.0), DVec3::splat(1.0)),
-        ShapeKind::Sphere { center, radius } => (*center - *radius, *center + *radius),
-        ShapeKind::Cylinder { p0, p1, radius } => (p0.min(*p1) - *radius, p0.max(*p1) + *radius),
-        ShapeKind::Mesh(m) => m.positions.iter().fold(
-            (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
-            |(lo, hi), p| (lo.min(*p), hi.max(*p)),
-        ),
+fn world_bounds(shape: &Shape) -> Bounds {
+    let object = match &shape.kind {
+        ShapeKind::Rectangle | ShapeKind::Disk => {
+            Bounds::from_points([DVec3::new(-1.0, -1.0, 0.0), DVec3::new(1.0, 1.0, 0.0)])
+        }
+        ShapeKind::Cube => Bounds::from_points([DVec3::splat(-1.0), DVec3::splat(1.0)]),
+        ShapeKind::Sphere { center, radius } => {
+            Bounds::from_points([*center - *radius, *center + *radius])
+        }
+        ShapeKind::Cylinder { p0, p1, radius } => {
+            Bounds::from_points([p0.min(*p1) - *radius, p0.max(*p1) + *radius])
+        }
+        ShapeKind::Mesh(m) => Bounds::from_points(m.positions.iter().copied()),
     };
-    if !(a.is_finite() && b.is_finite()) {
-        return (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+    if object.is_empty() || !(object.min.is_finite() && object.max.is_finite()) {
+        return Bounds::EMPTY;
     }
-    (0..8).fold(
-        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
-        |(lo, hi), k| {
-            let corner = DVec3::new(
-                if k & 1 == 0 { a.x } else { b.x },
-                if k & 2 == 0 { a.y } else { b.y },
-                if k & 4 == 0 { a.z } else { b.z },
-            );
-            let w = shape.world_from_object.transform_point3(corner);
-            (lo.min(w), hi.max(w))
-        },
-    )
+    let (a, b) = (object.min, object.max);
+    Bounds::from_points((0..8).map(|k| {
+        let corner = DVec3::new(
+            if k & 1 == 0 { a.x } else { b.x },
+            if k & 2 == 0 { a.y } else { b.y },
+            if k & 4 == 0 { a.z } else { b.z },
+        );
+        shape.world_from_object.transform_point3(corner)
+    }))
 }

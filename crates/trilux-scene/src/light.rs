@@ -7,12 +7,10 @@
 //! directions and any cutoff; trilux refuses them, each at its place.
 
 use glam::{DMat3, DMat4, DVec3};
-use trilux_color::ColorParam;
 use trilux_geometry::limits::MAX_COORDINATE;
 use trilux_geometry::{Punctual, SpotFalloff};
 
 use crate::error::{Result, SceneError};
-use crate::material::check_color;
 use crate::props::Props;
 use crate::scene::Light;
 use crate::xml::Element;
@@ -26,9 +24,18 @@ pub(crate) fn light(e: &Element) -> Result<Light> {
     // not its image.
     props.float("sampling_weight")?;
     let (punctual, intensity) = match e.plugin_type()? {
-        "point" => (point(&props)?, strength(&props, "intensity")?),
-        "spot" => (spot(&props)?, strength(&props, "intensity")?),
-        _ => (directional(&props)?, strength(&props, "irradiance")?),
+        "point" => (
+            point(&props)?,
+            crate::material::emitted_strength(&props, "intensity")?,
+        ),
+        "spot" => (
+            spot(&props)?,
+            crate::material::emitted_strength(&props, "intensity")?,
+        ),
+        _ => (
+            directional(&props)?,
+            crate::material::emitted_strength(&props, "irradiance")?,
+        ),
     };
     props.finish()?;
     Ok(Light {
@@ -36,28 +43,6 @@ pub(crate) fn light(e: &Element) -> Result<Light> {
         intensity,
         location: e.loc.clone(),
     })
-}
-
-/// The colour parameter `name` (Mitsuba's default 1), non-negative and
-/// within the radiance limit.
-fn strength(props: &Props<'_>, name: &str) -> Result<ColorParam> {
-    let c = props.color(name)?.unwrap_or(ColorParam::Float(1.0));
-    let loc = props.loc(name);
-    check_color(&c, &loc, name, None)?;
-    if let Some(v) = c
-        .values()
-        .into_iter()
-        .find(|v| *v > crate::limits::MAX_RADIANCE)
-    {
-        return Err(SceneError::at(
-            &loc,
-            format!(
-                "{name} {v:e} is beyond the limit {:e} (docs/limits.md)",
-                crate::limits::MAX_RADIANCE
-            ),
-        ));
-    }
-    Ok(c)
 }
 
 /// `to_world`, checked: finite, within the coordinate limit, not singular.

@@ -549,23 +549,25 @@ fn ior(props: &Props<'_>, name: &str, default: &str) -> Result<f64> {
     Ok(value)
 }
 
-/// An emitter's `radiance` (Mitsuba's default 1), checked as a material's
-/// colours are (finite, not negative) and within the limit.
-pub(crate) fn emitted_radiance(props: &Props<'_>) -> Result<ColorParam> {
-    let radiance = props.color("radiance")?.unwrap_or(ColorParam::Float(1.0));
-    check_color(&radiance, &props.loc("radiance"), "radiance", None)?;
-    if let Some(v) = radiance
+/// An emitter's strength `name` (`radiance`, a light's `intensity` or
+/// `irradiance`; Mitsuba's default 1), checked as a material's colours are
+/// (finite, not negative) and within the limit.
+pub(crate) fn emitted_strength(props: &Props<'_>, name: &str) -> Result<ColorParam> {
+    let value = props.color(name)?.unwrap_or(ColorParam::Float(1.0));
+    let loc = props.loc(name);
+    check_color(&value, &loc, name, None)?;
+    if let Some(v) = value
         .values()
         .into_iter()
         .find(|v| *v > crate::limits::MAX_RADIANCE)
     {
         return Err(SceneError::at(
-            &props.loc("radiance"),
+            &loc,
             format!(
-                "radiance {v:e} is beyond the limit {:e} (docs/limits.md)",
+                "{name} {v:e} is beyond the limit {:e} (docs/limits.md)",
                 crate::limits::MAX_RADIANCE
             ),
         ));
     }
-    Ok(radiance)
+    Ok(value)
 }

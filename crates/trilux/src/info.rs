@@ -96,13 +96,14 @@ pub fn run(args: &InfoArgs) -> Result<()> {
         Some(ModeArg::Spectral) => Mode::Spectral,
         None => scene.mode(),
     };
+    let geometry = scene.build_geometry()?;
     let info = InfoJson {
         shapes: scene.shapes.len(),
-        input_surfaces: scene.build_geometry()?.surfaces().len(),
+        input_surfaces: geometry.surfaces().len(),
         emitters: scene.emitters().count(),
         lights: scene.lights.len(),
         bsdfs: scene.bsdf_counts.clone(),
-        emitted_power: emitted_power(&scene, mode)?,
+        emitted_power: emitted_power(&scene, mode, trilux_solver::lights::scene_radius(&geometry))?,
         mode: mode.name(),
         camera: scene.camera.as_ref().map(|c| CameraJson {
             origin: c.origin.to_array(),

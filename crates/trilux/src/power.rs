@@ -1,6 +1,7 @@
 //! Emitted power per band, P = π · L · A for each one-sided Lambertian area
 //! emitter (radiance L in each band, area A), summed over the emitters,
-//! plus I · ∫ falloff dω for each point (4π I) and spot light.
+//! plus I · ∫ falloff dω for each point (4π I) and spot light and E π R²
+//! for each directional light (R the scene's bounding sphere's radius).
 //!
 //! L comes from trilux-color's emission conversion
 //! ([`ColorParam::emission`](trilux_color::ColorParam::emission)), exactly as
@@ -14,13 +15,15 @@ use anyhow::{Result, anyhow};
 use trilux_color::{ColorParam, Mode, Spectrum, WithBands};
 use trilux_scene::{Scene, surface_area};
 
-/// Total emitted power per band (W): Σ π · L · A over the area emitters.
-pub fn emitted_power(scene: &Scene, mode: Mode) -> Result<Vec<f64>> {
-    mode.with_bands(Power(scene))
+/// Total emitted power per band (W): Σ π · L · A over the area emitters
+/// and the lights' flux, a directional light's over the bounding sphere
+/// of radius `scene_radius` (as the solve counts it).
+pub fn emitted_power(scene: &Scene, mode: Mode, scene_radius: f64) -> Result<Vec<f64>> {
+    mode.with_bands(Power(scene, scene_radius))
 }
 
 /// [`emitted_power`] once the band count is known.
-struct Power<'a>(&'a Scene);
+struct Power<'a>(&'a Scene, f64);
 
 impl WithBands for Power<'_> {
     type Output = Result<Vec<f64>>;
@@ -32,16 +35,12 @@ impl WithBands for Power<'_> {
                 .map_err(|e| anyhow!("{}: emitted radiance: {e}", emitter.location))?;
             total += radiance * (std::f64::consts::PI * surface_area(&s.shape));
         }
-        // Point and spot lights send I · ∫ falloff dω; a directional
-        // light's power depends on the scene's bounding sphere (the
-        // solve's `emitted_flux` counts it).
+        // Point and spot lights send I · ∫ falloff dω, a directional one
+        // E π R² (the solve's `emitted_flux` counts the same).
         for l in &self.0.lights {
-            if matches!(l.punctual, trilux_geometry::Punctual::Directional { .. }) {
-                continue;
-            }
             let i = radiance::<N>(&l.intensity)
                 .map_err(|e| anyhow!("{}: intensity: {e}", l.location))?;
-            total += i * l.punctual.flux_factor(0.0);
+            total += i * l.punctual.flux_factor(self.1);
         }
         Ok(total.0.to_vec())
     }

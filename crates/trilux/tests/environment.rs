@@ -109,13 +109,13 @@ fn against_mitsuba(case: &str, file: &str, define: &str, bound: f64) {
 
 #[test]
 fn a_uniform_sky_lights_a_courtyard_as_in_mitsuba() {
-    // 1 %: Mitsuba's mean has a relative standard error below 1e-4
-    // (reference.json); trilux's at 64 spp about 1e-3, and its solution's
-    // remaining bias (the path gather reads it beyond the first bounce)
-    // was within 0.1 % when this was written. Without the sky the image is
-    // black, without its hiding 137 % brighter.
-    against_mitsuba("sky_seen", "courtyard.xml", "hide=false", 0.01);
-    against_mitsuba("sky_hidden", "courtyard.xml", "hide=true", 0.01);
+    // 0.5 %: Mitsuba's mean has a relative standard error below 1e-4
+    // (reference.json); trilux's at 64 spp about 1e-3 (4σ: 0.4 %), and its
+    // solution's remaining bias (the path gather reads it beyond the first
+    // bounce) was within 0.1 % when this was written. Without the sky the
+    // image is black, without its hiding 137 % brighter.
+    against_mitsuba("sky_seen", "courtyard.xml", "hide=false", 0.005);
+    against_mitsuba("sky_hidden", "courtyard.xml", "hide=true", 0.005);
 }
 
 #[test]
