@@ -47,6 +47,7 @@ mod build;
 pub mod camera;
 mod environment;
 pub mod error;
+mod glass;
 pub mod gltf;
 pub mod image;
 mod integrator;
