@@ -317,6 +317,20 @@ impl Geometry {
         Some((self.make_hit(ray.origin, ray.dir, h), shape))
     }
 
+    /// [`Geometry::closest_in`] ignoring shape `skip`.
+    pub(crate) fn closest_ignoring(
+        &self,
+        ray: &Ray,
+        tmin: f64,
+        tmax: f64,
+        skip: u32,
+    ) -> Option<(Hit, u32)> {
+        let q = QueryRay::new(ray.origin, ray.dir)?;
+        let h = self.bvh.closest(&q, tmin, tmax, Some(skip))?;
+        let shape = self.bvh.prim(h.prim).shape();
+        Some((self.make_hit(ray.origin, ray.dir, h), shape))
+    }
+
     /// Brute force closest hit over every primitive, without the BVH: the
     /// reference for tests.
     pub fn intersect_brute_force(&self, ray: &Ray, t_max: f64) -> Option<Hit> {

@@ -150,6 +150,26 @@ impl Geometry {
         }
     }
 
+    /// [`Geometry::intersect_ignoring`] that also goes through every
+    /// shape that lets light through: the first opaque hit of another
+    /// shape than `shape` (the burial probes: a pane in front of a face
+    /// does not cover it, the light passes).
+    pub fn intersect_opaque_ignoring(&self, ray: &Ray, t_max: f64, shape: u32) -> Option<Hit> {
+        if !self.has_transmission() {
+            return self.intersect_ignoring(ray, t_max, shape);
+        }
+        let len = ray.dir.length();
+        let mut tmin = self.ray_tmin(ray)?;
+        for _ in 0..MAX_CROSSINGS {
+            let (hit, s) = self.closest_ignoring(ray, tmin, t_max, shape)?;
+            if self.shape_transmittance(s).is_none() {
+                return Some(hit);
+            }
+            tmin = hit.t + self.epsilon_at(hit.point) / len;
+        }
+        None
+    }
+
     /// Hits along `ray` in order from `tmin` to `tmax`: the first opaque
     /// one (if any) and the product of the transmittances crossed before
     /// it. More than [`MAX_CROSSINGS`] crossings count as zero light.

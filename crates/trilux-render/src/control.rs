@@ -162,7 +162,7 @@ impl<S> ControlVariate<'_, S> {
         stats.gather_rays += 1;
         let xd = self.scene.intersect(x.point, bs.wi)?;
         // What panes of glass on the way let through.
-        bs.weight = bs.weight * self.scene.through(&xd);
+        bs.weight *= self.scene.through(&xd);
         Some((bs, xd))
     }
 
