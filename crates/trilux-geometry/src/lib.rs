@@ -91,8 +91,8 @@
 //!   burial map.
 //! - [`transmission`]: shapes that let a fraction of the light through
 //!   ([`Transmittance`]: a thin dielectric slab, a constant fraction), and
-//!   the segment queries that multiply their fractions
-//!   (`Geometry::transmittance`, `Geometry::intersect_through`).
+//!   [`through`], the segment and ray queries that multiply their
+//!   fractions (`Geometry::transmittance`, `Geometry::intersect_through`).
 //! - [`visibility`]: visible fractions from stratified shadow segments
 //!   ([`Visibility`], which takes the burial map explicitly).
 //! - [`coordinate_system`]: the orthonormal basis around a unit vector
@@ -131,6 +131,7 @@ pub mod sensor;
 mod sequence;
 pub mod shape;
 pub mod surface;
+pub mod through;
 mod transform;
 pub mod transmission;
 pub mod visibility;

@@ -31,7 +31,7 @@ use trilux_color::ColorParam;
 use trilux_geometry::Transmittance;
 
 use crate::error::{Result, SceneError};
-use crate::material::ior;
+use crate::ior::ior;
 use crate::props::Props;
 use crate::xml::Element;
 

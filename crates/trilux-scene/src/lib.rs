@@ -51,6 +51,7 @@ mod glass;
 pub mod gltf;
 pub mod image;
 mod integrator;
+mod ior;
 mod light;
 pub mod limits;
 mod material;

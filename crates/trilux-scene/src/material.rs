@@ -30,13 +30,14 @@
 use std::path::Path;
 
 use trilux_brdf::{
-    Branch, BsdfParams, Distribution, Filter, NAMED_IORS, PlasticParams, RoughConductorParams,
-    SlotKind, UvTransform, Wrap, named_ior,
+    Branch, BsdfParams, Distribution, Filter, PlasticParams, RoughConductorParams, SlotKind,
+    UvTransform, Wrap,
 };
 use trilux_color::ColorParam;
 
 use crate::error::{Result, SceneError, SourceLocation};
 use crate::image::Sampling;
+use crate::ior::ior;
 use crate::props::Props;
 use crate::textures::{ImageSource, TextureRequest};
 use crate::xml::Element;
@@ -548,36 +549,6 @@ fn plastic(props: &Props<'_>, rough: bool, textured: bool) -> Result<PlasticPara
         nonlinear,
         coat,
     })
-}
-
-/// An index of refraction given as a `<float>` or by one of Mitsuba's
-/// names (`default` when absent); finite and positive.
-pub(crate) fn ior(props: &Props<'_>, name: &str, default: &str) -> Result<f64> {
-    let loc = props.loc(name);
-    let value = match props.float(name) {
-        Ok(Some(v)) => v,
-        Ok(None) => named_ior(default).unwrap_or(1.0),
-        Err(_) => {
-            let given = props.string(name)?.unwrap_or_default();
-            named_ior(&given).ok_or_else(|| {
-                let names: Vec<&str> = NAMED_IORS.iter().map(|(n, _)| *n).collect();
-                SceneError::at(
-                    &loc,
-                    format!(
-                        "unknown index of refraction \"{given}\" for {name} (a float or one of: {})",
-                        names.join(", ")
-                    ),
-                )
-            })?
-        }
-    };
-    if !(value > 0.0 && value.is_finite()) {
-        return Err(SceneError::at(
-            &loc,
-            format!("{name} must be positive and finite, found {value}"),
-        ));
-    }
-    Ok(value)
 }
 
 /// An emitter's strength `name` (`radiance`, a light's `intensity` or
