@@ -98,7 +98,7 @@ impl<S> ControlVariate<'_, S> {
         if self.max_depth.is_none_or(|d| d >= 2) {
             l += self.reflected(&xs, wo, sampler, stats);
         }
-        stats.finite_or_dropped(l)
+        stats.finite_or_dropped(l * self.scene.through(&xs))
     }
 
     /// Reflected radiance leaving the camera hit `xs` towards `wo`: direct
@@ -155,12 +155,14 @@ impl<S> ControlVariate<'_, S> {
     where
         S: GatherScene<N>,
     {
-        let bs = self.scene.sample_bsdf(x, wo, u)?;
+        let mut bs = self.scene.sample_bsdf(x, wo, u)?;
         if bs.pdf.is_nan() || bs.pdf <= 0.0 || bs.weight.is_black() {
             return None;
         }
         stats.gather_rays += 1;
         let xd = self.scene.intersect(x.point, bs.wi)?;
+        // What panes of glass on the way let through.
+        bs.weight *= self.scene.through(&xd);
         Some((bs, xd))
     }
 

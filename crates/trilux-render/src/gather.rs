@@ -110,7 +110,7 @@ impl<'a, S> FinalGather<'a, S> {
         let wo = -dir;
         let le = self.scene.emitted(&xs, wo);
         let lr = self.gather(&xs, wo, 0, sampler, stats);
-        let l = le + lr;
+        let l = (le + lr) * self.scene.through(&xs);
         stats.finite_or_dropped(l)
     }
 
@@ -152,8 +152,10 @@ impl<'a, S> FinalGather<'a, S> {
             return l;
         };
         let back = -bs.wi;
+        // What panes of glass on the way let through.
+        let weight = bs.weight * scene.through(&xd);
         // Emission at the gather hit, with the BSDF-sampling MIS weight.
-        if let Some(le) = hit_emission(scene, &xd, back, bs.pdf, bs.weight) {
+        if let Some(le) = hit_emission(scene, &xd, back, bs.pdf, weight) {
             l += le;
         }
         // Reflected radiance at the gather hit: the solution, or one more
@@ -167,7 +169,7 @@ impl<'a, S> FinalGather<'a, S> {
         } else {
             scene.reflected(&xd, x)
         };
-        l + bs.weight * lr
+        l + weight * lr
     }
 
     /// The extra-bounce rule: would the piecewise-constant solution show here?

@@ -101,6 +101,7 @@ impl<S> LinkGather<'_, S> {
         };
         let wo = -dir;
         let scene = self.scene;
+        let through = scene.through(&xs);
         let mut w = Walk {
             sampler,
             caches,
@@ -121,14 +122,14 @@ impl<S> LinkGather<'_, S> {
                 // No links here: the path gather serves the whole BSDF.
                 None => {
                     let lr = self.fallback.gather(&xs, wo, 0, sampler, w.stats);
-                    return w.stats.finite_or_dropped(l + lr);
+                    return w.stats.finite_or_dropped((l + lr) * through);
                 }
             }
         }
         if scene.is_glossy(&xs, wo) {
             l += self.glossy(&xs, wo, 0, &mut w);
         }
-        w.stats.finite_or_dropped(l)
+        w.stats.finite_or_dropped(l * through)
     }
 
     /// One sample of the glossy part of the radiance leaving `x` towards
@@ -208,17 +209,18 @@ impl<S> LinkGather<'_, S> {
                 continue;
             };
             let back = -bs.wi;
+            let through = scene.through(&xd);
             let mut w = Walk {
                 sampler: &*sampler,
                 caches: &mut *caches,
                 stats: &mut *stats,
             };
             let level = if counts.links { 1 } else { LINK_LEVELS + 1 };
-            let mut l = self.reflected_at(&xd, x, back, level, &mut w) * (1.0 / (ng * p_mix));
+            let mut l = self.reflected_at(&xd, x, back, level, &mut w) * (through / (ng * p_mix));
             let le = scene.emitted(&xd, back);
             if !le.is_black() {
                 let p_light = light_density(scene, &xd, back);
-                l += le * (1.0 / (ng * p_mix + nl * p_light));
+                l += le * (through / (ng * p_mix + nl * p_light));
             }
             add(&fan, l);
         }
@@ -243,9 +245,10 @@ impl<S> LinkGather<'_, S> {
                 continue;
             }
             stats.shadow_rays += 1;
-            if scene.unoccluded(x, p.end) {
+            let tau = scene.transmittance(x, p.end);
+            if tau > 0.0 {
                 scene.glossy_fan(x, p.wi, wos, &mut fan);
-                add(&fan, p.irradiance);
+                add(&fan, p.irradiance * tau);
             }
         }
         out.iter().map(|&l| stats.finite_or_dropped(l)).collect()
@@ -281,6 +284,7 @@ impl<S> LinkGather<'_, S> {
             return Spectrum::zero();
         };
         let back = -wi;
+        let through = scene.through(&xd);
         // With density cos θ/π the estimate of (1/π) ∫ L cos dω is L.
         let mut e = Spectrum::zero();
         if correct {
@@ -299,7 +303,7 @@ impl<S> LinkGather<'_, S> {
             };
             e += g;
         }
-        e
+        e * through
     }
 
     /// The glossy part of the reflected radiance at `x` towards `wo`, at
@@ -336,7 +340,7 @@ impl<S> LinkGather<'_, S> {
             return l;
         };
         let back = -bs.wi;
-        let weight = f * (1.0 / bs.pdf);
+        let weight = f * (scene.through(&xd) / bs.pdf);
         if let Some(le) = hit_emission(scene, &xd, back, bs.pdf, weight) {
             l += le;
         }
@@ -433,10 +437,11 @@ fn unoccluded_light<S: SolutionGather<N>, const N: usize>(
         return None;
     }
     stats.shadow_rays += 1;
-    if !scene.unoccluded(x, ls.point) {
+    let tau = scene.transmittance(x, ls.point);
+    if tau <= 0.0 {
         return None;
     }
-    Some((d / dist, ls.radiance, ls.pdf_area * dist2 / cos_light))
+    Some((d / dist, ls.radiance * tau, ls.pdf_area * dist2 / cos_light))
 }
 
 /// The preview estimator: no random rays (module docs).
@@ -467,6 +472,7 @@ impl<S> Preview<'_, S> {
             return Spectrum::zero();
         };
         let wo = -dir;
+        let through = scene.through(&xs);
         let mut l = scene.emitted(&xs, wo);
         let rho = scene.diffuse_albedo(&xs, wo);
         if !rho.is_black()
@@ -486,10 +492,10 @@ impl<S> Preview<'_, S> {
                         || scene.reflected(&xd, &xs),
                         |l| l + scene.reflected_glossy(&xd, &xs),
                     );
-                l += albedo * reflected;
+                l += albedo * reflected * scene.through(&xd);
             }
         }
-        stats.finite_or_dropped(l)
+        stats.finite_or_dropped(l * through)
     }
 }
 

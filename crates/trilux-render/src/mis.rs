@@ -68,7 +68,8 @@ pub fn light_sample<S: GatherScene<N>, const N: usize>(
         return Spectrum::zero();
     }
     stats.shadow_rays += 1;
-    if !scene.unoccluded(x, ls.point) {
+    let tau = scene.transmittance(x, ls.point);
+    if tau <= 0.0 {
         return Spectrum::zero();
     }
     let pdf_light = ls.pdf_area * dist2 / cos_light;
@@ -77,12 +78,13 @@ pub fn light_sample<S: GatherScene<N>, const N: usize>(
     } else {
         1.0
     };
-    f * ls.radiance * (w / pdf_light)
+    f * ls.radiance * (tau * w / pdf_light)
 }
 
 /// The direct light of every light without area at `x`: Σ fr(ω_i) E⊥ V
 /// over the lights, `fr` the BSDF's fr·|cos θ_i| (or a part of it), one
-/// shadow ray each. No MIS weight: a delta light has no density a BSDF
+/// shadow ray each (V the fraction it lets through, panes of glass
+/// included). No MIS weight: a delta light has no density a BSDF
 /// sample could share, and no ray ever meets it.
 pub fn punctual_direct<S: GatherScene<N>, const N: usize>(
     scene: &S,
@@ -100,8 +102,9 @@ pub fn punctual_direct<S: GatherScene<N>, const N: usize>(
             continue;
         }
         stats.shadow_rays += 1;
-        if scene.unoccluded(x, p.end) {
-            sum += f * p.irradiance;
+        let tau = scene.transmittance(x, p.end);
+        if tau > 0.0 {
+            sum += f * p.irradiance * tau;
         }
     }
     sum

@@ -39,6 +39,22 @@ pub trait GatherScene<const N: usize>: Sync {
     /// `to` (a point on an emitter).
     fn unoccluded(&self, from: &SurfacePoint<Self::Locator>, to: DVec3) -> bool;
 
+    /// The fraction of light that goes from `to` to `from` along the
+    /// segment: 1 where nothing lies between, 0 where something opaque
+    /// does, between for surfaces that let light through (panes of glass).
+    /// By default [`GatherScene::unoccluded`]'s 0 or 1.
+    fn transmittance(&self, from: &SurfacePoint<Self::Locator>, to: DVec3) -> f64 {
+        if self.unoccluded(from, to) { 1.0 } else { 0.0 }
+    }
+
+    /// The fraction of light that the surfaces a ray crossed before it met
+    /// `at` ([`GatherScene::intersect`] goes through those that let light
+    /// through) let through: everything leaving `at` towards the ray's
+    /// origin arrives times this. By default 1 (no such surfaces).
+    fn through(&self, _at: &SurfacePoint<Self::Locator>) -> f64 {
+        1.0
+    }
+
     /// Radiance emitted from `at` in direction `wo` (zero if `at` is not on
     /// an emitter or `wo` leaves its back side).
     fn emitted(&self, at: &SurfacePoint<Self::Locator>, wo: DVec3) -> Spectrum<N>;

@@ -3,8 +3,10 @@
 //! emitters: `trilux_solver::PreparedScene`) and a solution
 //! ([`RadianceSolution`]: the solver's, or a stand-in).
 //!
-//! - Rays: `Geometry::intersect` (exact for analytic shapes, its own
-//!   self-intersection epsilon), shadow rays `Geometry::occluded`.
+//! - Rays: `Geometry::intersect_through` (exact for analytic shapes, its
+//!   own self-intersection epsilon; straight through surfaces that let
+//!   light through, the fraction they let through kept in the hit's
+//!   [`HitLocator::through`]), shadow rays `Geometry::transmittance`.
 //! - Materials: `Bsdf<N>` in the shading frame of the hit (z = shading
 //!   normal on the front side), textured ones at the hit's texture
 //!   coordinates (`PreparedScene::shading`); it reflects on the viewer's side (black from
@@ -52,6 +54,9 @@ pub struct HitLocator {
     pub shading_normal: DVec3,
     /// Index of the scene shape.
     pub shape: u32,
+    /// The fraction of light the surfaces the ray went through before
+    /// this hit let through (panes of glass; 1 without them).
+    pub through: f64,
 }
 
 /// The lobe solid angle of one side of a material: 4πα² for a
@@ -221,7 +226,7 @@ impl<const N: usize, S: RadianceSolution<N>> GatherScene<N> for SolvedScene<'_, 
 
     fn intersect(&self, origin: DVec3, dir: DVec3) -> Option<SurfacePoint<HitLocator>> {
         let geom = self.geom();
-        let hit = geom.intersect(&Ray { origin, dir }, f64::INFINITY)?;
+        let (hit, through) = geom.intersect_through(&Ray { origin, dir }, f64::INFINITY)?;
         let shape = geom.surface(hit.surface).shape;
         Some(SurfacePoint {
             point: hit.point,
@@ -232,6 +237,7 @@ impl<const N: usize, S: RadianceSolution<N>> GatherScene<N> for SolvedScene<'_, 
                 coord: hit.coord,
                 shading_normal: hit.shading_normal,
                 shape,
+                through,
             },
         })
     }
@@ -255,6 +261,14 @@ impl<const N: usize, S: RadianceSolution<N>> GatherScene<N> for SolvedScene<'_, 
 
     fn unoccluded(&self, from: &SurfacePoint<HitLocator>, to: DVec3) -> bool {
         !self.geom().occluded(from.point, to)
+    }
+
+    fn transmittance(&self, from: &SurfacePoint<HitLocator>, to: DVec3) -> f64 {
+        self.geom().transmittance(from.point, to)
+    }
+
+    fn through(&self, at: &SurfacePoint<HitLocator>) -> f64 {
+        at.locator.through
     }
 
     fn emitted(&self, at: &SurfacePoint<HitLocator>, wo: DVec3) -> Spectrum<N> {

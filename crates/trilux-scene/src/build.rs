@@ -263,6 +263,7 @@ fn scene_shape(e: &Element, folder: &Path) -> Result<ShapeRequests> {
     let mut bsdf = None;
     let mut textures = TextureCollector::new(folder);
     let mut emitter = None;
+    let mut transmission = None;
     for o in &props.objects {
         match o.tag.as_str() {
             "bsdf" => {
@@ -270,6 +271,7 @@ fn scene_shape(e: &Element, folder: &Path) -> Result<ShapeRequests> {
                     return Err(SceneError::at(&o.loc, "a <shape> takes at most one <bsdf>"));
                 }
                 bsdf = Some(build_bsdf(o, &mut textures)?);
+                transmission = crate::glass::transmission(o)?;
             }
             "emitter" => {
                 if emitter.is_some() {
@@ -314,6 +316,7 @@ fn scene_shape(e: &Element, folder: &Path) -> Result<ShapeRequests> {
         }),
         emitter,
         textures: Vec::new(),
+        transmission,
         location: e.loc.clone(),
     };
     Ok((shape, request, textures.requests))

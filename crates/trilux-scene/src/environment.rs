@@ -90,6 +90,7 @@ pub(crate) fn enclose(scene: &mut Scene) {
             location: env.location.clone(),
         }),
         textures: Vec::new(),
+        transmission: None,
         location: env.location.clone(),
     };
     let index = scene.shapes.len();

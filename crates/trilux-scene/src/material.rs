@@ -9,6 +9,8 @@
 //! | `roughplastic` | as `plastic`, with `distribution` (`beckmann` \| `ggx`) and `alpha` (0.1) or `alpha_u` = `alpha_v`; `sample_visible` ignored |
 //! | `blendbsdf` | `weight` (required, in \[0, 1\]), two nested BSDFs |
 //! | `twosided` | one nested BSDF (both sides) or two (front, back) |
+//! | `thindielectric` | black here; the light it lets through is its shape's ([`crate::glass`]) |
+//! | `mask` | `opacity` (0.5, a float) × one nested BSDF; the rest is let through by its shape ([`crate::glass`]) |
 //!
 //! Textures: `<texture type="bitmap" name="...">` (Mitsuba's `bitmap`:
 //! `filename`, `filter_type` `bilinear` | `nearest`, `wrap_mode` `repeat` |
@@ -28,13 +30,14 @@
 use std::path::Path;
 
 use trilux_brdf::{
-    Branch, BsdfParams, Distribution, Filter, NAMED_IORS, PlasticParams, RoughConductorParams,
-    SlotKind, UvTransform, Wrap, named_ior,
+    Branch, BsdfParams, Distribution, Filter, PlasticParams, RoughConductorParams, SlotKind,
+    UvTransform, Wrap,
 };
 use trilux_color::ColorParam;
 
 use crate::error::{Result, SceneError, SourceLocation};
 use crate::image::Sampling;
+use crate::ior::ior;
 use crate::props::Props;
 use crate::textures::{ImageSource, TextureRequest};
 use crate::xml::Element;
@@ -127,11 +130,36 @@ pub(crate) fn build_bsdf(e: &Element, tex: &mut TextureCollector<'_>) -> Result<
             props.boolean("allow_transmission")?;
             twosided(e, &props, tex)?
         }
+        // A pane: black here, its transmission the shape's (crate::glass).
+        "thindielectric" => {
+            crate::glass::thin_dielectric(&props)?;
+            BsdfParams::Diffuse {
+                reflectance: ColorParam::Float(0.0),
+            }
+        }
+        // Mitsuba's opacity: the nested BSDF times opacity, the rest let
+        // through (crate::glass).
+        "mask" => {
+            let opacity = crate::glass::opacity(&props)?;
+            let [inner] = nested::<1>(&props, "one nested BSDF")?;
+            let before = tex.requests.len();
+            let inner = tex.nested(Branch::Second, inner)?;
+            if tex.requests.len() > before {
+                return Err(SceneError::at(
+                    &e.loc,
+                    "a mask's nested BSDF cannot have textures here",
+                ));
+            }
+            crate::glass::masked(opacity, inner)
+        }
+        kind if crate::glass::REFRACTING.contains(&kind) => {
+            return Err(crate::glass::refused(e, kind)?);
+        }
         other => {
             return Err(SceneError::at(
                 &e.required("type")?.loc,
                 format!(
-                    "unknown bsdf plugin \"{other}\" (supported: diffuse, roughconductor, plastic, roughplastic, blendbsdf, twosided)"
+                    "unknown bsdf plugin \"{other}\" (supported: diffuse, roughconductor, plastic, roughplastic, blendbsdf, twosided, thindielectric, mask)"
                 ),
             ));
         }
@@ -166,6 +194,10 @@ fn build_nested(e: &Element, tex: &mut TextureCollector<'_>) -> Result<BsdfParam
             &e.loc,
             format!("expected a nested <bsdf>, found {}", e.describe()),
         ));
+    }
+    let kind = e.plugin_type()?;
+    if crate::glass::TRANSMITTING.contains(&kind) {
+        return Err(crate::glass::nested(e, kind)?);
     }
     build_bsdf(e, tex)
 }
@@ -517,36 +549,6 @@ fn plastic(props: &Props<'_>, rough: bool, textured: bool) -> Result<PlasticPara
         nonlinear,
         coat,
     })
-}
-
-/// An index of refraction given as a `<float>` or by one of Mitsuba's
-/// names (`default` when absent); finite and positive.
-fn ior(props: &Props<'_>, name: &str, default: &str) -> Result<f64> {
-    let loc = props.loc(name);
-    let value = match props.float(name) {
-        Ok(Some(v)) => v,
-        Ok(None) => named_ior(default).unwrap_or(1.0),
-        Err(_) => {
-            let given = props.string(name)?.unwrap_or_default();
-            named_ior(&given).ok_or_else(|| {
-                let names: Vec<&str> = NAMED_IORS.iter().map(|(n, _)| *n).collect();
-                SceneError::at(
-                    &loc,
-                    format!(
-                        "unknown index of refraction \"{given}\" for {name} (a float or one of: {})",
-                        names.join(", ")
-                    ),
-                )
-            })?
-        }
-    };
-    if !(value > 0.0 && value.is_finite()) {
-        return Err(SceneError::at(
-            &loc,
-            format!("{name} must be positive and finite, found {value}"),
-        ));
-    }
-    Ok(value)
 }
 
 /// An emitter's strength `name` (`radiance`, a light's `intensity` or

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use serde::Serialize;
 use trilux_brdf::{BsdfParams, TextureSlot};
 use trilux_color::{ColorParam, Mode};
-use trilux_geometry::{Bounds, Geometry, Punctual, Shape};
+use trilux_geometry::{Bounds, Geometry, Punctual, Shape, Transmittance};
 
 use crate::camera::Camera;
 use crate::error::{SceneError, SourceLocation};
@@ -70,6 +70,9 @@ pub struct SceneShape {
     /// holds placeholders for the parameters they stand for.
     #[serde(skip)]
     pub textures: Vec<TextureSlot>,
+    /// The fraction of light the shape lets through, undeviated, when its
+    /// BSDF is a `thindielectric` (`crate::glass`).
+    pub transmission: Option<Transmittance>,
     /// Where the `<shape>` is written.
     #[serde(skip)]
     pub location: SourceLocation,
@@ -142,6 +145,12 @@ impl Scene {
     /// order.
     pub fn texture_slots(&self) -> Vec<Vec<TextureSlot>> {
         self.shapes.iter().map(|s| s.textures.clone()).collect()
+    }
+
+    /// Every shape's transmittance (`None` for an opaque one), in shape
+    /// order (`PreparedScene::with_transmission`).
+    pub fn transmission_params(&self) -> Vec<Option<Transmittance>> {
+        self.shapes.iter().map(|s| s.transmission).collect()
     }
 
     /// Every shape's emitted radiance (`None` without an emitter), in shape

@@ -469,7 +469,8 @@ fn blendbsdf_and_twosided() {
     assert!(e(r#"<bsdf type="blendbsdf"><float name="weight" value="1.5"/><bsdf type="diffuse"/><bsdf type="diffuse"/></bsdf>"#).contains("[0, 1]"));
     assert!(e(r#"<bsdf type="blendbsdf"><float name="weight" value="0.5"/><bsdf type="diffuse"/></bsdf>"#).contains("exactly two"));
     assert!(e(r#"<bsdf type="twosided"/>"#).contains("one or two"));
-    assert!(e(r#"<bsdf type="dielectric"/>"#).contains("unknown bsdf plugin \"dielectric\""));
+    assert!(e(r#"<bsdf type="hair"/>"#).contains("unknown bsdf plugin \"hair\""));
+    assert!(e(r#"<bsdf type="dielectric"/>"#).contains("refracts light through a thick object"));
 }
 
 #[test]

@@ -97,10 +97,16 @@ impl<const N: usize> Solver<N> {
                 };
                 let cos = sign * y.normal.dot(a.wi);
                 let end = self.setup.scene.shadow_end(y.point, &a);
-                if cos <= 0.0 || end.is_none_or(|end| geometry.occluded(y.point, end)) {
+                // The fraction the segment lets through (panes of glass:
+                // trilux_geometry::transmission), 0 when blocked.
+                let tau = match end {
+                    Some(end) if cos > 0.0 => geometry.transmittance(y.point, end),
+                    _ => 0.0,
+                };
+                if tau <= 0.0 {
                     continue;
                 }
-                arrived += e * (cos / y.pdf_area);
+                arrived += e * (tau * cos / y.pdf_area);
             }
             if arrived.max_value() > 0.0 {
                 let centre = forest.element(leaf).centre;

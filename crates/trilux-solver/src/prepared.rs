@@ -13,7 +13,9 @@ use std::sync::Arc;
 use thiserror::Error;
 use trilux_brdf::{BrdfError, Bsdf, BsdfParams, Shading, TextureSlot, TexturedBsdf};
 use trilux_color::{ColorError, ColorParam, Spectrum};
-use trilux_geometry::{Bounds, Geometry, GeometryError, Punctual, Shape, SurfaceCoord, SurfaceId};
+use trilux_geometry::{
+    Bounds, Geometry, GeometryError, Punctual, Shape, SurfaceCoord, SurfaceId, Transmittance,
+};
 
 use crate::lights::{LightError, PreparedLight};
 
@@ -276,6 +278,21 @@ impl<const N: usize> PreparedScene<N> {
     /// towards directional lights end inside it.
     pub fn with_enclosure(mut self, enclosure: Option<Bounds>) -> Self {
         self.enclosure = enclosure;
+        self
+    }
+
+    /// The scene with some shapes letting a fraction of the light through
+    /// (`by_shape[i]` for shape `i`: trilux-geometry's `transmission`),
+    /// which every visibility of the solve and the render multiplies; they
+    /// enter the content hash.
+    pub fn with_transmission(mut self, by_shape: &[Option<Transmittance>]) -> Self {
+        if by_shape.iter().any(Option::is_some) {
+            Arc::make_mut(&mut self.geometry).set_transmission(by_shape);
+            let mut h = Fnv1a(self.hash);
+            if serde_json::to_writer(&mut h, by_shape).is_ok() {
+                self.hash = h.0;
+            }
+        }
         self
     }
 

@@ -153,6 +153,7 @@ pub fn prepare<const N: usize>(scene: &Scene) -> Result<Arc<PreparedScene<N>>, P
         .map_err(|e| PipelineError::from(located(scene, &e)))?;
     prepared
         .with_enclosure(scene.enclosure())
+        .with_transmission(&scene.transmission_params())
         .with_lights(&scene.light_params())
         .map(Arc::new)
         .map_err(|e| {
