@@ -186,7 +186,12 @@ impl<'a> Builder<'a> {
                     .is_some_and(|t| matches!(t.value.as_str(), "constant" | "envmap")) =>
             {
                 let env = if e.plugin_type()? == "envmap" {
-                    crate::envmap::envmap(e, self.folder)?
+                    Environment {
+                        radiance: trilux_color::ColorParam::Float(0.0),
+                        map: Some(crate::envmap::envmap(e, self.folder)?),
+                        shape: None,
+                        location: e.loc.clone(),
+                    }
                 } else {
                     crate::environment::constant(e)?
                 };

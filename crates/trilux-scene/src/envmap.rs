@@ -22,7 +22,6 @@ use serde::Serialize;
 use crate::error::{Result, SceneError};
 use crate::limits::{MAX_IMAGE_BYTES, MAX_RADIANCE, MAX_TEXTURE_TEXELS};
 use crate::props::Props;
-use crate::scene::Environment;
 use crate::xml::Element;
 
 /// An environment map as read: linear RGB texels, row-major from the top
@@ -45,9 +44,9 @@ pub struct EnvMap {
     pub world_from_sky: DMat3,
 }
 
-/// Builds a top-level `<emitter type="envmap">` whose relative file name
-/// starts in `folder`; the image is read and checked here.
-pub(crate) fn envmap(e: &Element, folder: &Path) -> Result<Environment> {
+/// Builds the map of a top-level `<emitter type="envmap">` whose relative
+/// file name starts in `folder`; the image is read and checked here.
+pub(crate) fn envmap(e: &Element, folder: &Path) -> Result<EnvMap> {
     e.check_attrs(&["type", "id", "name"])?;
     let props = Props::new(e)?;
     props.no_objects()?;
@@ -106,18 +105,13 @@ pub(crate) fn envmap(e: &Element, folder: &Path) -> Result<Environment> {
             texels[k]
         )));
     }
-    Ok(Environment {
-        radiance: trilux_color::ColorParam::Float(0.0),
-        shape: None,
-        map: Some(EnvMap {
-            file,
-            width,
-            height,
-            texels,
-            scale,
-            world_from_sky,
-        }),
-        location: e.loc.clone(),
+    Ok(EnvMap {
+        file,
+        width,
+        height,
+        texels,
+        scale,
+        world_from_sky,
     })
 }
 
