@@ -82,7 +82,7 @@ pub use gather::ExtraBounce;
 pub use image::Image;
 pub use mis::{power_heuristic, punctual_direct};
 pub use records::{
-    BsdfSample, GatherStats, LightSample, LinkVisibility, PunctualSample, SurfacePoint,
+    BsdfSample, GatherStats, LightSample, LinkVisibility, PunctualSample, SkyRay, SurfacePoint,
 };
 pub use sampler::PixelSampler;
 pub use scene::{GatherScene, SolutionGather};

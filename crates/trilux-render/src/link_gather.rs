@@ -28,6 +28,11 @@
 //!   the link sum at x_d (with the links' own visibility) times ρ_d(x_d),
 //!   plus its own glossy part, one level deeper; beyond that level the
 //!   solution is read directly.
+//! - The **sky** (an environment map) is not in the links either: the
+//!   Lambertian part takes one sky sample, MIS-combined with the cosine
+//!   ray (which then is always traced) leaving the scene; the glossy part
+//!   takes it with its light sample and its gather ray's misses
+//!   (`crate::mis`).
 //!
 //! [`Preview`] drops every random ray: the link sum with the links' own
 //! visibility at x_s, and for a glossy x_s the direct light by a fixed
@@ -41,7 +46,9 @@ use glam::DVec3;
 
 use crate::gather::FinalGather;
 use crate::link_sum::LinkCache;
-use crate::mis::{eye_hit, hit_emission, light_sample, punctual_direct};
+use crate::mis::{
+    eye_hit, hit_emission, light_sample, miss_emission, punctual_direct, sky_sample, sky_seen,
+};
 use crate::records::{GatherStats, LinkVisibility, SurfacePoint};
 use crate::sampler::{PixelSampler, dims, hammersley};
 use crate::scene::SolutionGather;
@@ -97,7 +104,7 @@ impl<S> LinkGather<'_, S> {
         }
         stats.camera_rays += 1;
         let Some(xs) = eye_hit(self.scene, origin, dir, self.fallback.hide_emitters) else {
-            return Spectrum::zero();
+            return sky_seen(self.scene, dir, self.fallback.hide_emitters);
         };
         let wo = -dir;
         let scene = self.scene;
@@ -271,28 +278,41 @@ impl<S> LinkGather<'_, S> {
         S: SolutionGather<N>,
     {
         let correct = level == 0 && !w.caches.pixel.coarse_near().is_empty();
-        if !self.glossy_scene && !correct {
-            return Spectrum::zero();
-        }
+        let traced = self.glossy_scene || correct;
         let scene = self.scene;
+        // The sky's share (not in the links): one sky sample, MIS-weighted
+        // against the cosine ray where that is traced.
+        let kernel = |wi| scene.cosine_pdf(x, wo, wi);
+        let sky = sky_sample(
+            scene,
+            x,
+            w.sampler.get2(dims::sky(level)),
+            |wi| Spectrum::splat(kernel(wi)),
+            kernel,
+            traced,
+            w.stats,
+        );
+        if !traced {
+            return sky;
+        }
         let u = w.sampler.get2(dims::GLOSSY_SENDERS + 2 * level);
         let Some(wi) = scene.sample_cosine(x, wo, u) else {
-            return Spectrum::zero();
+            return sky;
         };
         w.stats.gather_rays += 1;
+        // With density cos θ/π the estimate of (1/π) ∫ L cos dω is L.
         let Some(xd) = scene.intersect(x.point, wi) else {
-            return Spectrum::zero();
+            return sky + miss_emission(scene, wi, kernel(wi), Spectrum::splat(1.0));
         };
         let back = -wi;
         let through = scene.through(&xd);
-        // With density cos θ/π the estimate of (1/π) ∫ L cos dω is L.
         let mut e = Spectrum::zero();
         if correct {
             let Caches { pixel, scratch } = &mut *w.caches;
             let near = pixel.coarse_near();
             if let Some(c) = scene.near_correction(&xd, back, near, scratch, w.stats) {
                 w.stats.near_corrections += 1;
-                e = c;
+                e += c;
             }
         }
         if self.glossy_scene && scene.is_glossy(&xd, back) {
@@ -303,7 +323,7 @@ impl<S> LinkGather<'_, S> {
             };
             e += g;
         }
-        e * through
+        sky + e * through
     }
 
     /// The glossy part of the reflected radiance at `x` towards `wo`, at
@@ -336,11 +356,12 @@ impl<S> LinkGather<'_, S> {
             return l;
         }
         w.stats.gather_rays += 1;
+        let weight = f * (1.0 / bs.pdf);
         let Some(xd) = scene.intersect(x.point, bs.wi) else {
-            return l;
+            return l + miss_emission(scene, bs.wi, bs.pdf, weight);
         };
         let back = -bs.wi;
-        let weight = f * (scene.through(&xd) / bs.pdf);
+        let weight = weight * scene.through(&xd);
         if let Some(le) = hit_emission(scene, &xd, back, bs.pdf, weight) {
             l += le;
         }

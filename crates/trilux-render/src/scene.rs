@@ -22,7 +22,7 @@ use trilux_geometry::FaceElement;
 
 use crate::link_sum::LinkCache;
 use crate::records::{
-    BsdfSample, GatherStats, LightSample, LinkVisibility, PunctualSample, SurfacePoint,
+    BsdfSample, GatherStats, LightSample, LinkVisibility, PunctualSample, SkyRay, SurfacePoint,
 };
 
 /// Everything the path gather needs from a scene and its solution.
@@ -80,6 +80,15 @@ pub trait GatherScene<const N: usize>: Sync {
         reference: &SurfacePoint<Self::Locator>,
     ) -> Option<PunctualSample<N>>;
 
+    /// The sky's radiance arriving from unit direction `wi` (a ray that
+    /// leaves the scene) and the solid-angle density with which
+    /// [`GatherScene::sample_sky`] draws `wi`; zero and zero without a sky.
+    fn sky(&self, wi: DVec3) -> (Spectrum<N>, f64);
+
+    /// A direction drawn from the sky's distribution with `u`, as seen
+    /// from `reference`; `None` without a sky.
+    fn sample_sky(&self, reference: &SurfacePoint<Self::Locator>, u: DVec2) -> Option<SkyRay<N>>;
+
     /// The area density [`GatherScene::sample_light`] has at `at` (zero when
     /// `at` is not on an emitter).
     fn light_pdf_area(&self, at: &SurfacePoint<Self::Locator>) -> f64;
@@ -130,6 +139,11 @@ pub trait SolutionGather<const N: usize>: GatherScene<N> {
 
     /// True when some face of the scene has a glossy part.
     fn has_glossy_faces(&self) -> bool;
+
+    /// The density cos θ/π with which [`SolutionGather::sample_cosine`]
+    /// draws `wi` at `at` for the viewer direction `wo` (zero where it
+    /// cannot), the kernel of the Lambertian part's irradiance.
+    fn cosine_pdf(&self, at: &SurfacePoint<Self::Locator>, wo: DVec3, wi: DVec3) -> f64;
 
     /// The Lambertian part's reflectance ρ_d at `at` on the side of `wo`
     /// (zero where there is none).

@@ -37,7 +37,7 @@ use trilux_solver::{PreparedScene, SurfaceSite};
 
 use crate::link_sum::{LinkCache, LinkField, Receiver, link_sum};
 use crate::records::{
-    BsdfSample, GatherStats, LightSample, LinkVisibility, PunctualSample, SurfacePoint,
+    BsdfSample, GatherStats, LightSample, LinkVisibility, PunctualSample, SkyRay, SurfacePoint,
 };
 use crate::sampler::hammersley;
 use crate::scene::{GatherScene, SolutionGather};
@@ -259,6 +259,23 @@ impl<const N: usize, S: RadianceSolution<N>> GatherScene<N> for SolvedScene<'_, 
         })
     }
 
+    fn sky(&self, wi: DVec3) -> (Spectrum<N>, f64) {
+        match self.scene.sky() {
+            Some(s) => (s.radiance(wi), s.pdf(wi)),
+            None => (Spectrum::zero(), 0.0),
+        }
+    }
+
+    fn sample_sky(&self, reference: &SurfacePoint<HitLocator>, u: DVec2) -> Option<SkyRay<N>> {
+        let s = self.scene.sky()?.sample(u)?;
+        Some(SkyRay {
+            wi: s.wi,
+            end: self.scene.sky_end(reference.point, s.wi),
+            radiance: s.radiance,
+            pdf: s.pdf,
+        })
+    }
+
     fn unoccluded(&self, from: &SurfacePoint<HitLocator>, to: DVec3) -> bool {
         !self.geom().occluded(from.point, to)
     }
@@ -461,6 +478,16 @@ impl<const N: usize, S: RadianceSolution<N>> SolutionGather<N> for SolvedScene<'
     ) -> Spectrum<N> {
         let (from, towards) = Self::sites(from, towards);
         self.solution.reflected_glossy(&from, &towards)
+    }
+
+    fn cosine_pdf(&self, at: &SurfacePoint<HitLocator>, wo: DVec3, wi: DVec3) -> f64 {
+        let sign = viewer_side(at, wo).sign();
+        let cos = sign * at.locator.shading_normal.dot(wi);
+        if cos <= 0.0 || sign * at.normal.dot(wi) <= 0.0 {
+            0.0
+        } else {
+            cos / std::f64::consts::PI
+        }
     }
 
     fn sample_cosine(&self, at: &SurfacePoint<HitLocator>, wo: DVec3, u: DVec2) -> Option<DVec3> {

@@ -23,12 +23,15 @@ pub struct AreaEmitter {
     pub location: SourceLocation,
 }
 
-/// A `constant` environment emitter.
+/// An environment emitter: `constant` or `envmap`.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Environment {
     /// Radiance arriving from every direction (`radiance`, Mitsuba's
-    /// default 1).
+    /// default 1) of a `constant` sky (0 for an `envmap`).
     pub radiance: ColorParam,
+    /// The image of an `envmap` (`None` for a `constant` sky), which no
+    /// enclosure stands for (`crate::envmap`).
+    pub map: Option<crate::envmap::EnvMap>,
     /// The index in [`Scene::shapes`] of the enclosure standing for it
     /// (set when the scene's meshes are read: its size needs them;
     /// `crate::environment` says why an enclosure).
@@ -175,6 +178,11 @@ impl Scene {
             min: a.min(b),
             max: a.max(b),
         })
+    }
+
+    /// The environment map, if the scene's environment is an `envmap`.
+    pub fn sky_map(&self) -> Option<&crate::envmap::EnvMap> {
+        self.environment.as_ref()?.map.as_ref()
     }
 
     /// Every light without area as the solver takes it (where it is, its

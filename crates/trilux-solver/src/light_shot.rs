@@ -7,7 +7,8 @@
 //! radiance as for a pair link; the glossy share (the directional albedo
 //! for the light's direction less ρ_d) joins it, its energy kept and its
 //! direction lost (a smooth plastic's coat is carried the same way); the
-//! rest is absorbed, and what misses every element escapes.
+//! rest is absorbed, and what misses every element escapes. The sky
+//! (an environment map) is shot the same way, its deposits `sky_shot`'s.
 
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
@@ -19,16 +20,17 @@ use crate::lights::PreparedLight;
 use crate::solver::Solver;
 
 /// Stratified points per leaf element and light (4 × 4).
-const POINTS_PER_SIDE: u32 = 4;
+pub(crate) const POINTS_PER_SIDE: u32 = 4;
 
 /// What one leaf element of one face receives from a light.
-struct Deposit<const N: usize> {
-    face: FaceId,
-    leaf: ElementId,
+pub(crate) struct Deposit<const N: usize> {
+    pub face: FaceId,
+    pub leaf: ElementId,
     /// ∫ E dA over the leaf's exposed part.
-    arrived: Spectrum<N>,
-    /// Unit direction towards the light from the leaf's centre.
-    wi: DVec3,
+    pub arrived: Spectrum<N>,
+    /// Unit direction towards the light from the leaf's centre (the
+    /// sky's: the mean direction its light arrives from).
+    pub wi: DVec3,
 }
 
 impl<const N: usize> Solver<N> {
@@ -38,12 +40,18 @@ impl<const N: usize> Solver<N> {
         let phi = std::mem::take(&mut self.state.light_flux[k]);
         // Every watt a light shoots is emission.
         self.state.interreflection.book_shot(phi, Spectrum::zero());
-        let light = self.setup.scene.lights()[k].clone();
         let faces: Vec<FaceId> = self.setup.faces.iter().map(|(f, _)| f).collect();
-        let deposits: Vec<Deposit<N>> = faces
-            .par_iter()
-            .flat_map_iter(|&f| self.light_deposits(&light, f))
-            .collect();
+        // Light k past the lights without area is the sky (`sky_shot`).
+        let deposits: Vec<Deposit<N>> = match self.setup.scene.lights().get(k) {
+            Some(light) => faces
+                .par_iter()
+                .flat_map_iter(|&f| self.light_deposits(light, f))
+                .collect(),
+            None => faces
+                .par_iter()
+                .flat_map_iter(|&f| self.sky_deposits(f))
+                .collect(),
+        };
         let mut total = Spectrum::<N>::zero();
         let mut absorbed = Spectrum::<N>::zero();
         for d in &deposits {

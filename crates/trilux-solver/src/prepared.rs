@@ -18,6 +18,7 @@ use trilux_geometry::{
 };
 
 use crate::lights::{LightError, PreparedLight};
+use crate::sky::PreparedSky;
 
 /// What light transport needs of a scene, as plain data: per shape its
 /// geometry, its material and its area emitter's radiance (if any).
@@ -150,6 +151,8 @@ pub struct PreparedScene<const N: usize> {
     lights: Vec<PreparedLight<N>>,
     /// The box standing for a `constant` sky, if any (`with_enclosure`).
     enclosure: Option<Bounds>,
+    /// The environment map, if any (`with_sky`).
+    sky: Option<PreparedSky<N>>,
     hash: u64,
 }
 
@@ -211,6 +214,7 @@ impl<const N: usize> PreparedScene<N> {
             emission,
             lights: Vec::new(),
             enclosure: None,
+            sky: None,
             hash: content_hash(desc, textures, N)?,
         })
     }
@@ -294,6 +298,31 @@ impl<const N: usize> PreparedScene<N> {
             }
         }
         self
+    }
+
+    /// The scene lit by an environment map (`crate::sky`); its texels and
+    /// orientation enter the content hash.
+    pub fn with_sky(mut self, sky: Option<PreparedSky<N>>) -> Self {
+        if let Some(s) = &sky {
+            let mut h = Fnv1a(self.hash);
+            s.hash_into(&mut h);
+            self.hash = h.0;
+        }
+        self.sky = sky;
+        self
+    }
+
+    /// The environment map, if any.
+    pub fn sky(&self) -> Option<&PreparedSky<N>> {
+        self.sky.as_ref()
+    }
+
+    /// Where a shadow ray from `x` towards the sky in direction `wi` ends:
+    /// beyond everything in the scene.
+    pub fn sky_end(&self, x: glam::DVec3, wi: glam::DVec3) -> glam::DVec3 {
+        let b = self.geometry.bounds();
+        let reach = (b.max - b.min).length() + (x - 0.5 * (b.max + b.min)).length() + 1.0;
+        x + wi * reach
     }
 
     /// Where a shadow ray from `x` towards the light of `a` ends, `None`
