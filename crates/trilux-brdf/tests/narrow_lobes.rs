@@ -79,12 +79,7 @@ fn rule_sizes(width: f64, radius: f64) -> (u32, u32) {
 /// through the reflector into the cone `to`, per unit radiance:
 /// (1/π) ∫_{Ω_from} cos θ_i ∫_{Ω_to} fr cos θ_o, the incident directions
 /// on a stratified grid over the cone, each lobe sampled ([`rule_sizes`]).
-fn cone_transfer(
-    b: &Bsdf<3>,
-    table: &AlbedoTable<3>,
-    from: (DVec3, f64),
-    to: (DVec3, f64),
-) -> f64 {
+fn cone_transfer(b: &Bsdf<3>, table: &AlbedoTable<3>, from: (DVec3, f64), to: (DVec3, f64)) -> f64 {
     let (axis, radius) = from;
     let width = lobe_width(b, Side::Front).unwrap_or(f64::INFINITY);
     let (n, grid) = rule_sizes(width, radius);
@@ -103,14 +98,7 @@ fn cone_transfer(
             }
             let dw = 2.0 * PI * (1.0 - cos_r) / f64::from(n * n);
             samples.clear();
-            sample_glossy_lobe(
-                b,
-                wi,
-                glossy_albedo(b, table, wi),
-                grid,
-                1.0,
-                &mut samples,
-            );
+            sample_glossy_lobe(b, wi, glossy_albedo(b, table, wi), grid, 1.0, &mut samples);
             let into: f64 = samples
                 .iter()
                 .filter(|s| s.wo.dot(to.0) >= to.1.cos())
