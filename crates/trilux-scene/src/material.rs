@@ -32,8 +32,8 @@
 use std::path::Path;
 
 use trilux_brdf::{
-    Branch, BsdfParams, Distribution, Filter, MIRROR_ALPHA, NAMED_IORS, PlasticParams,
-    RoughConductorParams, SlotKind, UvTransform, Wrap, conductor_names, named_conductor, named_ior,
+    Branch, BsdfParams, Distribution, Filter, MIRROR_ALPHA, PlasticParams, RoughConductorParams,
+    SlotKind, UvTransform, Wrap, conductor_names, named_conductor,
 };
 use trilux_color::ColorParam;
 

@@ -41,35 +41,34 @@ fn the_metal_box_matches_mitsuba() {
         "{}",
         String::from_utf8_lossy(&run.stderr)
     );
-    let mut report = Vec::new();
-    let mut ok = true;
-    for (gather, tol) in [("paths", 0.02)] {
-        let out = dir.join(format!("metal-box-{gather}.exr"));
-        let run = trilux(&[
-            "render",
-            &file,
-            "--solution",
-            sol.to_str().unwrap(),
-            "--spp",
-            "16",
-            "--gather",
-            gather,
-            "-o",
-            out.to_str().unwrap(),
-        ]);
-        assert!(
-            run.status.success(),
-            "{}",
-            String::from_utf8_lossy(&run.stderr)
-        );
-        let rel = mean(&Image::read_exr(&out).unwrap()) / r - 1.0;
-        ok &= rel.abs() <= tol; // false for NaN
-        report.push(format!(
-            "metal-box {gather}: {:+.2} % (tolerance {} %)",
-            100.0 * rel,
-            100.0 * tol
-        ));
-    }
-    eprintln!("{}", report.join("\n"));
-    assert!(ok, "{}", report.join("\n"));
+    // The default path gather (2 %: the bound of the daylight rooms' scene
+    // comparisons; this scene is 1.7 % dark, a deficit not yet located,
+    // docs/results.md "Smooth and named conductors in a scene").
+    let tol = 0.02;
+    let out = dir.join("metal-box-paths.exr");
+    let run = trilux(&[
+        "render",
+        &file,
+        "--solution",
+        sol.to_str().unwrap(),
+        "--spp",
+        "16",
+        "--gather",
+        "paths",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let rel = mean(&Image::read_exr(&out).unwrap()) / r - 1.0;
+    let report = format!(
+        "metal-box paths: {:+.2} % (tolerance {} %)",
+        100.0 * rel,
+        100.0 * tol
+    );
+    eprintln!("{report}");
+    assert!(rel.abs() <= tol, "{report}"); // false for NaN
 }
