@@ -205,7 +205,7 @@ impl<const N: usize> GatherScene<N> for Furnace {
         None
     }
 
-    fn sky(&self, _wi: DVec3) -> (Spectrum<N>, f64) {
+    fn sky(&self, _from: DVec3, _wi: DVec3) -> (Spectrum<N>, f64) {
         (Spectrum::zero(), 0.0)
     }
 
@@ -362,7 +362,7 @@ impl<const N: usize> GatherScene<N> for LitFloor {
         None
     }
 
-    fn sky(&self, _wi: DVec3) -> (Spectrum<N>, f64) {
+    fn sky(&self, _from: DVec3, _wi: DVec3) -> (Spectrum<N>, f64) {
         (Spectrum::zero(), 0.0)
     }
 

@@ -91,7 +91,7 @@ impl<S> ControlVariate<'_, S> {
             return Spectrum::zero();
         }
         let Some(xs) = eye_hit(self.scene, origin, dir, self.hide_emitters) else {
-            return sky_seen(self.scene, dir, self.hide_emitters);
+            return sky_seen(self.scene, origin, dir, self.hide_emitters);
         };
         let wo = -dir;
         let mut l = self.scene.emitted(&xs, wo);
@@ -135,7 +135,7 @@ impl<S> ControlVariate<'_, S> {
             // A ray that leaves the scene brings the sky, and nothing
             // reflected.
             Some((bs, None)) => {
-                let sky = miss_emission(scene, bs.wi, bs.pdf, bs.weight);
+                let sky = miss_emission(scene, xs.point, bs.wi, bs.pdf, bs.weight);
                 return l + sky + control * (1.0 / f64::from(m));
             }
             None => return l + control * (1.0 / f64::from(m)),
@@ -215,7 +215,7 @@ impl<S> ControlVariate<'_, S> {
             };
             beta *= bs.weight;
             let Some(xn) = xn else {
-                l += miss_emission(scene, bs.wi, bs.pdf, beta);
+                l += miss_emission(scene, x.point, bs.wi, bs.pdf, beta);
                 break;
             };
             let back = -bs.wi;

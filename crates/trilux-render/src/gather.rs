@@ -108,7 +108,7 @@ impl<'a, S> FinalGather<'a, S> {
     {
         stats.camera_rays += 1;
         let Some(xs) = eye_hit(self.scene, origin, dir, self.hide_emitters) else {
-            return sky_seen(self.scene, dir, self.hide_emitters);
+            return sky_seen(self.scene, origin, dir, self.hide_emitters);
         };
         let wo = -dir;
         let le = self.scene.emitted(&xs, wo);
@@ -152,7 +152,7 @@ impl<'a, S> FinalGather<'a, S> {
         }
         stats.gather_rays += 1;
         let Some(xd) = scene.intersect(x.point, bs.wi) else {
-            return l + miss_emission(scene, bs.wi, bs.pdf, bs.weight);
+            return l + miss_emission(scene, x.point, bs.wi, bs.pdf, bs.weight);
         };
         let back = -bs.wi;
         // What panes of glass on the way let through.

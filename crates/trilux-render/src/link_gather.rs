@@ -104,7 +104,7 @@ impl<S> LinkGather<'_, S> {
         }
         stats.camera_rays += 1;
         let Some(xs) = eye_hit(self.scene, origin, dir, self.fallback.hide_emitters) else {
-            return sky_seen(self.scene, dir, self.fallback.hide_emitters);
+            return sky_seen(self.scene, origin, dir, self.fallback.hide_emitters);
         };
         let wo = -dir;
         let scene = self.scene;
@@ -302,7 +302,7 @@ impl<S> LinkGather<'_, S> {
         w.stats.gather_rays += 1;
         // With density cos θ/π the estimate of (1/π) ∫ L cos dω is L.
         let Some(xd) = scene.intersect(x.point, wi) else {
-            return sky + miss_emission(scene, wi, kernel(wi), Spectrum::splat(1.0));
+            return sky + miss_emission(scene, x.point, wi, kernel(wi), Spectrum::splat(1.0));
         };
         let back = -wi;
         let through = scene.through(&xd);
@@ -358,7 +358,7 @@ impl<S> LinkGather<'_, S> {
         w.stats.gather_rays += 1;
         let weight = f * (1.0 / bs.pdf);
         let Some(xd) = scene.intersect(x.point, bs.wi) else {
-            return l + miss_emission(scene, bs.wi, bs.pdf, weight);
+            return l + miss_emission(scene, x.point, bs.wi, bs.pdf, weight);
         };
         let back = -bs.wi;
         let weight = weight * scene.through(&xd);

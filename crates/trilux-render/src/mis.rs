@@ -129,7 +129,8 @@ pub fn sky_sample<S: GatherScene<N>, const N: usize>(
         return Spectrum::zero();
     }
     stats.shadow_rays += 1;
-    if !scene.unoccluded(x, s.end) {
+    let tau = scene.transmittance(x, s.end);
+    if tau <= 0.0 {
         return Spectrum::zero();
     }
     let w = if mis {
@@ -137,19 +138,21 @@ pub fn sky_sample<S: GatherScene<N>, const N: usize>(
     } else {
         1.0
     };
-    f * s.radiance * (w / s.pdf)
+    f * s.radiance * (tau * w / s.pdf)
 }
 
-/// The sky a ray sampled with density `pdf` in direction `wi` brings when
-/// it leaves the scene: L(ω) times the sample's `weight`, weighted by the
-/// power heuristic against sky sampling's density (zero without a sky).
+/// The sky a ray from `from` sampled with density `pdf` in direction `wi`
+/// brings when it leaves the scene: L(ω) (through any panes) times the
+/// sample's `weight`, weighted by the power heuristic against sky
+/// sampling's density (zero without a sky).
 pub fn miss_emission<S: GatherScene<N>, const N: usize>(
     scene: &S,
+    from: DVec3,
     wi: DVec3,
     pdf: f64,
     weight: Spectrum<N>,
 ) -> Spectrum<N> {
-    let (l, p_sky) = scene.sky(wi);
+    let (l, p_sky) = scene.sky(from, wi);
     if l.is_black() {
         return Spectrum::zero();
     }
@@ -185,17 +188,19 @@ pub fn punctual_direct<S: GatherScene<N>, const N: usize>(
     sum
 }
 
-/// The sky a camera ray that met nothing sees (black with `hide_emitters`,
-/// which hides the sky in Mitsuba 3.9.1 too, or without a sky).
+/// The sky a camera ray from `origin` that met nothing sees (black with
+/// `hide_emitters`, which hides the sky in Mitsuba 3.9.1 too, or without
+/// a sky).
 pub(crate) fn sky_seen<S: GatherScene<N>, const N: usize>(
     scene: &S,
+    origin: DVec3,
     dir: DVec3,
     hide_emitters: bool,
 ) -> Spectrum<N> {
     if hide_emitters {
         Spectrum::zero()
     } else {
-        scene.sky(dir).0
+        scene.sky(origin, dir).0
     }
 }
 

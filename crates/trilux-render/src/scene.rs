@@ -80,10 +80,12 @@ pub trait GatherScene<const N: usize>: Sync {
         reference: &SurfacePoint<Self::Locator>,
     ) -> Option<PunctualSample<N>>;
 
-    /// The sky's radiance arriving from unit direction `wi` (a ray that
-    /// leaves the scene) and the solid-angle density with which
-    /// [`GatherScene::sample_sky`] draws `wi`; zero and zero without a sky.
-    fn sky(&self, wi: DVec3) -> (Spectrum<N>, f64);
+    /// The sky's radiance arriving at `from` from unit direction `wi` (a
+    /// ray from `from` that leaves the scene), times what the surfaces it
+    /// went through let through (panes of glass), and the solid-angle
+    /// density with which [`GatherScene::sample_sky`] draws `wi`; zero and
+    /// zero without a sky.
+    fn sky(&self, from: DVec3, wi: DVec3) -> (Spectrum<N>, f64);
 
     /// A direction drawn from the sky's distribution with `u`, as seen
     /// from `reference`; `None` without a sky.

@@ -259,11 +259,20 @@ impl<const N: usize, S: RadianceSolution<N>> GatherScene<N> for SolvedScene<'_, 
         })
     }
 
-    fn sky(&self, wi: DVec3) -> (Spectrum<N>, f64) {
-        match self.scene.sky() {
-            Some(s) => (s.radiance(wi), s.pdf(wi)),
-            None => (Spectrum::zero(), 0.0),
-        }
+    fn sky(&self, from: DVec3, wi: DVec3) -> (Spectrum<N>, f64) {
+        let Some(s) = self.scene.sky() else {
+            return (Spectrum::zero(), 0.0);
+        };
+        let l = s.radiance(wi);
+        // The ray met nothing opaque; the panes it crossed (if the scene
+        // has any) take their share, walked again from `from`.
+        let geom = self.geom();
+        let tau = if geom.has_transmission() && !l.is_black() {
+            geom.transmittance(from, self.scene.sky_end(from, wi))
+        } else {
+            1.0
+        };
+        (l * tau, s.pdf(wi))
     }
 
     fn sample_sky(&self, reference: &SurfacePoint<HitLocator>, u: DVec2) -> Option<SkyRay<N>> {

@@ -86,7 +86,7 @@ impl GatherScene<3> for GlossyFloor {
         None
     }
 
-    fn sky(&self, _: DVec3) -> (Spectrum<3>, f64) {
+    fn sky(&self, _: DVec3, _: DVec3) -> (Spectrum<3>, f64) {
         (Spectrum::zero(), 0.0)
     }
     fn sample_sky(&self, _: &SurfacePoint<u8>, _: DVec2) -> Option<SkyRay<3>> {

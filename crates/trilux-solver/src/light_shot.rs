@@ -14,7 +14,7 @@ use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 use trilux_brdf::Frame;
 use trilux_color::Spectrum;
-use trilux_geometry::{ElementId, FaceId};
+use trilux_geometry::{ElementId, FaceId, SurfaceSample};
 
 use crate::lights::PreparedLight;
 use crate::solver::Solver;
@@ -72,6 +72,41 @@ impl<const N: usize> Solver<N> {
         deposits.len()
     }
 
+    /// The leaves of face `f` with an exposed part (the others receive
+    /// nothing).
+    pub(crate) fn lit_leaves(&self, f: FaceId) -> impl Iterator<Item = ElementId> + '_ {
+        let forest = self.setup.forest();
+        forest
+            .leaves(forest.root(f.surface()))
+            .into_iter()
+            .filter(move |leaf| self.setup.exposed_area[f.side()][leaf.index()] > 0.0)
+    }
+
+    /// The points a light shot samples on `leaf` of face `f`: the centres
+    /// of a [`POINTS_PER_SIDE`]² grid over its parameter square, with their
+    /// index, less those buried in another surface or of zero density.
+    pub(crate) fn leaf_points(
+        &self,
+        f: FaceId,
+        leaf: ElementId,
+    ) -> impl Iterator<Item = (u32, SurfaceSample)> + '_ {
+        let n = POINTS_PER_SIDE;
+        let forest = self.setup.forest();
+        (0..n * n).filter_map(move |s| {
+            let u = DVec2::new(
+                (f64::from(s % n) + 0.5) / f64::from(n),
+                (f64::from(s / n) + 0.5) / f64::from(n),
+            );
+            let y = forest.sample_element(leaf, u);
+            let buried = self
+                .setup
+                .burial
+                .as_ref()
+                .is_some_and(|m| m.is_buried(f, y.coord));
+            (y.pdf_area > 0.0 && !buried).then_some((s, y))
+        })
+    }
+
     /// What light `light` brings to each leaf of face `f` (leaves it
     /// does not reach are left out).
     fn light_deposits(&self, light: &PreparedLight<N>, f: FaceId) -> Vec<Deposit<N>> {
@@ -80,26 +115,9 @@ impl<const N: usize> Solver<N> {
         let sign = f.side().sign();
         let n = POINTS_PER_SIDE;
         let mut out = Vec::new();
-        for leaf in forest.leaves(forest.root(f.surface())) {
-            if self.setup.exposed_area[f.side()][leaf.index()] <= 0.0 {
-                continue;
-            }
+        for leaf in self.lit_leaves(f) {
             let mut arrived = Spectrum::<N>::zero();
-            for s in 0..n * n {
-                let u = DVec2::new(
-                    (f64::from(s % n) + 0.5) / f64::from(n),
-                    (f64::from(s / n) + 0.5) / f64::from(n),
-                );
-                let y = forest.sample_element(leaf, u);
-                if y.pdf_area <= 0.0
-                    || self
-                        .setup
-                        .burial
-                        .as_ref()
-                        .is_some_and(|m| m.is_buried(f, y.coord))
-                {
-                    continue;
-                }
+            for (_, y) in self.leaf_points(f, leaf) {
                 let Some((a, e)) = light.at(y.point) else {
                     continue;
                 };

@@ -48,28 +48,11 @@ impl<const N: usize> Solver<N> {
         let n = POINTS_PER_SIDE;
         let total = n * n * DIRECTIONS;
         let mut out = Vec::new();
-        for leaf in forest.leaves(forest.root(f.surface())) {
-            if self.setup.exposed_area[f.side()][leaf.index()] <= 0.0 {
-                continue;
-            }
-            let shift = rotation(leaf.0 ^ (u32::from(f.side().sign() > 0.0) << 31));
+        for leaf in self.lit_leaves(f) {
+            let shift = rotation(leaf.0 ^ (u32::from(sign > 0.0) << 31));
             let mut arrived = Spectrum::<N>::zero();
             let mut towards = DVec3::ZERO;
-            for s in 0..n * n {
-                let u = DVec2::new(
-                    (f64::from(s % n) + 0.5) / f64::from(n),
-                    (f64::from(s / n) + 0.5) / f64::from(n),
-                );
-                let y = forest.sample_element(leaf, u);
-                if y.pdf_area <= 0.0
-                    || self
-                        .setup
-                        .burial
-                        .as_ref()
-                        .is_some_and(|m| m.is_buried(f, y.coord))
-                {
-                    continue;
-                }
+            for (s, y) in self.leaf_points(f, leaf) {
                 let normal = sign * y.normal;
                 let mut e = Spectrum::<N>::zero();
                 for m in 0..DIRECTIONS {
@@ -84,11 +67,14 @@ impl<const N: usize> Solver<N> {
                     if cos <= 0.0 || smp.radiance.is_black() {
                         continue;
                     }
+                    // The fraction the way out lets through (panes of
+                    // glass, as for the lights), 0 when blocked.
                     let end = self.setup.scene.sky_end(y.point, smp.wi);
-                    if geometry.occluded(y.point, end) {
+                    let tau = geometry.transmittance(y.point, end);
+                    if tau <= 0.0 {
                         continue;
                     }
-                    let c = smp.radiance * (cos / smp.pdf);
+                    let c = smp.radiance * (tau * cos / smp.pdf);
                     towards += smp.wi * c.average();
                     e += c;
                 }

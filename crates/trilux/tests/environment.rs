@@ -10,27 +10,12 @@ use serde_json::Value;
 use trilux_render::Image;
 
 mod common;
-use common::{folder, trilux};
+use common::{folder, render, slab_transmittance, test_file, trilux};
 
 const SKY: [f64; 3] = [1.0, 0.8, 0.6];
 
 fn scene(name: &str) -> String {
-    format!(
-        "{}/../../tests/environment/{name}",
-        env!("CARGO_MANIFEST_DIR")
-    )
-}
-
-fn render(file: &str, extra: &[&str], out: &Path) -> Image {
-    let mut args = vec!["render", file, "-o", out.to_str().unwrap()];
-    args.extend_from_slice(extra);
-    let run = trilux(&args);
-    assert!(
-        run.status.success(),
-        "{}",
-        String::from_utf8_lossy(&run.stderr)
-    );
-    Image::read_exr(out).unwrap()
+    test_file(&format!("environment/{name}"))
 }
 
 fn pixel(image: &Image, x: u32, y: u32) -> [f64; 3] {
@@ -155,19 +140,6 @@ fn sky_through_a_pane_of_glass_lights_a_closed_room_as_in_mitsuba() {
     // the solution's known deficit with a pane in a window
     // (docs/solver.md, "Panes of glass").
     against_mitsuba("glazed_room", "glazed-room.xml", "sun=0", 0.02);
-}
-
-/// The unpolarised Fresnel reflectance of one interface at cos θ_i = `c`,
-/// relative index `eta`, by Snell's law and the Fresnel equations (the
-/// closed form the sun-through-glass test holds trilux to), and a thin
-/// slab's transmittance (1 − r)² / (1 − r²).
-fn slab_transmittance(c: f64, eta: f64) -> f64 {
-    let s = (1.0 - c * c).sqrt() / eta;
-    let ct = (1.0 - s * s).sqrt();
-    let rs = ((c - eta * ct) / (c + eta * ct)).powi(2);
-    let rp = ((ct - eta * c) / (ct + eta * c)).powi(2);
-    let r = 0.5 * (rs + rp);
-    (1.0 - r) * (1.0 - r) / (1.0 - r * r)
 }
 
 fn mean_rgb(image: &Image) -> [f64; 3] {
