@@ -14,18 +14,9 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 use serde_json::Value;
-use trilux_render::Image;
 
 mod common;
-use common::{folder, scene, trilux};
-
-fn mean(image: &Image) -> f64 {
-    let px = image.pixels();
-    px.iter()
-        .map(|p| f64::from(p[0]) + f64::from(p[1]) + f64::from(p[2]))
-        .sum::<f64>()
-        / px.len() as f64
-}
+use common::{folder, mean_rgb_sum as mean, render, scene, trilux};
 
 #[test]
 fn the_metal_box_matches_mitsuba() {
@@ -46,24 +37,19 @@ fn the_metal_box_matches_mitsuba() {
     // docs/results.md "Smooth and named conductors in a scene").
     let tol = 0.02;
     let out = dir.join("metal-box-paths.exr");
-    let run = trilux(&[
-        "render",
+    let image = render(
         &file,
-        "--solution",
-        sol.to_str().unwrap(),
-        "--spp",
-        "16",
-        "--gather",
-        "paths",
-        "-o",
-        out.to_str().unwrap(),
-    ]);
-    assert!(
-        run.status.success(),
-        "{}",
-        String::from_utf8_lossy(&run.stderr)
+        &[
+            "--solution",
+            sol.to_str().unwrap(),
+            "--spp",
+            "16",
+            "--gather",
+            "paths",
+        ],
+        &out,
     );
-    let rel = mean(&Image::read_exr(&out).unwrap()) / r - 1.0;
+    let rel = mean(&image) / r - 1.0;
     let report = format!(
         "metal-box paths: {:+.2} % (tolerance {} %)",
         100.0 * rel,

@@ -4,8 +4,6 @@
 //! errors of bad input.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
-use std::path::Path;
-
 use serde_json::Value;
 use trilux_render::Image;
 
