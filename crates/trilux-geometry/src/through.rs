@@ -10,18 +10,17 @@
 //! the product of the fractions it crossed on its way there.
 //!
 //! A mask ([`Transmittance::Cutout`], [`Transmittance::Constant`]) is
-//! partly a surface: where its
-//! opacity α(u, v) is 1 a ray stops on it, where α is 0 it passes. A
-//! segment (visibility) takes the expected fraction 1 − α at each
-//! crossing. A ray that looks for what it sees ([`Geometry::intersect_through`])
-//! does what Mitsuba's `mask` does, with a choice made by a hash of the
-//! crossing (its point and the ray): it stops there with probability α,
-//! its weight divided by α, and passes with probability 1 − α, so that
-//! the expected light it brings back is (1 − α) L_behind + α · (1/α) ·
-//! L_mask, where L_mask, the light the surface reflects with its BSDF
-//! already scaled by α (the loader's `blendbsdf` of black and the nested
-//! BSDF), is α times the nested BSDF's. Where α is 0 or 1 the choice is
-//! certain, and a cut-out of binary opacity is exact.
+//! partly a surface: where its opacity α(u, v) is 1 a ray stops on it,
+//! where α is 0 it passes. A segment (visibility) takes the expected
+//! fraction 1 − α at each crossing. A ray that looks for what it sees
+//! ([`Geometry::intersect_through`]) does what Mitsuba's `mask` does, with
+//! a choice made by a hash of the crossing (its point and the ray): it
+//! stops there with probability α, its weight divided by α, and passes
+//! with probability 1 − α. The surface reflects L_mask = α L_nested (the
+//! loader's `blendbsdf` of black and the nested BSDF, weight α), so the
+//! expected light the ray brings back is
+//! (1 − α) L_behind + α · (1/α) · α L_nested = (1 − α) L_behind + α L_nested.
+//! Where α is 0 or 1 the choice is certain: a binary cut-out is exact.
 
 use glam::DVec3;
 

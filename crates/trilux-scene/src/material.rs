@@ -145,28 +145,7 @@ pub(crate) fn build_bsdf(e: &Element, tex: &mut TextureCollector<'_>) -> Result<
         }
         // Mitsuba's opacity: the nested BSDF times opacity, the rest let
         // through (crate::glass).
-        "mask" => {
-            let textured = texture(&props, "opacity", SlotKind::Weight, tex)?;
-            let opacity = if textured { tex.requests.pop() } else { None };
-            let constant = match opacity {
-                Some(_) => 0.5,
-                None => crate::glass::opacity(&props)?,
-            };
-            let [inner] = nested::<1>(&props, "one nested BSDF")?;
-            let before = tex.requests.len();
-            let inner = tex.nested(Branch::Second, inner)?;
-            crate::glass::move_into_mask(&mut tex.requests, before, &inner);
-            let masked = crate::glass::masked(constant, inner);
-            if let Some(request) = opacity {
-                tex.requests
-                    .extend(crate::glass::opacity_slots(&request, &masked));
-                tex.cutout = Some(CutoutRequest {
-                    texture: request,
-                    rule: AlphaRule::Opacity,
-                });
-            }
-            masked
-        }
+        "mask" => mask(&props, tex)?,
         kind if crate::glass::REFRACTING.contains(&kind) => {
             return Err(crate::glass::refused(e, kind)?);
         }
@@ -181,6 +160,31 @@ pub(crate) fn build_bsdf(e: &Element, tex: &mut TextureCollector<'_>) -> Result<
     };
     props.finish()?;
     Ok(bsdf)
+}
+
+/// A `mask`: its nested BSDF times its opacity, a float or a texture
+/// (which is also its shape's cut-out, [`crate::cutout`]).
+fn mask(props: &Props<'_>, tex: &mut TextureCollector<'_>) -> Result<BsdfParams> {
+    let textured = texture(props, "opacity", SlotKind::Weight, tex)?;
+    let opacity = if textured { tex.requests.pop() } else { None };
+    let constant = match opacity {
+        Some(_) => 0.5,
+        None => crate::glass::opacity(props)?,
+    };
+    let [inner] = nested::<1>(props, "one nested BSDF")?;
+    let before = tex.requests.len();
+    let inner = tex.nested(Branch::Second, inner)?;
+    crate::glass::move_into_mask(&mut tex.requests, before, &inner);
+    let masked = crate::glass::masked(constant, inner);
+    if let Some(request) = opacity {
+        tex.requests
+            .extend(crate::glass::opacity_slots(&request, &masked));
+        tex.cutout = Some(CutoutRequest {
+            texture: request,
+            rule: AlphaRule::Opacity,
+        });
+    }
+    Ok(masked)
 }
 
 /// A `twosided` BSDF: one nested BSDF (both sides) or two (front, back).

@@ -95,6 +95,17 @@ pub(crate) struct Mapped {
     pub alpha: Alpha,
 }
 
+impl Mapped {
+    /// Every texture use: the slots', then the cut-out's.
+    pub fn uses(&self) -> impl Iterator<Item = &TextureUse> {
+        let cutout = match &self.alpha {
+            Alpha::Cutout(t) => Some(t),
+            _ => None,
+        };
+        self.textures.iter().chain(cutout)
+    }
+}
+
 /// What `alphaMode` `MASK` makes of a material (module docs).
 #[derive(Clone, Debug)]
 pub(crate) enum Alpha {

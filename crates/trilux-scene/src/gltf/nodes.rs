@@ -53,6 +53,14 @@ struct Placed {
     world: DMat4,
 }
 
+/// The warning for a primitive whose material is clear everywhere.
+fn left_out(file: &Path, here: &str) -> String {
+    format!(
+        "{}: {here}: its material's alpha is below its alphaCutoff everywhere (alphaMode MASK): the primitive is left out",
+        file.display()
+    )
+}
+
 /// The texture requests and cut-outs of [`GltfMeshes::finish`], by shape.
 pub(crate) type GltfTextures = (Vec<(usize, TextureRequest)>, Vec<(usize, CutoutRequest)>);
 
@@ -337,10 +345,7 @@ impl Walk<'_> {
             return Ok(());
         };
         if let Alpha::Transparent = mapped.alpha {
-            self.warnings.push(format!(
-                "{}: {here}: its material's alpha is below its alphaCutoff everywhere (alphaMode MASK): the primitive is left out",
-                self.file.display()
-            ));
+            self.warnings.push(left_out(self.file, &here));
             return Ok(());
         }
         let shape = self.shapes.len();
@@ -359,10 +364,7 @@ impl Walk<'_> {
                 ),
             });
         self.textures
-            .extend(mapped.textures.iter().map(|t| (shape, t.clone())));
-        if let Alpha::Cutout(t) = &mapped.alpha {
-            self.textures.push((shape, t.clone()));
-        }
+            .extend(mapped.uses().map(|t| (shape, t.clone())));
         let bsdf: BsdfParams = mapped.bsdf.clone();
         self.shapes.push(SceneShape {
             id: node.name().or(mesh.name()).map(str::to_string),
