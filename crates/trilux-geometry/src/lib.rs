@@ -90,7 +90,8 @@
 //!   a box sunk into the floor) cut off from the light, marked in the
 //!   burial map.
 //! - [`transmission`]: shapes that let a fraction of the light through
-//!   ([`Transmittance`]: a thin dielectric slab, a constant fraction), and
+//!   ([`Transmittance`]: a thin dielectric slab, a constant fraction, a
+//!   cut-out of varying opacity over an [`OpacityMap`]), and
 //!   [`through`], the segment and ray queries that multiply their
 //!   fractions (`Geometry::transmittance`, `Geometry::intersect_through`).
 //! - [`visibility`]: visible fractions from stratified shadow segments
@@ -158,6 +159,6 @@ pub use sampling::SurfaceSample;
 pub use sensor::{FovAxis, LookAtError, ReconstructionFilter, look_at};
 pub use shape::{Shape, ShapeKind, TriangleMesh};
 pub use surface::{InputSurface, SurfaceCoord, SurfaceKind, SurfacePoint};
-pub use transmission::Transmittance;
+pub use transmission::{Cutout, OpacityMap, Transmittance};
 pub use trilux_frame::coordinate_system;
 pub use visibility::Visibility;

@@ -14,6 +14,7 @@ use trilux_brdf::BsdfParams;
 use trilux_color::ColorParam;
 
 use crate::camera::{Camera, Crop, FovAxis, ReconstructionFilter, default_fov};
+use crate::cutout::CutoutRequest;
 use crate::error::{Result, SceneError};
 use crate::limits::MAX_SHAPES;
 use crate::material::{TextureCollector, build_bsdf};
@@ -140,11 +141,12 @@ impl<'a> Builder<'a> {
     fn top_level(&mut self, e: &'a Element) -> Result<()> {
         match e.tag.as_str() {
             "shape" => {
-                let (shape, request, textures) = scene_shape(e, self.folder)?;
+                let (shape, request, textures, cutout) = scene_shape(e, self.folder)?;
                 let index = self.shapes.len();
                 self.requests.meshes.extend(request.map(|r| (index, r)));
                 let textures = textures.into_iter().map(|t| (index, t));
                 self.requests.textures.extend(textures);
+                self.requests.cutouts.extend(cutout.map(|c| (index, c)));
                 self.shapes.push(shape);
             }
             "bsdf" => {
@@ -267,7 +269,12 @@ fn bsdf_is_sampled(b: &BsdfParams) -> bool {
     }
 }
 
-type ShapeRequests = (SceneShape, Option<MeshRequest>, Vec<TextureRequest>);
+type ShapeRequests = (
+    SceneShape,
+    Option<MeshRequest>,
+    Vec<TextureRequest>,
+    Option<CutoutRequest>,
+);
 
 fn scene_shape(e: &Element, folder: &Path) -> Result<ShapeRequests> {
     e.check_attrs(&["type", "id", "name"])?;
@@ -331,7 +338,7 @@ fn scene_shape(e: &Element, folder: &Path) -> Result<ShapeRequests> {
         transmission,
         location: e.loc.clone(),
     };
-    Ok((shape, request, textures.requests))
+    Ok((shape, request, textures.requests, textures.cutout))
 }
 
 fn area_emitter(e: &Element) -> Result<AreaEmitter> {

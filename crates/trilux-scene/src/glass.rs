@@ -6,14 +6,17 @@
 //! | plugin | parameters (default) |
 //! |---|---|
 //! | `thindielectric` | `int_ior` (`bk7`: 1.5046) / `ext_ior` (`air`: 1.000277), as a float or one of Mitsuba's named indices; `specular_reflectance` (1), `specular_transmittance` (1), grey, in \[0, 1\] |
-//! | `mask` | `opacity` (0.5), a float in \[0, 1\]; one nested BSDF, without textures |
+//! | `mask` | `opacity` (0.5), a float in \[0, 1\] or a `bitmap` (`checkerboard`) texture; one nested BSDF |
 //!
 //! Mitsuba's `mask` (an opacity) reflects opacity × its nested BSDF and
 //! lets 1 − opacity through, whatever the angle
 //! (`Transmittance::Constant`); the nested BSDF becomes a `blendbsdf` of
 //! black and itself with weight opacity (inside a nested `twosided`, on
-//! each side). A bitmap opacity (leaves cut out of a quad) varies over
-//! the surface, which a per-shape fraction cannot hold: refused.
+//! each side). A textured opacity (leaves cut out of a quad) is the
+//! `blendbsdf`'s textured weight, and the shape a cut-out
+//! ([`crate::cutout`]) that lets 1 − opacity(u, v) through at each
+//! crossing; the solve reflects with each element's mean opacity (the
+//! textured weight averaged over the element, as every texture is).
 //!
 //! A thin slab's reflection (R = 2r/(1 + r) of the light arriving) is not
 //! carried: neither the solve nor the render reflects light off the pane
@@ -26,13 +29,14 @@
 //! transmission belongs to the shape), a coloured or textured
 //! `specular_reflectance` or `specular_transmittance`.
 
-use trilux_brdf::BsdfParams;
+use trilux_brdf::{Branch, BsdfParams, SlotKind};
 use trilux_color::ColorParam;
 use trilux_geometry::Transmittance;
 
 use crate::error::{Result, SceneError};
 use crate::ior::ior;
 use crate::props::Props;
+use crate::textures::TextureRequest;
 use crate::xml::Element;
 
 /// The BSDF plugins that only [`crate::glass`] handles.
@@ -60,20 +64,21 @@ pub(crate) fn thin_dielectric(props: &Props<'_>) -> Result<Transmittance> {
 pub(crate) fn transmission(e: &Element) -> Result<Option<Transmittance>> {
     Ok(match e.plugin_type()? {
         "thindielectric" => Some(thin_dielectric(&Props::new(e)?)?),
+        // A textured opacity is a cut-out, made once its image is read.
+        "mask" if textured_opacity(e) => None,
         "mask" => Some(Transmittance::Constant(1.0 - opacity(&Props::new(e)?)?)),
         _ => None,
     })
 }
 
-/// A `mask`'s `opacity` (Mitsuba's default 0.5): a float in [0, 1]; a
-/// texture is refused (module docs).
+/// True when a `mask` element's opacity is a texture.
+fn textured_opacity(e: &Element) -> bool {
+    e.children.iter().any(|c| c.tag == "texture")
+}
+
+/// A `mask`'s constant `opacity` (Mitsuba's default 0.5): a float in
+/// [0, 1].
 pub(crate) fn opacity(props: &Props<'_>) -> Result<f64> {
-    if let Some(t) = props.objects.iter().find(|o| o.tag == "texture") {
-        return Err(SceneError::at(
-            &t.loc,
-            "a mask's opacity must be a float here: a texture varies over the surface, which trilux's per-shape transmittance cannot hold",
-        ));
-    }
     let loc = props.loc("opacity");
     let o = props.float("opacity")?.unwrap_or(0.5);
     if !(0.0..=1.0).contains(&o) {
@@ -102,6 +107,48 @@ pub(crate) fn masked(opacity: f64, inner: BsdfParams) -> BsdfParams {
         },
         other => dim(other),
     }
+}
+
+/// Moves the texture requests from `start` on, made for the nested BSDF
+/// `inner` of a mask as the second branch of its `blendbsdf`, to where
+/// [`masked`] puts that BSDF: inside a `twosided`, the blend is on each
+/// side ([Second, Front, …] → [Front, Second, …], and [Back, Second, …]
+/// too when one BSDF served both sides; [Second, Back, …] → [Back,
+/// Second, …]).
+pub(crate) fn move_into_mask(requests: &mut Vec<TextureRequest>, start: usize, inner: &BsdfParams) {
+    let BsdfParams::TwoSided { back, .. } = inner else {
+        return;
+    };
+    let one_for_both = back.is_none();
+    let moved: Vec<TextureRequest> = requests.drain(start..).collect();
+    for mut r in moved {
+        let side = r.path.get(1).copied().unwrap_or(Branch::Front);
+        let rest = r.path.get(2..).unwrap_or_default().to_vec();
+        r.path = [vec![side, Branch::Second], rest.clone()].concat();
+        if one_for_both {
+            let mut back = r.clone();
+            back.path = [vec![Branch::Back, Branch::Second], rest].concat();
+            requests.push(back);
+        }
+        requests.push(r);
+    }
+}
+
+/// The textured opacity `request` as the weight of every `blendbsdf`
+/// [`masked`] made (one per side inside a `twosided`).
+pub(crate) fn opacity_slots(request: &TextureRequest, masked: &BsdfParams) -> Vec<TextureRequest> {
+    let paths = match masked {
+        BsdfParams::TwoSided { .. } => vec![vec![Branch::Front], vec![Branch::Back]],
+        _ => vec![Vec::new()],
+    };
+    paths
+        .into_iter()
+        .map(|path| TextureRequest {
+            path,
+            kind: SlotKind::Weight,
+            ..request.clone()
+        })
+        .collect()
 }
 
 /// The error for a refracting plugin at the element's `type`.

@@ -2,8 +2,10 @@
 //! linear RGB texels ([`trilux_brdf::Texture`]).
 //!
 //! The format is told by the file's first bytes, not its name. Grey images
-//! give grey texels; an alpha channel is dropped (trilux's surfaces are
-//! opaque); 16-bit PNG channels keep their precision. Unless `raw`, the
+//! give grey texels; an alpha channel is dropped (as Mitsuba's `bitmap`
+//! drops it), unless the alpha channel is what is asked for (glTF's
+//! `alphaMode` `MASK`: [`Sampling::alpha`], linear, in every channel; 1
+//! for an image without one); 16-bit PNG channels keep their precision. Unless `raw`, the
 //! values are sRGB-encoded and decoded with the sRGB transfer function
 //! (IEC 61966-2-1), as Mitsuba 3 decodes a `bitmap` without `raw` and as
 //! glTF defines base colour textures; `raw` values are used as they are
@@ -26,6 +28,8 @@ pub struct Sampling {
     pub filter: Filter,
     /// Values used as stored (no sRGB decoding).
     pub raw: bool,
+    /// The alpha channel instead of the colour (linear whatever `raw`).
+    pub alpha: bool,
 }
 
 /// Why an image could not be decoded (the caller names the file).
@@ -86,7 +90,14 @@ pub fn decode(bytes: &[u8], sampling: Sampling) -> Result<Texture, ImageError> {
         .chunks_exact(channels)
         .map(|px| {
             let c = |i: usize| lut[usize::from(px[i])];
-            if channels >= 3 {
+            if sampling.alpha {
+                // Grey and alpha, or RGB and alpha: the last channel.
+                let a = match channels {
+                    2 | 4 => f64::from(px[channels - 1]) / f64::from(max),
+                    _ => 1.0,
+                };
+                [a as f32; 3]
+            } else if channels >= 3 {
                 [c(0), c(1), c(2)]
             } else {
                 [c(0); 3]

@@ -47,6 +47,7 @@
 
 mod build;
 pub mod camera;
+mod cutout;
 mod environment;
 mod envmap;
 pub mod error;

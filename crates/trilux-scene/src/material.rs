@@ -11,14 +11,14 @@
 //! | `blendbsdf` | `weight` (required, in \[0, 1\]), two nested BSDFs |
 //! | `twosided` | one nested BSDF (both sides) or two (front, back) |
 //! | `thindielectric` | black here; the light it lets through is its shape's ([`crate::glass`]) |
-//! | `mask` | `opacity` (0.5, a float) × one nested BSDF; the rest is let through by its shape ([`crate::glass`]) |
+//! | `mask` | `opacity` (0.5: a float, or a texture) × one nested BSDF; the rest is let through by its shape ([`crate::glass`], [`crate::cutout`]) |
 //!
 //! Textures: `<texture type="bitmap" name="...">` (Mitsuba's `bitmap`:
 //! `filename`, `filter_type` `bilinear` | `nearest`, `wrap_mode` `repeat` |
 //! `mirror` | `clamp`, `raw`) as the `reflectance` of `diffuse`, the
 //! `specular_reflectance` of `conductor` and `roughconductor`, the `diffuse_reflectance`
-//! of `plastic` and `roughplastic` and the `weight` of
-//! `blendbsdf`; the image is read when the scene is finished
+//! of `plastic` and `roughplastic`, the `weight` of
+//! `blendbsdf` and the `opacity` of `mask`; the image is read when the scene is finished
 //! ([`crate::textures`]).
 //!
 //! Refused: other plugins, anisotropic roughness (`alpha_u` ≠ `alpha_v`),
@@ -37,6 +37,7 @@ use trilux_brdf::{
 };
 use trilux_color::ColorParam;
 
+use crate::cutout::{AlphaRule, CutoutRequest};
 use crate::error::{Result, SceneError, SourceLocation};
 use crate::image::Sampling;
 use crate::ior::ior;
@@ -51,6 +52,8 @@ pub(crate) struct TextureCollector<'f> {
     path: Vec<Branch>,
     /// The textures found.
     pub requests: Vec<TextureRequest>,
+    /// A `mask`'s textured opacity ([`crate::cutout`]).
+    pub cutout: Option<CutoutRequest>,
 }
 
 impl<'f> TextureCollector<'f> {
@@ -60,6 +63,7 @@ impl<'f> TextureCollector<'f> {
             folder,
             path: Vec::new(),
             requests: Vec::new(),
+            cutout: None,
         }
     }
 
@@ -141,19 +145,7 @@ pub(crate) fn build_bsdf(e: &Element, tex: &mut TextureCollector<'_>) -> Result<
         }
         // Mitsuba's opacity: the nested BSDF times opacity, the rest let
         // through (crate::glass).
-        "mask" => {
-            let opacity = crate::glass::opacity(&props)?;
-            let [inner] = nested::<1>(&props, "one nested BSDF")?;
-            let before = tex.requests.len();
-            let inner = tex.nested(Branch::Second, inner)?;
-            if tex.requests.len() > before {
-                return Err(SceneError::at(
-                    &e.loc,
-                    "a mask's nested BSDF cannot have textures here",
-                ));
-            }
-            crate::glass::masked(opacity, inner)
-        }
+        "mask" => mask(&props, tex)?,
         kind if crate::glass::REFRACTING.contains(&kind) => {
             return Err(crate::glass::refused(e, kind)?);
         }
@@ -168,6 +160,31 @@ pub(crate) fn build_bsdf(e: &Element, tex: &mut TextureCollector<'_>) -> Result<
     };
     props.finish()?;
     Ok(bsdf)
+}
+
+/// A `mask`: its nested BSDF times its opacity, a float or a texture
+/// (which is also its shape's cut-out, [`crate::cutout`]).
+fn mask(props: &Props<'_>, tex: &mut TextureCollector<'_>) -> Result<BsdfParams> {
+    let textured = texture(props, "opacity", SlotKind::Weight, tex)?;
+    let opacity = if textured { tex.requests.pop() } else { None };
+    let constant = match opacity {
+        Some(_) => 0.5,
+        None => crate::glass::opacity(props)?,
+    };
+    let [inner] = nested::<1>(props, "one nested BSDF")?;
+    let before = tex.requests.len();
+    let inner = tex.nested(Branch::Second, inner)?;
+    crate::glass::move_into_mask(&mut tex.requests, before, &inner);
+    let masked = crate::glass::masked(constant, inner);
+    if let Some(request) = opacity {
+        tex.requests
+            .extend(crate::glass::opacity_slots(&request, &masked));
+        tex.cutout = Some(CutoutRequest {
+            texture: request,
+            rule: AlphaRule::Opacity,
+        });
+    }
+    Ok(masked)
 }
 
 /// A `twosided` BSDF: one nested BSDF (both sides) or two (front, back).
@@ -335,6 +352,7 @@ fn bitmap(e: &Element, kind: SlotKind, tex: &TextureCollector<'_>) -> Result<Tex
             wrap: [wrap; 2],
             filter,
             raw,
+            alpha: false,
         },
         scale: [1.0; 3],
         offset: [0.0; 3],
@@ -391,6 +409,7 @@ fn checkerboard(e: &Element, kind: SlotKind, tex: &TextureCollector<'_>) -> Resu
             wrap: [Wrap::Repeat; 2],
             filter: Filter::Nearest,
             raw: true,
+            alpha: false,
         },
         scale: std::array::from_fn(|c| c0[c] - c1[c]),
         offset: c1,

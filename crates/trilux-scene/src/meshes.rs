@@ -9,6 +9,7 @@
 //! options against it before it spends the time (and memory) of reading
 //! them ([`Pending::finish`]).
 
+use crate::cutout::CutoutRequest;
 use crate::error::{Errors, Result, SceneError};
 use crate::gltf::GltfMeshes;
 use crate::scene::Scene;
@@ -24,6 +25,8 @@ pub(crate) struct Requests {
     pub meshes: Vec<(usize, MeshRequest)>,
     /// Textures of materials.
     pub textures: Vec<(usize, TextureRequest)>,
+    /// Textured opacities (cut-outs).
+    pub cutouts: Vec<(usize, CutoutRequest)>,
     /// The meshes of a glTF file (its buffers are read by `finish`).
     pub gltf: Option<GltfMeshes>,
     /// The files the scene file `<include>`s (already read).
@@ -102,8 +105,11 @@ impl Pending {
         }
         let mut cache = TextureCache::default();
         let mut textures = self.requests.textures;
+        let mut cutouts = self.requests.cutouts;
         if let Some(gltf) = self.requests.gltf {
-            textures.extend(gltf.finish(&mut self.scene, &mut errors));
+            let (t, c) = gltf.finish(&mut self.scene, &mut errors);
+            textures.extend(t);
+            cutouts.extend(c);
         }
         for (index, request) in &textures {
             if failed.contains(index) {
@@ -124,6 +130,28 @@ impl Pending {
             }
             shape.textures.push(slot);
         }
+        for (index, request) in &cutouts {
+            if failed.contains(index) {
+                continue;
+            }
+            if let ShapeKind::Mesh(m) = &self.scene.shapes[*index].shape.kind
+                && m.texcoords.is_none()
+            {
+                // Said once per shape: by its material's textures if any.
+                if !textures.iter().any(|(i, _)| i == index) {
+                    errors.push(SceneError::at(
+                        &request.texture.location,
+                        "this cut-out's shape has no texture coordinates (OBJ vt, PLY u v, glTF TEXCOORD_0)",
+                    ));
+                }
+                continue;
+            }
+            if let Some(t) = errors.keep(request.finish(&mut cache)) {
+                self.scene.shapes[*index].transmission = Some(t);
+            }
+        }
+        let clear = crate::cutout::leave_out_clear(&mut self.scene);
+        flat.extend(clear);
         // Last, so that the indices of the requests above stay valid.
         let mut index = 0;
         self.scene.shapes.retain(|_| {

@@ -74,7 +74,8 @@ pub struct SceneShape {
     #[serde(skip)]
     pub textures: Vec<TextureSlot>,
     /// The fraction of light the shape lets through, undeviated, when its
-    /// BSDF is a `thindielectric` (`crate::glass`).
+    /// BSDF is a `thindielectric` or a `mask`, or its glTF material's
+    /// `alphaMode` is `MASK` (`crate::glass`, `crate::cutout`).
     pub transmission: Option<Transmittance>,
     /// Where the `<shape>` is written.
     #[serde(skip)]
@@ -153,7 +154,7 @@ impl Scene {
     /// Every shape's transmittance (`None` for an opaque one), in shape
     /// order (`PreparedScene::with_transmission`).
     pub fn transmission_params(&self) -> Vec<Option<Transmittance>> {
-        self.shapes.iter().map(|s| s.transmission).collect()
+        self.shapes.iter().map(|s| s.transmission.clone()).collect()
     }
 
     /// Every shape's emitted radiance (`None` without an emitter), in shape

@@ -27,8 +27,18 @@
 //! Refused (one error naming the material): `metallicRoughnessTexture`,
 //! `emissiveTexture`, the textures of `KHR_materials_specular`,
 //! texture coordinates other than `TEXCOORD_0`,
-//! `alphaMode` other than `OPAQUE`, and `normalTexture` (a shading normal
-//! per texel, which trilux's element normals cannot follow).
+//! `alphaMode` `BLEND` (a semi-transparent surface composited over what is
+//! behind it, which a physically based renderer has no meaning for), and
+//! `normalTexture` (a shading normal per texel, which trilux's element
+//! normals cannot follow).
+//!
+//! `alphaMode` `MASK` cuts the surface out: with a = baseColorFactor.a ×
+//! baseColorTexture.a, a point where a < `alphaCutoff` (0.5) is not there
+//! (light passes it), any other is opaque ([`crate::cutout`]). Without a
+//! base colour texture the whole primitive is opaque, or, when
+//! baseColorFactor.a < `alphaCutoff`, left out of the scene (a warning
+//! line). `alphaCutoff` must be a number ≥ 0 (glTF's schema); a vertex
+//! colour's alpha (`COLOR_0`) is not read, as no vertex colour is.
 //! `KHR_texture_transform` on the base colour texture maps TEXCOORD_0 (as
 //! Mitsuba's `to_uv` does). `occlusionTexture` is ignored: it approximates, for real-time engines,
 //! the shadowing that a global illumination solve computes.
@@ -67,6 +77,9 @@ pub(crate) struct TextureUse {
     pub to_uv: UvTransform,
     /// `/materials/i/pbrMetallicRoughness/baseColorTexture`.
     pub location: SourceLocation,
+    /// For the alpha of `alphaMode` `MASK`: its `alphaCutoff` (the use is
+    /// then a cut-out, not a slot).
+    pub cutoff: Option<f64>,
 }
 
 /// A glTF material as trilux takes it.
@@ -78,6 +91,31 @@ pub(crate) struct Mapped {
     pub emission: Option<ColorParam>,
     /// The BSDF types used, for `bsdf_counts`.
     pub types: Vec<&'static str>,
+    /// `alphaMode` `MASK` (module docs).
+    pub alpha: Alpha,
+}
+
+impl Mapped {
+    /// Every texture use: the slots', then the cut-out's.
+    pub fn uses(&self) -> impl Iterator<Item = &TextureUse> {
+        let cutout = match &self.alpha {
+            Alpha::Cutout(t) => Some(t),
+            _ => None,
+        };
+        self.textures.iter().chain(cutout)
+    }
+}
+
+/// What `alphaMode` `MASK` makes of a material (module docs).
+#[derive(Clone, Debug)]
+pub(crate) enum Alpha {
+    /// Opaque everywhere (`OPAQUE`, or `MASK` with a ≥ cutoff).
+    Opaque,
+    /// Transparent everywhere: the primitive is left out.
+    Transparent,
+    /// Cut out where the texture's alpha times `scale` is below the use's
+    /// `cutoff` (its `kind` and `path` are not used).
+    Cutout(TextureUse),
 }
 
 /// Maps one material (`None`: glTF's default material, white, metallic 1,
@@ -108,6 +146,7 @@ pub(crate) fn map(file: &Arc<Path>, m: &gltf::Material<'_>) -> Result<Mapped> {
             texture_info(&t, &at, suffix, location)
         })
         .transpose()?;
+    let alpha = alpha(m, &at, base_texture.as_ref())?;
     let (bsdf, mut types, mut textures) = lobe_bsdf(&lobes, base_texture.as_ref());
     let bsdf = if m.double_sided() {
         types.push("twosided");
@@ -126,6 +165,48 @@ pub(crate) fn map(file: &Arc<Path>, m: &gltf::Material<'_>) -> Result<Mapped> {
         textures,
         emission: emission(m, &at)?,
         types,
+        alpha,
+    })
+}
+
+/// `alphaMode` `MASK` with `alphaCutoff` (module docs); `BLEND` is refused
+/// before.
+fn alpha(m: &gltf::Material<'_>, at: &At<'_>, base: Option<&BaseTexture>) -> Result<Alpha> {
+    if m.alpha_mode() != gltf::material::AlphaMode::Mask {
+        return Ok(Alpha::Opaque);
+    }
+    let cutoff = f64::from(m.alpha_cutoff().unwrap_or(0.5));
+    if !(cutoff.is_finite() && cutoff >= 0.0) {
+        return Err(at(
+            "/alphaCutoff",
+            format!("alphaCutoff must be a number of at least 0, found {cutoff}"),
+        ));
+    }
+    let a = f64::from(m.pbr_metallic_roughness().base_color_factor()[3]);
+    if !a.is_finite() {
+        return Err(at(
+            "/pbrMetallicRoughness/baseColorFactor",
+            "the base colour's alpha is not a finite number".into(),
+        ));
+    }
+    let a = a.clamp(0.0, 1.0);
+    Ok(match base {
+        None if a >= cutoff => Alpha::Opaque,
+        None => Alpha::Transparent,
+        Some((image, sampling, to_uv, location)) => Alpha::Cutout(TextureUse {
+            path: Vec::new(),
+            kind: SlotKind::Weight,
+            image: *image,
+            sampling: Sampling {
+                alpha: true,
+                ..*sampling
+            },
+            scale: [a; 3],
+            offset: [0.0; 3],
+            to_uv: *to_uv,
+            location: location.clone(),
+            cutoff: Some(cutoff),
+        }),
     })
 }
 
@@ -222,6 +303,7 @@ fn lobe_bsdf(
                 offset,
                 to_uv: *to_uv,
                 location: location.clone(),
+                cutoff: None,
             });
         }
     };
@@ -284,9 +366,9 @@ fn refuse_unsupported(m: &gltf::Material<'_>, at: &At<'_>) -> Result<()> {
             "the textures of KHR_materials_specular are not supported (only its factors)",
         ),
         (
-            m.alpha_mode() != gltf::material::AlphaMode::Opaque,
+            m.alpha_mode() == gltf::material::AlphaMode::Blend,
             "/alphaMode",
-            "alphaMode MASK and BLEND are not supported (trilux's surfaces are opaque)",
+            "alphaMode BLEND is not supported (a surface composited over what is behind it has no physical meaning; a cut-out is MASK)",
         ),
     ];
     for (is, suffix, message) in refused {
@@ -378,6 +460,7 @@ fn texture_info(
             wrap: [ws, wt],
             filter,
             raw: false,
+            alpha: false,
         },
         to_uv,
         location,

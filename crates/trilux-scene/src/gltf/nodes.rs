@@ -32,8 +32,9 @@ use trilux_geometry::{Shape, ShapeKind, TriangleMesh};
 
 use super::accessor::{self, Kind};
 use super::buffers::{Buffers, data_uri, relative_path};
-use super::material::{Mapped, TextureUse, map};
+use super::material::{Alpha, Mapped, TextureUse, map};
 use crate::camera::{Camera, FovAxis, ReconstructionFilter};
+use crate::cutout::{AlphaRule, CutoutRequest};
 use crate::error::{Errors, Result, SceneError, SourceLocation};
 use crate::limits::{
     MAX_GLTF_NODES, MAX_GLTF_TRIANGLES, MAX_MESH_TRIANGLES, MAX_MESH_VERTICES, MAX_NODE_DEPTH,
@@ -51,6 +52,17 @@ struct Placed {
     primitive: usize,
     world: DMat4,
 }
+
+/// The warning for a primitive whose material is clear everywhere.
+fn left_out(file: &Path, here: &str) -> String {
+    format!(
+        "{}: {here}: its material's alpha is below its alphaCutoff everywhere (alphaMode MASK): the primitive is left out",
+        file.display()
+    )
+}
+
+/// The texture requests and cut-outs of [`GltfMeshes::finish`], by shape.
+pub(crate) type GltfTextures = (Vec<(usize, TextureRequest)>, Vec<(usize, CutoutRequest)>);
 
 /// What [`GltfMeshes::finish`] reads: the document, its binary chunk, the
 /// placed primitives and the textures of their materials.
@@ -332,6 +344,10 @@ impl Walk<'_> {
         let Some(Some(mapped)) = self.materials.get(&key) else {
             return Ok(());
         };
+        if let Alpha::Transparent = mapped.alpha {
+            self.warnings.push(left_out(self.file, &here));
+            return Ok(());
+        }
         let shape = self.shapes.len();
         let location = SourceLocation::json(self.file, format!("/nodes/{}", node.index()));
         let emitter = mapped
@@ -348,7 +364,7 @@ impl Walk<'_> {
                 ),
             });
         self.textures
-            .extend(mapped.textures.iter().map(|t| (shape, t.clone())));
+            .extend(mapped.uses().map(|t| (shape, t.clone())));
         let bsdf: BsdfParams = mapped.bsdf.clone();
         self.shapes.push(SceneShape {
             id: node.name().or(mesh.name()).map(str::to_string),
@@ -501,10 +517,10 @@ impl GltfMeshes {
     }
 
     /// Reads every placed primitive's mesh into `scene` and returns the
-    /// texture requests of their materials; the errors of each mesh and
-    /// image go into `errors` (a failed mesh's textures are not
-    /// requested).
-    pub fn finish(self, scene: &mut Scene, errors: &mut Errors) -> Vec<(usize, TextureRequest)> {
+    /// texture requests of their materials and their cut-outs
+    /// (`alphaMode` `MASK`); the errors of each mesh and image go into
+    /// `errors` (a failed mesh's textures are not requested).
+    pub fn finish(self, scene: &mut Scene, errors: &mut Errors) -> GltfTextures {
         let mut buffers = Buffers::new(
             Arc::clone(&self.file),
             self.blob.clone(),
@@ -529,6 +545,7 @@ impl GltfMeshes {
             .unwrap_or_default();
         let mut images: HashMap<usize, ImageSource> = HashMap::new();
         let mut out = Vec::with_capacity(self.textures.len());
+        let mut cutouts = Vec::new();
         for (shape, t) in &self.textures {
             if failed.contains(shape) {
                 continue;
@@ -544,21 +561,28 @@ impl GltfMeshes {
                     s
                 }
             };
-            out.push((
-                *shape,
-                TextureRequest {
-                    path: t.path.clone(),
-                    kind: t.kind,
-                    source,
-                    sampling: t.sampling,
-                    scale: t.scale,
-                    offset: t.offset,
-                    to_uv: t.to_uv,
-                    location: t.location.clone(),
-                },
-            ));
+            let request = TextureRequest {
+                path: t.path.clone(),
+                kind: t.kind,
+                source,
+                sampling: t.sampling,
+                scale: t.scale,
+                offset: t.offset,
+                to_uv: t.to_uv,
+                location: t.location.clone(),
+            };
+            match t.cutoff {
+                Some(cutoff) => cutouts.push((
+                    *shape,
+                    CutoutRequest {
+                        texture: request,
+                        rule: AlphaRule::Cutoff(cutoff),
+                    },
+                )),
+                None => out.push((*shape, request)),
+            }
         }
-        out
+        (out, cutouts)
     }
 
     fn image_source(
