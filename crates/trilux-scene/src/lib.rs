@@ -59,6 +59,7 @@ mod light;
 pub mod limits;
 mod material;
 pub mod meshes;
+mod normals;
 mod numbers;
 pub mod obj;
 pub mod ply;

@@ -12,6 +12,7 @@
 //! | `twosided` | one nested BSDF (both sides) or two (front, back) |
 //! | `thindielectric` | black here; the light it lets through is its shape's ([`crate::glass`]) |
 //! | `mask` | `opacity` (0.5, a float) × one nested BSDF; the rest is let through by its shape ([`crate::glass`]) |
+//! | `normalmap`, `bumpmap` | one nested BSDF whose shading normal a texture turns in the render ([`crate::normals`]) |
 //!
 //! Textures: `<texture type="bitmap" name="...">` (Mitsuba's `bitmap`:
 //! `filename`, `filter_type` `bilinear` | `nearest`, `wrap_mode` `repeat` |
@@ -51,6 +52,9 @@ pub(crate) struct TextureCollector<'f> {
     path: Vec<Branch>,
     /// The textures found.
     pub requests: Vec<TextureRequest>,
+    /// The material's normal or bump map, if it has one
+    /// ([`crate::normals`]).
+    normal: Option<TextureRequest>,
 }
 
 impl<'f> TextureCollector<'f> {
@@ -60,7 +64,37 @@ impl<'f> TextureCollector<'f> {
             folder,
             path: Vec::new(),
             requests: Vec::new(),
+            normal: None,
         }
+    }
+
+    /// Every texture found, the normal or bump map last.
+    pub fn into_requests(self) -> Vec<TextureRequest> {
+        let mut r = self.requests;
+        r.extend(self.normal);
+        r
+    }
+
+    /// The normal or bump map found so far.
+    pub fn normal_request(&self) -> Option<&TextureRequest> {
+        self.normal.as_ref()
+    }
+
+    /// Records the material's normal or bump map.
+    pub fn set_normal_request(&mut self, request: TextureRequest) {
+        self.normal = Some(request);
+    }
+
+    /// True at the top of the material or in the front of a `twosided`
+    /// (where a normal map turns the normal of the whole material).
+    pub fn at_top(&self) -> bool {
+        matches!(self.path.as_slice(), [] | [Branch::Front])
+    }
+
+    /// The BSDF nested in a `normalmap` or `bumpmap` (no branch: it is the
+    /// material).
+    pub fn nest(&mut self, e: &Element) -> Result<BsdfParams> {
+        build_nested(e, self)
     }
 
     fn nested(&mut self, branch: Branch, e: &Element) -> Result<BsdfParams> {
@@ -154,6 +188,7 @@ pub(crate) fn build_bsdf(e: &Element, tex: &mut TextureCollector<'_>) -> Result<
             }
             crate::glass::masked(opacity, inner)
         }
+        kind @ ("normalmap" | "bumpmap") => crate::normals::normal_mapped(e, kind, &props, tex)?,
         kind if crate::glass::REFRACTING.contains(&kind) => {
             return Err(crate::glass::refused(e, kind)?);
         }
@@ -161,7 +196,7 @@ pub(crate) fn build_bsdf(e: &Element, tex: &mut TextureCollector<'_>) -> Result<
             return Err(SceneError::at(
                 &e.required("type")?.loc,
                 format!(
-                    "unknown bsdf plugin \"{other}\" (supported: diffuse, conductor, roughconductor, plastic, roughplastic, blendbsdf, twosided, thindielectric, mask)"
+                    "unknown bsdf plugin \"{other}\" (supported: diffuse, conductor, roughconductor, plastic, roughplastic, blendbsdf, twosided, thindielectric, mask, normalmap, bumpmap)"
                 ),
             ));
         }
@@ -177,10 +212,19 @@ fn twosided(e: &Element, props: &Props<'_>, tex: &mut TextureCollector<'_>) -> R
             front: Box::new(tex.nested(Branch::Front, front)?),
             back: None,
         },
-        [front, back] => BsdfParams::TwoSided {
-            front: Box::new(tex.nested(Branch::Front, front)?),
-            back: Some(Box::new(tex.nested(Branch::Back, back)?)),
-        },
+        [front, back] => {
+            let front = tex.nested(Branch::Front, front)?;
+            if tex.normal_request().is_some() {
+                return Err(SceneError::at(
+                    &e.loc,
+                    "a normalmap or bumpmap turns the normal of the whole material: it cannot be the front of a twosided with two sides",
+                ));
+            }
+            BsdfParams::TwoSided {
+                front: Box::new(front),
+                back: Some(Box::new(tex.nested(Branch::Back, back)?)),
+            }
+        }
         _ => {
             return Err(SceneError::at(
                 &e.loc,
@@ -205,7 +249,10 @@ fn build_nested(e: &Element, tex: &mut TextureCollector<'_>) -> Result<BsdfParam
 }
 
 /// Exactly `N` nested `<bsdf>` elements (a `<texture>` is the caller's).
-fn nested<'a, const N: usize>(props: &Props<'a>, what: &str) -> Result<[&'a Element; N]> {
+pub(crate) fn nested<'a, const N: usize>(
+    props: &Props<'a>,
+    what: &str,
+) -> Result<[&'a Element; N]> {
     let owner = props.owner();
     let bsdfs: Vec<&Element> = props
         .objects
@@ -280,7 +327,11 @@ fn texture(
 
 /// A `<texture>`: `bitmap` (Mitsuba's defaults: bilinear, repeat, sRGB) or
 /// `checkerboard`, either with a `to_uv` transform.
-fn bitmap(e: &Element, kind: SlotKind, tex: &TextureCollector<'_>) -> Result<TextureRequest> {
+pub(crate) fn bitmap(
+    e: &Element,
+    kind: SlotKind,
+    tex: &TextureCollector<'_>,
+) -> Result<TextureRequest> {
     e.check_attrs(&["type", "id", "name"])?;
     let t = e.plugin_type()?;
     if t == "checkerboard" {
@@ -340,6 +391,7 @@ fn bitmap(e: &Element, kind: SlotKind, tex: &TextureCollector<'_>) -> Result<Tex
         offset: [0.0; 3],
         to_uv,
         location,
+        normal: None,
     })
 }
 
@@ -396,6 +448,7 @@ fn checkerboard(e: &Element, kind: SlotKind, tex: &TextureCollector<'_>) -> Resu
         offset: c1,
         to_uv,
         location: e.loc.clone(),
+        normal: None,
     })
 }
 

@@ -14,6 +14,8 @@ use crate::gltf::GltfMeshes;
 use crate::scene::Scene;
 use crate::shape::{MeshRequest, check_area};
 use crate::textures::{ImageSource, TextureCache, TextureRequest};
+use std::sync::Arc;
+
 use glam::{DMat4, DVec3};
 use trilux_geometry::{ShapeKind, TriangleMesh};
 
@@ -109,9 +111,6 @@ impl Pending {
             if failed.contains(index) {
                 continue;
             }
-            let Some(slot) = errors.keep(cache.slot(request)) else {
-                continue;
-            };
             let shape = &mut self.scene.shapes[*index];
             if let ShapeKind::Mesh(m) = &shape.shape.kind
                 && m.texcoords.is_none()
@@ -122,7 +121,13 @@ impl Pending {
                 ));
                 continue;
             }
-            shape.textures.push(slot);
+            if let Some(p) = request.normal {
+                if let Some(map) = errors.keep(cache.normal_map(request, p)) {
+                    shape.normal_map = Some(Arc::new(map));
+                }
+            } else if let Some(slot) = errors.keep(cache.slot(request)) {
+                shape.textures.push(slot);
+            }
         }
         // Last, so that the indices of the requests above stay valid.
         let mut index = 0;

@@ -27,8 +27,12 @@
 //! Refused (one error naming the material): `metallicRoughnessTexture`,
 //! `emissiveTexture`, the textures of `KHR_materials_specular`,
 //! texture coordinates other than `TEXCOORD_0`,
-//! `alphaMode` other than `OPAQUE`, and `normalTexture` (a shading normal
-//! per texel, which trilux's element normals cannot follow).
+//! and `alphaMode` other than `OPAQUE`. `normalTexture` turns the
+//! shading normal in the render (`trilux_brdf::normal_map`: n =
+//! normalize((2·rgb − 1) ⊙ (scale, scale, 1)) in the frame of ∂p/∂u and
+//! n × ∂p/∂u, green up; the mesh's `TANGENT` attribute is not read), not
+//! in the solve; with `KHR_texture_transform` or another `texCoord` it is
+//! refused.
 //! `KHR_texture_transform` on the base colour texture maps TEXCOORD_0 (as
 //! Mitsuba's `to_uv` does). `occlusionTexture` is ignored: it approximates, for real-time engines,
 //! the shadowing that a global illumination solve computes.
@@ -37,7 +41,8 @@ use std::path::Path;
 use std::sync::Arc;
 
 use trilux_brdf::{
-    Branch, BsdfParams, Distribution, Filter, RoughConductorParams, SlotKind, UvTransform, Wrap,
+    Branch, BsdfParams, Distribution, Filter, NormalPerturbation, RoughConductorParams, SlotKind,
+    UvTransform, Wrap,
 };
 use trilux_color::ColorParam;
 
@@ -67,6 +72,8 @@ pub(crate) struct TextureUse {
     pub to_uv: UvTransform,
     /// `/materials/i/pbrMetallicRoughness/baseColorTexture`.
     pub location: SourceLocation,
+    /// Set for the `normalTexture`: how it turns the shading normal.
+    pub normal: Option<NormalPerturbation>,
 }
 
 /// A glTF material as trilux takes it.
@@ -121,6 +128,13 @@ pub(crate) fn map(file: &Arc<Path>, m: &gltf::Material<'_>) -> Result<Mapped> {
     } else {
         bsdf
     };
+    if let Some(t) = m.normal_texture() {
+        textures.push(normal_texture(
+            &t,
+            &at,
+            SourceLocation::json(file, format!("{base}/normalTexture")),
+        )?);
+    }
     Ok(Mapped {
         bsdf,
         textures,
@@ -222,6 +236,7 @@ fn lobe_bsdf(
                 offset,
                 to_uv: *to_uv,
                 location: location.clone(),
+                normal: None,
             });
         }
     };
@@ -270,11 +285,6 @@ fn refuse_unsupported(m: &gltf::Material<'_>, at: &At<'_>) -> Result<()> {
             m.emissive_texture().is_some(),
             "/emissiveTexture",
             "emissiveTexture is not supported (trilux's area emitters have one radiance per shape)",
-        ),
-        (
-            m.normal_texture().is_some(),
-            "/normalTexture",
-            "normalTexture is not supported (trilux shades with the mesh's own normals)",
         ),
         (
             m.specular().is_some_and(|s| {
@@ -358,6 +368,57 @@ fn texture_info(
         None => UvTransform::IDENTITY,
     };
     let texture = t.texture();
+    let sampling = sampling(&texture, at, suffix)?;
+    Ok((texture.source().index(), sampling, to_uv, location))
+}
+
+/// The `normalTexture` (linear values; `scale` multiplies the normal's x
+/// and y: `trilux_brdf::normal_map`).
+fn normal_texture(
+    t: &gltf::material::NormalTexture<'_>,
+    at: &At<'_>,
+    location: SourceLocation,
+) -> Result<TextureUse> {
+    let suffix = "/normalTexture";
+    if t.tex_coord() != 0 {
+        return Err(at(
+            suffix,
+            format!(
+                "texCoord {} is not supported (only TEXCOORD_0)",
+                t.tex_coord()
+            ),
+        ));
+    }
+    if t.extension_value("KHR_texture_transform").is_some() {
+        return Err(at(
+            suffix,
+            "KHR_texture_transform on a normalTexture is not supported".into(),
+        ));
+    }
+    let scale = f64::from(t.scale());
+    if !scale.is_finite() {
+        return Err(at(suffix, format!("scale must be finite, found {scale}")));
+    }
+    let texture = t.texture();
+    let sampling = Sampling {
+        raw: true,
+        ..sampling(&texture, at, suffix)?
+    };
+    Ok(TextureUse {
+        path: Vec::new(),
+        kind: SlotKind::Reflectance,
+        image: texture.source().index(),
+        sampling,
+        scale: [1.0; 3],
+        offset: [0.0; 3],
+        to_uv: UvTransform::IDENTITY,
+        location,
+        normal: Some(NormalPerturbation::Normal { scale, flip: false }),
+    })
+}
+
+/// A texture's sampler as a [`Sampling`] (sRGB-decoded).
+fn sampling(texture: &gltf::texture::Texture<'_>, at: &At<'_>, suffix: &str) -> Result<Sampling> {
     let sampler = texture.sampler();
     let wrap = |w: gltf::texture::WrappingMode| match w {
         gltf::texture::WrappingMode::Repeat => Wrap::Repeat,
@@ -372,16 +433,11 @@ fn texture_info(
         Some(gltf::texture::MagFilter::Nearest) => Filter::Nearest,
         _ => Filter::Bilinear,
     };
-    Ok((
-        texture.source().index(),
-        Sampling {
-            wrap: [ws, wt],
-            filter,
-            raw: false,
-        },
-        to_uv,
-        location,
-    ))
+    Ok(Sampling {
+        wrap: [ws, wt],
+        filter,
+        raw: false,
+    })
 }
 
 /// `KHR_texture_transform` as the map from TEXCOORD_0 to the image's

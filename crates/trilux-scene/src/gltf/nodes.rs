@@ -360,6 +360,7 @@ impl Walk<'_> {
             bsdf,
             emitter,
             textures: Vec::new(),
+            normal_map: None,
             transmission: None,
             location,
         });
@@ -555,6 +556,7 @@ impl GltfMeshes {
                     offset: t.offset,
                     to_uv: t.to_uv,
                     location: t.location.clone(),
+                    normal: t.normal,
                 },
             ));
         }
