@@ -59,7 +59,6 @@ mod light;
 pub mod limits;
 mod material;
 pub mod meshes;
-mod normals;
 mod numbers;
 pub mod obj;
 pub mod ply;

@@ -12,7 +12,7 @@
 //! | `twosided` | one nested BSDF (both sides) or two (front, back) |
 //! | `thindielectric` | black here; the light it lets through is its shape's ([`crate::glass`]) |
 //! | `mask` | `opacity` (0.5, a float) × one nested BSDF; the rest is let through by its shape ([`crate::glass`]) |
-//! | `normalmap`, `bumpmap` | one nested BSDF whose shading normal a texture turns in the render ([`crate::normals`]) |
+//! | `normalmap`, `bumpmap` | one nested BSDF whose shading normal a texture turns in the render ([`normal_mapped`]) |
 //!
 //! Textures: `<texture type="bitmap" name="...">` (Mitsuba's `bitmap`:
 //! `filename`, `filter_type` `bilinear` | `nearest`, `wrap_mode` `repeat` |
@@ -33,8 +33,8 @@
 use std::path::Path;
 
 use trilux_brdf::{
-    Branch, BsdfParams, Distribution, Filter, MIRROR_ALPHA, PlasticParams, RoughConductorParams,
-    SlotKind, UvTransform, Wrap, conductor_names, named_conductor,
+    Branch, BsdfParams, Distribution, Filter, MIRROR_ALPHA, NormalPerturbation, PlasticParams,
+    RoughConductorParams, SlotKind, UvTransform, Wrap, conductor_names, named_conductor,
 };
 use trilux_color::ColorParam;
 
@@ -53,7 +53,7 @@ pub(crate) struct TextureCollector<'f> {
     /// The textures found.
     pub requests: Vec<TextureRequest>,
     /// The material's normal or bump map, if it has one
-    /// ([`crate::normals`]).
+    /// ([`normal_mapped`]).
     normal: Option<TextureRequest>,
 }
 
@@ -188,7 +188,7 @@ pub(crate) fn build_bsdf(e: &Element, tex: &mut TextureCollector<'_>) -> Result<
             }
             crate::glass::masked(opacity, inner)
         }
-        kind @ ("normalmap" | "bumpmap") => crate::normals::normal_mapped(e, kind, &props, tex)?,
+        kind @ ("normalmap" | "bumpmap") => normal_mapped(e, kind, &props, tex)?,
         kind if crate::glass::REFRACTING.contains(&kind) => {
             return Err(crate::glass::refused(e, kind)?);
         }
@@ -656,4 +656,100 @@ pub(crate) fn emitted_strength(props: &Props<'_>, name: &str) -> Result<ColorPar
         ));
     }
     Ok(value)
+}
+// Mitsuba 3's `normalmap` and `bumpmap` BSDFs: a nested BSDF whose
+// shading normal a texture turns (`trilux_brdf::normal_map`).
+//
+// | plugin | parameters (default) |
+// |---|---|
+// | `normalmap` | `<texture name="normalmap">` (RGB: n = 2·rgb − 1 in the tangent frame), one nested BSDF, `flip_invalid_normals` (true), `use_shadowing_function` (true: read, not applied) |
+// | `bumpmap` | one nested `<texture>` (its luminance a height field), `scale` (1), one nested BSDF, `flip_invalid_normals` (true), `use_shadowing_function` (true: read, not applied) |
+//
+// The material is its nested BSDF (the solve keeps the geometric normal);
+// the texture is kept with the shape and turns the shading normal in the
+// render only. Mitsuba's `use_shadowing_function` (Estevez et al.'s
+// attenuation of light arriving at grazing angles to the perturbed
+// normal) is not applied: docs/rendering.md, "Normal and bump maps".
+//
+// Refused (one located line): a second normal or bump map in one
+// material; one inside a `blendbsdf`, a `mask` or the back of a
+// two-sided BSDF with two sides (it turns the normal of the whole
+// material); a `scale` that is not finite; a texture that is not a
+// `bitmap`; a shape other than a mesh (`obj`, `ply`: Mitsuba 3.9.1's
+// `rectangle` has a shading frame of length 2, not a unit one); and, when the images are read, a normal
+// map whose image is not RGB.
+
+/// A `normalmap` or `bumpmap` BSDF (`kind`): its nested BSDF, with its
+/// texture recorded in `tex` as the material's normal map.
+pub(crate) fn normal_mapped(
+    e: &Element,
+    kind: &str,
+    props: &Props<'_>,
+    tex: &mut TextureCollector<'_>,
+) -> Result<BsdfParams> {
+    if tex.normal_request().is_some() {
+        return Err(SceneError::at(
+            &e.loc,
+            "a material takes one normalmap or bumpmap",
+        ));
+    }
+    if !tex.at_top() {
+        return Err(SceneError::at(
+            &e.loc,
+            format!(
+                "a {kind} turns the normal of the whole material: it cannot be inside a blendbsdf, a mask or the back of a twosided"
+            ),
+        ));
+    }
+    let flip = props.boolean("flip_invalid_normals")?.unwrap_or(true);
+    // Read (Mitsuba's default true), not applied: module docs.
+    props.boolean("use_shadowing_function")?;
+    let textures: Vec<&Element> = props
+        .objects
+        .iter()
+        .copied()
+        .filter(|o| o.tag == "texture")
+        .collect();
+    let texture = match (kind, textures.as_slice()) {
+        ("normalmap", [t]) if t.attr("name").map(|a| a.value.as_str()) == Some("normalmap") => *t,
+        ("bumpmap", [t]) => *t,
+        _ => {
+            let what = if kind == "normalmap" {
+                "one <texture name=\"normalmap\">"
+            } else {
+                "one nested <texture>"
+            };
+            return Err(SceneError::at(
+                &e.loc,
+                format!(
+                    "<bsdf type=\"{kind}\"> needs {what}, found {}",
+                    textures.len()
+                ),
+            ));
+        }
+    };
+    if texture.plugin_type()? != "bitmap" {
+        return Err(SceneError::at(
+            &texture.loc,
+            format!("the texture of a {kind} must be a bitmap"),
+        ));
+    }
+    let perturbation = if kind == "normalmap" {
+        NormalPerturbation::Normal { scale: 1.0, flip }
+    } else {
+        let scale = props.float("scale")?.unwrap_or(1.0);
+        if !scale.is_finite() {
+            return Err(SceneError::at(
+                &props.loc("scale"),
+                format!("bumpmap scale must be finite, found {scale}"),
+            ));
+        }
+        NormalPerturbation::Bump { scale, flip }
+    };
+    let mut request = bitmap(texture, SlotKind::Reflectance, tex)?;
+    request.normal = Some(perturbation);
+    let [inner] = nested::<1>(props, "one nested BSDF")?;
+    let inner = tex.nest(inner)?;
+    tex.set_normal_request(request);
+    Ok(inner)
 }
