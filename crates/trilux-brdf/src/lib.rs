@@ -49,6 +49,7 @@ pub mod frame;
 mod fresnel;
 pub mod lobe;
 pub mod microfacet;
+pub mod normal_map;
 pub mod params;
 pub mod plastic;
 mod special;
@@ -64,6 +65,7 @@ pub use bsdf::{Bsdf, BsdfSample};
 pub use conductors::{conductor_names, named_conductor};
 pub use error::BrdfError;
 pub use frame::Frame;
+pub use normal_map::{NormalMap, NormalPerturbation, TangentFrame};
 pub use params::{
     BsdfParams, Distribution, MIRROR_ALPHA, NAMED_IORS, PlasticParams, RoughConductorParams,
     named_ior,

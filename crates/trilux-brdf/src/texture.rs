@@ -241,6 +241,42 @@ impl Texture {
     }
 }
 
+impl Texture {
+    /// The gradient (∂h/∂u, ∂h/∂v) of the luminance h of the texture at
+    /// the surface's `uv`, looked up through `to_uv`, exactly as Mitsuba
+    /// 3.9.1's `bitmap::eval_1_grad` computes it (the height field of a
+    /// bump map): zero for the `nearest` filter; for `bilinear`, with the
+    /// four texels f00, f10, f01, f11 around p = uv'·res − ½ and the
+    /// weights w1 = p − ⌊p⌋, w0 = 1 − w1,
+    ///
+    /// ```text
+    /// ∂f/∂x = w0.y (f10 − f00) + w1.y (f11 − f01)
+    /// ∂f/∂y = w0.x (f01 − f00) + w1.x (f11 − f10)
+    /// ∇_uv h = res ⊙ (Mᵀ (∂f/∂x, ∂f/∂y))
+    /// ```
+    ///
+    /// with M the linear part of `to_uv` (Mitsuba multiplies by the
+    /// resolution after the transpose; the same for any `to_uv` without
+    /// shear or rotation). Zero where `uv` is not finite.
+    pub fn luminance_gradient(&self, uv: DVec2, to_uv: &UvTransform) -> DVec2 {
+        if self.filter == Filter::Nearest || !uv.is_finite() {
+            return DVec2::ZERO;
+        }
+        let res = DVec2::new(f64::from(self.width), f64::from(self.height));
+        let p = to_uv.apply(uv) * res - 0.5;
+        let f = p.floor();
+        let (w1, (x, y)) = (p - f, (f.x as i64, f.y as i64));
+        let w0 = DVec2::ONE - w1;
+        let h = |x, y| trilux_color::luminance(self.texel(x, y));
+        let (f00, f10) = (h(x, y), h(x + 1, y));
+        let (f01, f11) = (h(x, y + 1), h(x + 1, y + 1));
+        let dx = w0.y * (f10 - f00) + w1.y * (f11 - f01);
+        let dy = w0.x * (f01 - f00) + w1.x * (f11 - f10);
+        let m = &to_uv.0;
+        res * DVec2::new(m[0] * dx + m[3] * dy, m[1] * dx + m[4] * dy)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -207,6 +207,34 @@ impl Geometry {
         }
     }
 
+    /// ∂p/∂u and ∂p/∂v of a mesh chart at `coord` in its texture
+    /// coordinates, from the triangle's corners and theirs (Mitsuba 3's
+    /// `Mesh::compute_surface_interaction`): with Δp₁, Δp₂ and Δuv₁, Δuv₂
+    /// the edges from corner 0 and d = Δu₁Δv₂ − Δv₁Δu₂,
+    /// ∂p/∂u = (Δv₂ Δp₁ − Δv₁ Δp₂)/d, ∂p/∂v = (Δu₁ Δp₂ − Δu₂ Δp₁)/d.
+    /// `None` for a mesh without texture coordinates, a triangle whose
+    /// coordinates are degenerate (d = 0) and parametric surfaces.
+    pub fn uv_partials(&self, surface: SurfaceId, coord: SurfaceCoord) -> Option<(DVec3, DVec3)> {
+        let (SurfaceGeom::Chart { mesh, .. }, SurfaceCoord::Triangle { index, .. }) =
+            (&self.surfaces.get(surface.index())?.geom, coord)
+        else {
+            return None;
+        };
+        let m = &self.meshes[*mesh as usize];
+        let t = m.triangles.get(index as usize)?;
+        let [uv0, uv1, uv2] = t.map(|i| m.texcoords.as_ref().map(|uv| uv[i as usize]));
+        let (uv0, uv1, uv2) = (uv0?, uv1?, uv2?);
+        let [p0, p1, p2] = m.vertices(index);
+        let (dp1, dp2, duv1, duv2) = (p1 - p0, p2 - p0, uv1 - uv0, uv2 - uv0);
+        let d = duv1.x * duv2.y - duv1.y * duv2.x;
+        if d == 0.0 || !d.is_finite() {
+            return None;
+        }
+        let du = (duv2.y * dp1 - duv1.y * dp2) / d;
+        let dv = (duv1.x * dp2 - duv2.x * dp1) / d;
+        (du.is_finite() && dv.is_finite()).then_some((du, dv))
+    }
+
     #[inline]
     fn ray_epsilon(&self, o: DVec3) -> f64 {
         RAY_EPSILON * (o.abs().max_element() + self.extent)

@@ -8,7 +8,8 @@
 //!   light through, the fraction they let through kept in the hit's
 //!   [`HitLocator::through`]), shadow rays `Geometry::transmittance`.
 //! - Materials: `Bsdf<N>` in the shading frame of the hit (z = shading
-//!   normal on the front side), textured ones at the hit's texture
+//!   normal on the front side, turned by the material's normal or bump
+//!   map if it has one: `PreparedScene::normal_map`), textured ones at the hit's texture
 //!   coordinates (`PreparedScene::shading`); it reflects on the viewer's side (black from
 //!   the back unless `twosided`), as in Mitsuba.
 //! - Emitters: one-sided Lambertian area emitters on the front side. Light
@@ -28,10 +29,11 @@
 use std::sync::Arc;
 
 use glam::{DVec2, DVec3};
-use trilux_brdf::{Bsdf, Frame, Shading};
+use trilux_brdf::{Bsdf, Frame, Shading, TangentFrame};
 use trilux_color::Spectrum;
 use trilux_geometry::{
-    ElementForest, ElementId, FaceElement, FaceId, Geometry, Ray, Side, SurfaceCoord, SurfaceId,
+    ElementForest, ElementId, FaceElement, FaceId, Geometry, Hit, Ray, Side, SurfaceCoord,
+    SurfaceId,
 };
 use trilux_solver::{PreparedScene, SurfaceSite};
 
@@ -153,6 +155,30 @@ impl<'a, const N: usize, S: RadianceSolution<N>> SolvedScene<'a, N, S> {
         self.scene.shading(l.shape as usize, l.surface, l.coord)
     }
 
+    /// The shading normal at `hit` on `shape`: the geometry's, turned by
+    /// the material's normal or bump map where it has one
+    /// (`trilux_brdf::normal_map`), as seen along the ray's direction
+    /// `dir`. The solution was computed with the geometric normal; the
+    /// render reads it with this one.
+    fn shading_normal(&self, hit: &Hit, shape: u32, dir: DVec3) -> DVec3 {
+        let geom = self.geom();
+        let (Some(map), Some(uv)) = (
+            self.scene.normal_map(shape as usize),
+            geom.texcoord(hit.surface, hit.coord),
+        ) else {
+            return hit.shading_normal;
+        };
+        let at = TangentFrame {
+            n: hit.shading_normal,
+            ng: hit.geometric_normal,
+            dp_duv: geom.uv_partials(hit.surface, hit.coord),
+        };
+        match (-dir).try_normalize() {
+            Some(wo) => map.perturb(&at, uv, wo),
+            None => hit.shading_normal,
+        }
+    }
+
     fn site(p: &SurfacePoint<HitLocator>, side: Side) -> SurfaceSite {
         SurfaceSite {
             face: FaceId::new(p.locator.surface, side),
@@ -235,7 +261,7 @@ impl<const N: usize, S: RadianceSolution<N>> GatherScene<N> for SolvedScene<'_, 
             locator: HitLocator {
                 surface: hit.surface,
                 coord: hit.coord,
-                shading_normal: hit.shading_normal,
+                shading_normal: self.shading_normal(&hit, shape, dir),
                 shape,
                 through,
             },

@@ -311,6 +311,15 @@ fn scene_shape(e: &Element, folder: &Path) -> Result<ShapeRequests> {
     }
     let (shape, request) = build_shape(&props, folder)?;
     props.finish()?;
+    if textures.normal_request().is_some() && !matches!(shape.kind, ShapeKind::Mesh(_)) {
+        return Err(SceneError::at(
+            &e.loc,
+            format!(
+                "{} has a normalmap or bumpmap, but only obj and ply shapes have the texture frame it needs here",
+                e.describe()
+            ),
+        ));
+    }
     if !textures.requests.is_empty()
         && !matches!(shape.kind, ShapeKind::Rectangle | ShapeKind::Mesh(_))
     {
@@ -335,10 +344,12 @@ fn scene_shape(e: &Element, folder: &Path) -> Result<ShapeRequests> {
         }),
         emitter,
         textures: Vec::new(),
+        normal_map: None,
         transmission,
         location: e.loc.clone(),
     };
-    Ok((shape, request, textures.requests, textures.cutout))
+    let cutout = textures.cutout.take();
+    Ok((shape, request, textures.into_requests(), cutout))
 }
 
 fn area_emitter(e: &Element) -> Result<AreaEmitter> {

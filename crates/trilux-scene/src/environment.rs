@@ -95,6 +95,7 @@ pub(crate) fn enclose(scene: &mut Scene) {
             location: env.location.clone(),
         }),
         textures: Vec::new(),
+        normal_map: None,
         transmission: None,
         location: env.location.clone(),
     };

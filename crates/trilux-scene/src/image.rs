@@ -73,6 +73,12 @@ pub(crate) fn srgb_to_linear(v: f64) -> f64 {
 
 /// Decodes a PNG or JPEG image into a texture.
 pub fn decode(bytes: &[u8], sampling: Sampling) -> Result<Texture, ImageError> {
+    decode_counted(bytes, sampling).map(|(t, _)| t)
+}
+
+/// [`decode`], with the image's channel count (1 grey, 2 grey and alpha,
+/// 3 RGB, 4 RGB and alpha).
+pub fn decode_counted(bytes: &[u8], sampling: Sampling) -> Result<(Texture, usize), ImageError> {
     let (width, height, channels, values, max) = if bytes.starts_with(b"\x89PNG\r\n\x1a\n") {
         decode_png(bytes)?
     } else if bytes.starts_with(&[0xFF, 0xD8]) {
@@ -104,13 +110,10 @@ pub fn decode(bytes: &[u8], sampling: Sampling) -> Result<Texture, ImageError> {
             }
         })
         .collect();
-    Ok(Texture::new(
-        width,
-        height,
-        texels,
-        sampling.wrap,
-        sampling.filter,
-    )?)
+    Ok((
+        Texture::new(width, height, texels, sampling.wrap, sampling.filter)?,
+        channels,
+    ))
 }
 
 fn check_size(width: u32, height: u32) -> Result<(), ImageError> {

@@ -12,6 +12,7 @@
 //! | `twosided` | one nested BSDF (both sides) or two (front, back) |
 //! | `thindielectric` | black here; the light it lets through is its shape's ([`crate::glass`]) |
 //! | `mask` | `opacity` (0.5: a float, or a texture) × one nested BSDF; the rest is let through by its shape ([`crate::glass`], [`crate::cutout`]) |
+//! | `normalmap`, `bumpmap` | one nested BSDF whose shading normal a texture turns in the render ([`normal_mapped`]) |
 //!
 //! Textures: `<texture type="bitmap" name="...">` (Mitsuba's `bitmap`:
 //! `filename`, `filter_type` `bilinear` | `nearest`, `wrap_mode` `repeat` |
@@ -32,8 +33,8 @@
 use std::path::Path;
 
 use trilux_brdf::{
-    Branch, BsdfParams, Distribution, Filter, MIRROR_ALPHA, PlasticParams, RoughConductorParams,
-    SlotKind, UvTransform, Wrap, conductor_names, named_conductor,
+    Branch, BsdfParams, Distribution, Filter, MIRROR_ALPHA, NormalPerturbation, PlasticParams,
+    RoughConductorParams, SlotKind, UvTransform, Wrap, conductor_names, named_conductor,
 };
 use trilux_color::ColorParam;
 
@@ -54,6 +55,9 @@ pub(crate) struct TextureCollector<'f> {
     pub requests: Vec<TextureRequest>,
     /// A `mask`'s textured opacity ([`crate::cutout`]).
     pub cutout: Option<CutoutRequest>,
+    /// The material's normal or bump map, if it has one
+    /// ([`normal_mapped`]).
+    normal: Option<TextureRequest>,
 }
 
 impl<'f> TextureCollector<'f> {
@@ -64,7 +68,37 @@ impl<'f> TextureCollector<'f> {
             path: Vec::new(),
             requests: Vec::new(),
             cutout: None,
+            normal: None,
         }
+    }
+
+    /// Every texture found, the normal or bump map last.
+    pub fn into_requests(self) -> Vec<TextureRequest> {
+        let mut r = self.requests;
+        r.extend(self.normal);
+        r
+    }
+
+    /// The normal or bump map found so far.
+    pub fn normal_request(&self) -> Option<&TextureRequest> {
+        self.normal.as_ref()
+    }
+
+    /// Records the material's normal or bump map.
+    pub fn set_normal_request(&mut self, request: TextureRequest) {
+        self.normal = Some(request);
+    }
+
+    /// True at the top of the material or in the front of a `twosided`
+    /// (where a normal map turns the normal of the whole material).
+    pub fn at_top(&self) -> bool {
+        matches!(self.path.as_slice(), [] | [Branch::Front])
+    }
+
+    /// The BSDF nested in a `normalmap` or `bumpmap` (no branch: it is the
+    /// material).
+    pub fn nest(&mut self, e: &Element) -> Result<BsdfParams> {
+        build_nested(e, self)
     }
 
     fn nested(&mut self, branch: Branch, e: &Element) -> Result<BsdfParams> {
@@ -146,6 +180,7 @@ pub(crate) fn build_bsdf(e: &Element, tex: &mut TextureCollector<'_>) -> Result<
         // Mitsuba's opacity: the nested BSDF times opacity, the rest let
         // through (crate::glass).
         "mask" => mask(&props, tex)?,
+        kind @ ("normalmap" | "bumpmap") => normal_mapped(e, kind, &props, tex)?,
         kind if crate::glass::REFRACTING.contains(&kind) => {
             return Err(crate::glass::refused(e, kind)?);
         }
@@ -153,7 +188,7 @@ pub(crate) fn build_bsdf(e: &Element, tex: &mut TextureCollector<'_>) -> Result<
             return Err(SceneError::at(
                 &e.required("type")?.loc,
                 format!(
-                    "unknown bsdf plugin \"{other}\" (supported: diffuse, conductor, roughconductor, plastic, roughplastic, blendbsdf, twosided, thindielectric, mask)"
+                    "unknown bsdf plugin \"{other}\" (supported: diffuse, conductor, roughconductor, plastic, roughplastic, blendbsdf, twosided, thindielectric, mask, normalmap, bumpmap)"
                 ),
             ));
         }
@@ -194,10 +229,19 @@ fn twosided(e: &Element, props: &Props<'_>, tex: &mut TextureCollector<'_>) -> R
             front: Box::new(tex.nested(Branch::Front, front)?),
             back: None,
         },
-        [front, back] => BsdfParams::TwoSided {
-            front: Box::new(tex.nested(Branch::Front, front)?),
-            back: Some(Box::new(tex.nested(Branch::Back, back)?)),
-        },
+        [front, back] => {
+            let front = tex.nested(Branch::Front, front)?;
+            if tex.normal_request().is_some() {
+                return Err(SceneError::at(
+                    &e.loc,
+                    "a normalmap or bumpmap turns the normal of the whole material: it cannot be the front of a twosided with two sides",
+                ));
+            }
+            BsdfParams::TwoSided {
+                front: Box::new(front),
+                back: Some(Box::new(tex.nested(Branch::Back, back)?)),
+            }
+        }
         _ => {
             return Err(SceneError::at(
                 &e.loc,
@@ -222,7 +266,10 @@ fn build_nested(e: &Element, tex: &mut TextureCollector<'_>) -> Result<BsdfParam
 }
 
 /// Exactly `N` nested `<bsdf>` elements (a `<texture>` is the caller's).
-fn nested<'a, const N: usize>(props: &Props<'a>, what: &str) -> Result<[&'a Element; N]> {
+pub(crate) fn nested<'a, const N: usize>(
+    props: &Props<'a>,
+    what: &str,
+) -> Result<[&'a Element; N]> {
     let owner = props.owner();
     let bsdfs: Vec<&Element> = props
         .objects
@@ -297,7 +344,11 @@ fn texture(
 
 /// A `<texture>`: `bitmap` (Mitsuba's defaults: bilinear, repeat, sRGB) or
 /// `checkerboard`, either with a `to_uv` transform.
-fn bitmap(e: &Element, kind: SlotKind, tex: &TextureCollector<'_>) -> Result<TextureRequest> {
+pub(crate) fn bitmap(
+    e: &Element,
+    kind: SlotKind,
+    tex: &TextureCollector<'_>,
+) -> Result<TextureRequest> {
     e.check_attrs(&["type", "id", "name"])?;
     let t = e.plugin_type()?;
     if t == "checkerboard" {
@@ -358,6 +409,7 @@ fn bitmap(e: &Element, kind: SlotKind, tex: &TextureCollector<'_>) -> Result<Tex
         offset: [0.0; 3],
         to_uv,
         location,
+        normal: None,
     })
 }
 
@@ -415,6 +467,7 @@ fn checkerboard(e: &Element, kind: SlotKind, tex: &TextureCollector<'_>) -> Resu
         offset: c1,
         to_uv,
         location: e.loc.clone(),
+        normal: None,
     })
 }
 
@@ -622,4 +675,100 @@ pub(crate) fn emitted_strength(props: &Props<'_>, name: &str) -> Result<ColorPar
         ));
     }
     Ok(value)
+}
+// Mitsuba 3's `normalmap` and `bumpmap` BSDFs: a nested BSDF whose
+// shading normal a texture turns (`trilux_brdf::normal_map`).
+//
+// | plugin | parameters (default) |
+// |---|---|
+// | `normalmap` | `<texture name="normalmap">` (RGB: n = 2·rgb − 1 in the tangent frame), one nested BSDF, `flip_invalid_normals` (true), `use_shadowing_function` (true: read, not applied) |
+// | `bumpmap` | one nested `<texture>` (its luminance a height field), `scale` (1), one nested BSDF, `flip_invalid_normals` (true), `use_shadowing_function` (true: read, not applied) |
+//
+// The material is its nested BSDF (the solve keeps the geometric normal);
+// the texture is kept with the shape and turns the shading normal in the
+// render only. Mitsuba's `use_shadowing_function` (Estevez et al.'s
+// attenuation of light arriving at grazing angles to the perturbed
+// normal) is not applied: docs/rendering.md, "Normal and bump maps".
+//
+// Refused (one located line): a second normal or bump map in one
+// material; one inside a `blendbsdf`, a `mask` or the back of a
+// two-sided BSDF with two sides (it turns the normal of the whole
+// material); a `scale` that is not finite; a texture that is not a
+// `bitmap`; a shape other than a mesh (`obj`, `ply`: Mitsuba 3.9.1's
+// `rectangle` has a shading frame of length 2, not a unit one); and, when the images are read, a normal
+// map whose image is not RGB.
+
+/// A `normalmap` or `bumpmap` BSDF (`kind`): its nested BSDF, with its
+/// texture recorded in `tex` as the material's normal map.
+pub(crate) fn normal_mapped(
+    e: &Element,
+    kind: &str,
+    props: &Props<'_>,
+    tex: &mut TextureCollector<'_>,
+) -> Result<BsdfParams> {
+    if tex.normal_request().is_some() {
+        return Err(SceneError::at(
+            &e.loc,
+            "a material takes one normalmap or bumpmap",
+        ));
+    }
+    if !tex.at_top() {
+        return Err(SceneError::at(
+            &e.loc,
+            format!(
+                "a {kind} turns the normal of the whole material: it cannot be inside a blendbsdf, a mask or the back of a twosided"
+            ),
+        ));
+    }
+    let flip = props.boolean("flip_invalid_normals")?.unwrap_or(true);
+    // Read (Mitsuba's default true), not applied: module docs.
+    props.boolean("use_shadowing_function")?;
+    let textures: Vec<&Element> = props
+        .objects
+        .iter()
+        .copied()
+        .filter(|o| o.tag == "texture")
+        .collect();
+    let texture = match (kind, textures.as_slice()) {
+        ("normalmap", [t]) if t.attr("name").map(|a| a.value.as_str()) == Some("normalmap") => *t,
+        ("bumpmap", [t]) => *t,
+        _ => {
+            let what = if kind == "normalmap" {
+                "one <texture name=\"normalmap\">"
+            } else {
+                "one nested <texture>"
+            };
+            return Err(SceneError::at(
+                &e.loc,
+                format!(
+                    "<bsdf type=\"{kind}\"> needs {what}, found {}",
+                    textures.len()
+                ),
+            ));
+        }
+    };
+    if texture.plugin_type()? != "bitmap" {
+        return Err(SceneError::at(
+            &texture.loc,
+            format!("the texture of a {kind} must be a bitmap"),
+        ));
+    }
+    let perturbation = if kind == "normalmap" {
+        NormalPerturbation::Normal { scale: 1.0, flip }
+    } else {
+        let scale = props.float("scale")?.unwrap_or(1.0);
+        if !scale.is_finite() {
+            return Err(SceneError::at(
+                &props.loc("scale"),
+                format!("bumpmap scale must be finite, found {scale}"),
+            ));
+        }
+        NormalPerturbation::Bump { scale, flip }
+    };
+    let mut request = bitmap(texture, SlotKind::Reflectance, tex)?;
+    request.normal = Some(perturbation);
+    let [inner] = nested::<1>(props, "one nested BSDF")?;
+    let inner = tex.nest(inner)?;
+    tex.set_normal_request(request);
+    Ok(inner)
 }

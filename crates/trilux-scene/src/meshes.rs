@@ -15,6 +15,8 @@ use crate::gltf::GltfMeshes;
 use crate::scene::Scene;
 use crate::shape::{MeshRequest, check_area};
 use crate::textures::{ImageSource, TextureCache, TextureRequest};
+use std::sync::Arc;
+
 use glam::{DMat4, DVec3};
 use trilux_geometry::{ShapeKind, TriangleMesh};
 
@@ -115,9 +117,6 @@ impl Pending {
             if failed.contains(index) {
                 continue;
             }
-            let Some(slot) = errors.keep(cache.slot(request)) else {
-                continue;
-            };
             let shape = &mut self.scene.shapes[*index];
             if let ShapeKind::Mesh(m) = &shape.shape.kind
                 && m.texcoords.is_none()
@@ -128,7 +127,13 @@ impl Pending {
                 ));
                 continue;
             }
-            shape.textures.push(slot);
+            if let Some(p) = request.normal {
+                if let Some(map) = errors.keep(cache.normal_map(request, p)) {
+                    shape.normal_map = Some(Arc::new(map));
+                }
+            } else if let Some(slot) = errors.keep(cache.slot(request)) {
+                shape.textures.push(slot);
+            }
         }
         for (index, request) in &cutouts {
             if failed.contains(index) {

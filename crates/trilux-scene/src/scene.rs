@@ -3,9 +3,10 @@
 
 use std::collections::BTreeMap;
 use std::path::PathBuf;
+use std::sync::Arc;
 
 use serde::Serialize;
-use trilux_brdf::{BsdfParams, TextureSlot};
+use trilux_brdf::{BsdfParams, NormalMap, TextureSlot};
 use trilux_color::{ColorParam, Mode};
 use trilux_geometry::{Bounds, Geometry, Punctual, Shape, Transmittance};
 
@@ -73,6 +74,11 @@ pub struct SceneShape {
     /// holds placeholders for the parameters they stand for.
     #[serde(skip)]
     pub textures: Vec<TextureSlot>,
+    /// The normal or bump map of its material, if any: the render turns
+    /// its shading normals with it, the solve does not
+    /// (`trilux_brdf::normal_map`).
+    #[serde(skip)]
+    pub normal_map: Option<Arc<NormalMap>>,
     /// The fraction of light the shape lets through, undeviated, when its
     /// BSDF is a `thindielectric` or a `mask`, or its glTF material's
     /// `alphaMode` is `MASK` (`crate::glass`, `crate::cutout`).
@@ -149,6 +155,12 @@ impl Scene {
     /// order.
     pub fn texture_slots(&self) -> Vec<Vec<TextureSlot>> {
         self.shapes.iter().map(|s| s.textures.clone()).collect()
+    }
+
+    /// Every shape's normal or bump map (`None` for most), in shape order
+    /// (`PreparedScene::with_normal_maps`).
+    pub fn normal_maps(&self) -> Vec<Option<Arc<NormalMap>>> {
+        self.shapes.iter().map(|s| s.normal_map.clone()).collect()
     }
 
     /// Every shape's transmittance (`None` for an opaque one), in shape

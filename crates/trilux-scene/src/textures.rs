@@ -10,10 +10,12 @@ use std::collections::HashMap;
 use std::path::PathBuf;
 use std::sync::Arc;
 
-use trilux_brdf::{Branch, SlotKind, Texture, TextureSlot, UvTransform};
+use trilux_brdf::{
+    Branch, NormalMap, NormalPerturbation, SlotKind, Texture, TextureSlot, UvTransform,
+};
 
 use crate::error::{Result, SceneError, SourceLocation};
-use crate::image::{MAX_IMAGE_BYTES, Sampling, decode};
+use crate::image::{MAX_IMAGE_BYTES, Sampling, decode_counted};
 use crate::limits::MAX_SCENE_TEXELS;
 
 /// Where an image's bytes are.
@@ -48,36 +50,44 @@ pub(crate) struct TextureRequest {
     pub to_uv: UvTransform,
     /// Where the texture is named, for errors.
     pub location: SourceLocation,
+    /// Set for a normal or bump map: how it turns the shading normal
+    /// (`path` and `kind` then mean nothing).
+    pub normal: Option<NormalPerturbation>,
 }
 
-/// Decoded images, by source and lookup, and the texels they hold.
+/// Decoded images, by source and lookup, with their channel counts, and
+/// the texels they hold.
 #[derive(Default)]
 pub(crate) struct TextureCache {
-    images: HashMap<(ImageSource, Sampling), Arc<Texture>>,
+    images: HashMap<(ImageSource, Sampling), (Arc<Texture>, usize)>,
     texels: u64,
 }
 
 impl TextureCache {
+    /// The image of a request and its channel count, read and decoded once.
+    fn image(&mut self, request: &TextureRequest) -> Result<(Arc<Texture>, usize)> {
+        let key = (request.source.clone(), request.sampling);
+        if let Some((t, c)) = self.images.get(&key) {
+            return Ok((Arc::clone(t), *c));
+        }
+        let (t, channels) = read(request)?;
+        let t = Arc::new(t);
+        self.texels += u64::from(t.width()) * u64::from(t.height());
+        if self.texels > MAX_SCENE_TEXELS {
+            return Err(SceneError::at(
+                &request.location,
+                format!(
+                    "the scene's textures hold more than {MAX_SCENE_TEXELS} texels in all (docs/limits.md)"
+                ),
+            ));
+        }
+        self.images.insert(key, (Arc::clone(&t), channels));
+        Ok((t, channels))
+    }
+
     /// The slot a request stands for, its image read and decoded once.
     pub fn slot(&mut self, request: &TextureRequest) -> Result<TextureSlot> {
-        let key = (request.source.clone(), request.sampling);
-        let texture = match self.images.get(&key) {
-            Some(t) => Arc::clone(t),
-            None => {
-                let t = Arc::new(read(request)?);
-                self.texels += u64::from(t.width()) * u64::from(t.height());
-                if self.texels > MAX_SCENE_TEXELS {
-                    return Err(SceneError::at(
-                        &request.location,
-                        format!(
-                            "the scene's textures hold more than {MAX_SCENE_TEXELS} texels in all (docs/limits.md)"
-                        ),
-                    ));
-                }
-                self.images.insert(key, Arc::clone(&t));
-                t
-            }
-        };
+        let (texture, _) = self.image(request)?;
         Ok(TextureSlot {
             path: request.path.clone(),
             kind: request.kind,
@@ -87,15 +97,40 @@ impl TextureCache {
             to_uv: request.to_uv,
         })
     }
+
+    /// The normal or bump map of a request whose `normal` is set; a normal
+    /// map's image must be RGB (Mitsuba's `eval_3` refuses a grey one).
+    pub fn normal_map(
+        &mut self,
+        request: &TextureRequest,
+        perturbation: NormalPerturbation,
+    ) -> Result<NormalMap> {
+        let (texture, channels) = self.image(request)?;
+        if matches!(perturbation, NormalPerturbation::Normal { .. }) && channels < 3 {
+            return Err(SceneError::at(
+                &request.location,
+                format!(
+                    "a normal map needs an RGB image, found {channels} channel{}",
+                    if channels == 1 { "" } else { "s" }
+                ),
+            ));
+        }
+        Ok(NormalMap {
+            perturbation,
+            texture,
+            to_uv: request.to_uv,
+        })
+    }
 }
 
-fn read(request: &TextureRequest) -> Result<Texture> {
+fn read(request: &TextureRequest) -> Result<(Texture, usize)> {
     let at = |m: String| SceneError::at(&request.location, m);
     match &request.source {
         ImageSource::File(path) => {
             let bytes = trilux_files::read_limited(path, MAX_IMAGE_BYTES)
                 .map_err(|e| at(format!("cannot read image {}: {e}", path.display())))?;
-            decode(&bytes, request.sampling).map_err(|e| at(format!("{}: {e}", path.display())))
+            decode_counted(&bytes, request.sampling)
+                .map_err(|e| at(format!("{}: {e}", path.display())))
         }
         ImageSource::Checkerboard => Texture::new(
             2,
@@ -104,6 +139,7 @@ fn read(request: &TextureRequest) -> Result<Texture> {
             request.sampling.wrap,
             request.sampling.filter,
         )
+        .map(|t| (t, 3))
         .map_err(|e| at(e.to_string())),
         ImageSource::Bytes(bytes) => {
             if bytes.len() as u64 > MAX_IMAGE_BYTES {
@@ -112,7 +148,7 @@ fn read(request: &TextureRequest) -> Result<Texture> {
                     bytes.len()
                 )));
             }
-            decode(bytes, request.sampling).map_err(|e| at(e.to_string()))
+            decode_counted(bytes, request.sampling).map_err(|e| at(e.to_string()))
         }
     }
 }

@@ -11,7 +11,7 @@ use std::io::Write;
 use std::sync::Arc;
 
 use thiserror::Error;
-use trilux_brdf::{BrdfError, Bsdf, BsdfParams, Shading, TextureSlot, TexturedBsdf};
+use trilux_brdf::{BrdfError, Bsdf, BsdfParams, NormalMap, Shading, TextureSlot, TexturedBsdf};
 use trilux_color::{ColorError, ColorParam, Spectrum};
 use trilux_geometry::{
     Bounds, Geometry, GeometryError, Punctual, Shape, SurfaceCoord, SurfaceId, Transmittance,
@@ -153,6 +153,9 @@ pub struct PreparedScene<const N: usize> {
     enclosure: Option<Bounds>,
     /// The environment map, if any (`with_sky`).
     sky: Option<PreparedSky<N>>,
+    /// The textures that turn shading normals, by shape (empty when there
+    /// are none; `with_normal_maps`): the render's only.
+    normal_maps: Vec<Option<Arc<NormalMap>>>,
     hash: u64,
 }
 
@@ -215,6 +218,7 @@ impl<const N: usize> PreparedScene<N> {
             lights: Vec::new(),
             enclosure: None,
             sky: None,
+            normal_maps: Vec::new(),
             hash: content_hash(desc, textures, N)?,
         })
     }
@@ -310,6 +314,24 @@ impl<const N: usize> PreparedScene<N> {
         }
         self.sky = sky;
         self
+    }
+
+    /// The scene with the normal and bump maps of its materials
+    /// (`by_shape[i]` for shape `i`; `trilux_brdf::normal_map`). Only the
+    /// render reads them: the solve keeps the geometric normal, so they
+    /// leave the content hash (and a stored solution) as they are.
+    pub fn with_normal_maps(mut self, by_shape: &[Option<Arc<NormalMap>>]) -> Self {
+        self.normal_maps = if by_shape.iter().any(Option::is_some) {
+            by_shape.to_vec()
+        } else {
+            Vec::new()
+        };
+        self
+    }
+
+    /// The normal or bump map of a shape's material, if it has one.
+    pub fn normal_map(&self, shape: usize) -> Option<&NormalMap> {
+        self.normal_maps.get(shape)?.as_deref()
     }
 
     /// The environment map, if any.

@@ -154,6 +154,7 @@ pub fn prepare<const N: usize>(scene: &Scene) -> Result<Arc<PreparedScene<N>>, P
     prepared
         .with_enclosure(scene.enclosure())
         .with_transmission(&scene.transmission_params())
+        .with_normal_maps(&scene.normal_maps())
         .with_sky(prepared_sky(scene)?)
         .with_lights(&scene.light_params())
         .map(Arc::new)

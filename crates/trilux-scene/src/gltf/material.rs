@@ -27,10 +27,13 @@
 //! Refused (one error naming the material): `metallicRoughnessTexture`,
 //! `emissiveTexture`, the textures of `KHR_materials_specular`,
 //! texture coordinates other than `TEXCOORD_0`,
-//! `alphaMode` `BLEND` (a semi-transparent surface composited over what is
-//! behind it, which a physically based renderer has no meaning for), and
-//! `normalTexture` (a shading normal per texel, which trilux's element
-//! normals cannot follow).
+//! and `alphaMode` `BLEND` (a semi-transparent surface composited over what
+//! is behind it, which a physically based renderer has no meaning for). `normalTexture` turns the
+//! shading normal in the render (`trilux_brdf::normal_map`: n =
+//! normalize((2·rgb − 1) ⊙ (scale, scale, 1)) in the frame of ∂p/∂u and
+//! n × ∂p/∂u, green up; the mesh's `TANGENT` attribute is not read), not
+//! in the solve; with `KHR_texture_transform` or another `texCoord` it is
+//! refused.
 //!
 //! `alphaMode` `MASK` cuts the surface out: with a = baseColorFactor.a ×
 //! baseColorTexture.a, a point where a < `alphaCutoff` (0.5) is not there
@@ -47,7 +50,8 @@ use std::path::Path;
 use std::sync::Arc;
 
 use trilux_brdf::{
-    Branch, BsdfParams, Distribution, Filter, RoughConductorParams, SlotKind, UvTransform, Wrap,
+    Branch, BsdfParams, Distribution, Filter, NormalPerturbation, RoughConductorParams, SlotKind,
+    UvTransform, Wrap,
 };
 use trilux_color::ColorParam;
 
@@ -80,6 +84,8 @@ pub(crate) struct TextureUse {
     /// For the alpha of `alphaMode` `MASK`: its `alphaCutoff` (the use is
     /// then a cut-out, not a slot).
     pub cutoff: Option<f64>,
+    /// Set for the `normalTexture`: how it turns the shading normal.
+    pub normal: Option<NormalPerturbation>,
 }
 
 /// A glTF material as trilux takes it.
@@ -99,7 +105,7 @@ impl Mapped {
     /// Every texture use: the slots', then the cut-out's.
     pub fn uses(&self) -> impl Iterator<Item = &TextureUse> {
         let cutout = match &self.alpha {
-            Alpha::Cutout(t) => Some(t),
+            Alpha::Cutout(t) => Some(&**t),
             _ => None,
         };
         self.textures.iter().chain(cutout)
@@ -115,7 +121,7 @@ pub(crate) enum Alpha {
     Transparent,
     /// Cut out where the texture's alpha times `scale` is below the use's
     /// `cutoff` (its `kind` and `path` are not used).
-    Cutout(TextureUse),
+    Cutout(Box<TextureUse>),
 }
 
 /// Maps one material (`None`: glTF's default material, white, metallic 1,
@@ -160,6 +166,13 @@ pub(crate) fn map(file: &Arc<Path>, m: &gltf::Material<'_>) -> Result<Mapped> {
     } else {
         bsdf
     };
+    if let Some(t) = m.normal_texture() {
+        textures.push(normal_texture(
+            &t,
+            &at,
+            SourceLocation::json(file, format!("{base}/normalTexture")),
+        )?);
+    }
     Ok(Mapped {
         bsdf,
         textures,
@@ -193,7 +206,7 @@ fn alpha(m: &gltf::Material<'_>, at: &At<'_>, base: Option<&BaseTexture>) -> Res
     Ok(match base {
         None if a >= cutoff => Alpha::Opaque,
         None => Alpha::Transparent,
-        Some((image, sampling, to_uv, location)) => Alpha::Cutout(TextureUse {
+        Some((image, sampling, to_uv, location)) => Alpha::Cutout(Box::new(TextureUse {
             path: Vec::new(),
             kind: SlotKind::Weight,
             image: *image,
@@ -206,7 +219,8 @@ fn alpha(m: &gltf::Material<'_>, at: &At<'_>, base: Option<&BaseTexture>) -> Res
             to_uv: *to_uv,
             location: location.clone(),
             cutoff: Some(cutoff),
-        }),
+            normal: None,
+        })),
     })
 }
 
@@ -304,6 +318,7 @@ fn lobe_bsdf(
                 to_uv: *to_uv,
                 location: location.clone(),
                 cutoff: None,
+                normal: None,
             });
         }
     };
@@ -352,11 +367,6 @@ fn refuse_unsupported(m: &gltf::Material<'_>, at: &At<'_>) -> Result<()> {
             m.emissive_texture().is_some(),
             "/emissiveTexture",
             "emissiveTexture is not supported (trilux's area emitters have one radiance per shape)",
-        ),
-        (
-            m.normal_texture().is_some(),
-            "/normalTexture",
-            "normalTexture is not supported (trilux shades with the mesh's own normals)",
         ),
         (
             m.specular().is_some_and(|s| {
@@ -440,6 +450,58 @@ fn texture_info(
         None => UvTransform::IDENTITY,
     };
     let texture = t.texture();
+    let sampling = sampling(&texture, at, suffix)?;
+    Ok((texture.source().index(), sampling, to_uv, location))
+}
+
+/// The `normalTexture` (linear values; `scale` multiplies the normal's x
+/// and y: `trilux_brdf::normal_map`).
+fn normal_texture(
+    t: &gltf::material::NormalTexture<'_>,
+    at: &At<'_>,
+    location: SourceLocation,
+) -> Result<TextureUse> {
+    let suffix = "/normalTexture";
+    if t.tex_coord() != 0 {
+        return Err(at(
+            suffix,
+            format!(
+                "texCoord {} is not supported (only TEXCOORD_0)",
+                t.tex_coord()
+            ),
+        ));
+    }
+    if t.extension_value("KHR_texture_transform").is_some() {
+        return Err(at(
+            suffix,
+            "KHR_texture_transform on a normalTexture is not supported".into(),
+        ));
+    }
+    let scale = f64::from(t.scale());
+    if !scale.is_finite() {
+        return Err(at(suffix, format!("scale must be finite, found {scale}")));
+    }
+    let texture = t.texture();
+    let sampling = Sampling {
+        raw: true,
+        ..sampling(&texture, at, suffix)?
+    };
+    Ok(TextureUse {
+        path: Vec::new(),
+        kind: SlotKind::Reflectance,
+        image: texture.source().index(),
+        sampling,
+        scale: [1.0; 3],
+        offset: [0.0; 3],
+        to_uv: UvTransform::IDENTITY,
+        location,
+        cutoff: None,
+        normal: Some(NormalPerturbation::Normal { scale, flip: false }),
+    })
+}
+
+/// A texture's sampler as a [`Sampling`] (sRGB-decoded).
+fn sampling(texture: &gltf::texture::Texture<'_>, at: &At<'_>, suffix: &str) -> Result<Sampling> {
     let sampler = texture.sampler();
     let wrap = |w: gltf::texture::WrappingMode| match w {
         gltf::texture::WrappingMode::Repeat => Wrap::Repeat,
@@ -454,17 +516,12 @@ fn texture_info(
         Some(gltf::texture::MagFilter::Nearest) => Filter::Nearest,
         _ => Filter::Bilinear,
     };
-    Ok((
-        texture.source().index(),
-        Sampling {
-            wrap: [ws, wt],
-            filter,
-            raw: false,
-            alpha: false,
-        },
-        to_uv,
-        location,
-    ))
+    Ok(Sampling {
+        wrap: [ws, wt],
+        filter,
+        raw: false,
+        alpha: false,
+    })
 }
 
 /// `KHR_texture_transform` as the map from TEXCOORD_0 to the image's

@@ -376,6 +376,7 @@ impl Walk<'_> {
             bsdf,
             emitter,
             textures: Vec::new(),
+            normal_map: None,
             transmission: None,
             location,
         });
@@ -570,6 +571,7 @@ impl GltfMeshes {
                 offset: t.offset,
                 to_uv: t.to_uv,
                 location: t.location.clone(),
+                normal: t.normal,
             };
             match t.cutoff {
                 Some(cutoff) => cutouts.push((
