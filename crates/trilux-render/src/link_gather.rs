@@ -29,10 +29,13 @@
 //!   plus its own glossy part, one level deeper; beyond that level the
 //!   solution is read directly.
 //!
-//! [`Preview`] drops every random ray: the link sum with the links' own
-//! visibility at x_s, and for a glossy x_s the direct light by a fixed
-//! quadrature over the emitters plus one mirror-direction reading of the
-//! solution's reflected light. A noise-free (not shadow-exact) view for
+//! [`Preview`] drops every random ray at the pixel: the link sum with the
+//! links' own visibility at x_s plus E_g read at the corners of x_s's
+//! leaf element (module `glossy_irradiance`), and for a glossy x_s the directional
+//! bake's representation of L_glossy (harmonics plus a lobe fitted at the
+//! corners of x_s's leaf element, made once per corner with fixed seeds
+//! and shared: module `glossy_fit`), so that the preview and a viewer of
+//! the bake read the same light. A noise-free (not shadow-exact) view for
 //! walkthroughs.
 //!
 //! [`link_sum`]: crate::link_sum
@@ -40,10 +43,12 @@
 use glam::DVec3;
 
 use crate::gather::FinalGather;
+use crate::glossy_fit::GlossyFits;
+use crate::glossy_irradiance::GlossyIrradiance;
 use crate::link_sum::LinkCache;
 use crate::mis::{eye_hit, hit_emission, light_sample, punctual_direct};
 use crate::records::{GatherStats, LinkVisibility, SurfacePoint};
-use crate::sampler::{PixelSampler, dims, hammersley};
+use crate::sampler::{PixelSampler, dims};
 use crate::scene::SolutionGather;
 use trilux_color::Spectrum;
 
@@ -446,6 +451,11 @@ pub struct Preview<'a, S> {
     /// Camera rays that meet an emitter count as misses
     /// (`RenderSettings::hide_emitters`).
     pub hide_emitters: bool,
+    /// The glossy light's fits, made as hits need them.
+    pub fits: GlossyFits,
+    /// E_g, the light glossy senders reflect onto Lambertian parts, per
+    /// corner, made as hits need it.
+    pub glossy_senders: GlossyIrradiance,
 }
 
 impl<S> Preview<'_, S> {
@@ -473,48 +483,18 @@ impl<S> Preview<'_, S> {
             && let Some(e) =
                 scene.solution_irradiance(&xs, wo, LinkVisibility::Cached, &mut caches.pixel, stats)
         {
-            l += rho * e;
+            let e_g = if scene.has_glossy_faces() {
+                self.glossy_senders.at(scene, &xs, wo, stats)
+            } else {
+                Spectrum::zero()
+            };
+            l += rho * (e + e_g);
         }
         if scene.is_glossy(&xs, wo) {
-            l += preview_direct(scene, &xs, wo, stats);
-            if let Some((wi, albedo)) = scene.mirror(&xs, wo)
-                && let Some(xd) = scene.intersect(xs.point, wi)
-            {
-                stats.gather_rays += 1;
-                let reflected = lambertian_at(scene, &xd, -wi, &mut caches.scratch, stats)
-                    .map_or_else(
-                        || scene.reflected(&xd, &xs),
-                        |l| l + scene.reflected_glossy(&xd, &xs),
-                    );
-                l += albedo * reflected;
-            }
+            l += self.fits.radiance(scene, &xs, wo, stats);
         }
         stats.finite_or_dropped(l)
     }
-}
-
-/// Light points per glossy preview hit.
-const PREVIEW_LIGHT_POINTS: u32 = 16;
-
-/// The direct light a glossy part at `x` reflects towards `wo`, by a fixed
-/// quadrature over the emitters (the same [`PREVIEW_LIGHT_POINTS`] points
-/// of a Hammersley set at every pixel: no noise, and highlights of rough
-/// lobes; a narrow lobe sees the points as separate glints).
-fn preview_direct<S: SolutionGather<N>, const N: usize>(
-    scene: &S,
-    x: &SurfacePoint<S::Locator>,
-    wo: DVec3,
-    stats: &mut GatherStats,
-) -> Spectrum<N> {
-    let mut sum = Spectrum::zero();
-    for k in 0..PREVIEW_LIGHT_POINTS {
-        let u = hammersley(k, PREVIEW_LIGHT_POINTS);
-        let pick = (0.5 + f64::from(k) * 0.618_033_988_749_895).fract();
-        let fr = |wi| scene.glossy_cos(x, wi, wo);
-        sum += light_sample(scene, x, wo, pick, u, fr, false, stats);
-    }
-    let fr = |wi| scene.glossy_cos(x, wi, wo);
-    sum * (1.0 / f64::from(PREVIEW_LIGHT_POINTS)) + punctual_direct(scene, x, fr, stats)
 }
 
 /// ρ_d(xd) times the link sum at `xd` with the links' own visibility
