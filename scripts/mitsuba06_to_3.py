@@ -32,8 +32,14 @@ The rules:
     `coating`/`roughcoating` -> the BSDF they coat; `mixturebsdf` of two
     BSDFs -> `blendbsdf` (weight w2 / (w1 + w2)); microfacet distributions
     `phong` -> `beckmann` and `as` -> `ggx`; a conductor's `extEta` dropped;
-  - `sunsky`: y-up as in 0.6 (a `to_world` turning Mitsuba 3's z-up sky),
-    `sunRadiusScale`, `stretch`, `resolution`, `extend` dropped;
+  - `sunsky`: Mitsuba 3's sunsky, y-up as in 0.6 (a `to_world` turning
+    Mitsuba 3's z-up sky), `sunRadiusScale` -> `sun_aperture` (0.5358
+    degrees times it), `stretch`, `extend` dropped; then, as 0.6 itself
+    drew its sunsky into an environment map of `resolution` (512) x 256
+    pixels, rasterised into that `envmap` (OUTPUT-sky.exr beside the
+    output; sunsky_envmap.py, which needs Mitsuba 3's llvm_ad_rgb), since
+    trilux reads `envmap` and not Mitsuba 3's sunsky; `--sunsky keep` keeps
+    the sunsky element instead;
   - shapes: `maxSmoothAngle` -> `face_normals` true (Mitsuba 3 has no crease
     angle);
   - films: `ldrfilm` -> `hdrfilm`; the tone-mapping parameters (`gamma`,
@@ -49,6 +55,7 @@ The rules:
 """
 import argparse
 import math
+import pathlib
 import re
 import sys
 import xml.etree.ElementTree as ET
@@ -64,6 +71,9 @@ SAME = {
     "film": {"hdrfilm"},
     "emitter": {"area", "point", "spot", "directional", "constant", "envmap", "sunsky"},
 }
+# Mitsuba 3's sunsky default `sun_aperture` (degrees), which 0.6's
+# `sunRadiusScale` multiplies.
+SUN_APERTURE = 0.5358
 FILM_DROPPED = ["gamma", "exposure", "tonemap_method", "key", "burn", "banner",
                 "high_quality_edges", "attach_log"]
 
@@ -96,8 +106,9 @@ def describe(e):
 class Upgrade:
     """One file's upgrade: the tree changed in place, the changes listed."""
 
-    def __init__(self, root):
+    def __init__(self, root, rasterise_sky=None):
         self.root = root
+        self.rasterise_sky = rasterise_sky
         self.renames = {}
         self.unsupported = []
         self.defaults = {d.get("name"): d.get("value") for d in root.iter("default")}
@@ -324,12 +335,32 @@ class Upgrade:
         if e.get("type") not in SAME["emitter"]:
             self.unsupported.append(describe(e))
         if e.get("type") == "sunsky":
-            self.drop(e, ["sun_radius_scale", "stretch", "resolution", "extend"],
-                      "Mitsuba 3's sunsky has no such parameter")
-            if "to_world" not in self.params(e):
-                t = ET.SubElement(e, "transform", {"name": "to_world"})
-                ET.SubElement(t, "rotate", {"x": "1", "angle": "-90"})
-                self.note(f"{describe(e)}: to_world rotate x -90 (0.6's sky is y-up, Mitsuba 3's z-up)")
+            self.upgrade_sunsky(e)
+
+    def upgrade_sunsky(self, e):
+        """Mitsuba 3's `sunsky` with 0.6's parameters, then (with a sky
+        rasteriser) the `envmap` 0.6 itself drew it into."""
+        scale = self.value(e, "sun_radius_scale")
+        if scale is not None:
+            self.set_param(e, "float", "sun_aperture", f"{SUN_APERTURE * scale:g}")
+            self.note(f"{describe(e)}: sun_radius_scale {scale:g} -> sun_aperture {SUN_APERTURE * scale:g} degrees")
+        width = int(self.value(e, "resolution", 512))
+        self.drop(e, ["sun_radius_scale", "stretch", "resolution", "extend"],
+                  "Mitsuba 3's sunsky has no such parameter")
+        if "to_world" not in self.params(e):
+            t = ET.SubElement(e, "transform", {"name": "to_world"})
+            ET.SubElement(t, "rotate", {"x": "1", "angle": "-90"})
+            self.note(f"{describe(e)}: to_world rotate x -90 (0.6's sky is y-up, Mitsuba 3's z-up)")
+        if self.rasterise_sky is None:
+            return
+        name = self.rasterise_sky(ET.tostring(e, encoding="unicode"), width)
+        tail = e.tail
+        e.clear()
+        e.tail = tail
+        e.set("type", "envmap")
+        ET.SubElement(e, "string", {"name": "filename", "value": name})
+        self.note(f'<emitter type="sunsky"> -> type "envmap" {name}, {width} x {width // 2} '
+                  "(Mitsuba 3's sunsky rasterised, as 0.6 drew its sunsky into an envmap)")
 
     def plugin_integrator(self, e):
         for x in e.iter():
@@ -348,28 +379,53 @@ class Upgrade:
         self.drop(e, ["strict_normals"], "Mitsuba 3's path has no such parameter")
 
 
-def upgrade(text):
+def upgrade(text, rasterise_sky=None):
     """The upgraded XML of a Mitsuba 0.6 file's `text`, and the plugins
-    left as they are."""
+    left as they are. `rasterise_sky(sunsky_xml, width)`, when given,
+    writes a sunsky's envmap and returns its file name."""
     parser = ET.XMLParser(target=ET.TreeBuilder(insert_comments=True))
     root = ET.fromstring(text, parser=parser)
     if root.tag != "scene":
         raise ValueError(f"the root element is <{root.tag}>, not <scene>")
-    u = Upgrade(root)
+    u = Upgrade(root, rasterise_sky)
     u.run()
     body = ET.tostring(root, encoding="unicode")
     return '<?xml version="1.0" encoding="utf-8"?>\n' + body + "\n", u.unsupported
+
+
+def sky_rasteriser(args):
+    """The sunsky rasteriser for `--sunsky envmap`: writes OUTPUT-sky.exr
+    (-sky2.exr, ... for more skies) beside the output file."""
+    if args.sunsky == "keep":
+        return None
+    written = []
+
+    def rasterise(sunsky_xml, width):
+        if not args.output:
+            raise ValueError("a sunsky becomes an envmap image beside the output: give -o, "
+                             "or --sunsky keep")
+        import sunsky_envmap
+        out = pathlib.Path(args.output)
+        name = f"{out.stem}-sky{len(written) + 1 if written else ''}.exr"
+        sunsky_envmap.rasterise(sunsky_xml, out.parent / name, width)
+        written.append(name)
+        return name
+
+    return rasterise
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("scene", help="a Mitsuba 0.6 scene file")
     ap.add_argument("-o", "--output", help="the Mitsuba 3 file (default: stdout)")
+    ap.add_argument("--sunsky", choices=["envmap", "keep"], default="envmap",
+                    help="a sunsky becomes the envmap it rasterises to, beside the output "
+                         "(the default: trilux reads envmap, not sunsky), or stays Mitsuba 3's sunsky")
     args = ap.parse_args()
     try:
         with open(args.scene, encoding="utf-8") as f:
-            text, unsupported = upgrade(f.read())
-    except (OSError, ET.ParseError, ValueError) as e:
+            text, unsupported = upgrade(f.read(), sky_rasteriser(args))
+    except (OSError, ET.ParseError, ValueError, RuntimeError) as e:
         print(f"error: {args.scene}: {e}", file=sys.stderr)
         return 1
     if args.output:

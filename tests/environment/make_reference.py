@@ -2,7 +2,9 @@
 """Mitsuba 3.9.1's image means of the scenes lit by a `constant` sky in
 tests/environment/ (courtyard.xml with the sky seen and with
 `hide_emitters`; daylight-room.xml, a closed room lit through one window,
-under the sky alone and with a sun),
+under the sky alone and with a sun; glazed-room.xml, the same room with a
+pane of thin glass in the window, under the sky alone: Mitsuba's path
+tracer cannot carry a delta sun through a delta pane),
 for crates/trilux/tests/environment.rs.
 
 Usage (from anywhere):
@@ -36,6 +38,7 @@ def main():
         ("sky_hidden", "courtyard.xml", {"hide": "true"}),
         ("daylight_room", "daylight-room.xml", {}),
         ("daylight_room_sun", "daylight-room.xml", {"sun": SUN}),
+        ("glazed_room", "glazed-room.xml", {}),
     ):
         scene = mi.load_file(os.path.join(HERE, file), **params)
         mean, stderr = image_means.mean_over_passes(mi, scene, a.spp, a.passes)
@@ -43,7 +46,7 @@ def main():
     image_means.write(
         os.path.join(HERE, "reference.json"),
         {
-            "scenes": "tests/environment/{courtyard,daylight-room}.xml",
+            "scenes": "tests/environment/{courtyard,daylight-room,glazed-room}.xml",
             "mitsuba": mi.__version__,
             "variant": mi.variant(),
             "spp": a.spp,

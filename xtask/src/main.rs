@@ -103,9 +103,10 @@ fn ci() -> Result<()> {
         "cargo",
         &["doc", "--workspace", "--no-deps"],
     )?;
-    // The unit tests once in debug mode, where overflow checks and
-    // debug assertions are on (the release pass below runs everything).
-    run("cargo", &["test", "--workspace", "--lib", "--bins"])?;
+    // One build for every test: the release profile (the one xtask itself
+    // runs in, so the golden and viewer steps reuse it). .ci/run turns
+    // overflow checks and debug assertions on in that profile for the whole
+    // run, so unit, integration, golden and viewer tests all run with them.
     run("cargo", &["test", "--workspace", "--release"])?;
     package::main()?;
     color::color()?;

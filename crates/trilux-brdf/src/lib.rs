@@ -20,6 +20,8 @@
 //!   under a dielectric coat) and how the solver splits them.
 //! - [`microfacet`]: Mitsuba's Beckmann and GGX D, separable Smith G (its
 //!   rational G1 for Beckmann), and their sampling.
+//! - [`conductors`]: Mitsuba's named conductors (`material="Cu"`), their
+//!   measured η and k.
 //! - `special` (private): erf and its inverse (Beckmann visible-normal
 //!   sampling).
 //! - `fresnel` (private): conductor Fresnel from η and k, dielectric
@@ -41,6 +43,7 @@
 pub mod albedo;
 pub mod area;
 pub mod bsdf;
+pub mod conductors;
 pub mod error;
 pub mod frame;
 mod fresnel;
@@ -58,10 +61,12 @@ pub use area::{
     is_narrow, lobe_width, sample_glossy_lobe,
 };
 pub use bsdf::{Bsdf, BsdfSample};
+pub use conductors::{conductor_names, named_conductor};
 pub use error::BrdfError;
 pub use frame::Frame;
 pub use params::{
-    BsdfParams, Distribution, NAMED_IORS, PlasticParams, RoughConductorParams, named_ior,
+    BsdfParams, Distribution, MIRROR_ALPHA, NAMED_IORS, PlasticParams, RoughConductorParams,
+    named_ior,
 };
 pub use plastic::Plastic;
 pub use texture::{Filter, Texture, UvTransform, Wrap};

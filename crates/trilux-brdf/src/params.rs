@@ -16,7 +16,19 @@ pub enum Distribution {
     Ggx,
 }
 
-/// Parameters of Mitsuba 3's `roughconductor` (isotropic only).
+/// The roughness that stands for a perfectly smooth surface (Mitsuba's
+/// `conductor`, a mirror with a Dirac lobe): a Beckmann lobe of this α.
+/// Its values differ from the Dirac lobe's only within about 3α = 3e-4 rad
+/// of the mirror direction (Beckmann's D falls as exp(−tan²θ/α²)), where
+/// it keeps the Dirac lobe's energy (Beckmann's G1 is exactly 1 unless
+/// tan θ > 1/(1.6 α), within 0.01° of grazing); the solver samples it as a narrow lobe and the
+/// render continues paths through it (docs/solver.md, "Narrow lobes";
+/// docs/rendering.md, "Near-specular surfaces"), as for the α = 1e-4
+/// mirrors measured in docs/results.md.
+pub const MIRROR_ALPHA: f64 = 1e-5;
+
+/// Parameters of Mitsuba 3's `roughconductor` (isotropic only), and of
+/// its smooth `conductor` as a Beckmann lobe of α = [`MIRROR_ALPHA`].
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct RoughConductorParams {
     /// Normal distribution.

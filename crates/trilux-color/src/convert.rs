@@ -11,6 +11,7 @@
 //! | `<rgb>` | as given (spectral: smooth, within 0…1) | as given (spectral: D65 · smooth) | as given (spectral: smooth, ≥ 0) |
 //! | `<spectrum v>` | v everywhere | equal-energy v: RGB (1.20479, 0.948291, 0.908916)·v | v everywhere |
 //! | `<spectrum λ:v …>` | RGB: under D65, clamped to 0…1; spectral: band averages | RGB: through XYZ, ≥ 0; spectral: band averages | RGB: under D65, ≥ 0; spectral: band averages |
+//! | a named conductor (`Measured`) | RGB: through XYZ, no illuminant, ≥ 0 (Mitsuba's `ior_from_file`); spectral: band averages | same | same |
 //!
 //! Spectral band averages are weighted by the observer (x̄ + ȳ + z̄) within
 //! each band ([`SampledSpectrum::observer_weighted_average`]).
@@ -60,7 +61,7 @@ impl ColorParam {
         for v in self.values() {
             check(v)?;
         }
-        if let ColorParam::Sampled(s) = self {
+        if let ColorParam::Sampled(s) | ColorParam::Measured(s) = self {
             for &(l, _) in s {
                 if !l.is_finite() {
                     return Err(ColorError::NotFinite);
@@ -87,6 +88,11 @@ impl ColorParam {
                         Role::Emission => mitsuba::spectrum_to_srgb(&s, false, false),
                     }
                 }
+                // Mitsuba's `ior_from_file`: `spectrum_list_to_srgb(λ, v,
+                // bounded = false, d65 = false)`, whatever the role.
+                ColorParam::Measured(s) => {
+                    mitsuba::spectrum_to_srgb(&SampledSpectrum::new(s)?, false, false)
+                }
             };
             let mut a = [0.0; N];
             a[..3].copy_from_slice(&rgb);
@@ -103,7 +109,7 @@ impl ColorParam {
                     Role::Unbounded => smooth_unbounded::<N>(*c),
                     Role::Emission => smooth_emission::<N>(*c),
                 },
-                ColorParam::Sampled(s) => {
+                ColorParam::Sampled(s) | ColorParam::Measured(s) => {
                     let s = SampledSpectrum::new(s)?;
                     let mut a = [0.0; N];
                     for (b, v) in a.iter_mut().enumerate() {
@@ -142,6 +148,13 @@ impl ColorParam {
             }
             ColorParam::Sampled(s) => {
                 ColorParam::Sampled(s.iter().map(|&(l, v)| (l, v.abs())).collect())
+            }
+            ColorParam::Measured(s) if N == 3 => {
+                let rgb = mitsuba::spectrum_to_srgb(&SampledSpectrum::new(s)?, false, false);
+                ColorParam::Rgb(rgb)
+            }
+            ColorParam::Measured(s) => {
+                ColorParam::Measured(s.iter().map(|&(l, v)| (l, v.abs())).collect())
             }
         };
         magnitude.to_spectrum(Role::Unbounded)

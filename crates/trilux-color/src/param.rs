@@ -22,6 +22,13 @@ pub enum ColorParam {
     /// `<spectrum value="λ:v, λ:v, ...">`: samples (wavelength in nm, value),
     /// ascending in wavelength, linear in between and zero outside.
     Sampled(Vec<(f64, f64)>),
+    /// A measured spectrum named by a preset rather than written (a
+    /// conductor's `material="Cu"`: Mitsuba's `data/ior` tables), samples
+    /// as in [`ColorParam::Sampled`]. RGB mode converts it as Mitsuba's
+    /// `ior_from_file` does (no illuminant, negative channels to 0);
+    /// spectral mode as a sampled spectrum. It does not make a scene
+    /// spectral: Mitsuba's RGB variants take such a preset as RGB.
+    Measured(Vec<(f64, f64)>),
 }
 
 impl ColorParam {
@@ -36,7 +43,7 @@ impl ColorParam {
         match self {
             ColorParam::Float(v) | ColorParam::Constant(v) => vec![*v],
             ColorParam::Rgb(c) => c.to_vec(),
-            ColorParam::Sampled(s) => s.iter().map(|&(_, v)| v).collect(),
+            ColorParam::Sampled(s) | ColorParam::Measured(s) => s.iter().map(|&(_, v)| v).collect(),
         }
     }
 }

@@ -146,6 +146,7 @@ impl Builder {
             bvh,
             bounds,
             extent,
+            transmitters: Vec::new(),
         }
     }
 

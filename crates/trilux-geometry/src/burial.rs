@@ -21,6 +21,9 @@
 //! own shape, so a coincident face (a box's bottom on the floor) counts.
 //! A face seen through a gap wider than `reach` stays exposed: the light
 //! that enters the gap is then resolved by visibility, as everywhere else.
+//! Shapes that let light through ([`crate::transmission`]: a pane of
+//! glass close in front of a face, the sky's box just outside a window)
+//! cover nothing: the probes go on through them.
 //!
 //! **Crossings** ([`crate::crossing`], [`BurialMap::probe_with_light`]):
 //! on a face that another surface crosses, the parts the crossing cuts off
@@ -332,7 +335,7 @@ fn probe(geom: &Geometry, p: DVec3, n: DVec3, own_shape: u32, reach: f64) -> boo
         // Distances count from the face, not from the probe's origin.
         let t_max = reach + behind / d.dot(n).max(1e-3);
         if geom
-            .intersect_ignoring(&Ray { origin, dir: d }, t_max, own_shape)
+            .intersect_opaque_ignoring(&Ray { origin, dir: d }, t_max, own_shape)
             .is_none()
         {
             return false;

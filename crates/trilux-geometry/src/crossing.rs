@@ -26,7 +26,8 @@
 //!
 //! **Cut off.** A point p of a crossed face is *lit* when
 //! 1. a segment from p to one of `EMITTER_SAMPLES` points of some
-//!    emitter's front face is unoccluded (both facing), or
+//!    emitter's front face is unoccluded (both facing; panes of glass
+//!    between let light through), or
 //! 2. one of `REACH_RAYS` rays from p into its hemisphere meets a face
 //!    that sends light (`senders`) at a point that is lit by test 1, or
 //!    that lies on a face that is not crossed (whose every point counts as
@@ -158,7 +159,7 @@ impl Reach<'_> {
                 let d = q.point - p;
                 d.dot(n) > 0.0
                     && -d.dot(q.normal * e.side().sign()) > 0.0
-                    && !self.geom.occluded(p + n * eps, q.point)
+                    && self.geom.transmittance(p + n * eps, q.point) > 0.0
             })
         })
     }
@@ -180,7 +181,7 @@ impl Reach<'_> {
                 origin: p + n * eps,
                 dir: d,
             };
-            let Some(hit) = self.geom.intersect(&ray, f64::INFINITY) else {
+            let Some((hit, _)) = self.geom.intersect_through(&ray, f64::INFINITY) else {
                 return false;
             };
             let side = Side::from_back(!hit.front_facing(&ray));

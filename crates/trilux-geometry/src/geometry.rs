@@ -74,6 +74,9 @@ pub struct Geometry {
     pub(crate) bounds: Bounds,
     /// Largest absolute coordinate of the scene: the scale of ray epsilons.
     pub(crate) extent: f64,
+    /// The fraction of light each shape lets through, by shape; empty when
+    /// every shape is opaque ([`crate::transmission`]).
+    pub(crate) transmitters: Vec<Option<crate::transmission::Transmittance>>,
 }
 
 impl Geometry {
@@ -278,6 +281,54 @@ impl Geometry {
         let tmin = RAY_EPSILON * (r.omax + self.extent) / r.len;
         let tmax = 1.0 - self.ray_epsilon(q) / r.len;
         (tmin < tmax).then_some((r, tmin, tmax))
+    }
+
+    /// The ray, tmin and tmax of segment (p, q) as [`Geometry::occluded`]
+    /// takes them, `dir` = q − p.
+    pub(crate) fn segment_interval(&self, p: DVec3, q: DVec3) -> Option<(Ray, f64, f64)> {
+        let (r, tmin, tmax) = self.segment(p, q)?;
+        Some((
+            Ray {
+                origin: r.o,
+                dir: r.d,
+            },
+            tmin,
+            tmax,
+        ))
+    }
+
+    /// The tmin of `ray` (ε / |dir|), `None` for a ray that is not finite
+    /// or has a zero direction.
+    pub(crate) fn ray_tmin(&self, ray: &Ray) -> Option<f64> {
+        self.query(ray).map(|(_, tmin)| tmin)
+    }
+
+    /// The self-intersection distance ε at a point (module docs).
+    pub(crate) fn epsilon_at(&self, p: DVec3) -> f64 {
+        self.ray_epsilon(p)
+    }
+
+    /// The closest hit along `ray` with `tmin` < t < `tmax`, and the shape
+    /// it belongs to.
+    pub(crate) fn closest_in(&self, ray: &Ray, tmin: f64, tmax: f64) -> Option<(Hit, u32)> {
+        let q = QueryRay::new(ray.origin, ray.dir)?;
+        let h = self.bvh.closest(&q, tmin, tmax, None)?;
+        let shape = self.bvh.prim(h.prim).shape();
+        Some((self.make_hit(ray.origin, ray.dir, h), shape))
+    }
+
+    /// [`Geometry::closest_in`] ignoring shape `skip`.
+    pub(crate) fn closest_ignoring(
+        &self,
+        ray: &Ray,
+        tmin: f64,
+        tmax: f64,
+        skip: u32,
+    ) -> Option<(Hit, u32)> {
+        let q = QueryRay::new(ray.origin, ray.dir)?;
+        let h = self.bvh.closest(&q, tmin, tmax, Some(skip))?;
+        let shape = self.bvh.prim(h.prim).shape();
+        Some((self.make_hit(ray.origin, ray.dir, h), shape))
     }
 
     /// Brute force closest hit over every primitive, without the BVH: the

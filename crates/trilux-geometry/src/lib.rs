@@ -89,6 +89,10 @@
 //! - [`crossing`]: parts of crossed faces (a floor running past the walls,
 //!   a box sunk into the floor) cut off from the light, marked in the
 //!   burial map.
+//! - [`transmission`]: shapes that let a fraction of the light through
+//!   ([`Transmittance`]: a thin dielectric slab, a constant fraction), and
+//!   [`through`], the segment and ray queries that multiply their
+//!   fractions (`Geometry::transmittance`, `Geometry::intersect_through`).
 //! - [`visibility`]: visible fractions from stratified shadow segments
 //!   ([`Visibility`], which takes the burial map explicitly).
 //! - [`coordinate_system`]: the orthonormal basis around a unit vector
@@ -131,7 +135,9 @@ pub mod sensor;
 mod sequence;
 pub mod shape;
 pub mod surface;
+pub mod through;
 mod transform;
+pub mod transmission;
 pub mod visibility;
 
 pub use bounds::Bounds;
@@ -156,5 +162,6 @@ pub use sampling::SurfaceSample;
 pub use sensor::{FovAxis, LookAtError, ReconstructionFilter, look_at};
 pub use shape::{Shape, ShapeKind, TriangleMesh};
 pub use surface::{InputSurface, SurfaceCoord, SurfaceKind, SurfacePoint};
+pub use transmission::Transmittance;
 pub use trilux_frame::coordinate_system;
 pub use visibility::Visibility;

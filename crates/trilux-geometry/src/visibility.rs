@@ -1,5 +1,8 @@
 //! Visibility between elements: the fraction of stratified shadow segments
 //! that reach the other element unobstructed (paper §4.6 caches F × V).
+//! A segment through surfaces that let light through
+//! ([`crate::transmission`]) counts for the fraction they let through, so
+//! that V is the mean transmittance of the segments, not a count.
 //!
 //! Segment k joins the k-th point of an Owen-scrambled Sobol sequence on
 //! each element (independent scrambles on the two sides, seeded by the
@@ -52,25 +55,28 @@ impl<'a> Visibility<'a> {
         let n = samples.clamp(1, 1 << 16);
         let seed = seed_of(a.element.min(b.element), a.element.max(b.element));
         let geom = self.forest.geometry();
-        let (mut facing, mut facing_visible, mut visible) = (0u32, 0u32, 0u32);
+        let (mut facing, mut facing_visible, mut visible) = (0u32, 0.0, 0.0);
         let mut hint = None;
         for k in 0..n {
             let (x, y) = self.segment_ends(a.element, b.element, k, seed);
             let d = y.point - x.point;
             let faces =
                 a.side.sign() * x.normal.dot(d) > 0.0 && b.side.sign() * y.normal.dot(d) < 0.0;
-            let vis =
-                !self.buried_end(a, &x, b, &y) && !geom.occluded_hint(x.point, y.point, &mut hint);
-            visible += u32::from(vis);
+            let vis = if self.buried_end(a, &x, b, &y) {
+                0.0
+            } else {
+                geom.transmittance_hint(x.point, y.point, &mut hint)
+            };
+            visible += vis;
             if faces {
                 facing += 1;
-                facing_visible += u32::from(vis);
+                facing_visible += vis;
             }
         }
         if facing > 0 {
-            facing_visible as f64 / facing as f64
+            facing_visible / facing as f64
         } else {
-            visible as f64 / n as f64
+            visible / n as f64
         }
     }
 
@@ -102,8 +108,8 @@ impl<'a> Visibility<'a> {
                 continue;
             }
             total += w;
-            if !self.buried_end(a, &x, b, &y) && !geom.occluded_hint(x.point, y.point, &mut hint) {
-                seen += w;
+            if !self.buried_end(a, &x, b, &y) {
+                seen += w * geom.transmittance_hint(x.point, y.point, &mut hint);
             }
         }
         if total > 0.0 {

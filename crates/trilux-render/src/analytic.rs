@@ -16,7 +16,8 @@ use trilux_geometry::FaceElement;
 
 use crate::link_sum::LinkCache;
 use crate::records::{
-    BsdfSample, FitSite, GatherStats, LightSample, LinkVisibility, PunctualSample, SurfacePoint,
+    BsdfSample, FitSite, GatherStats, LightSample, LinkVisibility, PunctualSample, SkyRay,
+    SurfacePoint,
 };
 use crate::scene::{GatherScene, SolutionGather};
 
@@ -80,6 +81,9 @@ macro_rules! path_gather_only {
                 _to: &SurfacePoint<$locator>,
             ) -> Spectrum<N> {
                 Spectrum::zero()
+            }
+            fn cosine_pdf(&self, _at: &SurfacePoint<$locator>, _wo: DVec3, _wi: DVec3) -> f64 {
+                0.0
             }
             fn sample_cosine(
                 &self,
@@ -199,6 +203,14 @@ impl<const N: usize> GatherScene<N> for Furnace {
         _k: usize,
         _reference: &SurfacePoint<Self::Locator>,
     ) -> Option<PunctualSample<N>> {
+        None
+    }
+
+    fn sky(&self, _from: DVec3, _wi: DVec3) -> (Spectrum<N>, f64) {
+        (Spectrum::zero(), 0.0)
+    }
+
+    fn sample_sky(&self, _reference: &SurfacePoint<usize>, _u: DVec2) -> Option<SkyRay<N>> {
         None
     }
 
@@ -348,6 +360,14 @@ impl<const N: usize> GatherScene<N> for LitFloor {
         _k: usize,
         _reference: &SurfacePoint<Self::Locator>,
     ) -> Option<PunctualSample<N>> {
+        None
+    }
+
+    fn sky(&self, _from: DVec3, _wi: DVec3) -> (Spectrum<N>, f64) {
+        (Spectrum::zero(), 0.0)
+    }
+
+    fn sample_sky(&self, _reference: &SurfacePoint<u8>, _u: DVec2) -> Option<SkyRay<N>> {
         None
     }
 

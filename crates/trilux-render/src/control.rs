@@ -34,7 +34,7 @@
 use glam::{DVec2, DVec3};
 use trilux_color::Spectrum;
 
-use crate::mis::{eye_hit, hit_emission, light_sample, punctual_direct};
+use crate::mis::{eye_hit, hit_emission, light_sample, miss_emission, punctual_direct, sky_seen};
 use crate::records::{BsdfSample, GatherStats, SurfacePoint};
 use crate::sampler::{PixelSampler, dims};
 use crate::scene::GatherScene;
@@ -91,14 +91,14 @@ impl<S> ControlVariate<'_, S> {
             return Spectrum::zero();
         }
         let Some(xs) = eye_hit(self.scene, origin, dir, self.hide_emitters) else {
-            return Spectrum::zero();
+            return sky_seen(self.scene, origin, dir, self.hide_emitters);
         };
         let wo = -dir;
         let mut l = self.scene.emitted(&xs, wo);
         if self.max_depth.is_none_or(|d| d >= 2) {
             l += self.reflected(&xs, wo, sampler, stats);
         }
-        stats.finite_or_dropped(l)
+        stats.finite_or_dropped(l * self.scene.through(&xs))
     }
 
     /// Reflected radiance leaving the camera hit `xs` towards `wo`: direct
@@ -124,14 +124,21 @@ impl<S> ControlVariate<'_, S> {
         let mut control = Spectrum::zero();
         for j in 1..m {
             let u = sampler.get2(dims::CONTROL_LOOKUPS + 2 * (j - 1));
-            if let Some((bs, xd)) = self.gather_ray(xs, wo, u, stats) {
+            if let Some((bs, Some(xd))) = self.gather_ray(xs, wo, u, stats) {
                 control += bs.weight * scene.reflected(&xd, xs);
             }
         }
         // Lookup 0, shared with the residual: w L̃ (1/M of the control)
         // less w L̃ (the residual's subtracted term), plus w L_r by a path.
-        let Some((bs, xd)) = self.gather_ray(xs, wo, sampler.get2(base + 3), stats) else {
-            return l + control * (1.0 / f64::from(m));
+        let (bs, xd) = match self.gather_ray(xs, wo, sampler.get2(base + 3), stats) {
+            Some((bs, Some(xd))) => (bs, xd),
+            // A ray that leaves the scene brings the sky, and nothing
+            // reflected.
+            Some((bs, None)) => {
+                let sky = miss_emission(scene, xs.point, bs.wi, bs.pdf, bs.weight);
+                return l + sky + control * (1.0 / f64::from(m));
+            }
+            None => return l + control * (1.0 / f64::from(m)),
         };
         let back = -bs.wi;
         if let Some(le) = hit_emission(scene, &xd, back, bs.pdf, bs.weight) {
@@ -144,23 +151,29 @@ impl<S> ControlVariate<'_, S> {
     }
 
     /// A direction sampled from the BSDF at `x` with `u` and the hit it
-    /// leads to; `None` when the sample or the ray yields nothing.
+    /// leads to (`None` when the ray leaves the scene); `None` when the
+    /// sample yields nothing.
+    #[allow(clippy::type_complexity)]
     fn gather_ray<const N: usize>(
         &self,
         x: &SurfacePoint<S::Locator>,
         wo: DVec3,
         u: DVec2,
         stats: &mut GatherStats,
-    ) -> Option<(BsdfSample<N>, SurfacePoint<S::Locator>)>
+    ) -> Option<(BsdfSample<N>, Option<SurfacePoint<S::Locator>>)>
     where
         S: GatherScene<N>,
     {
-        let bs = self.scene.sample_bsdf(x, wo, u)?;
+        let mut bs = self.scene.sample_bsdf(x, wo, u)?;
         if bs.pdf.is_nan() || bs.pdf <= 0.0 || bs.weight.is_black() {
             return None;
         }
         stats.gather_rays += 1;
-        let xd = self.scene.intersect(x.point, bs.wi)?;
+        let xd = self.scene.intersect(x.point, bs.wi);
+        if let Some(xd) = &xd {
+            // What panes of glass on the way let through.
+            bs.weight *= self.scene.through(xd);
+        }
         Some((bs, xd))
     }
 
@@ -201,6 +214,10 @@ impl<S> ControlVariate<'_, S> {
                 break;
             };
             beta *= bs.weight;
+            let Some(xn) = xn else {
+                l += miss_emission(scene, x.point, bs.wi, bs.pdf, beta);
+                break;
+            };
             let back = -bs.wi;
             if let Some(le) = hit_emission(scene, &xn, back, bs.pdf, beta) {
                 l += le;

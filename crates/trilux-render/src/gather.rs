@@ -21,7 +21,10 @@
 //!      MIS weight (light sampling supplies the rest with its own weight);
 //!    - the **reflected** radiance comes from the solution with weight 1.
 //!
-//! Emitters seen directly from the eye show their radiance.
+//! Emitters seen directly from the eye show their radiance. The sky (an
+//! environment map, at infinity) is sampled beside the emitters, and a
+//! gather ray that leaves the scene brings its radiance, MIS-weighted
+//! (`crate::mis`).
 //!
 //! **Extra bounce.** The solution is piecewise constant over elements. Its
 //! steps would show where a gather hit is close to x_s compared with the
@@ -38,7 +41,7 @@
 
 use glam::DVec3;
 
-use crate::mis::{eye_hit, hit_emission, light_sample, punctual_direct};
+use crate::mis::{eye_hit, hit_emission, light_sample, miss_emission, punctual_direct, sky_seen};
 use crate::records::{GatherStats, SurfacePoint};
 use crate::sampler::{PixelSampler, dims};
 use crate::scene::SolutionGather;
@@ -105,12 +108,12 @@ impl<'a, S> FinalGather<'a, S> {
     {
         stats.camera_rays += 1;
         let Some(xs) = eye_hit(self.scene, origin, dir, self.hide_emitters) else {
-            return Spectrum::zero();
+            return sky_seen(self.scene, origin, dir, self.hide_emitters);
         };
         let wo = -dir;
         let le = self.scene.emitted(&xs, wo);
         let lr = self.gather(&xs, wo, 0, sampler, stats);
-        let l = le + lr;
+        let l = (le + lr) * self.scene.through(&xs);
         stats.finite_or_dropped(l)
     }
 
@@ -149,11 +152,13 @@ impl<'a, S> FinalGather<'a, S> {
         }
         stats.gather_rays += 1;
         let Some(xd) = scene.intersect(x.point, bs.wi) else {
-            return l;
+            return l + miss_emission(scene, x.point, bs.wi, bs.pdf, bs.weight);
         };
         let back = -bs.wi;
+        // What panes of glass on the way let through.
+        let weight = bs.weight * scene.through(&xd);
         // Emission at the gather hit, with the BSDF-sampling MIS weight.
-        if let Some(le) = hit_emission(scene, &xd, back, bs.pdf, bs.weight) {
+        if let Some(le) = hit_emission(scene, &xd, back, bs.pdf, weight) {
             l += le;
         }
         // Reflected radiance at the gather hit: the solution, or one more
@@ -167,7 +172,7 @@ impl<'a, S> FinalGather<'a, S> {
         } else {
             scene.reflected(&xd, x)
         };
-        l + bs.weight * lr
+        l + weight * lr
     }
 
     /// The extra-bounce rule: would the piecewise-constant solution show here?

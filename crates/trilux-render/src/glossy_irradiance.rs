@@ -85,7 +85,8 @@ fn corner<S: SolutionGather<N>, const N: usize>(
             continue;
         };
         if scene.is_glossy(&xd, -wi) {
-            sum += scene.reflected_glossy(&xd, x);
+            // Through any panes the ray crossed before x_d.
+            sum += scene.reflected_glossy(&xd, x) * scene.through(&xd);
         }
     }
     sum * (1.0 / f64::from(COSINE_RAYS))

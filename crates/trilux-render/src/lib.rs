@@ -88,7 +88,7 @@ pub use gather::ExtraBounce;
 pub use image::Image;
 pub use mis::{power_heuristic, punctual_direct};
 pub use records::{
-    BsdfSample, FitKey, FitSite, GatherStats, LightSample, LinkVisibility, PunctualSample,
+    BsdfSample, FitKey, FitSite, GatherStats, LightSample, LinkVisibility, PunctualSample, SkyRay,
     SurfacePoint,
 };
 pub use sampler::PixelSampler;

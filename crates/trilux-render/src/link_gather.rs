@@ -28,6 +28,11 @@
 //!   the link sum at x_d (with the links' own visibility) times ρ_d(x_d),
 //!   plus its own glossy part, one level deeper; beyond that level the
 //!   solution is read directly.
+//! - The **sky** (an environment map) is not in the links either: the
+//!   Lambertian part takes one sky sample, MIS-combined with the cosine
+//!   ray (which then is always traced) leaving the scene; the glossy part
+//!   takes it with its light sample and its gather ray's misses
+//!   (`crate::mis`).
 //!
 //! [`Preview`] drops every random ray at the pixel: the link sum with the
 //! links' own visibility at x_s plus E_g read at the corners of x_s's
@@ -40,13 +45,15 @@
 //!
 //! [`link_sum`]: crate::link_sum
 
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 
 use crate::gather::FinalGather;
 use crate::glossy_fit::GlossyFits;
 use crate::glossy_irradiance::GlossyIrradiance;
 use crate::link_sum::LinkCache;
-use crate::mis::{eye_hit, hit_emission, light_sample, punctual_direct};
+use crate::mis::{
+    eye_hit, hit_emission, light_sample, miss_emission, punctual_direct, sky_sample, sky_seen,
+};
 use crate::records::{GatherStats, LinkVisibility, SurfacePoint};
 use crate::sampler::{PixelSampler, dims};
 use crate::scene::SolutionGather;
@@ -102,10 +109,11 @@ impl<S> LinkGather<'_, S> {
         }
         stats.camera_rays += 1;
         let Some(xs) = eye_hit(self.scene, origin, dir, self.fallback.hide_emitters) else {
-            return Spectrum::zero();
+            return sky_seen(self.scene, origin, dir, self.fallback.hide_emitters);
         };
         let wo = -dir;
         let scene = self.scene;
+        let through = scene.through(&xs);
         let mut w = Walk {
             sampler,
             caches,
@@ -126,14 +134,14 @@ impl<S> LinkGather<'_, S> {
                 // No links here: the path gather serves the whole BSDF.
                 None => {
                     let lr = self.fallback.gather(&xs, wo, 0, sampler, w.stats);
-                    return w.stats.finite_or_dropped(l + lr);
+                    return w.stats.finite_or_dropped((l + lr) * through);
                 }
             }
         }
         if scene.is_glossy(&xs, wo) {
             l += self.glossy(&xs, wo, 0, &mut w);
         }
-        w.stats.finite_or_dropped(l)
+        w.stats.finite_or_dropped(l * through)
     }
 
     /// One sample of the glossy part of the radiance leaving `x` towards
@@ -164,7 +172,8 @@ impl<S> LinkGather<'_, S> {
     /// them (for directional bakes): `counts.gather` BSDF-sampled gather
     /// rays, sample k drawn from the lobe of direction ⌊(k + u)·D/K⌋ (the
     /// strata together draw from the mixture of all D lobes), and
-    /// `counts.light` light samples. Every sample serves every direction,
+    /// `counts.light` light samples (each with a sky sample, where there is a
+    /// sky: the sky as `light_sample` takes it). Every sample serves every direction,
     /// weighted by the balance heuristic over the lobe mixture and light
     /// sampling (Veach's multi-sample estimator, unbiased): what a sample
     /// brings (the gather hit read as [`LinkGather::glossy_sample`] reads
@@ -210,20 +219,26 @@ impl<S> LinkGather<'_, S> {
             }
             stats.gather_rays += 1;
             let Some(xd) = scene.intersect(x.point, bs.wi) else {
+                // The sky (through any panes), balanced against its samples.
+                let (le, p_sky) = scene.sky(x.point, bs.wi);
+                if !le.is_black() {
+                    add(&fan, le * (1.0 / (ng * p_mix + nl * p_sky)));
+                }
                 continue;
             };
             let back = -bs.wi;
+            let through = scene.through(&xd);
             let mut w = Walk {
                 sampler: &*sampler,
                 caches: &mut *caches,
                 stats: &mut *stats,
             };
             let level = if counts.links { 1 } else { LINK_LEVELS + 1 };
-            let mut l = self.reflected_at(&xd, x, back, level, &mut w) * (1.0 / (ng * p_mix));
+            let mut l = self.reflected_at(&xd, x, back, level, &mut w) * (through / (ng * p_mix));
             let le = scene.emitted(&xd, back);
             if !le.is_black() {
                 let p_light = light_density(scene, &xd, back);
-                l += le * (1.0 / (ng * p_mix + nl * p_light));
+                l += le * (through / (ng * p_mix + nl * p_light));
             }
             add(&fan, l);
         }
@@ -237,6 +252,12 @@ impl<S> LinkGather<'_, S> {
                 let p_mix = scene.glossy_fan(x, wi, wos, &mut fan);
                 add(&fan, le * (1.0 / (nl * p_light + ng * p_mix)));
             }
+            // With a sky, one sky sample beside each light sample, as
+            // `light_sample` takes.
+            if let Some((wi, le, p_sky)) = unoccluded_sky(scene, x, u, stats) {
+                let p_mix = scene.glossy_fan(x, wi, wos, &mut fan);
+                add(&fan, le * (1.0 / (nl * p_sky + ng * p_mix)));
+            }
         }
         // Lights without area: one shadow ray each, no MIS (no ray meets
         // them), as `punctual_direct` for a single direction.
@@ -248,9 +269,10 @@ impl<S> LinkGather<'_, S> {
                 continue;
             }
             stats.shadow_rays += 1;
-            if scene.unoccluded(x, p.end) {
+            let tau = scene.transmittance(x, p.end);
+            if tau > 0.0 {
                 scene.glossy_fan(x, p.wi, wos, &mut fan);
-                add(&fan, p.irradiance);
+                add(&fan, p.irradiance * tau);
             }
         }
         out.iter().map(|&l| stats.finite_or_dropped(l)).collect()
@@ -273,27 +295,41 @@ impl<S> LinkGather<'_, S> {
         S: SolutionGather<N>,
     {
         let correct = level == 0 && !w.caches.pixel.coarse_near().is_empty();
-        if !self.glossy_scene && !correct {
-            return Spectrum::zero();
-        }
+        let traced = self.glossy_scene || correct;
         let scene = self.scene;
+        // The sky's share (not in the links): one sky sample, MIS-weighted
+        // against the cosine ray where that is traced.
+        let kernel = |wi| scene.cosine_pdf(x, wo, wi);
+        let sky = sky_sample(
+            scene,
+            x,
+            w.sampler.get2(dims::sky(level)),
+            |wi| Spectrum::splat(kernel(wi)),
+            kernel,
+            traced,
+            w.stats,
+        );
+        if !traced {
+            return sky;
+        }
         let u = w.sampler.get2(dims::GLOSSY_SENDERS + 2 * level);
         let Some(wi) = scene.sample_cosine(x, wo, u) else {
-            return Spectrum::zero();
+            return sky;
         };
         w.stats.gather_rays += 1;
+        // With density cos θ/π the estimate of (1/π) ∫ L cos dω is L.
         let Some(xd) = scene.intersect(x.point, wi) else {
-            return Spectrum::zero();
+            return sky + miss_emission(scene, x.point, wi, kernel(wi), Spectrum::splat(1.0));
         };
         let back = -wi;
-        // With density cos θ/π the estimate of (1/π) ∫ L cos dω is L.
+        let through = scene.through(&xd);
         let mut e = Spectrum::zero();
         if correct {
             let Caches { pixel, scratch } = &mut *w.caches;
             let near = pixel.coarse_near();
             if let Some(c) = scene.near_correction(&xd, back, near, scratch, w.stats) {
                 w.stats.near_corrections += 1;
-                e = c;
+                e += c;
             }
         }
         if self.glossy_scene && scene.is_glossy(&xd, back) {
@@ -304,7 +340,7 @@ impl<S> LinkGather<'_, S> {
             };
             e += g;
         }
-        e
+        sky + e * through
     }
 
     /// The glossy part of the reflected radiance at `x` towards `wo`, at
@@ -337,11 +373,12 @@ impl<S> LinkGather<'_, S> {
             return l;
         }
         w.stats.gather_rays += 1;
+        let weight = f * (1.0 / bs.pdf);
         let Some(xd) = scene.intersect(x.point, bs.wi) else {
-            return l;
+            return l + miss_emission(scene, x.point, bs.wi, bs.pdf, weight);
         };
         let back = -bs.wi;
-        let weight = f * (1.0 / bs.pdf);
+        let weight = weight * scene.through(&xd);
         if let Some(le) = hit_emission(scene, &xd, back, bs.pdf, weight) {
             l += le;
         }
@@ -438,10 +475,29 @@ fn unoccluded_light<S: SolutionGather<N>, const N: usize>(
         return None;
     }
     stats.shadow_rays += 1;
-    if !scene.unoccluded(x, ls.point) {
+    let tau = scene.transmittance(x, ls.point);
+    if tau <= 0.0 {
         return None;
     }
-    Some((d / dist, ls.radiance, ls.pdf_area * dist2 / cos_light))
+    Some((d / dist, ls.radiance * tau, ls.pdf_area * dist2 / cos_light))
+}
+
+/// A sky sample at `x` drawn with `u`: its direction, its radiance times
+/// the panes' fraction and its solid-angle density (`None` without a sky,
+/// or hidden).
+fn unoccluded_sky<S: SolutionGather<N>, const N: usize>(
+    scene: &S,
+    x: &SurfacePoint<S::Locator>,
+    u: DVec2,
+    stats: &mut GatherStats,
+) -> Option<(DVec3, Spectrum<N>, f64)> {
+    let s = scene.sample_sky(x, u)?;
+    if !(s.pdf > 0.0 && s.pdf.is_finite()) || s.radiance.is_black() {
+        return None;
+    }
+    stats.shadow_rays += 1;
+    let tau = scene.transmittance(x, s.end);
+    (tau > 0.0).then(|| (s.wi, s.radiance * tau, s.pdf))
 }
 
 /// The preview estimator: no random rays (module docs).
@@ -477,6 +533,7 @@ impl<S> Preview<'_, S> {
             return Spectrum::zero();
         };
         let wo = -dir;
+        let through = scene.through(&xs);
         let mut l = scene.emitted(&xs, wo);
         let rho = scene.diffuse_albedo(&xs, wo);
         if !rho.is_black()
@@ -493,7 +550,7 @@ impl<S> Preview<'_, S> {
         if scene.is_glossy(&xs, wo) {
             l += self.fits.radiance(scene, &xs, wo, stats);
         }
-        stats.finite_or_dropped(l)
+        stats.finite_or_dropped(l * through)
     }
 }
 

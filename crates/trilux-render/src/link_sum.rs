@@ -589,11 +589,7 @@ impl<const N: usize> PartialRays<'_, N> {
                 continue;
             }
             stats.shadow_rays += 1;
-            let visible = if forest.geometry().occluded(r.x, y.point) {
-                0.0
-            } else {
-                1.0
-            };
+            let visible = forest.geometry().transmittance(r.x, y.point);
             // L G (V − v) / pdf(y), divided by the pick probability w_k / Σ w.
             sum += link.l * (g / y.pdf_area * total / weights[chosen] * (visible - link.v));
         }

@@ -8,7 +8,13 @@
 //! - [`punctual_direct`]: the lights without area, by one shadow ray
 //!   each (a delta light needs no MIS weight);
 //! - [`hit_emission`]: the emission met by a BSDF-sampled ray, weighted by
-//!   the power heuristic against light sampling's density at the hit.
+//!   the power heuristic against light sampling's density at the hit;
+//! - [`sky_sample`] and [`miss_emission`]: the same two halves for the sky
+//!   (an environment map, a light at infinity sampled by direction): a
+//!   sky direction with a shadow ray, and the sky a BSDF-sampled ray that
+//!   leaves the scene brings. [`light_sample`] takes one sky sample beside
+//!   its emitter sample, from the same two numbers (each is unbiased on
+//!   its own, so their sum is).
 
 use glam::{DVec2, DVec3};
 
@@ -36,7 +42,8 @@ pub fn power_heuristic(a: f64, b: f64) -> f64 {
 /// density, weighted by the power heuristic against BSDF sampling when
 /// `mis`. Zero when the point is behind the emitter, at x, of zero density
 /// or black, or hidden; a value that is not a number (the emitter's
-/// cosine, the density) counts as zero.
+/// cosine, the density) counts as zero. With a sky, one sky sample
+/// ([`sky_sample`], from `u`) is added.
 #[allow(clippy::too_many_arguments)]
 pub fn light_sample<S: GatherScene<N>, const N: usize>(
     scene: &S,
@@ -44,7 +51,23 @@ pub fn light_sample<S: GatherScene<N>, const N: usize>(
     wo: DVec3,
     pick: f64,
     u: DVec2,
-    fr: impl FnOnce(DVec3) -> Spectrum<N>,
+    fr: impl Fn(DVec3) -> Spectrum<N>,
+    mis: bool,
+    stats: &mut GatherStats,
+) -> Spectrum<N> {
+    let sky = sky_sample(scene, x, u, &fr, |wi| scene.bsdf_pdf(x, wo, wi), mis, stats);
+    sky + emitter_sample(scene, x, wo, pick, u, fr, mis, stats)
+}
+
+/// [`light_sample`]'s sample of a point on an emitter.
+#[allow(clippy::too_many_arguments)]
+fn emitter_sample<S: GatherScene<N>, const N: usize>(
+    scene: &S,
+    x: &SurfacePoint<S::Locator>,
+    wo: DVec3,
+    pick: f64,
+    u: DVec2,
+    fr: impl Fn(DVec3) -> Spectrum<N>,
     mis: bool,
     stats: &mut GatherStats,
 ) -> Spectrum<N> {
@@ -68,7 +91,8 @@ pub fn light_sample<S: GatherScene<N>, const N: usize>(
         return Spectrum::zero();
     }
     stats.shadow_rays += 1;
-    if !scene.unoccluded(x, ls.point) {
+    let tau = scene.transmittance(x, ls.point);
+    if tau <= 0.0 {
         return Spectrum::zero();
     }
     let pdf_light = ls.pdf_area * dist2 / cos_light;
@@ -77,12 +101,68 @@ pub fn light_sample<S: GatherScene<N>, const N: usize>(
     } else {
         1.0
     };
-    f * ls.radiance * (w / pdf_light)
+    f * ls.radiance * (tau * w / pdf_light)
+}
+
+/// One sky sample at `x`: a direction drawn from the sky's distribution
+/// with `u`, fr(ω_i) L / p_sky with a shadow ray, weighted by the power
+/// heuristic against the density `other` of the strategy that also
+/// reaches the sky (BSDF or cosine sampling) when `mis`. Zero without a
+/// sky, where fr is black or the sky hidden.
+pub fn sky_sample<S: GatherScene<N>, const N: usize>(
+    scene: &S,
+    x: &SurfacePoint<S::Locator>,
+    u: DVec2,
+    fr: impl Fn(DVec3) -> Spectrum<N>,
+    other: impl FnOnce(DVec3) -> f64,
+    mis: bool,
+    stats: &mut GatherStats,
+) -> Spectrum<N> {
+    let Some(s) = scene.sample_sky(x, u) else {
+        return Spectrum::zero();
+    };
+    if !(s.pdf > 0.0 && s.pdf.is_finite()) || s.radiance.is_black() {
+        return Spectrum::zero();
+    }
+    let f = fr(s.wi);
+    if f.is_black() {
+        return Spectrum::zero();
+    }
+    stats.shadow_rays += 1;
+    let tau = scene.transmittance(x, s.end);
+    if tau <= 0.0 {
+        return Spectrum::zero();
+    }
+    let w = if mis {
+        power_heuristic(s.pdf, other(s.wi))
+    } else {
+        1.0
+    };
+    f * s.radiance * (tau * w / s.pdf)
+}
+
+/// The sky a ray from `from` sampled with density `pdf` in direction `wi`
+/// brings when it leaves the scene: L(ω) (through any panes) times the
+/// sample's `weight`, weighted by the power heuristic against sky
+/// sampling's density (zero without a sky).
+pub fn miss_emission<S: GatherScene<N>, const N: usize>(
+    scene: &S,
+    from: DVec3,
+    wi: DVec3,
+    pdf: f64,
+    weight: Spectrum<N>,
+) -> Spectrum<N> {
+    let (l, p_sky) = scene.sky(from, wi);
+    if l.is_black() {
+        return Spectrum::zero();
+    }
+    weight * l * power_heuristic(pdf, p_sky)
 }
 
 /// The direct light of every light without area at `x`: Σ fr(ω_i) E⊥ V
 /// over the lights, `fr` the BSDF's fr·|cos θ_i| (or a part of it), one
-/// shadow ray each. No MIS weight: a delta light has no density a BSDF
+/// shadow ray each (V the fraction it lets through, panes of glass
+/// included). No MIS weight: a delta light has no density a BSDF
 /// sample could share, and no ray ever meets it.
 pub fn punctual_direct<S: GatherScene<N>, const N: usize>(
     scene: &S,
@@ -100,11 +180,28 @@ pub fn punctual_direct<S: GatherScene<N>, const N: usize>(
             continue;
         }
         stats.shadow_rays += 1;
-        if scene.unoccluded(x, p.end) {
-            sum += f * p.irradiance;
+        let tau = scene.transmittance(x, p.end);
+        if tau > 0.0 {
+            sum += f * p.irradiance * tau;
         }
     }
     sum
+}
+
+/// The sky a camera ray from `origin` that met nothing sees (black with
+/// `hide_emitters`, which hides the sky in Mitsuba 3.9.1 too, or without
+/// a sky).
+pub(crate) fn sky_seen<S: GatherScene<N>, const N: usize>(
+    scene: &S,
+    origin: DVec3,
+    dir: DVec3,
+    hide_emitters: bool,
+) -> Spectrum<N> {
+    if hide_emitters {
+        Spectrum::zero()
+    } else {
+        scene.sky(origin, dir).0
+    }
 }
 
 /// Where a camera ray meets the scene. With `hide_emitters` (Mitsuba's

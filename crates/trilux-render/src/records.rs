@@ -112,6 +112,19 @@ pub struct PunctualSample<const N: usize> {
     pub irradiance: Spectrum<N>,
 }
 
+/// A direction sampled on the sky (an environment map) from a point.
+#[derive(Clone, Copy, Debug)]
+pub struct SkyRay<const N: usize> {
+    /// Unit direction from the point towards the sky.
+    pub wi: DVec3,
+    /// Where a shadow ray towards it ends (beyond the scene).
+    pub end: DVec3,
+    /// Radiance arriving from `wi`.
+    pub radiance: Spectrum<N>,
+    /// Solid-angle density of `wi`.
+    pub pdf: f64,
+}
+
 /// A direction sampled from a BSDF at a surface point.
 #[derive(Clone, Copy, Debug)]
 pub struct BsdfSample<const N: usize> {

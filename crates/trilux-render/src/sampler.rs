@@ -42,6 +42,16 @@ pub mod dims {
     /// Dimensions one path vertex uses: light pick (1), point on the light
     /// (2), BSDF direction (2), Russian roulette (1).
     pub const PER_PATH_VERTEX: u32 = 6;
+    /// The link gather's sky sample for the Lambertian part at gather
+    /// level L: 2 dimensions from SKY + 2 (L mod 16) (deeper levels share
+    /// them; past the control variate's first 21 path vertices).
+    pub const SKY: u32 = 224;
+
+    /// The first of the two dimensions of the link gather's sky sample at
+    /// gather `level` ([`SKY`]).
+    pub const fn sky(level: u32) -> u32 {
+        SKY + 2 * (level % 16)
+    }
 }
 
 /// Largest number of samples per pixel the sequence supports (the limit

@@ -22,7 +22,8 @@ use trilux_geometry::FaceElement;
 
 use crate::link_sum::LinkCache;
 use crate::records::{
-    BsdfSample, FitSite, GatherStats, LightSample, LinkVisibility, PunctualSample, SurfacePoint,
+    BsdfSample, FitSite, GatherStats, LightSample, LinkVisibility, PunctualSample, SkyRay,
+    SurfacePoint,
 };
 
 /// Everything the path gather needs from a scene and its solution.
@@ -38,6 +39,22 @@ pub trait GatherScene<const N: usize>: Sync {
     /// True when nothing blocks the segment from `from` (a surface point) to
     /// `to` (a point on an emitter).
     fn unoccluded(&self, from: &SurfacePoint<Self::Locator>, to: DVec3) -> bool;
+
+    /// The fraction of light that goes from `to` to `from` along the
+    /// segment: 1 where nothing lies between, 0 where something opaque
+    /// does, between for surfaces that let light through (panes of glass).
+    /// By default [`GatherScene::unoccluded`]'s 0 or 1.
+    fn transmittance(&self, from: &SurfacePoint<Self::Locator>, to: DVec3) -> f64 {
+        if self.unoccluded(from, to) { 1.0 } else { 0.0 }
+    }
+
+    /// The fraction of light that the surfaces a ray crossed before it met
+    /// `at` ([`GatherScene::intersect`] goes through those that let light
+    /// through) let through: everything leaving `at` towards the ray's
+    /// origin arrives times this. By default 1 (no such surfaces).
+    fn through(&self, _at: &SurfacePoint<Self::Locator>) -> f64 {
+        1.0
+    }
 
     /// Radiance emitted from `at` in direction `wo` (zero if `at` is not on
     /// an emitter or `wo` leaves its back side).
@@ -63,6 +80,17 @@ pub trait GatherScene<const N: usize>: Sync {
         k: usize,
         reference: &SurfacePoint<Self::Locator>,
     ) -> Option<PunctualSample<N>>;
+
+    /// The sky's radiance arriving at `from` from unit direction `wi` (a
+    /// ray from `from` that leaves the scene), times what the surfaces it
+    /// went through let through (panes of glass), and the solid-angle
+    /// density with which [`GatherScene::sample_sky`] draws `wi`; zero and
+    /// zero without a sky.
+    fn sky(&self, from: DVec3, wi: DVec3) -> (Spectrum<N>, f64);
+
+    /// A direction drawn from the sky's distribution with `u`, as seen
+    /// from `reference`; `None` without a sky.
+    fn sample_sky(&self, reference: &SurfacePoint<Self::Locator>, u: DVec2) -> Option<SkyRay<N>>;
 
     /// The area density [`GatherScene::sample_light`] has at `at` (zero when
     /// `at` is not on an emitter).
@@ -114,6 +142,11 @@ pub trait SolutionGather<const N: usize>: GatherScene<N> {
 
     /// True when some face of the scene has a glossy part.
     fn has_glossy_faces(&self) -> bool;
+
+    /// The density cos θ/π with which [`SolutionGather::sample_cosine`]
+    /// draws `wi` at `at` for the viewer direction `wo` (zero where it
+    /// cannot), the kernel of the Lambertian part's irradiance.
+    fn cosine_pdf(&self, at: &SurfacePoint<Self::Locator>, wo: DVec3, wi: DVec3) -> f64;
 
     /// The Lambertian part's reflectance ρ_d at `at` on the side of `wo`
     /// (zero where there is none).

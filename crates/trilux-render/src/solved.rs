@@ -3,8 +3,10 @@
 //! emitters: `trilux_solver::PreparedScene`) and a solution
 //! ([`RadianceSolution`]: the solver's, or a stand-in).
 //!
-//! - Rays: `Geometry::intersect` (exact for analytic shapes, its own
-//!   self-intersection epsilon), shadow rays `Geometry::occluded`.
+//! - Rays: `Geometry::intersect_through` (exact for analytic shapes, its
+//!   own self-intersection epsilon; straight through surfaces that let
+//!   light through, the fraction they let through kept in the hit's
+//!   [`HitLocator::through`]), shadow rays `Geometry::transmittance`.
 //! - Materials: `Bsdf<N>` in the shading frame of the hit (z = shading
 //!   normal on the front side), textured ones at the hit's texture
 //!   coordinates (`PreparedScene::shading`); it reflects on the viewer's side (black from
@@ -36,7 +38,7 @@ use trilux_solver::{PreparedScene, SurfaceSite};
 
 use crate::link_sum::{LinkCache, LinkField, Receiver, link_sum};
 use crate::records::{
-    BsdfSample, FitKey, FitSite, GatherStats, LightSample, LinkVisibility, PunctualSample,
+    BsdfSample, FitKey, FitSite, GatherStats, LightSample, LinkVisibility, PunctualSample, SkyRay,
     SurfacePoint,
 };
 use crate::scene::{GatherScene, SolutionGather};
@@ -53,6 +55,9 @@ pub struct HitLocator {
     pub shading_normal: DVec3,
     /// Index of the scene shape.
     pub shape: u32,
+    /// The fraction of light the surfaces the ray went through before
+    /// this hit let through (panes of glass; 1 without them).
+    pub through: f64,
 }
 
 /// The lobe solid angle of one side of a material: 4πα² for a
@@ -222,7 +227,7 @@ impl<const N: usize, S: RadianceSolution<N>> GatherScene<N> for SolvedScene<'_, 
 
     fn intersect(&self, origin: DVec3, dir: DVec3) -> Option<SurfacePoint<HitLocator>> {
         let geom = self.geom();
-        let hit = geom.intersect(&Ray { origin, dir }, f64::INFINITY)?;
+        let (hit, through) = geom.intersect_through(&Ray { origin, dir }, f64::INFINITY)?;
         let shape = geom.surface(hit.surface).shape;
         Some(SurfacePoint {
             point: hit.point,
@@ -233,6 +238,7 @@ impl<const N: usize, S: RadianceSolution<N>> GatherScene<N> for SolvedScene<'_, 
                 coord: hit.coord,
                 shading_normal: hit.shading_normal,
                 shape,
+                through,
             },
         })
     }
@@ -254,8 +260,42 @@ impl<const N: usize, S: RadianceSolution<N>> GatherScene<N> for SolvedScene<'_, 
         })
     }
 
+    fn sky(&self, from: DVec3, wi: DVec3) -> (Spectrum<N>, f64) {
+        let Some(s) = self.scene.sky() else {
+            return (Spectrum::zero(), 0.0);
+        };
+        let l = s.radiance(wi);
+        // The ray met nothing opaque; the panes it crossed (if the scene
+        // has any) take their share, walked again from `from`.
+        let geom = self.geom();
+        let tau = if geom.has_transmission() && !l.is_black() {
+            geom.transmittance(from, self.scene.sky_end(from, wi))
+        } else {
+            1.0
+        };
+        (l * tau, s.pdf(wi))
+    }
+
+    fn sample_sky(&self, reference: &SurfacePoint<HitLocator>, u: DVec2) -> Option<SkyRay<N>> {
+        let s = self.scene.sky()?.sample(u)?;
+        Some(SkyRay {
+            wi: s.wi,
+            end: self.scene.sky_end(reference.point, s.wi),
+            radiance: s.radiance,
+            pdf: s.pdf,
+        })
+    }
+
     fn unoccluded(&self, from: &SurfacePoint<HitLocator>, to: DVec3) -> bool {
         !self.geom().occluded(from.point, to)
+    }
+
+    fn transmittance(&self, from: &SurfacePoint<HitLocator>, to: DVec3) -> f64 {
+        self.geom().transmittance(from.point, to)
+    }
+
+    fn through(&self, at: &SurfacePoint<HitLocator>) -> f64 {
+        at.locator.through
     }
 
     fn emitted(&self, at: &SurfacePoint<HitLocator>, wo: DVec3) -> Spectrum<N> {
@@ -448,6 +488,16 @@ impl<const N: usize, S: RadianceSolution<N>> SolutionGather<N> for SolvedScene<'
     ) -> Spectrum<N> {
         let (from, towards) = Self::sites(from, towards);
         self.solution.reflected_glossy(&from, &towards)
+    }
+
+    fn cosine_pdf(&self, at: &SurfacePoint<HitLocator>, wo: DVec3, wi: DVec3) -> f64 {
+        let sign = viewer_side(at, wo).sign();
+        let cos = sign * at.locator.shading_normal.dot(wi);
+        if cos <= 0.0 || sign * at.normal.dot(wi) <= 0.0 {
+            0.0
+        } else {
+            cos / std::f64::consts::PI
+        }
     }
 
     fn sample_cosine(&self, at: &SurfacePoint<HitLocator>, wo: DVec3, u: DVec2) -> Option<DVec3> {

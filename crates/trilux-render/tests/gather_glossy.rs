@@ -20,7 +20,7 @@ use trilux_render::link_gather::{Caches, IncidentSamples, LinkGather, Preview};
 use trilux_render::link_sum::LinkCache;
 use trilux_render::{
     BsdfSample, Camera, ExtraBounce, FitKey, FitSite, FovAxis, GatherScene, GatherStats,
-    LightSample, LinkVisibility, ReconstructionFilter, RenderSettings, SolutionGather,
+    LightSample, LinkVisibility, ReconstructionFilter, RenderSettings, SkyRay, SolutionGather,
     SurfacePoint, render_image,
 };
 
@@ -90,6 +90,12 @@ impl GatherScene<3> for GlossyFloor {
         None
     }
 
+    fn sky(&self, _: DVec3, _: DVec3) -> (Spectrum<3>, f64) {
+        (Spectrum::zero(), 0.0)
+    }
+    fn sample_sky(&self, _: &SurfacePoint<u8>, _: DVec2) -> Option<SkyRay<3>> {
+        None
+    }
     fn unoccluded(&self, _: &SurfacePoint<u8>, _: DVec3) -> bool {
         true
     }
@@ -204,6 +210,9 @@ impl SolutionGather<3> for GlossyFloor {
     }
     fn reflected_glossy(&self, _: &SurfacePoint<u8>, _: &SurfacePoint<u8>) -> Spectrum<3> {
         Spectrum::zero()
+    }
+    fn cosine_pdf(&self, _: &SurfacePoint<u8>, _: DVec3, _: DVec3) -> f64 {
+        0.0
     }
     fn sample_cosine(&self, _: &SurfacePoint<u8>, _: DVec3, _: DVec2) -> Option<DVec3> {
         None

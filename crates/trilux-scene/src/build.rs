@@ -181,8 +181,20 @@ impl<'a> Builder<'a> {
                 self.integrator = Some(e);
                 self.params = Some(crate::integrator::integrator(e)?);
             }
-            "emitter" if e.attr("type").is_some_and(|t| t.value == "constant") => {
-                let env = crate::environment::constant(e)?;
+            "emitter"
+                if e.attr("type")
+                    .is_some_and(|t| matches!(t.value.as_str(), "constant" | "envmap")) =>
+            {
+                let env = if e.plugin_type()? == "envmap" {
+                    Environment {
+                        radiance: trilux_color::ColorParam::Float(0.0),
+                        map: Some(crate::envmap::envmap(e, self.folder)?),
+                        shape: None,
+                        location: e.loc.clone(),
+                    }
+                } else {
+                    crate::environment::constant(e)?
+                };
                 if let Some(first) = &self.environment {
                     return Err(crate::environment::second(e, first));
                 }
@@ -226,7 +238,7 @@ fn top_level_emitter(e: &Element) -> Result<()> {
         "area" if e.attr("id").is_some() => return area_emitter(e).map(|_| ()),
         "area" => "an area <emitter> must be placed inside a <shape> (or given an id and named there by a <ref>)".to_string(),
         _ => format!(
-            "unknown emitter plugin \"{t}\" (supported: area inside a shape; point, spot, directional, constant)"
+            "unknown emitter plugin \"{t}\" (supported: area inside a shape; point, spot, directional, constant, envmap)"
         ),
     };
     Err(SceneError::at(&e.loc, message))
@@ -263,6 +275,7 @@ fn scene_shape(e: &Element, folder: &Path) -> Result<ShapeRequests> {
     let mut bsdf = None;
     let mut textures = TextureCollector::new(folder);
     let mut emitter = None;
+    let mut transmission = None;
     for o in &props.objects {
         match o.tag.as_str() {
             "bsdf" => {
@@ -270,6 +283,7 @@ fn scene_shape(e: &Element, folder: &Path) -> Result<ShapeRequests> {
                     return Err(SceneError::at(&o.loc, "a <shape> takes at most one <bsdf>"));
                 }
                 bsdf = Some(build_bsdf(o, &mut textures)?);
+                transmission = crate::glass::transmission(o)?;
             }
             "emitter" => {
                 if emitter.is_some() {
@@ -314,6 +328,7 @@ fn scene_shape(e: &Element, folder: &Path) -> Result<ShapeRequests> {
         }),
         emitter,
         textures: Vec::new(),
+        transmission,
         location: e.loc.clone(),
     };
     Ok((shape, request, textures.requests))

@@ -36,6 +36,7 @@ pub(crate) fn constant(e: &Element) -> Result<Environment> {
     props.finish()?;
     Ok(Environment {
         radiance,
+        map: None,
         shape: None,
         location: e.loc.clone(),
     })
@@ -58,6 +59,10 @@ pub(crate) fn enclose(scene: &mut Scene) {
     let Some(env) = &scene.environment else {
         return;
     };
+    if env.map.is_some() {
+        // An envmap is a distant light, not a box (`crate::envmap`).
+        return;
+    }
     let mut bounds = scene
         .shapes
         .iter()
@@ -90,6 +95,7 @@ pub(crate) fn enclose(scene: &mut Scene) {
             location: env.location.clone(),
         }),
         textures: Vec::new(),
+        transmission: None,
         location: env.location.clone(),
     };
     let index = scene.shapes.len();

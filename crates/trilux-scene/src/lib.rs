@@ -21,7 +21,9 @@
 //! 3. `build`: typed parameters (`props`, `value`, [`transform`], their
 //!    numbers read by `numbers`) → the
 //!    model: shapes ([`shape`]), materials (`material`), area lights,
-//!    lights without area (`light`: point, spot, directional) and the
+//!    lights without area (`light`: point, spot, directional), the
+//!    environment (`environment`: a `constant` sky's enclosure; `envmap`:
+//!    an environment map's image, with `rgbe` for `.hdr` files) and the
 //!    camera ([`camera`], its film's filter in [`rfilter`]), and the
 //!    `integrator` a solve stands for.
 //! 4. [`meshes`]: the OBJ, PLY and serialized files the shapes name
@@ -46,10 +48,13 @@
 mod build;
 pub mod camera;
 mod environment;
+mod envmap;
 pub mod error;
+mod glass;
 pub mod gltf;
 pub mod image;
 mod integrator;
+mod ior;
 mod light;
 pub mod limits;
 mod material;
@@ -59,6 +64,7 @@ pub mod obj;
 pub mod ply;
 mod props;
 mod resolve;
+mod rgbe;
 /// The film's reconstruction filters (defined beside the rest of the
 /// sensor's plain data in `trilux_geometry::sensor`).
 pub use trilux_geometry::sensor::rfilter;
@@ -75,6 +81,7 @@ use std::path::Path;
 use std::sync::Arc;
 
 pub use camera::{Camera, FovAxis, ReconstructionFilter};
+pub use envmap::EnvMap;
 pub use error::{SceneError, SourceLocation};
 pub use meshes::Pending;
 pub use scene::{AreaEmitter, Environment, Light, Scene, SceneShape};

@@ -4,22 +4,26 @@
 //! | plugin | parameters (default) |
 //! |---|---|
 //! | `diffuse` | `reflectance` (0.5) |
-//! | `roughconductor` | `distribution` (`beckmann` \| `ggx`), `alpha` (0.1) or `alpha_u` = `alpha_v`, `material` (`none`: Fresnel = 1), `eta` (0) / `k` (1), `specular_reflectance` (1); `sample_visible` ignored |
+//! | `conductor` | `material` (`none`: Fresnel = 1; or one of Mitsuba's measured conductors, `Cu`, `Au`, `Ag`, `Al`, `Cr`, …: `trilux_brdf::conductors`), `eta` (0) / `k` (1), `specular_reflectance` (1); a mirror, as a Beckmann lobe of α = `MIRROR_ALPHA` (1e-5) |
+//! | `roughconductor` | `distribution` (`beckmann` \| `ggx`), `alpha` (0.1) or `alpha_u` = `alpha_v`, `material`, `eta` / `k` and `specular_reflectance` as `conductor`; `sample_visible` ignored |
 //! | `plastic` | `diffuse_reflectance` (0.5), `specular_reflectance` (1), `int_ior` (`polypropylene`: 1.49) / `ext_ior` (`air`: 1.000277), as a float or one of Mitsuba's named indices (`bk7`, `water`, …), `nonlinear` (false) |
 //! | `roughplastic` | as `plastic`, with `distribution` (`beckmann` \| `ggx`) and `alpha` (0.1) or `alpha_u` = `alpha_v`; `sample_visible` ignored |
 //! | `blendbsdf` | `weight` (required, in \[0, 1\]), two nested BSDFs |
 //! | `twosided` | one nested BSDF (both sides) or two (front, back) |
+//! | `thindielectric` | black here; the light it lets through is its shape's ([`crate::glass`]) |
+//! | `mask` | `opacity` (0.5, a float) × one nested BSDF; the rest is let through by its shape ([`crate::glass`]) |
 //!
 //! Textures: `<texture type="bitmap" name="...">` (Mitsuba's `bitmap`:
 //! `filename`, `filter_type` `bilinear` | `nearest`, `wrap_mode` `repeat` |
 //! `mirror` | `clamp`, `raw`) as the `reflectance` of `diffuse`, the
-//! `specular_reflectance` of `roughconductor`, the `diffuse_reflectance`
+//! `specular_reflectance` of `conductor` and `roughconductor`, the `diffuse_reflectance`
 //! of `plastic` and `roughplastic` and the `weight` of
 //! `blendbsdf`; the image is read when the scene is finished
 //! ([`crate::textures`]).
 //!
 //! Refused: other plugins, anisotropic roughness (`alpha_u` ≠ `alpha_v`),
-//! named conductor materials, other textures, `alpha` ≤ 0, indices of
+//! a conductor `material` Mitsuba does not name, or given with `eta` or
+//! `k`, other textures, `alpha` ≤ 0, indices of
 //! refraction ≤ 0 (or equal inside and out for `roughplastic`, as in
 //! Mitsuba), negative (but for a conductor's `eta` and `k`, as in Mitsuba)
 //! or NaN values, and reflectances above 1 (they would create energy and keep the
@@ -28,13 +32,14 @@
 use std::path::Path;
 
 use trilux_brdf::{
-    Branch, BsdfParams, Distribution, Filter, NAMED_IORS, PlasticParams, RoughConductorParams,
-    SlotKind, UvTransform, Wrap, named_ior,
+    Branch, BsdfParams, Distribution, Filter, MIRROR_ALPHA, PlasticParams, RoughConductorParams,
+    SlotKind, UvTransform, Wrap, conductor_names, named_conductor,
 };
 use trilux_color::ColorParam;
 
 use crate::error::{Result, SceneError, SourceLocation};
 use crate::image::Sampling;
+use crate::ior::ior;
 use crate::props::Props;
 use crate::textures::{ImageSource, TextureRequest};
 use crate::xml::Element;
@@ -81,7 +86,7 @@ pub(crate) fn build_bsdf(e: &Element, tex: &mut TextureCollector<'_>) -> Result<
             };
             BsdfParams::Diffuse { reflectance }
         }
-        "roughconductor" => {
+        kind @ ("roughconductor" | "conductor") => {
             let textured = texture(
                 &props,
                 "specular_reflectance",
@@ -89,7 +94,7 @@ pub(crate) fn build_bsdf(e: &Element, tex: &mut TextureCollector<'_>) -> Result<
                 tex,
             )?;
             no_other_objects(&props)?;
-            BsdfParams::RoughConductor(rough_conductor(&props, textured)?)
+            BsdfParams::RoughConductor(rough_conductor(&props, textured, kind == "conductor")?)
         }
         kind @ ("plastic" | "roughplastic") => {
             let textured = texture(&props, "diffuse_reflectance", SlotKind::Reflectance, tex)?;
@@ -127,11 +132,36 @@ pub(crate) fn build_bsdf(e: &Element, tex: &mut TextureCollector<'_>) -> Result<
             props.boolean("allow_transmission")?;
             twosided(e, &props, tex)?
         }
+        // A pane: black here, its transmission the shape's (crate::glass).
+        "thindielectric" => {
+            crate::glass::thin_dielectric(&props)?;
+            BsdfParams::Diffuse {
+                reflectance: ColorParam::Float(0.0),
+            }
+        }
+        // Mitsuba's opacity: the nested BSDF times opacity, the rest let
+        // through (crate::glass).
+        "mask" => {
+            let opacity = crate::glass::opacity(&props)?;
+            let [inner] = nested::<1>(&props, "one nested BSDF")?;
+            let before = tex.requests.len();
+            let inner = tex.nested(Branch::Second, inner)?;
+            if tex.requests.len() > before {
+                return Err(SceneError::at(
+                    &e.loc,
+                    "a mask's nested BSDF cannot have textures here",
+                ));
+            }
+            crate::glass::masked(opacity, inner)
+        }
+        kind if crate::glass::REFRACTING.contains(&kind) => {
+            return Err(crate::glass::refused(e, kind)?);
+        }
         other => {
             return Err(SceneError::at(
                 &e.required("type")?.loc,
                 format!(
-                    "unknown bsdf plugin \"{other}\" (supported: diffuse, roughconductor, plastic, roughplastic, blendbsdf, twosided)"
+                    "unknown bsdf plugin \"{other}\" (supported: diffuse, conductor, roughconductor, plastic, roughplastic, blendbsdf, twosided, thindielectric, mask)"
                 ),
             ));
         }
@@ -166,6 +196,10 @@ fn build_nested(e: &Element, tex: &mut TextureCollector<'_>) -> Result<BsdfParam
             &e.loc,
             format!("expected a nested <bsdf>, found {}", e.describe()),
         ));
+    }
+    let kind = e.plugin_type()?;
+    if crate::glass::TRANSMITTING.contains(&kind) {
+        return Err(crate::glass::nested(e, kind)?);
     }
     build_bsdf(e, tex)
 }
@@ -398,31 +432,19 @@ pub(crate) fn check_color(
     Ok(())
 }
 
-fn rough_conductor(props: &Props<'_>, textured: bool) -> Result<RoughConductorParams> {
-    let (distribution, alpha) = roughness(props)?;
-    match props.string("material")?.as_deref() {
-        None | Some("none") => {}
-        Some(other) => {
-            return Err(SceneError::at(
-                &props.loc("material"),
-                format!(
-                    "named conductor materials are not supported (\"{other}\"): give eta and k, or material=\"none\""
-                ),
-            ));
-        }
-    }
-    // Negative values are Mitsuba's too (published data have them): its
-    // Fresnel term sees only their squares (`trilux_color::Role::Unbounded`).
-    let eta = props.color("eta")?;
-    let k = props.color("k")?;
-    let eta_k = match (eta, k) {
-        (None, None) => None,
-        // Mitsuba's defaults for a conductor given by eta/k: eta 0, k 1.
-        (eta, k) => Some((
-            eta.unwrap_or(ColorParam::Float(0.0)),
-            k.unwrap_or(ColorParam::Float(1.0)),
-        )),
+/// `roughconductor`, or the smooth `conductor` (`smooth`) as a Beckmann
+/// lobe of α = [`MIRROR_ALPHA`] (trilux_brdf::params).
+fn rough_conductor(
+    props: &Props<'_>,
+    textured: bool,
+    smooth: bool,
+) -> Result<RoughConductorParams> {
+    let (distribution, alpha) = if smooth {
+        (Distribution::Beckmann, MIRROR_ALPHA)
+    } else {
+        roughness(props)?
     };
+    let eta_k = conductor_ior(props)?;
     let specular_reflectance = if textured {
         ColorParam::Float(1.0)
     } else {
@@ -433,6 +455,47 @@ fn rough_conductor(props: &Props<'_>, textured: bool) -> Result<RoughConductorPa
         alpha,
         eta_k,
         specular_reflectance,
+    })
+}
+
+/// A conductor's complex index of refraction, as Mitsuba 3.9.1 reads it:
+/// `eta` / `k` (defaults 0 and 1), or `material` naming one of its
+/// measured conductors (`Cu`, `Au`, …; `trilux_brdf::conductors`), not
+/// both; `None` for `material="none"` without `eta` and `k` (Fresnel = 1).
+fn conductor_ior(props: &Props<'_>) -> Result<Option<(ColorParam, ColorParam)>> {
+    let material = props.string("material")?;
+    match material.as_deref() {
+        None | Some("none") => {}
+        Some(name) => {
+            if let Some(given) = ["eta", "k"].into_iter().find(|n| props.has(n)) {
+                return Err(SceneError::at(
+                    &props.loc(given),
+                    format!("give either material (\"{name}\") or eta and k, not both"),
+                ));
+            }
+            return match named_conductor(name) {
+                Some(eta_k) => Ok(Some(eta_k)),
+                None => Err(SceneError::at(
+                    &props.loc("material"),
+                    format!(
+                        "unknown conductor material \"{name}\" (Mitsuba's names, case as written: {}, or none)",
+                        conductor_names().collect::<Vec<_>>().join(", ")
+                    ),
+                )),
+            };
+        }
+    }
+    // Negative values are Mitsuba's too (published data have them): its
+    // Fresnel term sees only their squares (`trilux_color::Role::Unbounded`).
+    let eta = props.color("eta")?;
+    let k = props.color("k")?;
+    Ok(match (eta, k) {
+        (None, None) => None,
+        // Mitsuba's defaults for a conductor given by eta/k: eta 0, k 1.
+        (eta, k) => Some((
+            eta.unwrap_or(ColorParam::Float(0.0)),
+            k.unwrap_or(ColorParam::Float(1.0)),
+        )),
     })
 }
 
@@ -517,36 +580,6 @@ fn plastic(props: &Props<'_>, rough: bool, textured: bool) -> Result<PlasticPara
         nonlinear,
         coat,
     })
-}
-
-/// An index of refraction given as a `<float>` or by one of Mitsuba's
-/// names (`default` when absent); finite and positive.
-fn ior(props: &Props<'_>, name: &str, default: &str) -> Result<f64> {
-    let loc = props.loc(name);
-    let value = match props.float(name) {
-        Ok(Some(v)) => v,
-        Ok(None) => named_ior(default).unwrap_or(1.0),
-        Err(_) => {
-            let given = props.string(name)?.unwrap_or_default();
-            named_ior(&given).ok_or_else(|| {
-                let names: Vec<&str> = NAMED_IORS.iter().map(|(n, _)| *n).collect();
-                SceneError::at(
-                    &loc,
-                    format!(
-                        "unknown index of refraction \"{given}\" for {name} (a float or one of: {})",
-                        names.join(", ")
-                    ),
-                )
-            })?
-        }
-    };
-    if !(value > 0.0 && value.is_finite()) {
-        return Err(SceneError::at(
-            &loc,
-            format!("{name} must be positive and finite, found {value}"),
-        ));
-    }
-    Ok(value)
 }
 
 /// An emitter's strength `name` (`radiance`, a light's `intensity` or

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use serde::Serialize;
 use trilux_brdf::{BsdfParams, TextureSlot};
 use trilux_color::{ColorParam, Mode};
-use trilux_geometry::{Bounds, Geometry, Punctual, Shape};
+use trilux_geometry::{Bounds, Geometry, Punctual, Shape, Transmittance};
 
 use crate::camera::Camera;
 use crate::error::{SceneError, SourceLocation};
@@ -23,12 +23,15 @@ pub struct AreaEmitter {
     pub location: SourceLocation,
 }
 
-/// A `constant` environment emitter.
+/// An environment emitter: `constant` or `envmap`.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Environment {
     /// Radiance arriving from every direction (`radiance`, Mitsuba's
-    /// default 1).
+    /// default 1) of a `constant` sky (0 for an `envmap`).
     pub radiance: ColorParam,
+    /// The image of an `envmap` (`None` for a `constant` sky), which no
+    /// enclosure stands for (`crate::envmap`).
+    pub map: Option<crate::envmap::EnvMap>,
     /// The index in [`Scene::shapes`] of the enclosure standing for it
     /// (set when the scene's meshes are read: its size needs them;
     /// `crate::environment` says why an enclosure).
@@ -70,6 +73,9 @@ pub struct SceneShape {
     /// holds placeholders for the parameters they stand for.
     #[serde(skip)]
     pub textures: Vec<TextureSlot>,
+    /// The fraction of light the shape lets through, undeviated, when its
+    /// BSDF is a `thindielectric` (`crate::glass`).
+    pub transmission: Option<Transmittance>,
     /// Where the `<shape>` is written.
     #[serde(skip)]
     pub location: SourceLocation,
@@ -144,6 +150,12 @@ impl Scene {
         self.shapes.iter().map(|s| s.textures.clone()).collect()
     }
 
+    /// Every shape's transmittance (`None` for an opaque one), in shape
+    /// order (`PreparedScene::with_transmission`).
+    pub fn transmission_params(&self) -> Vec<Option<Transmittance>> {
+        self.shapes.iter().map(|s| s.transmission).collect()
+    }
+
     /// Every shape's emitted radiance (`None` without an emitter), in shape
     /// order.
     pub fn emitter_radiance(&self) -> Vec<Option<ColorParam>> {
@@ -166,6 +178,11 @@ impl Scene {
             min: a.min(b),
             max: a.max(b),
         })
+    }
+
+    /// The environment map, if the scene's environment is an `envmap`.
+    pub fn sky_map(&self) -> Option<&crate::envmap::EnvMap> {
+        self.environment.as_ref()?.map.as_ref()
     }
 
     /// Every light without area as the solver takes it (where it is, its

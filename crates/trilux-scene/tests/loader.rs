@@ -422,7 +422,13 @@ fn roughconductor_refusals() {
     assert!(e(r#"<float name="alpha_u" value="0.1"/>"#).contains("both alpha_u and alpha_v"));
     assert!(e(r#"<float name="alpha" value="0"/>"#).contains("alpha must be positive"));
     assert!(e(r#"<float name="alpha" value="-0.1"/>"#).contains("alpha must be positive"));
-    assert!(e(r#"<string name="material" value="Au"/>"#).contains("named conductor materials"));
+    // Mitsuba's named conductors load (`Au`); a name it does not ship, or a
+    // name beside eta, is refused.
+    assert!(e(r#"<string name="material" value="Gold"/>"#).contains("unknown conductor material"));
+    assert!(
+        e(r#"<string name="material" value="Au"/><float name="eta" value="0.2"/>"#)
+            .contains("not both")
+    );
     assert!(
         e(r#"<string name="distribution" value="phong"/>"#)
             .contains("unknown microfacet distribution")
@@ -469,7 +475,8 @@ fn blendbsdf_and_twosided() {
     assert!(e(r#"<bsdf type="blendbsdf"><float name="weight" value="1.5"/><bsdf type="diffuse"/><bsdf type="diffuse"/></bsdf>"#).contains("[0, 1]"));
     assert!(e(r#"<bsdf type="blendbsdf"><float name="weight" value="0.5"/><bsdf type="diffuse"/></bsdf>"#).contains("exactly two"));
     assert!(e(r#"<bsdf type="twosided"/>"#).contains("one or two"));
-    assert!(e(r#"<bsdf type="dielectric"/>"#).contains("unknown bsdf plugin \"dielectric\""));
+    assert!(e(r#"<bsdf type="hair"/>"#).contains("unknown bsdf plugin \"hair\""));
+    assert!(e(r#"<bsdf type="dielectric"/>"#).contains("refracts light through a thick object"));
 }
 
 #[test]

@@ -353,7 +353,7 @@ impl FarContext<'_> {
             return 0.0;
         }
         let geom = self.forest.geometry();
-        let (mut seen, mut count) = (0u32, 0u32);
+        let (mut seen, mut count) = (0.0, 0u32);
         let mut hint = None;
         for k in 0..CLUSTER_RAYS {
             let u = r2(k, 0.5);
@@ -370,11 +370,11 @@ impl FarContext<'_> {
                 .burial
                 .is_some_and(|b| b.is_buried(a_face, x.coord) || b.is_buried(face, y.coord));
             count += 1;
-            if !buried && !geom.occluded_hint(x.point, y.point, &mut hint) {
-                seen += 1;
+            if !buried {
+                seen += geom.transmittance_hint(x.point, y.point, &mut hint);
             }
         }
-        f64::from(seen) / f64::from(count.max(1))
+        seen / f64::from(count.max(1))
     }
 
     /// V of far block `block` of sender `a`, traced on first use.

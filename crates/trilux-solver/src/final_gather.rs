@@ -65,8 +65,9 @@ pub(crate) fn gather_links<const N: usize>(
     let ctx = setup.refine_context(cache);
     let forest = setup.forest();
     // A glossy face without a Lambertian part holds two-point radiance
-    // only from lights without area (their glossy share, `light_shot`).
-    let lights = !setup.scene.lights().is_empty();
+    // only from lights without area and the sky (their glossy share,
+    // `light_shot`).
+    let lights = !setup.scene.lights().is_empty() || setup.scene.sky().is_some();
     let mut faces: Vec<(usize, FaceId, &TransportFace<N>, f64)> = setup
         .faces
         .iter()

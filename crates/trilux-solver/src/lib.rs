@@ -40,7 +40,8 @@
 //!   `state`: what the shots change (unshot radiance, hierarchies, ledger).
 //! - [`lights`]: lights without area (point, spot, directional) in
 //!   bands, with their flux; `light_shot`: their shot, a point-to-element
-//!   transfer into every leaf.
+//!   transfer into every leaf; [`sky`]: an environment map (Mitsuba's
+//!   `envmap`), its lookup and its importance sampling, shot as they are.
 //! - [`solver`]: the progressive loop (§4, Fig. 7 and 9); `shot`: one
 //!   shot's phases; `glossy`: the glossy renormalisation.
 //! - [`gather_links`]: the final gather's links, kept for rendering;
@@ -76,6 +77,8 @@ pub mod settings;
 mod setup;
 mod shards;
 mod shot;
+pub mod sky;
+mod sky_shot;
 pub mod solution;
 pub mod solver;
 mod state;
@@ -94,6 +97,7 @@ pub use ledger::Ledger;
 pub use lights::{LightError, PreparedLight};
 pub use prepared::{PrepareError, PreparedScene, SceneDescription};
 pub use settings::{Quality, SolverSettings, Transport};
+pub use sky::{PreparedSky, SkyError, SkySample};
 pub use solution::{FORMAT_VERSION, Solution, SurfaceSite, solve_hash};
 pub use solver::{Progress, Solver};
 pub use stats::{Ambient, SolveStats, StopReason, TracePoint};

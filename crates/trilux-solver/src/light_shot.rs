@@ -7,28 +7,30 @@
 //! radiance as for a pair link; the glossy share (the directional albedo
 //! for the light's direction less ρ_d) joins it, its energy kept and its
 //! direction lost (a smooth plastic's coat is carried the same way); the
-//! rest is absorbed, and what misses every element escapes.
+//! rest is absorbed, and what misses every element escapes. The sky
+//! (an environment map) is shot the same way, its deposits `sky_shot`'s.
 
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 use trilux_brdf::Frame;
 use trilux_color::Spectrum;
-use trilux_geometry::{ElementId, FaceId};
+use trilux_geometry::{ElementId, FaceId, SurfaceSample};
 
 use crate::lights::PreparedLight;
 use crate::solver::Solver;
 
 /// Stratified points per leaf element and light (4 × 4).
-const POINTS_PER_SIDE: u32 = 4;
+pub(crate) const POINTS_PER_SIDE: u32 = 4;
 
 /// What one leaf element of one face receives from a light.
-struct Deposit<const N: usize> {
-    face: FaceId,
-    leaf: ElementId,
+pub(crate) struct Deposit<const N: usize> {
+    pub face: FaceId,
+    pub leaf: ElementId,
     /// ∫ E dA over the leaf's exposed part.
-    arrived: Spectrum<N>,
-    /// Unit direction towards the light from the leaf's centre.
-    wi: DVec3,
+    pub arrived: Spectrum<N>,
+    /// Unit direction towards the light from the leaf's centre (the
+    /// sky's: the mean direction its light arrives from).
+    pub wi: DVec3,
 }
 
 impl<const N: usize> Solver<N> {
@@ -38,12 +40,18 @@ impl<const N: usize> Solver<N> {
         let phi = std::mem::take(&mut self.state.light_flux[k]);
         // Every watt a light shoots is emission.
         self.state.interreflection.book_shot(phi, Spectrum::zero());
-        let light = self.setup.scene.lights()[k].clone();
         let faces: Vec<FaceId> = self.setup.faces.iter().map(|(f, _)| f).collect();
-        let deposits: Vec<Deposit<N>> = faces
-            .par_iter()
-            .flat_map_iter(|&f| self.light_deposits(&light, f))
-            .collect();
+        // Light k past the lights without area is the sky (`sky_shot`).
+        let deposits: Vec<Deposit<N>> = match self.setup.scene.lights().get(k) {
+            Some(light) => faces
+                .par_iter()
+                .flat_map_iter(|&f| self.light_deposits(light, f))
+                .collect(),
+            None => faces
+                .par_iter()
+                .flat_map_iter(|&f| self.sky_deposits(f))
+                .collect(),
+        };
         let mut total = Spectrum::<N>::zero();
         let mut absorbed = Spectrum::<N>::zero();
         for d in &deposits {
@@ -64,6 +72,41 @@ impl<const N: usize> Solver<N> {
         deposits.len()
     }
 
+    /// The leaves of face `f` with an exposed part (the others receive
+    /// nothing).
+    pub(crate) fn lit_leaves(&self, f: FaceId) -> impl Iterator<Item = ElementId> + '_ {
+        let forest = self.setup.forest();
+        forest
+            .leaves(forest.root(f.surface()))
+            .into_iter()
+            .filter(move |leaf| self.setup.exposed_area[f.side()][leaf.index()] > 0.0)
+    }
+
+    /// The points a light shot samples on `leaf` of face `f`: the centres
+    /// of a [`POINTS_PER_SIDE`]² grid over its parameter square, with their
+    /// index, less those buried in another surface or of zero density.
+    pub(crate) fn leaf_points(
+        &self,
+        f: FaceId,
+        leaf: ElementId,
+    ) -> impl Iterator<Item = (u32, SurfaceSample)> + '_ {
+        let n = POINTS_PER_SIDE;
+        let forest = self.setup.forest();
+        (0..n * n).filter_map(move |s| {
+            let u = DVec2::new(
+                (f64::from(s % n) + 0.5) / f64::from(n),
+                (f64::from(s / n) + 0.5) / f64::from(n),
+            );
+            let y = forest.sample_element(leaf, u);
+            let buried = self
+                .setup
+                .burial
+                .as_ref()
+                .is_some_and(|m| m.is_buried(f, y.coord));
+            (y.pdf_area > 0.0 && !buried).then_some((s, y))
+        })
+    }
+
     /// What light `light` brings to each leaf of face `f` (leaves it
     /// does not reach are left out).
     fn light_deposits(&self, light: &PreparedLight<N>, f: FaceId) -> Vec<Deposit<N>> {
@@ -72,35 +115,24 @@ impl<const N: usize> Solver<N> {
         let sign = f.side().sign();
         let n = POINTS_PER_SIDE;
         let mut out = Vec::new();
-        for leaf in forest.leaves(forest.root(f.surface())) {
-            if self.setup.exposed_area[f.side()][leaf.index()] <= 0.0 {
-                continue;
-            }
+        for leaf in self.lit_leaves(f) {
             let mut arrived = Spectrum::<N>::zero();
-            for s in 0..n * n {
-                let u = DVec2::new(
-                    (f64::from(s % n) + 0.5) / f64::from(n),
-                    (f64::from(s / n) + 0.5) / f64::from(n),
-                );
-                let y = forest.sample_element(leaf, u);
-                if y.pdf_area <= 0.0
-                    || self
-                        .setup
-                        .burial
-                        .as_ref()
-                        .is_some_and(|m| m.is_buried(f, y.coord))
-                {
-                    continue;
-                }
+            for (_, y) in self.leaf_points(f, leaf) {
                 let Some((a, e)) = light.at(y.point) else {
                     continue;
                 };
                 let cos = sign * y.normal.dot(a.wi);
                 let end = self.setup.scene.shadow_end(y.point, &a);
-                if cos <= 0.0 || end.is_none_or(|end| geometry.occluded(y.point, end)) {
+                // The fraction the segment lets through (panes of glass:
+                // trilux_geometry::transmission), 0 when blocked.
+                let tau = match end {
+                    Some(end) if cos > 0.0 => geometry.transmittance(y.point, end),
+                    _ => 0.0,
+                };
+                if tau <= 0.0 {
                     continue;
                 }
-                arrived += e * (cos / y.pdf_area);
+                arrived += e * (tau * cos / y.pdf_area);
             }
             if arrived.max_value() > 0.0 {
                 let centre = forest.element(leaf).centre;

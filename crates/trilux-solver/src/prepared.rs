@@ -13,9 +13,12 @@ use std::sync::Arc;
 use thiserror::Error;
 use trilux_brdf::{BrdfError, Bsdf, BsdfParams, Shading, TextureSlot, TexturedBsdf};
 use trilux_color::{ColorError, ColorParam, Spectrum};
-use trilux_geometry::{Bounds, Geometry, GeometryError, Punctual, Shape, SurfaceCoord, SurfaceId};
+use trilux_geometry::{
+    Bounds, Geometry, GeometryError, Punctual, Shape, SurfaceCoord, SurfaceId, Transmittance,
+};
 
 use crate::lights::{LightError, PreparedLight};
+use crate::sky::PreparedSky;
 
 /// What light transport needs of a scene, as plain data: per shape its
 /// geometry, its material and its area emitter's radiance (if any).
@@ -148,6 +151,8 @@ pub struct PreparedScene<const N: usize> {
     lights: Vec<PreparedLight<N>>,
     /// The box standing for a `constant` sky, if any (`with_enclosure`).
     enclosure: Option<Bounds>,
+    /// The environment map, if any (`with_sky`).
+    sky: Option<PreparedSky<N>>,
     hash: u64,
 }
 
@@ -209,6 +214,7 @@ impl<const N: usize> PreparedScene<N> {
             emission,
             lights: Vec::new(),
             enclosure: None,
+            sky: None,
             hash: content_hash(desc, textures, N)?,
         })
     }
@@ -277,6 +283,46 @@ impl<const N: usize> PreparedScene<N> {
     pub fn with_enclosure(mut self, enclosure: Option<Bounds>) -> Self {
         self.enclosure = enclosure;
         self
+    }
+
+    /// The scene with some shapes letting a fraction of the light through
+    /// (`by_shape[i]` for shape `i`: trilux-geometry's `transmission`),
+    /// which every visibility of the solve and the render multiplies; they
+    /// enter the content hash.
+    pub fn with_transmission(mut self, by_shape: &[Option<Transmittance>]) -> Self {
+        if by_shape.iter().any(Option::is_some) {
+            Arc::make_mut(&mut self.geometry).set_transmission(by_shape);
+            let mut h = Fnv1a(self.hash);
+            if serde_json::to_writer(&mut h, by_shape).is_ok() {
+                self.hash = h.0;
+            }
+        }
+        self
+    }
+
+    /// The scene lit by an environment map (`crate::sky`); its texels and
+    /// orientation enter the content hash.
+    pub fn with_sky(mut self, sky: Option<PreparedSky<N>>) -> Self {
+        if let Some(s) = &sky {
+            let mut h = Fnv1a(self.hash);
+            s.hash_into(&mut h);
+            self.hash = h.0;
+        }
+        self.sky = sky;
+        self
+    }
+
+    /// The environment map, if any.
+    pub fn sky(&self) -> Option<&PreparedSky<N>> {
+        self.sky.as_ref()
+    }
+
+    /// Where a shadow ray from `x` towards the sky in direction `wi` ends:
+    /// beyond everything in the scene.
+    pub fn sky_end(&self, x: glam::DVec3, wi: glam::DVec3) -> glam::DVec3 {
+        let b = self.geometry.bounds();
+        let reach = (b.max - b.min).length() + (x - 0.5 * (b.max + b.min)).length() + 1.0;
+        x + wi * reach
     }
 
     /// Where a shadow ray from `x` towards the light of `a` ends, `None`

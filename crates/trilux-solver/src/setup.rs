@@ -74,7 +74,8 @@ pub(crate) struct Setup<const N: usize> {
     pub textures: Option<ElementTextures<N>>,
     /// The emitted flux IF per band (paper §6), the lights' included.
     pub emitted: Spectrum<N>,
-    /// The flux of every light without area (`lights`).
+    /// The flux of every light without area (`lights`), then of the sky
+    /// (`sky`) when there is one.
     pub light_flux: Vec<Spectrum<N>>,
     /// Warnings of the preparation (clamped reflectances).
     pub warnings: Vec<String>,
@@ -125,7 +126,9 @@ impl<const N: usize> Setup<N> {
             }
         }
         let radius = crate::lights::scene_radius(scene.geometry());
-        let light_flux: Vec<Spectrum<N>> = scene.lights().iter().map(|l| l.flux(radius)).collect();
+        let mut light_flux: Vec<Spectrum<N>> =
+            scene.lights().iter().map(|l| l.flux(radius)).collect();
+        light_flux.extend(scene.sky().map(|s| s.flux(radius)));
         for f in &light_flux {
             emitted += *f;
         }

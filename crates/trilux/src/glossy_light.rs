@@ -58,6 +58,7 @@ impl<'a, const N: usize> RenderedGlossy<'a, N> {
                 coord: p.coord,
                 shading_normal: p.normal,
                 shape: p.shape,
+                through: 1.0,
             },
         };
         let mut stats = GatherStats::default();

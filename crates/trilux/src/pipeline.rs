@@ -12,11 +12,11 @@ use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
-use trilux_color::{Mode, WithBands};
+use trilux_color::{ColorParam, Mode, WithBands};
 use trilux_scene::{Scene, SceneError};
 use trilux_solver::{
-    PrepareError, PreparedScene, Progress, SceneDescription, Solution, SolveStats, Solver,
-    SolverError, SolverSettings,
+    PrepareError, PreparedScene, PreparedSky, Progress, SceneDescription, Solution, SolveStats,
+    Solver, SolverError, SolverSettings,
 };
 
 use trilux_render::{
@@ -153,6 +153,8 @@ pub fn prepare<const N: usize>(scene: &Scene) -> Result<Arc<PreparedScene<N>>, P
         .map_err(|e| PipelineError::from(located(scene, &e)))?;
     prepared
         .with_enclosure(scene.enclosure())
+        .with_transmission(&scene.transmission_params())
+        .with_sky(prepared_sky(scene)?)
         .with_lights(&scene.light_params())
         .map(Arc::new)
         .map_err(|e| {
@@ -162,6 +164,26 @@ pub fn prepare<const N: usize>(scene: &Scene) -> Result<Arc<PreparedScene<N>>, P
                 .map_or_else(|| scene.shape_location(usize::MAX), |l| l.location.clone());
             SceneError::at(&at, e.problem).into()
         })
+}
+
+/// The scene's environment map in `N` bands, scaled (`None` without
+/// one); errors at its `<emitter>`.
+pub fn prepared_sky<const N: usize>(
+    scene: &Scene,
+) -> Result<Option<PreparedSky<N>>, PipelineError> {
+    let (Some(env), Some(map)) = (&scene.environment, scene.sky_map()) else {
+        return Ok(None);
+    };
+    let at = |m: String| PipelineError::from(SceneError::at(&env.location, m));
+    let texels = map
+        .texels
+        .iter()
+        .map(|t| ColorParam::Rgb(t.map(|c| f64::from(c) * map.scale)).emission::<N>())
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| at(e.to_string()))?;
+    PreparedSky::new(map.width, map.height, texels, map.world_from_sky)
+        .map(Some)
+        .map_err(|e| at(e.to_string()))
 }
 
 /// A preparation error at its place in the scene file.

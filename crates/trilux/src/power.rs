@@ -1,7 +1,8 @@
 //! Emitted power per band, P = π · L · A for each one-sided Lambertian area
 //! emitter (radiance L in each band, area A), summed over the emitters,
 //! plus I · ∫ falloff dω for each point (4π I) and spot light and E π R²
-//! for each directional light (R the scene's bounding sphere's radius).
+//! for each directional light (R the scene's bounding sphere's radius),
+//! and π R² ∫ L dω for an environment map.
 //!
 //! L comes from trilux-color's emission conversion
 //! ([`ColorParam::emission`](trilux_color::ColorParam::emission)), exactly as
@@ -41,6 +42,10 @@ impl WithBands for Power<'_> {
             let i = radiance::<N>(&l.intensity)
                 .map_err(|e| anyhow!("{}: intensity: {e}", l.location))?;
             total += i * l.punctual.flux_factor(self.1);
+        }
+        // An environment map sends π R² ∫ L dω (trilux-solver's `sky`).
+        if let Some(sky) = trilux::pipeline::prepared_sky::<N>(self.0)? {
+            total += sky.flux(self.1);
         }
         Ok(total.0.to_vec())
     }

@@ -79,11 +79,11 @@ fn unknown_plugin() {
     assert_scene_error(
         "bsdf-plugin",
         &format!(
-            "{HEAD}  <shape type=\"cube\">\n    <bsdf type=\"dielectric\"/>\n  </shape>\n</scene>\n"
+            "{HEAD}  <shape type=\"cube\">\n    <bsdf type=\"hair\"/>\n  </shape>\n</scene>\n"
         ),
         3,
-        "dielectric",
-        "unknown bsdf plugin \"dielectric\"",
+        "hair",
+        "unknown bsdf plugin \"hair\"",
     );
 }
 

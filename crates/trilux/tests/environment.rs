@@ -4,33 +4,16 @@
 //! errors of bad input.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
-use std::path::Path;
-
 use serde_json::Value;
 use trilux_render::Image;
 
 mod common;
-use common::{folder, trilux};
+use common::{folder, render, slab_transmittance, test_file, trilux};
 
 const SKY: [f64; 3] = [1.0, 0.8, 0.6];
 
 fn scene(name: &str) -> String {
-    format!(
-        "{}/../../tests/environment/{name}",
-        env!("CARGO_MANIFEST_DIR")
-    )
-}
-
-fn render(file: &str, extra: &[&str], out: &Path) -> Image {
-    let mut args = vec!["render", file, "-o", out.to_str().unwrap()];
-    args.extend_from_slice(extra);
-    let run = trilux(&args);
-    assert!(
-        run.status.success(),
-        "{}",
-        String::from_utf8_lossy(&run.stderr)
-    );
-    Image::read_exr(out).unwrap()
+    test_file(&format!("environment/{name}"))
 }
 
 fn pixel(image: &Image, x: u32, y: u32) -> [f64; 3] {
@@ -140,6 +123,121 @@ fn sun_and_sky_through_a_window_light_a_closed_room_as_in_mitsuba() {
         "daylight-room.xml",
         "sun=40, 38, 34",
         0.02,
+    );
+}
+
+#[test]
+fn sky_through_a_pane_of_glass_lights_a_closed_room_as_in_mitsuba() {
+    // The daylight room with a thin glass pane (BK7) in its window: the
+    // sky's light reaches the room times the pane's Fresnel transmittance
+    // (about 0.92 near normal incidence, less towards grazing), in the
+    // solve's visibility and in the render's rays alike. Mitsuba's open
+    // room is 12 % brighter, so a pane taken as open or as opaque fails by
+    // far. 2 %: the daylight rooms' gate (Mitsuba's relative standard
+    // error 5e-4); trilux was 1.9 % dark at worst when this was written,
+    // the solution's known deficit with a pane in a window
+    // (docs/solver.md, "Panes of glass").
+    against_mitsuba("glazed_room", "glazed-room.xml", "sun=0", 0.02);
+}
+
+fn mean_rgb(image: &Image) -> [f64; 3] {
+    let n = f64::from(image.width() * image.height());
+    let mut m = [0.0; 3];
+    for y in 0..image.height() {
+        for x in 0..image.width() {
+            for (c, v) in pixel(image, x, y).iter().enumerate() {
+                m[c] += v / n;
+            }
+        }
+    }
+    m
+}
+
+#[test]
+fn a_sun_behind_glass_lights_the_floor_by_the_panes_fresnel_transmittance() {
+    // Mitsuba's path tracer cannot carry a delta sun through a delta pane
+    // (its shadow rays stop at the glass, and no sampled direction meets a
+    // delta light), so this is held to a closed form: with a black wall,
+    // the floor's only light is the sun's through the pane, and its
+    // radiance ρ/π · E · cos θ · T(cos θ) (pane and floor parallel: one
+    // cosine, 0.5/|d|), T the thin slab's transmittance at BK7 in air.
+    let file = scene("sun-through-glass.xml");
+    let dir = folder("environment-sun-glass");
+    let floor = render(
+        &file,
+        &["-D", "wall=0", "--spp", "4"],
+        &dir.join("floor.exr"),
+    );
+    let cos = 0.5 / (0.09f64 + 0.25 + 1.0).sqrt();
+    let t = slab_transmittance(cos, 1.5046 / 1.000277);
+    // At 64° from the normal one interface reflects 12 %: T ≈ 0.79, well
+    // below the 0.92 of normal incidence, so the angle is tested too.
+    assert!((0.78..0.80).contains(&t), "{t}");
+    let e = [2.0, 1.5, 1.0];
+    let m = mean_rgb(&floor);
+    for c in 0..3 {
+        let want = 0.5 / std::f64::consts::PI * e[c] * cos * t;
+        // 1e-4: the direct light is one shadow ray per sample through the
+        // pane, deterministic; nothing else lights the floor.
+        assert!(
+            (m[c] / want - 1.0).abs() < 1e-4,
+            "channel {c}: trilux {}, closed form {want}",
+            m[c]
+        );
+    }
+    // A wall lit by the sun through the pane and by the floor: every path
+    // of light crosses the pane once, at the same cosine, so the whole
+    // image is the clear pane's (air in air: T = 1) times T. The view reads
+    // the solution at the first gather hit (`--extra-bounce never`), so the
+    // solve's light shot through the pane is what the wall's indirect light
+    // shows.
+    let view = [
+        "--lookat",
+        "1,1,0,-2,1,0",
+        "--extra-bounce",
+        "never",
+        "--spp",
+        "16",
+    ];
+    let mut glazed_args = vec!["-D", "wall=0.8"];
+    glazed_args.extend_from_slice(&view);
+    let glazed = mean_rgb(&render(&file, &glazed_args, &dir.join("glazed.exr")));
+    let mut clear_args = vec!["-D", "wall=0.8", "-D", "int_ior=air"];
+    clear_args.extend_from_slice(&view);
+    let clear = mean_rgb(&render(&file, &clear_args, &dir.join("clear.exr")));
+    for c in 0..3 {
+        // 0.5 %: the two solves refine their links by flux, which T
+        // changes; the rays traced are otherwise the same.
+        assert!(
+            (glazed[c] / clear[c] / t - 1.0).abs() < 0.005,
+            "channel {c}: glazed {} / clear {} against T = {t}",
+            glazed[c],
+            clear[c]
+        );
+    }
+}
+
+#[test]
+fn a_bad_pane_is_one_located_line() {
+    let negative = refused(
+        "<scene version=\"3.0.0\">\n<shape type=\"rectangle\">\n<bsdf type=\"thindielectric\"><float name=\"int_ior\" value=\"-1.5\"/></bsdf>\n</shape>\n</scene>\n",
+        "pane-negative",
+    );
+    assert!(
+        negative.contains("scene.xml:3:")
+            && negative.contains("int_ior")
+            && negative.lines().count() == 1,
+        "{negative}"
+    );
+    let thick = refused(
+        "<scene version=\"3.0.0\">\n<shape type=\"sphere\">\n<bsdf type=\"dielectric\"/>\n</shape>\n</scene>\n",
+        "pane-thick",
+    );
+    assert!(
+        thick.contains("scene.xml:3:")
+            && thick.contains("thindielectric")
+            && thick.lines().count() == 1,
+        "{thick}"
     );
 }
 

@@ -25,15 +25,7 @@ use serde_json::Value;
 use trilux_render::Image;
 
 mod common;
-use common::{folder, scene, trilux};
-
-fn mean(image: &Image) -> f64 {
-    let px = image.pixels();
-    px.iter()
-        .map(|p| f64::from(p[0]) + f64::from(p[1]) + f64::from(p[2]))
-        .sum::<f64>()
-        / px.len() as f64
-}
+use common::{folder, mean_rgb_sum as mean, scene, trilux};
 
 fn reference(name: &str) -> f64 {
     let text = std::fs::read_to_string(scene(&format!("lights/{name}.json"))).unwrap();

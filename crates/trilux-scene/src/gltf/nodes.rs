@@ -360,6 +360,7 @@ impl Walk<'_> {
             bsdf,
             emitter,
             textures: Vec::new(),
+            transmission: None,
             location,
         });
         self.placed.push(Placed {

@@ -7,6 +7,47 @@ pub mod serialized;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+/// A file under the repository's `tests/` folder.
+pub fn test_file(name: &str) -> String {
+    format!("{}/../../tests/{name}", env!("CARGO_MANIFEST_DIR"))
+}
+
+/// `trilux render FILE -o OUT EXTRA…`, which must succeed, and its image.
+pub fn render(file: &str, extra: &[&str], out: &Path) -> trilux_render::Image {
+    let mut args = vec!["render", file, "-o", out.to_str().unwrap()];
+    args.extend_from_slice(extra);
+    let run = trilux(&args);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    trilux_render::Image::read_exr(out).unwrap()
+}
+
+/// The mean over an image's pixels of R + G + B (the figure the scenes'
+/// Mitsuba references store as their `mean_rgb` summed).
+pub fn mean_rgb_sum(image: &trilux_render::Image) -> f64 {
+    let px = image.pixels();
+    px.iter()
+        .map(|p| f64::from(p[0]) + f64::from(p[1]) + f64::from(p[2]))
+        .sum::<f64>()
+        / px.len() as f64
+}
+
+/// A thin slab's transmittance (1 − r)² / (1 − r²) at cos θ_i = `c`, r
+/// the unpolarised Fresnel reflectance of one interface of relative index
+/// `eta` by Snell's law and the Fresnel equations: the closed form the
+/// pane-of-glass tests hold trilux to.
+pub fn slab_transmittance(c: f64, eta: f64) -> f64 {
+    let s = (1.0 - c * c).sqrt() / eta;
+    let ct = (1.0 - s * s).sqrt();
+    let rs = ((c - eta * ct) / (c + eta * ct)).powi(2);
+    let rp = ((ct - eta * c) / (ct + eta * c)).powi(2);
+    let r = 0.5 * (rs + rp);
+    (1.0 - r) * (1.0 - r) / (1.0 - r * r)
+}
+
 /// Runs the `trilux` binary with `args`.
 pub fn trilux(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_trilux"))
