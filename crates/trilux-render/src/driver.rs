@@ -23,7 +23,8 @@ use crate::gather::{ExtraBounce, FinalGather};
 use crate::glossy_fit::GlossyFits;
 use crate::glossy_irradiance::GlossyIrradiance;
 use crate::image::Image;
-use crate::link_gather::{Caches, LinkGather, Preview};
+use crate::link_gather::{Caches, LinkGather};
+use crate::preview::Preview;
 use crate::records::GatherStats;
 use crate::sampler::{MAX_SAMPLES, PixelSampler, dims};
 use crate::scene::SolutionGather;
@@ -45,7 +46,7 @@ pub enum Estimator {
     Paths,
     /// No random rays at the pixel: the links with their own visibility,
     /// and glossy parts read from the directional bake's representation
-    /// fitted at element corners (`link_gather::Preview`, `glossy_fit`).
+    /// fitted at element corners (`preview::Preview`, `glossy_fit`).
     Preview,
     /// The solution as a control variate: its lookups along
     /// [`RenderSettings::lookups`] gather rays plus a path-traced residual;

@@ -70,6 +70,7 @@ pub mod image;
 pub mod link_gather;
 pub mod link_sum;
 pub mod mis;
+pub mod preview;
 pub mod records;
 pub mod sampler;
 pub mod scene;

@@ -34,7 +34,7 @@
 //!   takes it with its light sample and its gather ray's misses
 //!   (`crate::mis`).
 //!
-//! [`Preview`] drops every random ray at the pixel: the link sum with the
+//! `preview::Preview` drops every random ray at the pixel: the link sum with the
 //! links' own visibility at x_s plus E_g read at the corners of x_s's
 //! leaf element (module `glossy_irradiance`), and for a glossy x_s the directional
 //! bake's representation of L_glossy (harmonics plus a lobe fitted at the
@@ -48,8 +48,6 @@
 use glam::{DVec2, DVec3};
 
 use crate::gather::FinalGather;
-use crate::glossy_fit::GlossyFits;
-use crate::glossy_irradiance::GlossyIrradiance;
 use crate::link_sum::LinkCache;
 use crate::mis::{
     eye_hit, hit_emission, light_sample, miss_emission, punctual_direct, sky_sample, sky_seen,
@@ -498,60 +496,6 @@ fn unoccluded_sky<S: SolutionGather<N>, const N: usize>(
     stats.shadow_rays += 1;
     let tau = scene.transmittance(x, s.end);
     (tau > 0.0).then(|| (s.wi, s.radiance * tau, s.pdf))
-}
-
-/// The preview estimator: no random rays (module docs).
-pub struct Preview<'a, S> {
-    /// The scene and its solution.
-    pub scene: &'a S,
-    /// Camera rays that meet an emitter count as misses
-    /// (`RenderSettings::hide_emitters`).
-    pub hide_emitters: bool,
-    /// The glossy light's fits, made as hits need them.
-    pub fits: GlossyFits,
-    /// E_g, the light glossy senders reflect onto Lambertian parts, per
-    /// corner, made as hits need it.
-    pub glossy_senders: GlossyIrradiance,
-}
-
-impl<S> Preview<'_, S> {
-    /// Radiance arriving at the eye along a camera ray, without random
-    /// rays.
-    pub fn camera_sample<const N: usize>(
-        &self,
-        origin: DVec3,
-        dir: DVec3,
-        caches: &mut Caches<N>,
-        stats: &mut GatherStats,
-    ) -> Spectrum<N>
-    where
-        S: SolutionGather<N>,
-    {
-        stats.camera_rays += 1;
-        let scene = self.scene;
-        let Some(xs) = eye_hit(scene, origin, dir, self.hide_emitters) else {
-            return Spectrum::zero();
-        };
-        let wo = -dir;
-        let through = scene.through(&xs);
-        let mut l = scene.emitted(&xs, wo);
-        let rho = scene.diffuse_albedo(&xs, wo);
-        if !rho.is_black()
-            && let Some(e) =
-                scene.solution_irradiance(&xs, wo, LinkVisibility::Cached, &mut caches.pixel, stats)
-        {
-            let e_g = if scene.has_glossy_faces() {
-                self.glossy_senders.at(scene, &xs, wo, stats)
-            } else {
-                Spectrum::zero()
-            };
-            l += rho * (e + e_g);
-        }
-        if scene.is_glossy(&xs, wo) {
-            l += self.fits.radiance(scene, &xs, wo, stats);
-        }
-        stats.finite_or_dropped(l * through)
-    }
 }
 
 /// ρ_d(xd) times the link sum at `xd` with the links' own visibility

@@ -16,8 +16,9 @@ use trilux_render::camera::look_at;
 use trilux_render::gather::FinalGather;
 use trilux_render::glossy_fit::{FIT_SAMPLES, GlossyFits, fit_point, fit_sampler};
 use trilux_render::glossy_irradiance::GlossyIrradiance;
-use trilux_render::link_gather::{Caches, IncidentSamples, LinkGather, Preview};
+use trilux_render::link_gather::{Caches, IncidentSamples, LinkGather};
 use trilux_render::link_sum::LinkCache;
+use trilux_render::preview::Preview;
 use trilux_render::{
     BsdfSample, Camera, ExtraBounce, FitKey, FitSite, FovAxis, GatherScene, GatherStats,
     LightSample, LinkVisibility, ReconstructionFilter, RenderSettings, SkyRay, SolutionGather,
