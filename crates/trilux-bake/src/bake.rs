@@ -24,6 +24,7 @@ use std::time::Instant;
 use glam::DVec3;
 use serde_json::{Value, json};
 use trilux_brdf::BsdfParams;
+use trilux_geometry::glossy_fit::{FIT_DIRECTIONS, FIT_GATHER_SAMPLES, FIT_LIGHT_SAMPLES};
 use trilux_geometry::{ElementForest, ElementId, FaceId, Side, SurfaceId};
 use trilux_solver::{ElementTextures, Solution};
 
@@ -69,7 +70,7 @@ pub struct BakeOptions {
     /// `directional`; on by default: without, the glossy light is left out
     /// and its materials marked).
     pub glossy: bool,
-    /// The glossy light's form (order-1 harmonics and a lobe, or order-2
+    /// The glossy light's form (order-2 harmonics and a lobe, or order-2
     /// harmonics).
     pub glossy_form: GlossyForm,
     /// Directions per vertex over which the glossy light is fitted
@@ -100,9 +101,10 @@ impl Default for BakeOptions {
             albedo_maps: true,
             glossy: true,
             glossy_form: GlossyForm::Lobe,
-            glossy_directions: 96,
-            glossy_samples: 16,
-            glossy_light_samples: 8,
+            // The preview's counts too (`trilux_geometry::glossy_fit`).
+            glossy_directions: FIT_DIRECTIONS as u32,
+            glossy_samples: FIT_GATHER_SAMPLES,
+            glossy_light_samples: FIT_LIGHT_SAMPLES,
             glossy_links: false,
             glossy_budget: 8_000_000,
         }

@@ -24,8 +24,8 @@ use glam::DVec3;
 use rayon::prelude::*;
 use trilux_geometry::{Side, SurfaceCoord, SurfaceId};
 
-use crate::sh::sh_part;
-pub use crate::sh::{
+use trilux_geometry::glossy_fit::sh::sh_part;
+pub use trilux_geometry::glossy_fit::sh::{
     GlossyRecord, SH_COEFFICIENTS, SLOTS, fit_sh, hemisphere_directions, sh_basis, sh_eval,
 };
 
@@ -93,7 +93,7 @@ impl GlossyForm {
     pub fn eval(self, c: &GlossyRecord, d: DVec3) -> [f64; 3] {
         match self {
             GlossyForm::Sh2 => sh_eval(&sh_part(c), d),
-            GlossyForm::Lobe => crate::lobe::lobe_eval(c, d),
+            GlossyForm::Lobe => trilux_geometry::glossy_fit::lobe::lobe_eval(c, d),
         }
     }
 
@@ -105,7 +105,7 @@ impl GlossyForm {
                 r[..SH_COEFFICIENTS].copy_from_slice(&c);
                 r
             }),
-            GlossyForm::Lobe => crate::lobe::fit_lobe(directions, values),
+            GlossyForm::Lobe => trilux_geometry::glossy_fit::lobe::fit_lobe(directions, values),
         }
     }
 

@@ -21,9 +21,10 @@
 //! - `albedo`: textured materials as an albedo map times the light.
 //! - `camera`: the scene's camera ([`BakeCamera`]) as a glTF camera node.
 //! - [`directional`]: the glossy light of glossy sides per vertex,
-//!   fitted from a [`GlossyLight`]: order-1 spherical harmonics plus one
-//!   spherical Gaussian ([`lobe`]), or order-2 harmonics.
-//! - [`sh`]: order-2 real spherical harmonics and their least-squares fit.
+//!   fitted from a [`GlossyLight`]: order-2 spherical harmonics plus one
+//!   spherical Gaussian ([`lobe`]), or order-2 harmonics alone.
+//! - [`sh`] and [`lobe`]: the fitting code, `trilux_geometry::glossy_fit`'s
+//!   (the renderer's preview fits the same form), re-exported.
 //! - `glb`: the glTF JSON and the binary container.
 //! - [`bake()`](bake()): the whole, with its [`BakeStats`].
 //! - [`mod@error`]: the error type, [`BakeError`].
@@ -35,9 +36,7 @@ mod camera;
 pub mod directional;
 pub mod error;
 mod glb;
-pub mod lobe;
 pub mod reconstruct;
-pub mod sh;
 mod tessellate;
 
 pub use bake::{BakeInput, BakeOptions, BakeStats, Baked, MIN_GLOSSY_DIRECTIONS, bake};
@@ -45,3 +44,6 @@ pub use camera::BakeCamera;
 pub use directional::{GlossyForm, GlossyLight, GlossyPoint, GlossySamples};
 pub use error::BakeError;
 pub use tessellate::ShapeMesh;
+/// The fitting code, shared with the renderer's preview
+/// (`trilux_geometry::glossy_fit`).
+pub use trilux_geometry::glossy_fit::{lobe, sh};

@@ -102,6 +102,9 @@
 //! - [`punctual`]: lights without area ([`Punctual`]: point, spot with
 //!   its [`SpotFalloff`], directional) and the light they bring to a point
 //!   ([`Arrival`]), shared by the loader, the solver and the renderer.
+//! - [`glossy_fit`]: a point's glossy light as a function of direction,
+//!   order-2 spherical harmonics plus one spherical Gaussian, fitted by
+//!   least squares (shared by the directional bake and the preview).
 //! - [`sensor`]: the camera's plain data shared by the scene loader and
 //!   the renderer: Mitsuba's `look_at` ([`look_at`]), the field of view's
 //!   axis ([`FovAxis`]) and the film's reconstruction filters
@@ -122,6 +125,7 @@ pub mod face;
 pub mod forest;
 pub mod form_factor;
 pub mod geometry;
+pub mod glossy_fit;
 pub mod ids;
 pub mod limits;
 mod patch;

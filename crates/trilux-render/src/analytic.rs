@@ -16,7 +16,8 @@ use trilux_geometry::FaceElement;
 
 use crate::link_sum::LinkCache;
 use crate::records::{
-    BsdfSample, GatherStats, LightSample, LinkVisibility, PunctualSample, SkyRay, SurfacePoint,
+    BsdfSample, FitSite, GatherStats, LightSample, LinkVisibility, PunctualSample, SkyRay,
+    SurfacePoint,
 };
 use crate::scene::{GatherScene, SolutionGather};
 
@@ -92,12 +93,12 @@ macro_rules! path_gather_only {
             ) -> Option<DVec3> {
                 None
             }
-            fn mirror(
+            fn fit_sites(
                 &self,
                 _at: &SurfacePoint<$locator>,
                 _wo: DVec3,
-            ) -> Option<(DVec3, Spectrum<N>)> {
-                None
+            ) -> Vec<FitSite<$locator>> {
+                Vec::new()
             }
         }
     };

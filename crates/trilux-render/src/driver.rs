@@ -20,8 +20,11 @@ use crate::error::RenderError;
 use crate::film::Film;
 use crate::filter::ReconstructionFilter;
 use crate::gather::{ExtraBounce, FinalGather};
+use crate::glossy_fit::GlossyFits;
+use crate::glossy_irradiance::GlossyIrradiance;
 use crate::image::Image;
-use crate::link_gather::{Caches, LinkGather, Preview};
+use crate::link_gather::{Caches, LinkGather};
+use crate::preview::Preview;
 use crate::records::GatherStats;
 use crate::sampler::{MAX_SAMPLES, PixelSampler, dims};
 use crate::scene::SolutionGather;
@@ -41,8 +44,9 @@ pub enum Estimator {
     /// (or one bounce later, by the extra-bounce rule). The default.
     #[default]
     Paths,
-    /// No random rays: the links with their own visibility, one mirror
-    /// reading for glossy parts (`link_gather::Preview`).
+    /// No random rays at the pixel: the links with their own visibility,
+    /// and glossy parts read from the directional bake's representation
+    /// fitted at element corners (`preview::Preview`, `glossy_fit`).
     Preview,
     /// The solution as a control variate: its lookups along
     /// [`RenderSettings::lookups`] gather rays plus a path-traced residual;
@@ -204,6 +208,8 @@ impl<'a, S> Estimators<'a, S> {
             preview: Preview {
                 scene,
                 hide_emitters,
+                fits: GlossyFits::default(),
+                glossy_senders: GlossyIrradiance::default(),
             },
         }
     }

@@ -33,6 +33,10 @@
 //! - [`gather`]: the path gather of paper §4.5 (the default estimator).
 //! - [`link_gather`]: rendering from the solution's gather links, and the
 //!   noise-free preview.
+//! - [`glossy_fit`]: the preview's glossy light, fitted per corner of a
+//!   leaf element as the directional bake fits it per vertex, cached.
+//! - [`glossy_irradiance`]: the preview's light from glossy senders onto
+//!   Lambertian parts, per corner, cached likewise.
 //! - [`control`]: the solution as a control variate (lookups plus a
 //!   path-traced residual): unbiased whatever the solution's error.
 //! - [`solved`]: [`GatherScene`] and [`SolutionGather`] for trilux's
@@ -60,10 +64,13 @@ pub mod error;
 pub mod film;
 pub mod filter;
 pub mod gather;
+pub mod glossy_fit;
+pub mod glossy_irradiance;
 pub mod image;
 pub mod link_gather;
 pub mod link_sum;
 pub mod mis;
+pub mod preview;
 pub mod records;
 pub mod sampler;
 pub mod scene;
@@ -82,7 +89,8 @@ pub use gather::ExtraBounce;
 pub use image::Image;
 pub use mis::{power_heuristic, punctual_direct};
 pub use records::{
-    BsdfSample, GatherStats, LightSample, LinkVisibility, PunctualSample, SkyRay, SurfacePoint,
+    BsdfSample, FitKey, FitSite, GatherStats, LightSample, LinkVisibility, PunctualSample, SkyRay,
+    SurfacePoint,
 };
 pub use sampler::PixelSampler;
 pub use scene::{GatherScene, SolutionGather};

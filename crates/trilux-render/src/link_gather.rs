@@ -34,15 +34,18 @@
 //!   takes it with its light sample and its gather ray's misses
 //!   (`crate::mis`).
 //!
-//! [`Preview`] drops every random ray: the link sum with the links' own
-//! visibility at x_s, and for a glossy x_s the direct light by a fixed
-//! quadrature over the emitters plus one mirror-direction reading of the
-//! solution's reflected light. A noise-free (not shadow-exact) view for
+//! `preview::Preview` drops every random ray at the pixel: the link sum with the
+//! links' own visibility at x_s plus E_g read at the corners of x_s's
+//! leaf element (module `glossy_irradiance`), and for a glossy x_s the directional
+//! bake's representation of L_glossy (harmonics plus a lobe fitted at the
+//! corners of x_s's leaf element, made once per corner with fixed seeds
+//! and shared: module `glossy_fit`), so that the preview and a viewer of
+//! the bake read the same light. A noise-free (not shadow-exact) view for
 //! walkthroughs.
 //!
 //! [`link_sum`]: crate::link_sum
 
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 
 use crate::gather::FinalGather;
 use crate::link_sum::LinkCache;
@@ -50,7 +53,7 @@ use crate::mis::{
     eye_hit, hit_emission, light_sample, miss_emission, punctual_direct, sky_sample, sky_seen,
 };
 use crate::records::{GatherStats, LinkVisibility, SurfacePoint};
-use crate::sampler::{PixelSampler, dims, hammersley};
+use crate::sampler::{PixelSampler, dims};
 use crate::scene::SolutionGather;
 use trilux_color::Spectrum;
 
@@ -167,7 +170,8 @@ impl<S> LinkGather<'_, S> {
     /// them (for directional bakes): `counts.gather` BSDF-sampled gather
     /// rays, sample k drawn from the lobe of direction ⌊(k + u)·D/K⌋ (the
     /// strata together draw from the mixture of all D lobes), and
-    /// `counts.light` light samples. Every sample serves every direction,
+    /// `counts.light` light samples (each with a sky sample, where there is a
+    /// sky: the sky as `light_sample` takes it). Every sample serves every direction,
     /// weighted by the balance heuristic over the lobe mixture and light
     /// sampling (Veach's multi-sample estimator, unbiased): what a sample
     /// brings (the gather hit read as [`LinkGather::glossy_sample`] reads
@@ -213,6 +217,11 @@ impl<S> LinkGather<'_, S> {
             }
             stats.gather_rays += 1;
             let Some(xd) = scene.intersect(x.point, bs.wi) else {
+                // The sky (through any panes), balanced against its samples.
+                let (le, p_sky) = scene.sky(x.point, bs.wi);
+                if !le.is_black() {
+                    add(&fan, le * (1.0 / (ng * p_mix + nl * p_sky)));
+                }
                 continue;
             };
             let back = -bs.wi;
@@ -240,6 +249,12 @@ impl<S> LinkGather<'_, S> {
             if let Some((wi, le, p_light)) = unoccluded_light(scene, x, pick, u, stats) {
                 let p_mix = scene.glossy_fan(x, wi, wos, &mut fan);
                 add(&fan, le * (1.0 / (nl * p_light + ng * p_mix)));
+            }
+            // With a sky, one sky sample beside each light sample, as
+            // `light_sample` takes.
+            if let Some((wi, le, p_sky)) = unoccluded_sky(scene, x, u, stats) {
+                let p_mix = scene.glossy_fan(x, wi, wos, &mut fan);
+                add(&fan, le * (1.0 / (nl * p_sky + ng * p_mix)));
             }
         }
         // Lights without area: one shadow ray each, no MIS (no ray meets
@@ -465,83 +480,22 @@ fn unoccluded_light<S: SolutionGather<N>, const N: usize>(
     Some((d / dist, ls.radiance * tau, ls.pdf_area * dist2 / cos_light))
 }
 
-/// The preview estimator: no random rays (module docs).
-pub struct Preview<'a, S> {
-    /// The scene and its solution.
-    pub scene: &'a S,
-    /// Camera rays that meet an emitter count as misses
-    /// (`RenderSettings::hide_emitters`).
-    pub hide_emitters: bool,
-}
-
-impl<S> Preview<'_, S> {
-    /// Radiance arriving at the eye along a camera ray, without random
-    /// rays.
-    pub fn camera_sample<const N: usize>(
-        &self,
-        origin: DVec3,
-        dir: DVec3,
-        caches: &mut Caches<N>,
-        stats: &mut GatherStats,
-    ) -> Spectrum<N>
-    where
-        S: SolutionGather<N>,
-    {
-        stats.camera_rays += 1;
-        let scene = self.scene;
-        let Some(xs) = eye_hit(scene, origin, dir, self.hide_emitters) else {
-            return Spectrum::zero();
-        };
-        let wo = -dir;
-        let through = scene.through(&xs);
-        let mut l = scene.emitted(&xs, wo);
-        let rho = scene.diffuse_albedo(&xs, wo);
-        if !rho.is_black()
-            && let Some(e) =
-                scene.solution_irradiance(&xs, wo, LinkVisibility::Cached, &mut caches.pixel, stats)
-        {
-            l += rho * e;
-        }
-        if scene.is_glossy(&xs, wo) {
-            l += preview_direct(scene, &xs, wo, stats);
-            if let Some((wi, albedo)) = scene.mirror(&xs, wo)
-                && let Some(xd) = scene.intersect(xs.point, wi)
-            {
-                stats.gather_rays += 1;
-                let reflected = lambertian_at(scene, &xd, -wi, &mut caches.scratch, stats)
-                    .map_or_else(
-                        || scene.reflected(&xd, &xs),
-                        |l| l + scene.reflected_glossy(&xd, &xs),
-                    );
-                l += albedo * reflected * scene.through(&xd);
-            }
-        }
-        stats.finite_or_dropped(l * through)
-    }
-}
-
-/// Light points per glossy preview hit.
-const PREVIEW_LIGHT_POINTS: u32 = 16;
-
-/// The direct light a glossy part at `x` reflects towards `wo`, by a fixed
-/// quadrature over the emitters (the same [`PREVIEW_LIGHT_POINTS`] points
-/// of a Hammersley set at every pixel: no noise, and highlights of rough
-/// lobes; a narrow lobe sees the points as separate glints).
-fn preview_direct<S: SolutionGather<N>, const N: usize>(
+/// A sky sample at `x` drawn with `u`: its direction, its radiance times
+/// the panes' fraction and its solid-angle density (`None` without a sky,
+/// or hidden).
+fn unoccluded_sky<S: SolutionGather<N>, const N: usize>(
     scene: &S,
     x: &SurfacePoint<S::Locator>,
-    wo: DVec3,
+    u: DVec2,
     stats: &mut GatherStats,
-) -> Spectrum<N> {
-    let mut sum = Spectrum::zero();
-    for k in 0..PREVIEW_LIGHT_POINTS {
-        let u = hammersley(k, PREVIEW_LIGHT_POINTS);
-        let pick = (0.5 + f64::from(k) * 0.618_033_988_749_895).fract();
-        let fr = |wi| scene.glossy_cos(x, wi, wo);
-        sum += light_sample(scene, x, wo, pick, u, fr, false, stats);
+) -> Option<(DVec3, Spectrum<N>, f64)> {
+    let s = scene.sample_sky(x, u)?;
+    if !(s.pdf > 0.0 && s.pdf.is_finite()) || s.radiance.is_black() {
+        return None;
     }
-    let fr = |wi| scene.glossy_cos(x, wi, wo);
-    sum * (1.0 / f64::from(PREVIEW_LIGHT_POINTS)) + punctual_direct(scene, x, fr, stats)
+    stats.shadow_rays += 1;
+    let tau = scene.transmittance(x, s.end);
+    (tau > 0.0).then(|| (s.wi, s.radiance * tau, s.pdf))
 }
 
 /// ρ_d(xd) times the link sum at `xd` with the links' own visibility

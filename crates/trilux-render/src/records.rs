@@ -1,7 +1,8 @@
 //! The records the final gather passes between a scene and its estimators
 //! (Mitsuba 3 keeps its in `records.h`): a hit ([`SurfacePoint`]), a point
 //! sampled on a light ([`LightSample`]), a direction sampled from a BSDF
-//! ([`BsdfSample`]), how a link sum treats partial visibility
+//! ([`BsdfSample`]), a corner where the preview fits glossy light
+//! ([`FitSite`]), how a link sum treats partial visibility
 //! ([`LinkVisibility`]) and the counters of a render ([`GatherStats`]).
 //!
 //! A leaf: it names no estimator and no scene, so that the scene traits
@@ -24,6 +25,63 @@ pub struct SurfacePoint<L> {
     /// What the scene needs to find this point's material, emitter and
     /// solution elements again (for trilux: surface id and surface coordinate).
     pub locator: L,
+}
+
+/// A point where the preview fits the glossy light (a corner of the leaf
+/// element around a hit), its weight in the hit's interpolation and the
+/// key that names it in the scene (`link_gather`'s fit cache; it also
+/// seeds the fit's samples).
+#[derive(Clone, Copy, Debug)]
+pub struct FitSite<L> {
+    /// The corner as a surface point (`t` zero).
+    pub point: SurfacePoint<L>,
+    /// Its interpolation weight at the hit (the weights of a hit's sites
+    /// sum to 1).
+    pub weight: f64,
+    /// The same number for the same corner seen from any element sharing
+    /// it, on the same side; a different one for every other.
+    pub key: FitKey,
+}
+
+/// What names a fitted corner ([`FitSite::key`]): the shape, the side,
+/// the position and the shading normal rounded to f32 (so that elements
+/// sharing a corner share its fit, and a crease keeps one per normal).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct FitKey {
+    /// Index of the scene shape.
+    pub shape: u32,
+    /// True on the back side.
+    pub back: bool,
+    /// The position's coordinates as f32 bits (−0 as +0).
+    pub position: [u32; 3],
+    /// The unit shading normal's coordinates as f32 bits.
+    pub normal: [u32; 3],
+}
+
+impl FitKey {
+    /// The key of a corner of `shape` at `position` with unit shading
+    /// normal `normal`, on the back side or not.
+    pub fn new(shape: u32, back: bool, position: DVec3, normal: DVec3) -> Self {
+        let bits = |v: DVec3| v.as_vec3().to_array().map(|x| (x + 0.0).to_bits());
+        FitKey {
+            shape,
+            back,
+            position: bits(position),
+            normal: bits(normal),
+        }
+    }
+
+    /// A 64-bit number of the key (FNV-1a over its words: the same on
+    /// every run and machine), to seed the fit's samples.
+    pub fn seed(&self) -> u64 {
+        let words = [self.shape, u32::from(self.back)]
+            .into_iter()
+            .chain(self.position)
+            .chain(self.normal);
+        words.fold(0xcbf2_9ce4_8422_2325, |h, w| {
+            (h ^ u64::from(w)).wrapping_mul(0x0100_0000_01b3)
+        })
+    }
 }
 
 /// A point sampled on an emitter for light sampling.

@@ -22,7 +22,8 @@ use trilux_geometry::FaceElement;
 
 use crate::link_sum::LinkCache;
 use crate::records::{
-    BsdfSample, GatherStats, LightSample, LinkVisibility, PunctualSample, SkyRay, SurfacePoint,
+    BsdfSample, FitSite, GatherStats, LightSample, LinkVisibility, PunctualSample, SkyRay,
+    SurfacePoint,
 };
 
 /// Everything the path gather needs from a scene and its solution.
@@ -219,7 +220,11 @@ pub trait SolutionGather<const N: usize>: GatherScene<N> {
     fn sample_cosine(&self, at: &SurfacePoint<Self::Locator>, wo: DVec3, u: DVec2)
     -> Option<DVec3>;
 
-    /// The mirror direction of `wo` about the shading normal at `at` and
-    /// the glossy part's directional albedo there (for previews).
-    fn mirror(&self, at: &SurfacePoint<Self::Locator>, wo: DVec3) -> Option<(DVec3, Spectrum<N>)>;
+    /// Where the preview fits the glossy light around `at` seen from `wo`
+    /// (`glossy_fit`): the corners of the leaf element containing `at`
+    /// (of the triangle of its mesh piece, or of its (u, v) rectangle)
+    /// with `at`'s barycentric or bilinear weights, on the side of `wo`.
+    /// Empty where the scene has no elements to fit at.
+    fn fit_sites(&self, at: &SurfacePoint<Self::Locator>, wo: DVec3)
+    -> Vec<FitSite<Self::Locator>>;
 }

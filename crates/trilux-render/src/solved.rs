@@ -32,16 +32,16 @@ use glam::{DVec2, DVec3};
 use trilux_brdf::{Bsdf, Frame, Shading, TangentFrame};
 use trilux_color::Spectrum;
 use trilux_geometry::{
-    ElementForest, ElementId, FaceElement, FaceId, Geometry, Hit, Ray, Side, SurfaceCoord,
-    SurfaceId,
+    ElementDomain, ElementForest, ElementId, FaceElement, FaceId, Geometry, Hit, Piece, Ray, Side,
+    SurfaceCoord, SurfaceId,
 };
 use trilux_solver::{PreparedScene, SurfaceSite};
 
 use crate::link_sum::{LinkCache, LinkField, Receiver, link_sum};
 use crate::records::{
-    BsdfSample, GatherStats, LightSample, LinkVisibility, PunctualSample, SkyRay, SurfacePoint,
+    BsdfSample, FitKey, FitSite, GatherStats, LightSample, LinkVisibility, PunctualSample, SkyRay,
+    SurfacePoint,
 };
-use crate::sampler::hammersley;
 use crate::scene::{GatherScene, SolutionGather};
 use crate::solution::RadianceSolution;
 
@@ -540,31 +540,153 @@ impl<const N: usize, S: RadianceSolution<N>> SolutionGather<N> for SolvedScene<'
         self.solution.has_links()
     }
 
-    fn mirror(&self, at: &SurfacePoint<HitLocator>, wo: DVec3) -> Option<(DVec3, Spectrum<N>)> {
-        let n = at.locator.shading_normal;
-        let wi = 2.0 * n.dot(wo) * n - wo;
-        if wi.dot(at.normal) * wo.dot(at.normal) <= 0.0 {
-            return None;
-        }
-        let frame = Frame::from_normal(n);
-        let bsdf = self.bsdf(at);
-        // The albedo by a fixed quadrature of the BSDF's own sampling (the
-        // exact integral, `Bsdf::albedo`, costs ~28k evaluations a call).
-        let local = frame.to_local(wo);
-        let albedo: Spectrum<N> = (0..MIRROR_ALBEDO_POINTS)
-            .filter_map(|k| bsdf.sample(local, hammersley(k, MIRROR_ALBEDO_POINTS)))
-            .map(|s| s.weight)
-            .sum::<Spectrum<N>>()
-            * (1.0 / f64::from(MIRROR_ALBEDO_POINTS));
-        let glossy = albedo - bsdf.diffuse_albedo(viewer_side(at, wo));
-        Some((wi, glossy.max(Spectrum::zero())))
+    fn fit_sites(&self, at: &SurfacePoint<HitLocator>, wo: DVec3) -> Vec<FitSite<HitLocator>> {
+        let forest = self.solution.forest();
+        let l = at.locator;
+        let leaf = forest.locate(l.surface, l.coord);
+        let corners = match (forest.element(leaf).domain, l.coord) {
+            (ElementDomain::Rect { min, max }, SurfaceCoord::Uv(p)) => rect_corners(min, max, p),
+            (ElementDomain::Cluster { .. }, SurfaceCoord::Triangle { index, bary }) => {
+                piece_corners(forest.element_pieces(leaf), index, bary)
+            }
+            _ => Vec::new(),
+        };
+        let back = viewer_side(at, wo) == Side::Back;
+        corners
+            .into_iter()
+            .filter(|&(_, weight)| weight > 0.0)
+            .filter_map(|(coord, weight)| {
+                // The bake's vertex normal: the geometric one (module
+                // `tessellate` of trilux-bake).
+                let p = self.geom().surface_point(l.surface, coord)?;
+                Some(FitSite {
+                    point: SurfacePoint {
+                        point: p.point,
+                        normal: p.normal,
+                        t: 0.0,
+                        locator: HitLocator {
+                            coord,
+                            shading_normal: p.normal,
+                            ..l
+                        },
+                    },
+                    weight,
+                    key: FitKey::new(l.shape, back, p.point, p.normal),
+                })
+            })
+            .collect()
     }
 }
 
-/// BSDF samples of the preview's albedo estimate ([`SolutionGather::mirror`]).
-const MIRROR_ALBEDO_POINTS: u32 = 16;
+/// The corners of the (u, v) rectangle [min, max] and the bilinear
+/// weights of `p` in it.
+fn rect_corners(min: DVec2, max: DVec2, p: DVec2) -> Vec<(SurfaceCoord, f64)> {
+    let size = max - min;
+    let t = ((p - min) / size.max(DVec2::splat(f64::MIN_POSITIVE))).clamp(DVec2::ZERO, DVec2::ONE);
+    vec![
+        (SurfaceCoord::Uv(min), (1.0 - t.x) * (1.0 - t.y)),
+        (
+            SurfaceCoord::Uv(DVec2::new(max.x, min.y)),
+            t.x * (1.0 - t.y),
+        ),
+        (SurfaceCoord::Uv(max), t.x * t.y),
+        (
+            SurfaceCoord::Uv(DVec2::new(min.x, max.y)),
+            (1.0 - t.x) * t.y,
+        ),
+    ]
+}
+
+/// The corners of the piece of triangle `index` that holds `bary` (the
+/// one it lies deepest inside, when rounding puts it on none) and its
+/// barycentric weights there.
+fn piece_corners(pieces: &[Piece], index: u32, bary: DVec2) -> Vec<(SurfaceCoord, f64)> {
+    let weights = |c: &[DVec2; 3]| {
+        let (e1, e2, d) = (c[1] - c[0], c[2] - c[0], bary - c[0]);
+        let det = e1.perp_dot(e2);
+        if det.abs() <= f64::MIN_POSITIVE {
+            return [1.0, 0.0, 0.0];
+        }
+        let (w1, w2) = (d.perp_dot(e2) / det, e1.perp_dot(d) / det);
+        [1.0 - w1 - w2, w1, w2]
+    };
+    let inside = |w: &[f64; 3]| w.iter().copied().fold(f64::INFINITY, f64::min);
+    let best = pieces
+        .iter()
+        .filter(|p| p.triangle == index)
+        .map(|p| (p, weights(&p.bary)))
+        .max_by(|a, b| inside(&a.1).total_cmp(&inside(&b.1)));
+    let Some((piece, w)) = best else {
+        return Vec::new();
+    };
+    // Clamped into the piece and renormalised.
+    let w = w.map(|x| x.max(0.0));
+    let sum = w.iter().sum::<f64>().max(f64::MIN_POSITIVE);
+    (0..3)
+        .map(|k| {
+            let coord = SurfaceCoord::Triangle {
+                index,
+                bary: piece.bary[k],
+            };
+            (coord, w[k] / sum)
+        })
+        .collect()
+}
 
 /// The side of `at`'s surface the viewer direction `wo` is on (geometric).
 fn viewer_side(at: &SurfacePoint<HitLocator>, wo: DVec3) -> Side {
     Side::from_back(at.normal.dot(wo) < 0.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The corners' weights are an interpolation: non-negative, summing to
+    /// one, and reproducing the point (Σ w_k c_k = p), for a rectangle
+    /// and for a piece of a triangle, whichever piece of the triangle the
+    /// point lies in.
+    #[test]
+    fn corner_weights_interpolate_the_point() {
+        let at = |c: SurfaceCoord| match c {
+            SurfaceCoord::Uv(p) | SurfaceCoord::Triangle { bary: p, .. } => p,
+        };
+        let check = |corners: Vec<(SurfaceCoord, f64)>, p: DVec2| {
+            assert!(!corners.is_empty());
+            let sum: f64 = corners.iter().map(|c| c.1).sum();
+            let mean: DVec2 = corners.iter().map(|&(c, w)| at(c) * w).sum();
+            assert!(corners.iter().all(|c| c.1 >= 0.0), "{corners:?}");
+            assert!((sum - 1.0).abs() < 1e-12, "{sum}");
+            assert!((mean - p).length() < 1e-12, "{mean} vs {p}");
+        };
+        let (min, max) = (DVec2::new(0.25, 0.5), DVec2::new(0.5, 0.75));
+        for p in [DVec2::new(0.3, 0.6), min, max, DVec2::new(0.49, 0.51)] {
+            check(rect_corners(min, max, p), p);
+        }
+        // Triangle 7 split into its four midpoint pieces, and another
+        // triangle's piece that must not be taken.
+        let (a, b, c) = (DVec2::ZERO, DVec2::X, DVec2::Y);
+        let (ab, bc, ca) = ((a + b) / 2.0, (b + c) / 2.0, (c + a) / 2.0);
+        let piece = |triangle, bary| Piece { triangle, bary };
+        let pieces = [
+            piece(3, [a, b, c]),
+            piece(7, [a, ab, ca]),
+            piece(7, [ab, b, bc]),
+            piece(7, [ca, bc, c]),
+            piece(7, [bc, ca, ab]),
+        ];
+        for p in [
+            DVec2::new(0.1, 0.1),
+            DVec2::new(0.6, 0.2),
+            DVec2::new(0.3, 0.3),
+        ] {
+            let corners = piece_corners(&pieces, 7, p);
+            assert!(
+                corners
+                    .iter()
+                    .all(|c| matches!(c.0, SurfaceCoord::Triangle { index: 7, .. }))
+            );
+            check(corners, p);
+        }
+    }
 }

@@ -13,11 +13,16 @@ use trilux_brdf::{Bsdf, BsdfParams, Distribution, RoughConductorParams};
 use trilux_color::{ColorParam, Spectrum};
 use trilux_geometry::FaceElement;
 use trilux_render::camera::look_at;
+use trilux_render::gather::FinalGather;
+use trilux_render::glossy_fit::{FIT_SAMPLES, GlossyFits, fit_point, fit_sampler};
+use trilux_render::glossy_irradiance::GlossyIrradiance;
+use trilux_render::link_gather::{Caches, IncidentSamples, LinkGather};
 use trilux_render::link_sum::LinkCache;
+use trilux_render::preview::Preview;
 use trilux_render::{
-    BsdfSample, Camera, Estimator, ExtraBounce, FovAxis, GatherScene, GatherStats, LightSample,
-    LinkVisibility, ReconstructionFilter, RenderSettings, SkyRay, SolutionGather, SurfacePoint,
-    render_image,
+    BsdfSample, Camera, ExtraBounce, FitKey, FitSite, FovAxis, GatherScene, GatherStats,
+    LightSample, LinkVisibility, ReconstructionFilter, RenderSettings, SkyRay, SolutionGather,
+    SurfacePoint, render_image,
 };
 
 /// Floor z = 0 with a glossy BSDF (normal +z: world = local frame) under a
@@ -213,19 +218,75 @@ impl SolutionGather<3> for GlossyFloor {
     fn sample_cosine(&self, _: &SurfacePoint<u8>, _: DVec3, _: DVec2) -> Option<DVec3> {
         None
     }
-    fn mirror(&self, _: &SurfacePoint<u8>, _: DVec3) -> Option<(DVec3, Spectrum<3>)> {
-        None
+    fn fit_sites(&self, _: &SurfacePoint<u8>, _: DVec3) -> Vec<FitSite<u8>> {
+        Vec::new()
     }
 }
 
-/// The preview's fixed 16-point quadrature of a glossy floor's direct
-/// light against brute force, for lobes wide enough that 16 points over
-/// the light resolve them (α ≥ 0.3; docs/rendering.md says a narrow lobe
-/// sees the points as separate glints). Tolerance 5 %: the preview's stated
-/// accuracy for rough lobes; it has no noise, so the bound is the
-/// quadrature's error alone.
+/// The preview's glossy reading of a floor point: the bake's form fitted
+/// at the point (the floor has no elements, so no corners) from
+/// `counts` incident samples, evaluated towards the eye.
+fn preview_at(scene: &GlossyFloor, fits: GlossyFits, eye: DVec3, target: DVec3) -> f64 {
+    let preview = Preview {
+        scene,
+        hide_emitters: false,
+        fits,
+        glossy_senders: GlossyIrradiance::default(),
+    };
+    let (mut caches, mut stats) = (Caches::<3>::default(), GatherStats::default());
+    let dir = (target - eye).normalize();
+    preview.camera_sample(eye, dir, &mut caches, &mut stats).0[0]
+}
+
+/// The preview's glossy light is the bake's representation: at a hit it
+/// equals, to rounding, the harmonics-plus-lobe fit that `fit_point` (the
+/// bake's estimator and fitting code) makes there with the bake's counts
+/// and directions and the hit's own seed, evaluated towards the eye. A
+/// preview that read anything else (the old mirror reading, another
+/// seed, the fit towards another direction) differs by far more.
 #[test]
-fn preview_glossy_direct_light_matches_brute_force() {
+fn preview_reads_the_fit_the_bake_makes() {
+    use trilux_geometry::glossy_fit::FIT_DIRECTIONS;
+    use trilux_geometry::glossy_fit::lobe::lobe_eval;
+    let scene = GlossyFloor::new(Distribution::Ggx, 0.2);
+    let (eye, target) = (DVec3::new(1.0, -0.5, 0.9), DVec3::new(0.3, 0.1, 0.0));
+    let got = preview_at(&scene, GlossyFits::default(), eye, target);
+    let dir = (target - eye).normalize();
+    let xs = scene.intersect(eye, dir).unwrap();
+    let gather = LinkGather {
+        scene: &scene,
+        fallback: FinalGather {
+            scene: &scene,
+            extra: ExtraBounce::default(),
+            hide_emitters: false,
+        },
+        glossy_scene: true,
+    };
+    let key = FitKey::new(u32::MAX, false, xs.point, xs.normal);
+    let mut sampler = fit_sampler(key.seed());
+    let mut stats = GatherStats::default();
+    let sizes = (FIT_SAMPLES, FIT_DIRECTIONS);
+    let record = fit_point(&gather, &xs, xs.normal, sizes, &mut sampler, &mut stats).unwrap();
+    let expected = lobe_eval(&record, -dir)[0].max(0.0);
+    assert!(expected > 0.05, "{expected} too dark to test");
+    assert!(
+        (got - expected).abs() <= 1e-12 * expected,
+        "preview {got}, fit {expected}"
+    );
+}
+
+/// The preview's glossy light converges to the form fitted to the exact
+/// light: with enough incident samples (4096 + 4096 a fit) the preview
+/// towards the eye is within 3 % of the harmonics-plus-lobe fit of the
+/// brute-force values towards the fit's 96 directions, evaluated towards
+/// the eye (what is left is the samples' noise; a wrong weight, frame,
+/// side or interpolation shows as tens of percent). The form's own error
+/// against brute force towards the eye is another matter, printed here:
+/// +7.6 % for GGX α = 0.5 at this point (docs/results.md, "The preview").
+#[test]
+fn preview_glossy_light_converges_to_the_fit_of_the_exact_light() {
+    use trilux_geometry::glossy_fit::lobe::{fit_lobe, lobe_eval};
+    use trilux_geometry::glossy_fit::sh::hemisphere_directions;
     for (dist, alpha, target) in [
         (Distribution::Beckmann, 0.3, DVec3::new(0.6, -0.1, 0.0)),
         (Distribution::Ggx, 0.5, DVec3::new(1.2, 0.4, 0.0)),
@@ -233,30 +294,27 @@ fn preview_glossy_direct_light_matches_brute_force() {
     ] {
         let scene = GlossyFloor::new(dist, alpha);
         let eye = DVec3::new(target.x * 2.0 + 0.4, target.y * 2.0 - 0.3, 0.9);
-        let cam = Camera::new(
-            look_at(eye, target, DVec3::Z).unwrap(),
-            0.01,
-            FovAxis::X,
-            1,
-            1,
-        )
-        .unwrap();
-        let settings = RenderSettings {
-            spp: 1,
-            filter: ReconstructionFilter::Box,
-            estimator: Estimator::Preview,
-            ..Default::default()
+        let counts = IncidentSamples {
+            gather: 4096,
+            light: 4096,
+            links: false,
         };
-        let (img, _) = render_image::<_, 3>(&scene, &cam, &settings, |l| l.0, |_, _| {}).unwrap();
-        let expected = scene.brute_force(target, (eye - target).normalize());
-        let got = img.get(0, 0)[0] as f64;
-        assert!(
-            expected > 0.05,
-            "{dist:?} {alpha}: {expected} too dark to test"
+        let got = preview_at(&scene, GlossyFits::new(counts, 96), eye, target);
+        let dirs = hemisphere_directions(DVec3::Z, 96);
+        let exact: Vec<[f64; 3]> = dirs
+            .iter()
+            .map(|&d| [scene.brute_force(target, d); 3])
+            .collect();
+        let wo = (eye - target).normalize();
+        let fitted = lobe_eval(&fit_lobe(&dirs, &exact).unwrap(), wo)[0].max(0.0);
+        let truth = scene.brute_force(target, wo);
+        println!(
+            "{dist:?} α={alpha}: preview {got}, fit of the exact light {fitted}, exact {truth}"
         );
+        assert!(fitted > 0.05, "{dist:?} {alpha}: {fitted} too dark to test");
         assert!(
-            (got - expected).abs() < 0.05 * expected,
-            "{dist:?} α={alpha}: preview {got}, brute force {expected}"
+            (got - fitted).abs() < 0.03 * fitted,
+            "{dist:?} α={alpha}: preview {got}, fit of the exact light {fitted}"
         );
     }
 }
@@ -310,8 +368,6 @@ fn glossy_direct_light_matches_brute_force() {
 /// direction.
 #[test]
 fn shared_incident_samples_match_brute_force_in_every_direction() {
-    use trilux_render::gather::FinalGather;
-    use trilux_render::link_gather::{Caches, IncidentSamples, LinkGather};
     for (dist, alpha, x) in [
         (Distribution::Ggx, 0.1, DVec3::new(0.3, 0.2, 0.0)),
         (Distribution::Beckmann, 0.3, DVec3::new(0.6, -0.1, 0.0)),

@@ -6,14 +6,18 @@
 //! read as the full render reads it, through its links and one more
 //! glossy level). The bake's glossy light is thus the full render's,
 //! fitted; each sample's cost is paid once per point, not per direction.
+//! Its samples are seeded as the preview's fits are
+//! (`trilux_render::glossy_fit::fit_sampler`), which fit the same form at
+//! the corners of leaf elements.
 
 use glam::DVec3;
 use rayon::prelude::*;
 use trilux_bake::{GlossyLight, GlossyPoint, GlossySamples};
 use trilux_render::gather::{ExtraBounce, FinalGather};
+use trilux_render::glossy_fit::fit_sampler;
 use trilux_render::link_gather::{Caches, IncidentSamples, LinkGather};
 use trilux_render::solved::HitLocator;
-use trilux_render::{GatherStats, PixelSampler, SolvedScene, SurfacePoint};
+use trilux_render::{GatherStats, SolvedScene, SurfacePoint};
 use trilux_solver::Solution;
 
 /// The render's glossy light over a solution.
@@ -58,9 +62,7 @@ impl<'a, const N: usize> RenderedGlossy<'a, N> {
             },
         };
         let mut stats = GatherStats::default();
-        // The seed folds the point's key into the sampler's two indices.
-        let (lo, hi) = (p.key as u32, (p.key >> 32) as u32);
-        let mut sampler = PixelSampler::new(hi ^ 0x9e37_79b9, lo, 0);
+        let mut sampler = fit_sampler(p.key);
         let counts = IncidentSamples {
             gather: samples.gather,
             light: samples.light,

@@ -350,19 +350,7 @@ impl Walk<'_> {
         }
         let shape = self.shapes.len();
         let location = SourceLocation::json(self.file, format!("/nodes/{}", node.index()));
-        let emitter = mapped
-            .emission
-            .clone()
-            .map(|radiance: ColorParam| AreaEmitter {
-                radiance,
-                location: SourceLocation::json(
-                    self.file,
-                    format!(
-                        "/materials/{}/emissiveFactor",
-                        key.map_or("-".into(), |k| k.to_string())
-                    ),
-                ),
-            });
+        let emitter = emitter(self.file, mapped, key);
         self.textures
             .extend(mapped.uses().map(|t| (shape, t.clone())));
         let bsdf: BsdfParams = mapped.bsdf.clone();
@@ -388,6 +376,23 @@ impl Walk<'_> {
         });
         Ok(())
     }
+}
+
+/// The area emitter of a mapped material, if it emits.
+fn emitter(file: &Arc<Path>, mapped: &Mapped, key: Option<usize>) -> Option<AreaEmitter> {
+    mapped
+        .emission
+        .clone()
+        .map(|radiance: ColorParam| AreaEmitter {
+            radiance,
+            location: SourceLocation::json(
+                file,
+                format!(
+                    "/materials/{}/emissiveFactor",
+                    key.map_or("-".into(), |k| k.to_string())
+                ),
+            ),
+        })
 }
 
 /// The camera named `name` (a camera's or its node's name), else the first.

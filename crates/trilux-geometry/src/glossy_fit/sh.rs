@@ -1,6 +1,6 @@
 //! Real spherical harmonics of order 2 and their least-squares fit over
-//! directions: the part of a glossy record both forms share (modules
-//! `directional` and `lobe`).
+//! directions: the part of a glossy record both forms share (the
+//! harmonics alone, and with the lobe of module `lobe`).
 
 use glam::DVec3;
 
@@ -8,7 +8,7 @@ use glam::DVec3;
 pub const SH_COEFFICIENTS: usize = 9;
 
 /// RGB slots of a vertex's glossy record: the order-2 harmonics, then
-/// (form `GlossyForm::Lobe`) the lobe's axis × sharpness and amplitude.
+/// (the lobe form, module `lobe`) the lobe's axis × sharpness and amplitude.
 pub const SLOTS: usize = SH_COEFFICIENTS + 2;
 
 /// A vertex's glossy light in its form's slots.
@@ -32,7 +32,7 @@ pub fn sh_basis(d: DVec3) -> [f64; SH_COEFFICIENTS] {
 }
 
 /// The order-2 harmonics of a record.
-pub(crate) fn sh_part(c: &GlossyRecord) -> [[f64; 3]; SH_COEFFICIENTS] {
+pub fn sh_part(c: &GlossyRecord) -> [[f64; 3]; SH_COEFFICIENTS] {
     std::array::from_fn(|j| c[j])
 }
 

@@ -1,5 +1,5 @@
 //! The glossy light of a vertex as order-2 spherical harmonics plus one
-//! spherical Gaussian lobe (module `directional` chooses it by default):
+//! spherical Gaussian lobe (the bake's default form, the preview's only):
 //!
 //! L_g(ω) = Σ_{j<9} c_j Y_j(ω) + a · exp(v·ω − |v|),
 //!
@@ -18,7 +18,7 @@
 
 use glam::DVec3;
 
-use crate::sh::{GlossyRecord, SH_COEFFICIENTS, SLOTS, cholesky_solve, sh_basis};
+use crate::glossy_fit::sh::{GlossyRecord, SH_COEFFICIENTS, SLOTS, cholesky_solve, sh_basis};
 
 /// Coefficients of the harmonics beside the lobe (order 2).
 const BASE: usize = SH_COEFFICIENTS;
@@ -238,7 +238,7 @@ fn colours(directions: &[DVec3], values: &[[f64; 3]], v: Option<DVec3>) -> Gloss
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sh::{fit_sh, hemisphere_directions, sh_eval};
+    use crate::glossy_fit::sh::{fit_sh, hemisphere_directions, sh_eval};
 
     /// A constant plus a spherical Gaussian whose axis lies between the
     /// sample directions is fitted back: the fitted form matches the data
