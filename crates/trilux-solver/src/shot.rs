@@ -526,7 +526,7 @@ impl<const N: usize> Solver<N> {
         // The glossy share each group reflects into its face's far field
         // (per far block, before the group's renormalisation).
         let far_adds: Vec<Option<Vec<Spectrum<N>>>> = pair_links
-            .iter()
+            .par_iter()
             .zip(incidences)
             .map(|(l, inc)| self.far_reflection(l, inc.as_ref(), shot_scale))
             .collect();
@@ -537,6 +537,8 @@ impl<const N: usize> Solver<N> {
                 }
             }
         }
+        let late = self.past_deadline();
+        let targets = self.glossy_targets(pair_links, incidences, shot_scale, (&glossy_flux, late));
         let mut group_scale =
             vec![(Spectrum::<N>::splat(1.0), Spectrum::splat(1.0)); pair_links.len()];
         let mut total_arrived = Spectrum::<N>::zero();
@@ -556,8 +558,7 @@ impl<const N: usize> Solver<N> {
             // What an element reflects may not exceed what arrived there.
             let room = (arrived - diffuse).max(Spectrum::zero());
             let (glossy, sampled) = (glossy_flux[g], sampled_flux[g]);
-            let late = self.past_deadline();
-            let target = self.glossy_target(l, incidences[g].as_ref(), arrived, (glossy, late));
+            let target = targets[g];
             self.state.stats.late_groups += u64::from(late && target.is_some());
             let scale = crate::glossy::group_scale(target, glossy, sampled, room);
             group_scale[g] = scale;
@@ -632,6 +633,26 @@ impl<const N: usize> Solver<N> {
                 })
                 .collect(),
         )
+    }
+
+    /// Each group's glossy target (`glossy::glossy_target`), in parallel:
+    /// its hemisphere coverage traces rays.
+    fn glossy_targets(
+        &self,
+        pair_links: &[PairLink<N>],
+        incidences: &[Option<Incidence<N>>],
+        shot_scale: Spectrum<N>,
+        (glossy_flux, late): (&[Spectrum<N>], bool),
+    ) -> Vec<Option<Spectrum<N>>> {
+        pair_links
+            .par_iter()
+            .zip(incidences)
+            .zip(glossy_flux)
+            .map(|((l, inc), &glossy)| {
+                let arrived = l.unshot * shot_scale * (PI * l.t);
+                self.glossy_target(l, inc.as_ref(), arrived, (glossy, late))
+            })
+            .collect()
     }
 
     /// The Lambertian share of a pair link: ρ_d (T_ij / A_j) δL into j's

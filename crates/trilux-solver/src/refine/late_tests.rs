@@ -23,7 +23,7 @@ use crate::throughput::ThroughputCache;
 /// so that only the photometric criterion or the deadline stops
 /// refinement.
 fn mirror_scene() -> (Setup<3>, ShotState<3>) {
-    super::triple::tests::mirror_scene(1.0, 1.0, 2, 1e-12)
+    super::triple_tests::mirror_scene(1.0, 1.0, 2, 1e-12)
 }
 
 /// E's shot into hierarchy R → K with photometric threshold `threshold`

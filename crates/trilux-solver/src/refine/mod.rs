@@ -24,7 +24,7 @@
 //! across the parallel tasks of one shot.
 //!
 //! Files, in reading order: `context` (what refinement reads, T through
-//! the cache), `pair` (stage 1), `triple` (stage 2), `incidences` (stage 2's sub-pairs, once per
+//! the cache), `pair` (stage 1), `triple` (stage 2, its tests in `triple_tests`), `incidences` (stage 2's sub-pairs, once per
 //! shot), `narrow_lobe` (the
 //! sampled lobes stage 2 uses). The links and senders are in
 //! `crate::link`.
@@ -36,6 +36,8 @@ mod late_tests;
 mod narrow_lobe;
 mod pair;
 mod triple;
+#[cfg(test)]
+mod triple_tests;
 
 pub(crate) use context::{Lateness, RefineContext};
 pub(crate) use incidences::IncidenceMemo;

@@ -37,10 +37,14 @@ impl<const N: usize> RefineContext<'_, N> {
         if th.t <= 0.0 {
             // Fully occluded or facing away. Near the roots a handful of
             // shadow rays may miss a gap: look one level further there
-            // (not past the deadline).
+            // (not past the deadline), unless all the light the pair could
+            // carry unoccluded, π A_j F_ji δL_i, is below the photometric
+            // threshold.
             if ei.depth + ej.depth < 2
                 && th.v == 0.0
                 && !self.past_deadline()
+                && PI * ej.area * th.f * sender.sent_radiance(self.forest, i, j).sum()
+                    >= self.flux_threshold
                 && self.unoccluded_positive(si.of(i), sj.of(j))
             {
                 self.split_pair(shot, i, j, budget, out);
@@ -297,6 +301,54 @@ mod tests {
             fine.iter().map(key).collect::<Vec<_>>(),
             free.iter().map(key).collect::<Vec<_>>()
         );
+    }
+
+    /// A root pair whose shadow rays are all blocked (a wide plate halfway
+    /// between the plates) is looked into one level down for a gap the
+    /// rays missed, but only when the light it could carry unoccluded,
+    /// π A_j F_ji δL_i, reaches the photometric threshold: below it (late
+    /// shots) no child pair's throughput is made.
+    #[test]
+    fn an_occluded_root_pair_is_retried_only_above_the_threshold() {
+        let shapes = [
+            ts::square(DVec3::new(0.0, 0.0, 1.0), 1.0, true),
+            ts::square(DVec3::ZERO, 1.0, false),
+            ts::square(DVec3::new(0.0, 0.0, 0.5), 3.0, false),
+        ];
+        let setup = ts::setup(
+            &shapes,
+            &[ts::diffuse(0.0), ts::diffuse(0.5), ts::diffuse(0.5)],
+            &[Some(1.0), None, None],
+            ts::settings(2),
+        );
+        let state = ShotState::new(&setup);
+        let unoccluded = PI * 0.199825 * 3.0;
+        for (threshold, retried) in [(1.05 * unoccluded, false), (0.95 * unoccluded, true)] {
+            let cache = ThroughputCache::new(1 << 16);
+            let mut ctx = setup.refine_context(&cache);
+            ctx.flux_threshold = threshold;
+            let (si, sj) = (ts::front(0), ts::front(1));
+            let (ri, rj) = (ts::root(ctx.forest, si), ts::root(ctx.forest, sj));
+            let sender = Sender::Radiosity {
+                field: &state.field,
+                side: si.side(),
+                sent: Sent::Unshot,
+                emission: Spectrum::zero(),
+            };
+            let shot = PairShot {
+                sender: &sender,
+                si,
+                sj,
+            };
+            let mut out = Vec::new();
+            ctx.refine_pair(shot, ri.element, rj.element, 0.0, &mut out);
+            assert!(out.is_empty(), "nothing passes the plate");
+            let th = ctx.throughput(rj, ri);
+            assert_eq!(th.v, 0.0);
+            let child = ctx.forest.element(rj.element).children().unwrap()[0];
+            let made = cache.get(sj.of(child), ri).is_some();
+            assert_eq!(made, retried, "threshold {threshold}");
+        }
     }
 
     /// Parallel, directly opposed unit squares at distance 1 exchange
