@@ -18,7 +18,6 @@ apply).
 
     python3 scenes/normalmap/make_references.py [SPP]   # default 4096
 """
-import json
 import os
 import re
 import sys
@@ -29,6 +28,9 @@ import mitsuba as mi
 
 mi.set_variant("llvm_ad_rgb")
 HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(HERE, "..", "..", "scripts"))
+from mitsuba_passes import render_passes, write_reference  # noqa: E402
+
 SCENES = ["normalmap-box", "bumpmap-box"]
 N = 64
 
@@ -59,11 +61,7 @@ def render(path, spp, passes, shadowing):
         scene = mi.load_file(tmp)
     finally:
         os.remove(tmp)
-    images = []
-    for k in range(passes):
-        img = mi.render(scene, spp=spp // passes, seed=k)
-        images.append(np.array(img, dtype=np.float64)[..., :3])
-    return np.array(images)
+    return render_passes(scene, spp, passes)
 
 
 def main():
@@ -73,26 +71,12 @@ def main():
     for name in sys.argv[2:] or SCENES:
         path = os.path.join(HERE, name + ".xml")
         images = render(path, spp, passes, False)
-        means = images.reshape(passes, -1, 3).mean(axis=1)
-        mean = means.mean(axis=0)
-        stderr = means.std(axis=0, ddof=1) / np.sqrt(passes) / np.abs(mean)
-        mi.Bitmap(images.mean(axis=0).astype(np.float32)).write(os.path.join(HERE, name + ".exr"))
         shadowed = render(path, spp // 4, passes, True).reshape(passes, -1, 3).mean(axis=(0, 1))
-        rec = {
-            "scene": name + ".xml",
-            "mitsuba": mi.MI_VERSION,
-            "variant": "llvm_ad_rgb",
-            "spp": spp,
-            "passes": passes,
-            "mean_rgb": [round(float(x), 7) for x in mean],
-            "mean_rel_stderr": [round(float(x), 6) for x in stderr],
+        extra = {
             "mean_rgb_use_shadowing_function": [round(float(x), 7) for x in shadowed],
             "spp_use_shadowing_function": spp // 4,
         }
-        with open(os.path.join(HERE, name + ".json"), "w", encoding="utf-8") as f:
-            json.dump(rec, f, indent=2)
-            f.write("\n")
-        print(json.dumps(rec), flush=True)
+        write_reference(HERE, name, name + ".xml", images, spp, extra)
 
 
 if __name__ == "__main__":

@@ -252,7 +252,19 @@ mod tests {
         deadline: Option<std::time::Instant>,
     ) -> (Vec<PairLink<3>>, f64, u64) {
         let cache = ThroughputCache::new(1 << 16);
-        let mut ctx = setup.refine_context(&cache);
+        refine_with(setup, state, &cache, threshold, budget, deadline)
+    }
+
+    /// [`refine_by`] with the throughput cache given (to see what it made).
+    fn refine_with(
+        setup: &Setup<3>,
+        state: &ShotState<3>,
+        cache: &ThroughputCache,
+        threshold: impl Fn(f64) -> f64,
+        budget: f64,
+        deadline: Option<std::time::Instant>,
+    ) -> (Vec<PairLink<3>>, f64, u64) {
+        let mut ctx = setup.refine_context(cache);
         ctx.deadline = deadline;
         let (si, sj) = (ts::front(0), ts::front(1));
         let (ri, rj) = (ts::root(ctx.forest, si), ts::root(ctx.forest, sj));
@@ -323,29 +335,15 @@ mod tests {
         );
         let state = ShotState::new(&setup);
         let unoccluded = PI * 0.199825 * 3.0;
+        let forest = setup.forest();
+        let (si, sj) = (ts::front(0), ts::front(1));
+        let (ri, rj) = (ts::root(forest, si), ts::root(forest, sj));
+        let child = forest.element(rj.element).children().unwrap()[0];
         for (threshold, retried) in [(1.05 * unoccluded, false), (0.95 * unoccluded, true)] {
             let cache = ThroughputCache::new(1 << 16);
-            let mut ctx = setup.refine_context(&cache);
-            ctx.flux_threshold = threshold;
-            let (si, sj) = (ts::front(0), ts::front(1));
-            let (ri, rj) = (ts::root(ctx.forest, si), ts::root(ctx.forest, sj));
-            let sender = Sender::Radiosity {
-                field: &state.field,
-                side: si.side(),
-                sent: Sent::Unshot,
-                emission: Spectrum::zero(),
-            };
-            let shot = PairShot {
-                sender: &sender,
-                si,
-                sj,
-            };
-            let mut out = Vec::new();
-            ctx.refine_pair(shot, ri.element, rj.element, 0.0, &mut out);
+            let (out, _, _) = refine_with(&setup, &state, &cache, |_| threshold, 0.0, None);
             assert!(out.is_empty(), "nothing passes the plate");
-            let th = ctx.throughput(rj, ri);
-            assert_eq!(th.v, 0.0);
-            let child = ctx.forest.element(rj.element).children().unwrap()[0];
+            assert_eq!(cache.get(rj, ri).map(|t| t.v), Some(0.0));
             let made = cache.get(sj.of(child), ri).is_some();
             assert_eq!(made, retried, "threshold {threshold}");
         }
