@@ -134,12 +134,12 @@ impl Geometry {
             let cos = hit.geometric_normal.dot(ray.dir).abs() / len;
             match (tr, crossing) {
                 (Transmittance::Cutout(_) | Transmittance::Constant(_), Crossing::Chosen) => {
-                    let alpha = 1.0 - tr.at_point(cos, uv());
+                    let alpha = 1.0 - tr.at_point(cos, uv);
                     if alpha > 0.0 && (alpha >= 1.0 || choice(ray, &hit) < alpha) {
                         return (Some(hit), tau / alpha);
                     }
                 }
-                _ => tau *= tr.at_point(cos, uv()),
+                _ => tau *= tr.at_point(cos, uv),
             }
             if tau <= 0.0 {
                 return (None, 0.0);

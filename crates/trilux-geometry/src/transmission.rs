@@ -106,11 +106,11 @@ impl Transmittance {
     }
 
     /// The fraction let through at a crossing at |cos θ| = `cos` and
-    /// texture coordinates `uv` (the origin when the surface has none,
-    /// as Mitsuba reads them).
-    pub fn at_point(&self, cos: f64, uv: Option<DVec2>) -> f64 {
+    /// texture coordinates `uv()` (the origin when the surface has none,
+    /// as Mitsuba reads them), which only a cut-out asks for.
+    pub fn at_point(&self, cos: f64, uv: impl FnOnce() -> Option<DVec2>) -> f64 {
         match self {
-            Transmittance::Cutout(c) => c.fraction(uv.unwrap_or(DVec2::ZERO)),
+            Transmittance::Cutout(c) => c.fraction(uv().unwrap_or(DVec2::ZERO)),
             other => other.at(cos),
         }
     }

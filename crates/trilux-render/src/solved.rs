@@ -162,10 +162,12 @@ impl<'a, const N: usize, S: RadianceSolution<N>> SolvedScene<'a, N, S> {
     /// render reads it with this one.
     fn shading_normal(&self, hit: &Hit, shape: u32, dir: DVec3) -> DVec3 {
         let geom = self.geom();
-        let (Some(map), Some(uv)) = (
-            self.scene.normal_map(shape as usize),
-            geom.texcoord(hit.surface, hit.coord),
-        ) else {
+        // The texture coordinates only where a map needs them: most
+        // shapes have none, and this runs for every camera and gather hit.
+        let Some(map) = self.scene.normal_map(shape as usize) else {
+            return hit.shading_normal;
+        };
+        let Some(uv) = geom.texcoord(hit.surface, hit.coord) else {
             return hit.shading_normal;
         };
         let at = TangentFrame {
