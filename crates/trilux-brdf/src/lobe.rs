@@ -9,7 +9,7 @@ use glam::{DVec2, DVec3};
 use trilux_color::Spectrum;
 
 use crate::fresnel::fresnel_conductor;
-use crate::microfacet::{Microfacet, microfacet_albedo};
+use crate::microfacet::{Microfacet, microfacet_albedo, unit_albedo};
 use crate::plastic::Plastic;
 
 /// A rough conductor, ready to evaluate.
@@ -86,6 +86,11 @@ impl<const N: usize> Conductor<N> {
 
     /// Directional albedo ∫ fr(wi, wo) cosθi dωi ([`microfacet_albedo`]).
     pub fn albedo(&self, wo: DVec3) -> Spectrum<N> {
+        if self.eta_k.is_none() {
+            // Fresnel 1: the specular reflectance times the lobe's own
+            // albedo, shared by every conductor of this roughness.
+            return self.specular_reflectance * unit_albedo(&self.microfacet, wo.z);
+        }
         microfacet_albedo(&self.microfacet, wo, |c| self.fresnel(c))
     }
 }

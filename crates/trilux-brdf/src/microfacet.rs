@@ -21,7 +21,9 @@
 //! pdf is the true density of the sampler up to the inversion's accuracy
 //! (CDF to 1e-7, erf⁻¹ to 1e-6), which the χ² tests check.
 
+use std::collections::HashMap;
 use std::f64::consts::PI;
+use std::sync::{Mutex, OnceLock};
 
 use glam::{DVec2, DVec3};
 
@@ -214,6 +216,57 @@ fn sample_ggx_visible(wo: DVec3, alpha: f64, u: DVec2) -> DVec3 {
     DVec3::new(alpha * nh.x, alpha * nh.y, nh.z.max(1e-12)).normalize()
 }
 
+/// Midpoints of [`microfacet_albedo`]'s φ rule, (cos φ, sin φ), made once.
+fn phi_midpoints() -> &'static [(f64, f64); ALBEDO_NPHI] {
+    static TABLE: OnceLock<[(f64, f64); ALBEDO_NPHI]> = OnceLock::new();
+    TABLE.get_or_init(|| {
+        std::array::from_fn(|j| {
+            let phi = (j as f64 + 0.5) / ALBEDO_NPHI as f64 * PI;
+            (phi.cos(), phi.sin())
+        })
+    })
+}
+
+/// φ midpoints of [`microfacet_albedo`] over a half turn.
+const ALBEDO_NPHI: usize = 96;
+
+/// Largest number of values [`unit_albedo`] keeps (then it starts again):
+/// a material's albedo table asks for 91 directions.
+const UNIT_ALBEDO_CACHE: usize = 1 << 16;
+
+/// [`microfacet_albedo`] with Fresnel = 1, remembered per (distribution,
+/// α, cos θ_o): a scene's rough conductors without an index of refraction
+/// (Fresnel 1 times a `specular_reflectance`) usually share one roughness,
+/// and each albedo table costs 91 × 28k evaluations. The value is the same
+/// as computing it again (a pure function of the key).
+pub fn unit_albedo(microfacet: &Microfacet, cos_o: f64) -> f64 {
+    type Key = (Distribution, u64, u64);
+    static CACHE: OnceLock<Mutex<HashMap<Key, f64>>> = OnceLock::new();
+    let key = (
+        microfacet.distribution,
+        microfacet.alpha.to_bits(),
+        cos_o.to_bits(),
+    );
+    let cache = CACHE.get_or_init(Default::default);
+    if let Some(&v) = cache
+        .lock()
+        .ok()
+        .and_then(|c| c.get(&key).copied())
+        .as_ref()
+    {
+        return v;
+    }
+    let wo = DVec3::new((1.0 - cos_o * cos_o).max(0.0).sqrt(), 0.0, cos_o);
+    let v = microfacet_albedo::<1>(microfacet, wo, |_| Spectrum([1.0]))[0];
+    if let Ok(mut c) = cache.lock() {
+        if c.len() >= UNIT_ALBEDO_CACHE {
+            c.clear();
+        }
+        c.insert(key, v);
+    }
+    v
+}
+
 /// Directional albedo ∫ fr(wi, wo) cosθi dωi of a microfacet reflection
 /// lobe with Fresnel term `fresnel(wo·m)`, by deterministic quadrature
 /// over the microfacet normal: m is mapped from the unit square by the
@@ -237,7 +290,7 @@ pub fn microfacet_albedo<const N: usize>(
     let wo = DVec3::new((1.0 - wo.z * wo.z).max(0.0).sqrt(), 0.0, wo.z);
     const SEGMENTS: usize = 24;
     const PER_SEGMENT: usize = 12;
-    const NPHI: usize = 96;
+    const NPHI: usize = ALBEDO_NPHI;
     let a2 = microfacet.alpha * microfacet.alpha;
     let mut acc = Spectrum::<N>::zero();
     for seg in 0..SEGMENTS {
@@ -257,9 +310,8 @@ pub fn microfacet_albedo<const N: usize>(
             let cos_m = 1.0 / (1.0 + tan2).sqrt();
             let sin_m = (1.0 - cos_m * cos_m).max(0.0).sqrt();
             let mut ring = Spectrum::<N>::zero();
-            for j in 0..NPHI {
-                let phi = (j as f64 + 0.5) / NPHI as f64 * PI;
-                let m = DVec3::new(sin_m * phi.cos(), sin_m * phi.sin(), cos_m);
+            for &(cos_phi, sin_phi) in phi_midpoints() {
+                let m = DVec3::new(sin_m * cos_phi, sin_m * sin_phi, cos_m);
                 let dot = wo.dot(m);
                 if dot <= 0.0 {
                     continue;

@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 use trilux_color::ColorParam;
 
 /// Microfacet normal distribution of `roughconductor` and `roughplastic`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[non_exhaustive]
 pub enum Distribution {
     /// Beckmann (Mitsuba's default).

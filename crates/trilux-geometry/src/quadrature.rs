@@ -47,6 +47,18 @@ pub(crate) const GL3_X: [f64; 3] = [
 /// Weights of [`GL3_X`] (sum 1).
 pub(crate) const GL3_W: [f64; 3] = [5.0 / 18.0, 8.0 / 18.0, 5.0 / 18.0];
 
+/// The 2-point Gauss–Legendre rule on [0, 1] (exact for degree 3), weights
+/// ½ each: the cubature's error check for [`GL3_X`].
+pub(crate) const GL2_X: [f64; 2] = [0.5 - 0.288_675_134_594_812_9, 0.5 + 0.288_675_134_594_812_9];
+
+/// Strang and Fix's 3-point rule on a triangle (exact for degree 2),
+/// weights ⅓ each: the cubature's error check for [`TRI7`].
+pub(crate) const TRI3: [[f64; 3]; 3] = [
+    [2.0 / 3.0, 1.0 / 6.0, 1.0 / 6.0],
+    [1.0 / 6.0, 2.0 / 3.0, 1.0 / 6.0],
+    [1.0 / 6.0, 1.0 / 6.0, 2.0 / 3.0],
+];
+
 /// Dunavant's 7-point rule on a triangle (exact for degree 5): barycentric
 /// coordinates and weights (sum 1).
 pub(crate) const TRI7: [([f64; 3], f64); 7] = [

@@ -3,15 +3,16 @@
 //!
 //! A domain is a uv rectangle of a parametric patch or a triangle. Its
 //! degree-5 rule (3×3 Gauss–Legendre, or Dunavant's 7 points) is compared
-//! with the one-point rule, or with the same rule on its four children, and
-//! refined where they differ by more than the domain's share of the
+//! with a lower-order rule (2×2 Gauss–Legendre, degree 3, or Strang and
+//! Fix's 3 points, degree 2), or with the same rule on its four children,
+//! and refined where they differ by more than the domain's share of the
 //! tolerance. [`integrate_pairs`] does the same over pairs of domains, for
 //! the kernel itself when neither element is polygonal.
 
 use glam::{DVec2, DVec3};
 
 use crate::patch::Patch;
-use crate::quadrature::{GL3_W, GL3_X, TRI7, triangle_area};
+use crate::quadrature::{GL2_X, GL3_W, GL3_X, TRI3, TRI7, triangle_area};
 
 use super::kernel;
 
@@ -75,7 +76,6 @@ impl QDom<'_> {
         }
     }
 
-    /// The one-point (centre) rule: a cheap first estimate.
     fn centre_rule(&self, f: &mut dyn FnMut(DVec3, DVec3) -> (f64, f64)) -> f64 {
         match *self {
             QDom::Rect { patch, min, max, s } => {
@@ -87,7 +87,37 @@ impl QDom<'_> {
         }
     }
 
-    /// The one-point rule's point (position, normal, weight = area).
+    /// The lower-order rule that checks [`QDom::rule`]: 2×2 Gauss–Legendre
+    /// on a rectangle, Strang and Fix's 3 points on a triangle. Their
+    /// difference estimates the lower rule's error, h⁴ or h³ in the
+    /// domain's size against the degree-5 rule's h⁶, so accepting the
+    /// degree-5 value when they agree is conservative for smooth
+    /// integrands (the one-point rule, h², refined most domains of
+    /// neighbouring elements where the degree-5 error was already
+    /// negligible: docs/results.md, "Form factors per second").
+    fn check_rule(&self, f: &mut dyn FnMut(DVec3, DVec3) -> (f64, f64)) -> f64 {
+        match *self {
+            QDom::Rect { patch, min, max, s } => {
+                let d = max - min;
+                let mut sum = 0.0;
+                for x in GL2_X {
+                    for y in GL2_X {
+                        let pp = patch.eval(min + d * DVec2::new(x, y));
+                        sum += 0.25 * pp.jacobian() * f(pp.p, s * pp.n).0;
+                    }
+                }
+                sum * d.x * d.y
+            }
+            QDom::Tri { v: [a, b, c], n } => {
+                let sum: f64 = TRI3
+                    .iter()
+                    .map(|l| f(l[0] * a + l[1] * b + l[2] * c, n).0)
+                    .sum();
+                triangle_area(a, b, c) * sum / 3.0
+            }
+        }
+    }
+
     fn centre_point(&self) -> (DVec3, DVec3, f64) {
         match *self {
             QDom::Rect { patch, min, max, s } => {
@@ -194,18 +224,36 @@ fn adaptive(
     if err <= tol || depth == 0 {
         return (q1, err + qs.iter().map(|q| q.1).sum::<f64>());
     }
+    // Only the children whose own check fails are refined further (near
+    // a shared edge, where the integrand is singular, one or two of four).
     let mut v = 0.0;
     let mut e = 0.0;
     for (c, q) in children.iter().zip(qs) {
-        let (cv, ce) = adaptive(c, f, q, 0.5 * tol, depth - 1);
+        let (cv, ce) = accept_or_refine(c, f, q, 0.5 * tol, depth - 1);
         v += cv;
         e += ce;
     }
     (v, e)
 }
 
+/// A domain's degree-5 estimate `q` when its lower-order check agrees
+/// within `tol` (error: their difference), else [`adaptive`].
+fn accept_or_refine(
+    dom: &QDom<'_>,
+    f: &mut dyn FnMut(DVec3, DVec3) -> (f64, f64),
+    q: (f64, f64),
+    tol: f64,
+    depth: u32,
+) -> (f64, f64) {
+    let c = dom.check_rule(f);
+    if (c - q.0).abs() <= tol {
+        return (q.0, (c - q.0).abs() + q.1);
+    }
+    adaptive(dom, f, q, tol, depth)
+}
+
 /// Integrates `f` over a list of domains to a relative tolerance. A domain
-/// whose degree-5 estimate agrees with its one-point estimate within the
+/// whose degree-5 estimate agrees with its lower-order check within the
 /// tolerance is accepted at once (error: their difference, a conservative
 /// bound for smooth integrands); the others are refined adaptively.
 pub(crate) fn integrate(
