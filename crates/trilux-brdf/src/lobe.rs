@@ -178,7 +178,7 @@ impl<const N: usize> Lobe<N> {
 
     /// Sets the roughness α of every conductor part (a textured roughness
     /// at one point: `trilux_brdf::textured`).
-    pub fn set_alpha(&mut self, alpha: f64) {
+    pub(crate) fn set_alpha(&mut self, alpha: f64) {
         match self {
             Lobe::Conductor(c) => c.microfacet.alpha = alpha,
             Lobe::Blend { first, second, .. } => {

@@ -14,7 +14,6 @@ use serde::Serialize;
 use trilux_color::luminance;
 
 use crate::texture::{Texture, UvTransform};
-use crate::textured::Branch;
 
 /// The smallest GGX α of a glTF roughness (roughness 0.1): smoother
 /// surfaces are mirrors that no element-based solve can resolve
@@ -30,6 +29,19 @@ pub fn gltf_alpha(r: f64) -> f64 {
         1.0
     };
     (r * r).max(MIN_GLTF_ALPHA)
+}
+
+/// One step from a BSDF to a BSDF nested in it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub enum Branch {
+    /// The front BSDF of a `twosided` (both sides when it has one only).
+    Front,
+    /// The back BSDF of a `twosided` with two.
+    Back,
+    /// The first BSDF of a `blendbsdf`.
+    First,
+    /// The second BSDF of a `blendbsdf`.
+    Second,
 }
 
 /// Which parameter a texture stands for.
@@ -100,27 +112,6 @@ fn texture_summary<S: serde::Serializer>(t: &Arc<Texture>, s: S) -> Result<S::Ok
 }
 
 impl TextureSlot {
-    /// A slot without a factor, bounded by 1.
-    pub fn linear(
-        path: Vec<Branch>,
-        kind: SlotKind,
-        texture: Arc<Texture>,
-        scale: [f64; 3],
-        offset: [f64; 3],
-        to_uv: UvTransform,
-    ) -> Self {
-        TextureSlot {
-            path,
-            kind,
-            texture,
-            scale,
-            offset,
-            to_uv,
-            factor: None,
-            max: 1.0,
-        }
-    }
-
     /// The linear part offset + scale ⊙ `rgb` for the texture value `rgb`.
     pub fn value(&self, rgb: [f64; 3]) -> [f64; 3] {
         std::array::from_fn(|c| self.offset[c] + self.scale[c] * rgb[c])

@@ -23,32 +23,26 @@
 //! `roughconductor` (checked by [`TexturedBsdf::new`]): the microfacet
 //! lobe's shape never varies, only how much of it there is. The solver
 //! takes ρ_d and g of each element's average slot values; the renderer
-//! takes them at each hit.
+//! takes them at each hit. A slot may be the product of two lookups
+//! ([`SlotFactor`]): still linear in each, and an element's average of it
+//! is the average of the product.
+//!
+//! The one exception to a fixed shape is a [`SlotKind::Roughness`] slot
+//! (glTF's roughness, α = max(r², 0.01)): the renderer's material at a hit
+//! ([`TexturedBsdf::at`]) is the nominal one with that point's α; the
+//! solver keeps the nominal α, the one at the texture's mean roughness
+//! (docs/gltf.md, "Metalness and roughness textures").
 
 use std::borrow::Cow;
 
 use glam::{DVec2, DVec3};
-use serde::Serialize;
 use trilux_color::{ColorParam, Role, Spectrum};
 use trilux_frame::{Side, Sided};
 
 use crate::bsdf::{Bsdf, BsdfSample};
 use crate::error::BrdfError;
 use crate::params::BsdfParams;
-pub use crate::slot::{MIN_GLTF_ALPHA, SlotFactor, SlotKind, TextureSlot, gltf_alpha};
-
-/// One step from a BSDF to a BSDF nested in it.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
-pub enum Branch {
-    /// The front BSDF of a `twosided` (both sides when it has one only).
-    Front,
-    /// The back BSDF of a `twosided` with two.
-    Back,
-    /// The first BSDF of a `blendbsdf`.
-    First,
-    /// The second BSDF of a `blendbsdf`.
-    Second,
-}
+pub use crate::slot::{Branch, MIN_GLTF_ALPHA, SlotFactor, SlotKind, TextureSlot, gltf_alpha};
 
 /// Most textures one material takes.
 pub const MAX_SLOTS: usize = 4;
@@ -636,14 +630,16 @@ mod tests {
     }
 
     fn slot(path: Vec<Branch>, kind: SlotKind, scale: f64) -> TextureSlot {
-        TextureSlot::linear(
+        TextureSlot {
             path,
             kind,
-            checker(),
-            [scale; 3],
-            [0.0; 3],
-            UvTransform::IDENTITY,
-        )
+            texture: checker(),
+            scale: [scale; 3],
+            offset: [0.0; 3],
+            to_uv: UvTransform::IDENTITY,
+            factor: None,
+            max: 1.0,
+        }
     }
 
     /// A textured point is the untextured material with the texture's value
@@ -748,7 +744,10 @@ mod tests {
             let at = t.at(DVec2::new(u, 0.5));
             let direct: Bsdf<3> = Bsdf::new(&conductor(alpha)).unwrap();
             let (a, b) = (at.eval(wi, wo), direct.eval(wi, wo));
-            assert!((a.0[0] - b.0[0]).abs() <= 1e-12 * b.0[0], "{u}: {a:?} {b:?}");
+            assert!(
+                (a.0[0] - b.0[0]).abs() <= 1e-12 * b.0[0],
+                "{u}: {a:?} {b:?}"
+            );
             assert_eq!(at.min_alpha(Side::Front), Some(alpha));
             let (a, b) = (at.albedo(wo), direct.albedo(wo));
             assert!((a.0[1] - b.0[1]).abs() < 1e-9, "{u}: {a:?} {b:?}");

@@ -139,7 +139,8 @@ fn floor_texels_with_metalness_0_1_and_between() {
 fn a_metalness_texture_without_a_base_colour_texture() {
     let t = material(1);
     let b = [0.9f32, 0.7, 0.4].map(f64::from);
-    let rough = |x: u32| 0.8 * (255.0 * (0.3 + 0.6 * f64::from(x) / 15.0)).round_ties_even() / 255.0;
+    let rough =
+        |x: u32| 0.8 * (255.0 * (0.3 + 0.6 * f64::from(x) / 15.0)).round_ties_even() / 255.0;
     let (d, s) = lobes(b, 1.0);
     check(&t, texel(3, 1), d, s, rough(3) * rough(3), "metal");
     let (d, s) = lobes(b, 0.0);

@@ -24,7 +24,18 @@
 //! is also `doubleSided` is refused (glTF would have it emit on both sides,
 //! and trilux's area emitters emit on the front only).
 //!
-//! Refused (one error naming the material): `metallicRoughnessTexture`,
+//! `metallicRoughnessTexture` (linear: metalness m = metallicFactor × blue,
+//! roughness r = roughnessFactor × green) makes the mapping hold at each
+//! point: D and S are slots affine in the base colour lookup t and the
+//! metalness lookup M, value = offset + scale ⊙ t + M · (offset′ + scale′ ⊙ t)
+//! (`trilux_brdf::SlotFactor`, exact); with M textured, D̂ is D at m = 0
+//! and Ŝ the larger of S at m = 0 and m = metallicFactor, so D̂ + Ŝ may
+//! pass 1 and the blend's inner values are bounded by 1/(1 − w) and 1/w
+//! (`TextureSlot::max`). r is a `SlotKind::Roughness` slot: the render
+//! takes each hit's α, the solve the material's α at the mean roughness
+//! (a warning line; docs/gltf.md, "Metalness and roughness textures").
+//!
+//! Refused (one error naming the material):
 //! `emissiveTexture`, the textures of `KHR_materials_specular`,
 //! texture coordinates other than `TEXCOORD_0`,
 //! and `alphaMode` `BLEND` (a semi-transparent surface composited over what
