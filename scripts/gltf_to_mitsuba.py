@@ -236,12 +236,19 @@ class Converter:
                     + diffuse(d_scale / (1 - w)) + conductor(s_scale / w, s_offset / w) + "</bsdf>")
         if m.get("doubleSided"):
             bsdf = '<bsdf type="twosided">' + bsdf + "</bsdf>"
+        return bsdf, self.emitter(index, m)
+
+    def emitter(self, index, m):
+        """The area emitter of material `m` (emissiveFactor x
+        KHR_materials_emissive_strength, one-sided), or ""."""
+        ext = m.get("extensions", {})
         strength = ext.get("KHR_materials_emissive_strength", {}).get("emissiveStrength", 1.0)
         e = np.array(m.get("emissiveFactor", [0, 0, 0]), float) * strength
         if e.max() > 0 and m.get("doubleSided"):
             raise SystemExit(f"material {index}: a double-sided emissive material is refused")
-        emitter = ('<emitter type="area">' + rgb("radiance", e) + "</emitter>") if e.max() > 0 else ""
-        return bsdf, emitter
+        if e.max() <= 0:
+            return ""
+        return f'<emitter type="area"><rgb name="radiance" value="{e[0]:.9g}, {e[1]:.9g}, {e[2]:.9g}"/></emitter>'
 
     def raw_image(self, index):
         """The image as float RGB (H x W x 3) of its stored values / 255
@@ -333,12 +340,7 @@ class Converter:
                 + self.bitmap_xml("specular_reflectance", inner_s, info) + "</bsdf></bsdf>")
         if m.get("doubleSided"):
             bsdf = '<bsdf type="twosided">' + bsdf + "</bsdf>"
-        ext = m.get("extensions", {})
-        strength = ext.get("KHR_materials_emissive_strength", {}).get("emissiveStrength", 1.0)
-        e = np.array(m.get("emissiveFactor", [0, 0, 0]), float) * strength
-        if e.max() > 0:
-            raise SystemExit(f"material {index}: an emissive material with a metallicRoughnessTexture is refused")
-        return bsdf, ""
+        return bsdf, self.emitter(index, m)
 
     def light(self, i, node, world):
         """A KHR_lights_punctual light as Mitsuba's emitter, in trilux's
