@@ -22,6 +22,10 @@ r = roughness, F0 = min(0.04 specularColorFactor, 1) specularFactor
     else blendbsdf(weight w = Sh/(Dh + Sh), diffuse(D/(1-w)), roughconductor(S/w))
     doubleSided: twosided; emission emissiveFactor x emissiveStrength, an area
     emitter (one-sided). What trilux refuses, this refuses too.
+A material with a metallicRoughnessTexture (metalness blue, roughness
+green, linear) is evaluated per texel from glTF's formulas instead
+(Converter.textured_material): per-texel images of the blend weight, D, S
+and alpha.
 Cameras: perspective, yfov along y, 768 x round(768/aspectRatio) pixels.
 Needs numpy and Mitsuba 3.
 """
@@ -190,7 +194,7 @@ class Converter:
             raise SystemExit(f"material {index}: alphaMode is refused")
         pbr = m.get("pbrMetallicRoughness", {})
         if "metallicRoughnessTexture" in pbr:
-            raise SystemExit(f"material {index}: metallicRoughnessTexture is refused")
+            return self.textured_material(index, m)
         b = np.clip(np.array(pbr.get("baseColorFactor", [1, 1, 1, 1])[:3], float), 0, 1)
         metal = min(max(pbr.get("metallicFactor", 1.0), 0.0), 1.0)
         rough = min(max(pbr.get("roughnessFactor", 1.0), 0.0), 1.0)
@@ -232,12 +236,111 @@ class Converter:
                     + diffuse(d_scale / (1 - w)) + conductor(s_scale / w, s_offset / w) + "</bsdf>")
         if m.get("doubleSided"):
             bsdf = '<bsdf type="twosided">' + bsdf + "</bsdf>"
+        return bsdf, self.emitter(index, m)
+
+    def emitter(self, index, m):
+        """The area emitter of material `m` (emissiveFactor x
+        KHR_materials_emissive_strength, one-sided), or ""."""
+        ext = m.get("extensions", {})
         strength = ext.get("KHR_materials_emissive_strength", {}).get("emissiveStrength", 1.0)
         e = np.array(m.get("emissiveFactor", [0, 0, 0]), float) * strength
         if e.max() > 0 and m.get("doubleSided"):
             raise SystemExit(f"material {index}: a double-sided emissive material is refused")
-        emitter = ('<emitter type="area">' + rgb("radiance", e) + "</emitter>") if e.max() > 0 else ""
-        return bsdf, emitter
+        if e.max() <= 0:
+            return ""
+        return f'<emitter type="area"><rgb name="radiance" value="{e[0]:.9g}, {e[1]:.9g}, {e[2]:.9g}"/></emitter>'
+
+    def raw_image(self, index):
+        """The image as float RGB (H x W x 3) of its stored values / 255
+        (no sRGB decoding: glTF's metallicRoughnessTexture is linear)."""
+        img = self.j["images"][index]
+        if "bufferView" in img:
+            data, _ = view_bytes(self.j, self.buffers, img["bufferView"])
+            tmp = os.path.join(self.out, f"raw{index}.png")
+            open(tmp, "wb").write(bytes(data))
+        else:
+            from urllib.parse import unquote
+            tmp = os.path.join(self.folder, unquote(img["uri"]))
+        bmp = mi.Bitmap(tmp)
+        bmp.set_srgb_gamma(False)
+        return np.array(bmp.convert(mi.Bitmap.PixelFormat.RGB, mi.Struct.Type.Float32, srgb_gamma=False), np.float64)
+
+    def bitmap_xml(self, name, texels, info):
+        """A bitmap texture `name` of the linear `texels` (H x W x 3, or
+        H x W for a float parameter), with `info`'s sampler and transform."""
+        tex = self.j["textures"][info["index"]]
+        sampler = self.j.get("samplers", [{}])[tex["sampler"]] if "sampler" in tex else {}
+        fname = f"texture{len(self.textures)}.exr"
+        self.textures[("per-texel", fname)] = fname
+        arr = np.ascontiguousarray(texels if texels.ndim == 3 else texels[..., None], np.float32)
+        mi.Bitmap(arr).write(os.path.join(self.out, fname))
+        filt = "nearest" if sampler.get("magFilter") == 9728 else "bilinear"
+        return (f'<texture type="bitmap" name="{name}"><string name="filename" value="{fname}"/>'
+                f'<boolean name="raw" value="true"/><string name="filter_type" value="{filt}"/>'
+                f'<string name="wrap_mode" value="{WRAP[sampler.get("wrapS", 10497)]}"/>'
+                f'{self.to_uv_xml(info)}</texture>')
+
+    def textured_material(self, index, m):
+        """A material with a metallicRoughnessTexture: glTF's formulas
+        evaluated per texel (B = baseColorFactor x sRGB-decoded base colour
+        texel, m = metallicFactor x blue, r = roughnessFactor x green,
+        D = (1 - m)(1 - F) B, S = (1 - m) F0 + m B, alpha = max(r^2, 0.01)),
+        written as blendbsdf(w, diffuse(D / (1 - w)), roughconductor(S / w,
+        alpha)) with a per-texel weight w = max S / (max D + max S) (any w
+        gives the same BRDF; this one keeps both inner values within
+        [0, 1]). Both textures must share size, sampler and transform, as
+        the images are their per-texel products: exact with NEAREST; with
+        bilinear filtering the product of two lookups differs from the
+        lookup of the products between texel centres (a warning)."""
+        pbr = m["pbrMetallicRoughness"]
+        for key in ("normalTexture", "emissiveTexture"):
+            if key in m:
+                raise SystemExit(f"material {index}: {key} with a metallicRoughnessTexture is refused")
+        if m.get("alphaMode", "OPAQUE") != "OPAQUE":
+            raise SystemExit(f"material {index}: alphaMode is refused")
+        mr_info, base_info = pbr["metallicRoughnessTexture"], pbr.get("baseColorTexture")
+        for info in (mr_info, base_info):
+            if info is not None and info.get("texCoord", 0) != 0:
+                raise SystemExit("texCoord other than 0 is refused")
+        mr = self.raw_image(self.j["textures"][mr_info["index"]]["source"])
+        if base_info is not None:
+            same = lambda k: (self.j["textures"][mr_info["index"]].get(k)  # noqa: E731
+                              == self.j["textures"][base_info["index"]].get(k))
+            t = self.image(self.j["textures"][base_info["index"]]["source"])
+            if (t.shape != mr.shape or not same("sampler")
+                    or mr_info.get("extensions") != base_info.get("extensions")):
+                raise SystemExit(f"material {index}: the base colour and metallicRoughness textures "
+                                 "must share size, sampler and KHR_texture_transform")
+        else:
+            t = np.ones_like(mr)
+        sampler_index = self.j["textures"][mr_info["index"]].get("sampler")
+        sampler = self.j.get("samplers", [{}])[sampler_index] if sampler_index is not None else {}
+        if sampler.get("magFilter") != 9728:
+            print(f"warning: material {index}: bilinear lookups of per-texel products differ from "
+                  "glTF's products of lookups between texel centres", file=sys.stderr)
+        b = np.clip(np.array(pbr.get("baseColorFactor", [1, 1, 1, 1])[:3], float), 0, 1) * t
+        metal = np.clip(pbr.get("metallicFactor", 1.0), 0, 1) * mr[..., 2:3]
+        rough = np.clip(pbr.get("roughnessFactor", 1.0), 0, 1) * mr[..., 1]
+        spec = m.get("extensions", {}).get("KHR_materials_specular", {})
+        sf = min(max(spec.get("specularFactor", 1.0), 0.0), 1.0)
+        f0 = np.clip(0.04 * np.array(spec.get("specularColorFactor", [1, 1, 1]), float), 0, 1) * sf
+        d = (1 - metal) * (1 - f0.max()) * b
+        s = (1 - metal) * f0 + metal * b
+        dh, sh = d.max(axis=-1), s.max(axis=-1)
+        w = np.where(dh + sh > 0, sh / np.maximum(dh + sh, 1e-300), 0.5)
+        safe = lambda v: np.maximum(v, 1e-300)[..., None]  # noqa: E731
+        inner_d = np.where(w[..., None] < 1, d / safe(1 - w), 0)
+        inner_s = np.where(w[..., None] > 0, s / safe(w), 0)
+        alpha = np.maximum(rough * rough, MIN_ALPHA)
+        info = mr_info
+        bsdf = ('<bsdf type="blendbsdf">' + self.bitmap_xml("weight", w, info)
+                + '<bsdf type="diffuse">' + self.bitmap_xml("reflectance", inner_d, info) + "</bsdf>"
+                + '<bsdf type="roughconductor"><string name="distribution" value="ggx"/>'
+                + '<string name="material" value="none"/>' + self.bitmap_xml("alpha", alpha, info)
+                + self.bitmap_xml("specular_reflectance", inner_s, info) + "</bsdf></bsdf>")
+        if m.get("doubleSided"):
+            bsdf = '<bsdf type="twosided">' + bsdf + "</bsdf>"
+        return bsdf, self.emitter(index, m)
 
     def light(self, i, node, world):
         """A KHR_lights_punctual light as Mitsuba's emitter, in trilux's

@@ -167,6 +167,19 @@ impl<const N: usize> Bsdf<N> {
         self.side(side).and_then(Lobe::min_alpha)
     }
 
+    /// This material with roughness `alpha` for the conductor parts of the
+    /// sides in `sides` (a textured roughness at one point; `alpha` must be
+    /// finite and positive, as a `roughconductor`'s).
+    pub fn with_alpha(&self, sides: &trilux_frame::Sided<bool>, alpha: f64) -> Self {
+        let mut out = self.clone();
+        for (on, lobe) in [(sides.front, &mut out.front), (sides.back, &mut out.back)] {
+            if let (true, Some(l)) = (on, lobe.as_mut()) {
+                l.set_alpha(alpha);
+            }
+        }
+        out
+    }
+
     fn side(&self, side: Side) -> Option<&Lobe<N>> {
         match side {
             Side::Front => self.front.as_ref(),

@@ -33,6 +33,8 @@
 //! - [`textured`]: materials whose Lambertian reflectance and glossy weight
 //!   vary over a surface ([`TexturedBsdf`], [`TextureSlot`]) and the
 //!   material at one point ([`Shading`]).
+//! - [`slot`]: the parameter a texture stands for ([`TextureSlot`]) and
+//!   its value, a product of two textures included ([`SlotFactor`]).
 //! - [`area`]: area reflectance R(I→J→K) = π F_JI fr (paper Eq. 5) and the
 //!   BRDF variation estimate over three elements (docs/solver.md,
 //!   "Refinement").
@@ -52,6 +54,7 @@ pub mod microfacet;
 pub mod normal_map;
 pub mod params;
 pub mod plastic;
+pub mod slot;
 mod special;
 pub mod texture;
 pub mod textured;
@@ -72,5 +75,8 @@ pub use params::{
 };
 pub use plastic::Plastic;
 pub use texture::{Filter, Texture, UvTransform, Wrap};
-pub use textured::{Branch, PointParts, Shading, SlotKind, SlotValues, TextureSlot, TexturedBsdf};
+pub use textured::{
+    Branch, MIN_GLTF_ALPHA, PointParts, Shading, SlotFactor, SlotKind, SlotValues, TextureSlot,
+    TexturedBsdf, gltf_alpha,
+};
 pub use trilux_frame::Side;

@@ -181,6 +181,19 @@ impl<const N: usize> Lobe<N> {
         }
     }
 
+    /// Sets the roughness α of every conductor part (a textured roughness
+    /// at one point: `trilux_brdf::textured`).
+    pub(crate) fn set_alpha(&mut self, alpha: f64) {
+        match self {
+            Lobe::Conductor(c) => c.microfacet.alpha = alpha,
+            Lobe::Blend { first, second, .. } => {
+                first.set_alpha(alpha);
+                second.set_alpha(alpha);
+            }
+            Lobe::Diffuse { .. } | Lobe::Plastic(_) => {}
+        }
+    }
+
     /// The smallest roughness α of a conductor part with non-zero weight
     /// (`None` when there is none): the narrowest lobe this side has.
     pub fn min_alpha(&self) -> Option<f64> {

@@ -23,80 +23,26 @@
 //! `roughconductor` (checked by [`TexturedBsdf::new`]): the microfacet
 //! lobe's shape never varies, only how much of it there is. The solver
 //! takes ρ_d and g of each element's average slot values; the renderer
-//! takes them at each hit.
+//! takes them at each hit. A slot may be the product of two lookups
+//! ([`SlotFactor`]): still linear in each, and an element's average of it
+//! is the average of the product.
+//!
+//! The one exception to a fixed shape is a [`SlotKind::Roughness`] slot
+//! (glTF's roughness, α = max(r², 0.01)): the renderer's material at a hit
+//! ([`TexturedBsdf::at`]) is the nominal one with that point's α; the
+//! solver keeps the nominal α, the one at the texture's mean roughness
+//! (docs/gltf.md, "Metalness and roughness textures").
 
-use std::sync::Arc;
+use std::borrow::Cow;
 
 use glam::{DVec2, DVec3};
-use serde::Serialize;
-use trilux_color::{ColorParam, Role, Spectrum, luminance};
+use trilux_color::{ColorParam, Role, Spectrum};
 use trilux_frame::{Side, Sided};
 
 use crate::bsdf::{Bsdf, BsdfSample};
 use crate::error::BrdfError;
 use crate::params::BsdfParams;
-use crate::texture::{Texture, UvTransform};
-
-/// One step from a BSDF to a BSDF nested in it.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
-pub enum Branch {
-    /// The front BSDF of a `twosided` (both sides when it has one only).
-    Front,
-    /// The back BSDF of a `twosided` with two.
-    Back,
-    /// The first BSDF of a `blendbsdf`.
-    First,
-    /// The second BSDF of a `blendbsdf`.
-    Second,
-}
-
-/// Which parameter a texture stands for.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
-pub enum SlotKind {
-    /// `reflectance` of a `diffuse`, `diffuse_reflectance` of a `plastic`
-    /// or `roughplastic`.
-    Reflectance,
-    /// `specular_reflectance` of a `roughconductor`.
-    SpecularReflectance,
-    /// `weight` of a `blendbsdf` (the texture's luminance).
-    Weight,
-}
-
-/// A texture standing for one parameter of a material (module docs).
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct TextureSlot {
-    /// The path from the top of the material to the BSDF that has the
-    /// parameter.
-    pub path: Vec<Branch>,
-    /// The parameter.
-    pub kind: SlotKind,
-    /// The image.
-    #[serde(serialize_with = "texture_summary")]
-    pub texture: Arc<Texture>,
-    /// value = offset + scale ⊙ texture (per RGB channel).
-    pub scale: [f64; 3],
-    /// See `scale`.
-    pub offset: [f64; 3],
-    /// The map from the surface's texture coordinates to the image's.
-    pub to_uv: UvTransform,
-}
-
-fn texture_summary<S: serde::Serializer>(t: &Arc<Texture>, s: S) -> Result<S::Ok, S::Error> {
-    t.as_ref().serialize(s)
-}
-
-impl TextureSlot {
-    /// The slot's linear RGB value for the texture value `rgb`.
-    pub fn value(&self, rgb: [f64; 3]) -> [f64; 3] {
-        std::array::from_fn(|c| self.offset[c] + self.scale[c] * rgb[c])
-    }
-
-    /// The slot's value at the texture's mean, within the parameter's
-    /// range: the nominal value.
-    pub fn nominal(&self) -> [f64; 3] {
-        slot_value(self, self.texture.mean())
-    }
-}
+pub use crate::slot::{Branch, MIN_GLTF_ALPHA, SlotFactor, SlotKind, TextureSlot, gltf_alpha};
 
 /// Most textures one material takes.
 pub const MAX_SLOTS: usize = 4;
@@ -204,6 +150,8 @@ pub struct TexturedBsdf<const N: usize> {
     sides: Sided<Option<Node<N>>>,
     slots: Vec<TextureSlot>,
     nominal_glossy: Sided<Spectrum<N>>,
+    /// The roughness slot, if any, and the sides whose conductor it sets.
+    roughness: Option<(usize, Sided<bool>)>,
 }
 
 fn color<const N: usize>(c: &ColorParam, what: &'static str) -> Result<Spectrum<N>, BrdfError> {
@@ -234,6 +182,9 @@ fn compile<const N: usize>(
             })
         }
         BsdfParams::RoughConductor(rc) => {
+            // A roughness slot changes the lobe's shape, not ρ_d or g:
+            // `TexturedBsdf::at` takes it.
+            let _ = slot(SlotKind::Roughness, path, used);
             Node::Conductor(match slot(SlotKind::SpecularReflectance, path, used) {
                 Some(v) => v,
                 None => Value::Const(color(
@@ -310,16 +261,6 @@ fn plastic_node<const N: usize>(
     })
 }
 
-/// A slot's value for texture value `rgb`, within its parameter's range
-/// ([0, 1]; a weight is the luminance).
-fn slot_value(s: &TextureSlot, rgb: [f64; 3]) -> [f64; 3] {
-    let v = s.value(rgb).map(|c| c.max(0.0));
-    match s.kind {
-        SlotKind::Weight => [luminance(v).clamp(0.0, 1.0); 3],
-        SlotKind::Reflectance | SlotKind::SpecularReflectance => v.map(|c| c.min(1.0)),
-    }
-}
-
 /// Writes `value` into the parameter `kind` of the BSDF at `path`
 /// (`None` when there is no such parameter).
 fn set_nominal(p: &mut BsdfParams, path: &[Branch], kind: SlotKind, value: [f64; 3]) -> Option<()> {
@@ -332,6 +273,9 @@ fn set_nominal(p: &mut BsdfParams, path: &[Branch], kind: SlotKind, value: [f64;
         }
         (BsdfParams::RoughConductor(rc), None) if kind == SlotKind::SpecularReflectance => {
             rc.specular_reflectance = ColorParam::Rgb(value);
+        }
+        (BsdfParams::RoughConductor(rc), None) if kind == SlotKind::Roughness => {
+            rc.alpha = gltf_alpha(value[0]);
         }
         (BsdfParams::Blend { weight, .. }, None) if kind == SlotKind::Weight => *weight = value[0],
         (BsdfParams::Blend { first, .. }, Some((Branch::First, rest))) => {
@@ -372,7 +316,7 @@ impl<const N: usize> TexturedBsdf<N> {
         }
         let mut params = params.clone();
         for (i, slot) in slots.iter().enumerate() {
-            let nominal = slot_value(slot, slot.texture.mean());
+            let nominal = slot.nominal();
             set_nominal(&mut params, &slot.path, slot.kind, nominal).ok_or_else(|| {
                 BrdfError::TextureSlot(format!("{:?} at {:?}", slots[i].kind, slots[i].path))
             })?;
@@ -406,11 +350,13 @@ impl<const N: usize> TexturedBsdf<N> {
                 return Err(BrdfError::TexturedConductors);
             }
         }
+        let roughness = roughness_sides(params, &slots);
         let mut t = TexturedBsdf {
             bsdf,
             sides,
             slots,
             nominal_glossy: Sided::from_fn(|_| Spectrum::zero()),
+            roughness,
         };
         let nominal = t.nominal_values();
         t.nominal_glossy = Sided::from_fn(|side| {
@@ -436,20 +382,16 @@ impl<const N: usize> TexturedBsdf<N> {
     pub fn nominal_values(&self) -> SlotValues {
         let mut v = [[0.0; 3]; MAX_SLOTS];
         for (i, s) in self.slots.iter().enumerate() {
-            v[i] = self.slot_value(i, s.texture.mean());
+            v[i] = s.nominal();
         }
         SlotValues(v)
-    }
-
-    fn slot_value(&self, i: usize, rgb: [f64; 3]) -> [f64; 3] {
-        slot_value(&self.slots[i], rgb)
     }
 
     /// Every slot's value at texture coordinates `uv`.
     pub fn values_at(&self, uv: DVec2) -> SlotValues {
         let mut v = [[0.0; 3]; MAX_SLOTS];
         for (i, s) in self.slots.iter().enumerate() {
-            v[i] = self.slot_value(i, s.texture.eval(s.to_uv.apply(uv)));
+            v[i] = s.at(uv);
         }
         SlotValues(v)
     }
@@ -483,33 +425,66 @@ impl<const N: usize> TexturedBsdf<N> {
         })
     }
 
-    /// The material at texture coordinates `uv`.
+    /// The material at texture coordinates `uv`: ρ_d and g of the point's
+    /// slot values and, with a roughness slot, the nominal material with
+    /// the point's α = max(r², 0.01) (the lobe's shape at that point).
     pub fn at(&self, uv: DVec2) -> Shading<'_, N> {
+        let values = self.values_at(uv);
+        let bsdf = match &self.roughness {
+            Some((i, sides)) => {
+                Cow::Owned(self.bsdf.with_alpha(sides, gltf_alpha(values.0[*i][0])))
+            }
+            None => Cow::Borrowed(&self.bsdf),
+        };
         Shading {
-            bsdf: &self.bsdf,
-            parts: Some(self.parts(&self.values_at(uv))),
+            bsdf,
+            parts: Some(self.parts(&values)),
         }
     }
+}
+
+/// The roughness slot of `slots` and the sides of `params` its path
+/// reaches: a `twosided` without a back has its front on both sides.
+fn roughness_sides(params: &BsdfParams, slots: &[TextureSlot]) -> Option<(usize, Sided<bool>)> {
+    let i = slots.iter().position(|s| s.kind == SlotKind::Roughness)?;
+    let sides = match (params, slots[i].path.first()) {
+        (BsdfParams::TwoSided { back: None, .. }, Some(Branch::Front)) => Sided {
+            front: true,
+            back: true,
+        },
+        (BsdfParams::TwoSided { .. }, Some(Branch::Back)) => Sided {
+            front: false,
+            back: true,
+        },
+        _ => Sided {
+            front: true,
+            back: false,
+        },
+    };
+    Some((i, sides))
 }
 
 /// The material at one point: a [`Bsdf`], with the point's ρ_d and g when
 /// the material is textured (module docs). Its methods are [`Bsdf`]'s.
 #[derive(Clone, Debug)]
 pub struct Shading<'a, const N: usize> {
-    bsdf: &'a Bsdf<N>,
+    bsdf: Cow<'a, Bsdf<N>>,
     parts: Option<Sided<PointParts<N>>>,
 }
 
 impl<'a, const N: usize> Shading<'a, N> {
     /// An untextured material, the same everywhere.
     pub fn uniform(bsdf: &'a Bsdf<N>) -> Self {
-        Shading { bsdf, parts: None }
+        Shading {
+            bsdf: Cow::Borrowed(bsdf),
+            parts: None,
+        }
     }
 
     /// The nominal material with the parts `parts` (an element's).
     pub fn with_parts(bsdf: &'a Bsdf<N>, parts: Sided<PointParts<N>>) -> Self {
         Shading {
-            bsdf,
+            bsdf: Cow::Borrowed(bsdf),
             parts: Some(parts),
         }
     }
@@ -622,7 +597,8 @@ impl<'a, const N: usize> Shading<'a, N> {
 mod tests {
     use super::*;
     use crate::params::{Distribution, RoughConductorParams};
-    use crate::texture::{Filter, Wrap};
+    use crate::texture::{Filter, Texture, UvTransform, Wrap};
+    use std::sync::Arc;
 
     fn checker() -> Arc<Texture> {
         // 2 × 1: black, white.
@@ -661,6 +637,8 @@ mod tests {
             scale: [scale; 3],
             offset: [0.0; 3],
             to_uv: UvTransform::IDENTITY,
+            factor: None,
+            max: 1.0,
         }
     }
 
@@ -701,6 +679,87 @@ mod tests {
         assert_eq!(p.front.rho, Spectrum::zero());
         assert!((p.front.glossy.0[0] - 2.0).abs() < 1e-12);
         assert_eq!(p.back.rho, Spectrum::zero());
+    }
+
+    /// A slot with a factor is offset + scale ⊙ t + f · (offset' + scale' ⊙ t)
+    /// with t and f each looked up with its own mapping: here t of the
+    /// black/white checker at u, f of a 2 × 1 texture (0.25, 0.75) at
+    /// u + 0.5 (so that the two lookups differ at every point).
+    #[test]
+    fn a_factor_is_a_second_lookup_multiplying_its_term() {
+        let f = Texture::new(
+            2,
+            1,
+            vec![[0.25; 3], [0.75; 3]],
+            [Wrap::Repeat; 2],
+            Filter::Nearest,
+        )
+        .unwrap();
+        let mut s = slot(Vec::new(), SlotKind::Reflectance, 0.5);
+        s.offset = [0.1; 3];
+        s.factor = Some(SlotFactor {
+            texture: Arc::new(f),
+            to_uv: UvTransform([1.0, 0.0, 0.5, 0.0, 1.0, 0.0]),
+            scale: [-0.4; 3],
+            offset: [0.2; 3],
+        });
+        // u = 0.25: t = 0, f = 0.75 → 0.1 + 0.75 · 0.2 = 0.25.
+        assert!((s.at(DVec2::new(0.25, 0.5))[0] - 0.25).abs() < 1e-12);
+        // u = 0.75: t = 1, f = 0.25 → 0.1 + 0.5 + 0.25 · (0.2 − 0.4) = 0.55.
+        assert!((s.at(DVec2::new(0.75, 0.5))[1] - 0.55).abs() < 1e-12);
+        // Nominal: the means t = 0.5, f = 0.5 → 0.1 + 0.25 + 0.5 · 0.0 = 0.35.
+        assert!((s.nominal()[2] - 0.35).abs() < 1e-12);
+        // A bound above 1 lets a point pass 1; the nominal stays within 1.
+        s.scale = [2.0; 3];
+        s.max = 1.5;
+        assert!((s.at(DVec2::new(0.75, 0.5))[0] - 1.5).abs() < 1e-12);
+        assert!(s.nominal()[0] <= 1.0);
+    }
+
+    /// A roughness slot gives each point the α of its roughness,
+    /// α = max(r², 0.01) (glTF), and the nominal material the α of the
+    /// mean roughness: r = 0.6 t on the checker.
+    #[test]
+    fn a_roughness_slot_sets_each_points_alpha() {
+        let conductor = |alpha: f64| {
+            BsdfParams::RoughConductor(RoughConductorParams {
+                distribution: Distribution::Ggx,
+                alpha,
+                eta_k: None,
+                specular_reflectance: ColorParam::Float(0.7),
+            })
+        };
+        let t: TexturedBsdf<3> = TexturedBsdf::new(
+            &conductor(0.5),
+            vec![slot(Vec::new(), SlotKind::Roughness, 0.6)],
+        )
+        .unwrap();
+        // Mean r = 0.3: α = 0.09.
+        assert_eq!(t.bsdf().min_alpha(Side::Front), Some(0.3 * 0.3));
+        let (wi, wo) = (
+            DVec3::new(0.3, 0.1, 0.9).normalize(),
+            DVec3::new(-0.2, 0.0, 1.0).normalize(),
+        );
+        for (u, alpha) in [(0.75, 0.36), (0.25, 0.01)] {
+            let at = t.at(DVec2::new(u, 0.5));
+            let direct: Bsdf<3> = Bsdf::new(&conductor(alpha)).unwrap();
+            let (a, b) = (at.eval(wi, wo), direct.eval(wi, wo));
+            assert!(
+                (a.0[0] - b.0[0]).abs() <= 1e-12 * b.0[0],
+                "{u}: {a:?} {b:?}"
+            );
+            assert_eq!(at.min_alpha(Side::Front), Some(alpha));
+            let (a, b) = (at.albedo(wo), direct.albedo(wo));
+            assert!((a.0[1] - b.0[1]).abs() < 1e-9, "{u}: {a:?} {b:?}");
+        }
+        // On a diffuse part, a roughness slot names no parameter.
+        assert!(
+            TexturedBsdf::<3>::new(
+                &blend(0.5, 0.5, 0.5),
+                vec![slot(vec![Branch::First], SlotKind::Roughness, 1.0)]
+            )
+            .is_err()
+        );
     }
 
     #[test]

@@ -9,7 +9,8 @@
 //! values are sRGB-encoded and decoded with the sRGB transfer function
 //! (IEC 61966-2-1), as Mitsuba 3 decodes a `bitmap` without `raw` and as
 //! glTF defines base colour textures; `raw` values are used as they are
-//! (divided by 255 or 65535).
+//! (divided by 255 or 65535). [`Sampling::channel`] takes one colour
+//! channel into all three (glTF's metallicRoughnessTexture).
 //!
 //! Bounded: the file by [`MAX_IMAGE_BYTES`] (read by the caller), the image
 //! by [`MAX_TEXTURE_TEXELS`], checked from its header before it is decoded.
@@ -30,6 +31,10 @@ pub struct Sampling {
     pub raw: bool,
     /// The alpha channel instead of the colour (linear whatever `raw`).
     pub alpha: bool,
+    /// One colour channel (0 red, 1 green, 2 blue) in every channel
+    /// instead of the colour: glTF's metalness (blue) and roughness
+    /// (green). A grey image has its grey in every channel.
+    pub channel: Option<u8>,
 }
 
 /// Why an image could not be decoded (the caller names the file).
@@ -103,6 +108,8 @@ pub fn decode_counted(bytes: &[u8], sampling: Sampling) -> Result<(Texture, usiz
                     _ => 1.0,
                 };
                 [a as f32; 3]
+            } else if let (Some(k), true) = (sampling.channel, channels >= 3) {
+                [c(usize::from(k.min(2))); 3]
             } else if channels >= 3 {
                 [c(0), c(1), c(2)]
             } else {

@@ -404,12 +404,15 @@ pub(crate) fn bitmap(
             filter,
             raw,
             alpha: false,
+            channel: None,
         },
         scale: [1.0; 3],
         offset: [0.0; 3],
         to_uv,
         location,
         normal: None,
+        factor: None,
+        max: 1.0,
     })
 }
 
@@ -462,12 +465,15 @@ fn checkerboard(e: &Element, kind: SlotKind, tex: &TextureCollector<'_>) -> Resu
             filter: Filter::Nearest,
             raw: true,
             alpha: false,
+            channel: None,
         },
         scale: std::array::from_fn(|c| c0[c] - c1[c]),
         offset: c1,
         to_uv,
         location: e.loc.clone(),
         normal: None,
+        factor: None,
+        max: 1.0,
     })
 }
 

@@ -11,7 +11,7 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use trilux_brdf::{
-    Branch, NormalMap, NormalPerturbation, SlotKind, Texture, TextureSlot, UvTransform,
+    Branch, NormalMap, NormalPerturbation, SlotFactor, SlotKind, Texture, TextureSlot, UvTransform,
 };
 
 use crate::error::{Result, SceneError, SourceLocation};
@@ -53,6 +53,12 @@ pub(crate) struct TextureRequest {
     /// Set for a normal or bump map: how it turns the shading normal
     /// (`path` and `kind` then mean nothing).
     pub normal: Option<NormalPerturbation>,
+    /// A second texture multiplying part of the value
+    /// (`trilux_brdf::SlotFactor`; its `path`, `kind`, `factor` and `max`
+    /// mean nothing).
+    pub factor: Option<Box<TextureRequest>>,
+    /// The largest value at a point (`trilux_brdf::TextureSlot::max`).
+    pub max: f64,
 }
 
 /// Decoded images, by source and lookup, with their channel counts, and
@@ -88,6 +94,15 @@ impl TextureCache {
     /// The slot a request stands for, its image read and decoded once.
     pub fn slot(&mut self, request: &TextureRequest) -> Result<TextureSlot> {
         let (texture, _) = self.image(request)?;
+        let factor = match &request.factor {
+            Some(f) => Some(SlotFactor {
+                texture: self.image(f)?.0,
+                to_uv: f.to_uv,
+                scale: f.scale,
+                offset: f.offset,
+            }),
+            None => None,
+        };
         Ok(TextureSlot {
             path: request.path.clone(),
             kind: request.kind,
@@ -95,6 +110,8 @@ impl TextureCache {
             scale: request.scale,
             offset: request.offset,
             to_uv: request.to_uv,
+            factor,
+            max: request.max,
         })
     }
 

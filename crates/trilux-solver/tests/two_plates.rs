@@ -233,6 +233,8 @@ fn textured_receiver_one_bounce_resolves_the_texture() {
         scale: [1.0; 3],
         offset: [0.0; 3],
         to_uv: trilux_brdf::UvTransform::IDENTITY,
+        factor: None,
+        max: 1.0,
     };
     let prepared = PreparedScene::<3>::new_textured(&input, &[vec![], vec![slot]]).unwrap();
     let mut solution = Solver::new(Arc::new(prepared), one_bounce_settings())

@@ -24,7 +24,18 @@
 //! is also `doubleSided` is refused (glTF would have it emit on both sides,
 //! and trilux's area emitters emit on the front only).
 //!
-//! Refused (one error naming the material): `metallicRoughnessTexture`,
+//! `metallicRoughnessTexture` (linear: metalness m = metallicFactor × blue,
+//! roughness r = roughnessFactor × green) makes the mapping hold at each
+//! point: D and S are slots affine in the base colour lookup t and the
+//! metalness lookup M, value = offset + scale ⊙ t + M · (offset′ + scale′ ⊙ t)
+//! (`trilux_brdf::SlotFactor`, exact); with M textured, D̂ is D at m = 0
+//! and Ŝ the larger of S at m = 0 and m = metallicFactor, so D̂ + Ŝ may
+//! pass 1 and the blend's inner values are bounded by 1/(1 − w) and 1/w
+//! (`TextureSlot::max`). r is a `SlotKind::Roughness` slot: the render
+//! takes each hit's α, the solve the material's α at the mean roughness
+//! (a warning line; docs/gltf.md, "Metalness and roughness textures").
+//!
+//! Refused (one error naming the material):
 //! `emissiveTexture`, the textures of `KHR_materials_specular`,
 //! texture coordinates other than `TEXCOORD_0`,
 //! and `alphaMode` `BLEND` (a semi-transparent surface composited over what
@@ -51,16 +62,12 @@ use std::sync::Arc;
 
 use trilux_brdf::{
     Branch, BsdfParams, Distribution, Filter, NormalPerturbation, RoughConductorParams, SlotKind,
-    UvTransform, Wrap,
+    UvTransform, Wrap, gltf_alpha,
 };
 use trilux_color::ColorParam;
 
 use crate::error::{Result, SceneError, SourceLocation};
 use crate::image::Sampling;
-
-/// The smallest GGX α a glTF roughness maps to (roughness 0.1): smoother
-/// surfaces are mirrors that no element-based solve can resolve.
-pub(crate) const MIN_ALPHA: f64 = 0.01;
 
 /// A texture of a mapped material, its image not read yet.
 #[derive(Clone, Debug)]
@@ -86,6 +93,12 @@ pub(crate) struct TextureUse {
     pub cutoff: Option<f64>,
     /// Set for the `normalTexture`: how it turns the shading normal.
     pub normal: Option<NormalPerturbation>,
+    /// The metalness texture multiplying part of the value
+    /// (`trilux_brdf::SlotFactor`: value += m · (its offset + its scale ⊙
+    /// texture)).
+    pub factor: Option<Box<TextureUse>>,
+    /// The largest value at a point (`trilux_brdf::TextureSlot::max`).
+    pub max: f64,
 }
 
 /// A glTF material as trilux takes it.
@@ -99,6 +112,8 @@ pub(crate) struct Mapped {
     pub types: Vec<&'static str>,
     /// `alphaMode` `MASK` (module docs).
     pub alpha: Alpha,
+    /// Warning lines (without the file): approximations of the solve.
+    pub warnings: Vec<String>,
 }
 
 impl Mapped {
@@ -142,7 +157,7 @@ pub(crate) fn map(file: &Arc<Path>, m: &gltf::Material<'_>) -> Result<Mapped> {
         )
     };
     refuse_unsupported(m, &at)?;
-    let lobes = lobes(m, &at)?;
+    let factors = factors(m, &at)?;
     let pbr = m.pbr_metallic_roughness();
     let base_texture = pbr
         .base_color_texture()
@@ -152,8 +167,18 @@ pub(crate) fn map(file: &Arc<Path>, m: &gltf::Material<'_>) -> Result<Mapped> {
             texture_info(&t, &at, suffix, location)
         })
         .transpose()?;
+    let mr = pbr
+        .metallic_roughness_texture()
+        .map(|t| {
+            let suffix = "/pbrMetallicRoughness/metallicRoughnessTexture";
+            let location = SourceLocation::json(file, format!("{base}{suffix}"));
+            texture_info(&t, &at, suffix, location)
+        })
+        .transpose()?;
     let alpha = alpha(m, &at, base_texture.as_ref())?;
-    let (bsdf, mut types, mut textures) = lobe_bsdf(&lobes, base_texture.as_ref());
+    let textures = Textures::new(base_texture, mr, &factors);
+    let lobes = Lobes::of(&factors, textures.metal.is_some());
+    let (bsdf, mut types, mut textures, warnings) = lobe_bsdf(&lobes, &textures);
     let bsdf = if m.double_sided() {
         types.push("twosided");
         for t in &mut textures {
@@ -179,6 +204,7 @@ pub(crate) fn map(file: &Arc<Path>, m: &gltf::Material<'_>) -> Result<Mapped> {
         emission: emission(m, &at)?,
         types,
         alpha,
+        warnings,
     })
 }
 
@@ -220,25 +246,63 @@ fn alpha(m: &gltf::Material<'_>, at: &At<'_>, base: Option<&BaseTexture>) -> Res
             location: location.clone(),
             cutoff: Some(cutoff),
             normal: None,
+            factor: None,
+            max: 1.0,
         })),
     })
 }
 
+/// One lobe's reflectance as an affine function of the base colour
+/// texture's value t and the metalness texture's value M (each 1 where
+/// there is none): offset + scale ⊙ t + M · (m_offset + m_scale ⊙ t).
+#[derive(Clone, Copy, Debug, Default)]
+struct Affine {
+    offset: [f64; 3],
+    scale: [f64; 3],
+    m_offset: [f64; 3],
+    m_scale: [f64; 3],
+}
+
+impl Affine {
+    fn map(&self, f: impl Fn(f64) -> f64) -> Affine {
+        Affine {
+            offset: self.offset.map(&f),
+            scale: self.scale.map(&f),
+            m_offset: self.m_offset.map(&f),
+            m_scale: self.m_scale.map(&f),
+        }
+    }
+
+    /// The value with both textures at 1: the lobe's value when neither
+    /// texture enters it.
+    fn constant(&self) -> [f64; 3] {
+        std::array::from_fn(|c| self.offset[c] + self.scale[c] + self.m_offset[c] + self.m_scale[c])
+    }
+}
+
 /// The material's two lobes as the module's header derives them: the
-/// diffuse part D = d_scale ⊙ texture and the specular part
-/// S = s_offset + s_scale ⊙ texture, with their largest values D̂ and Ŝ.
+/// diffuse part D and the specular part S ([`Affine`] in the textures),
+/// with D̂ and Ŝ, the largest channel of each over every texel value.
 struct Lobes {
     rough: f64,
-    d_scale: [f64; 3],
-    s_scale: [f64; 3],
-    s_offset: [f64; 3],
+    metal_textured: bool,
+    diffuse: Affine,
+    specular: Affine,
     d_hat: f64,
     s_hat: f64,
 }
 
-/// The [`Lobes`] of `m`'s factors (clamped to [0, 1]; refused unless
-/// finite).
-fn lobes(m: &gltf::Material<'_>, at: &At<'_>) -> Result<Lobes> {
+/// A material's factors: base colour b, metallic, roughness and the
+/// dielectric's F0.
+struct Factors {
+    b: [f64; 3],
+    metal: f64,
+    rough: f64,
+    f0: [f64; 3],
+}
+
+/// The [`Factors`] of `m` (clamped to [0, 1]; refused unless finite).
+fn factors(m: &gltf::Material<'_>, at: &At<'_>) -> Result<Factors> {
     let pbr = m.pbr_metallic_roughness();
     let f = pbr.base_color_factor();
     let b = [f[0], f[1], f[2]].map(|v| f64::from(v).clamp(0.0, 1.0));
@@ -260,109 +324,251 @@ fn lobes(m: &gltf::Material<'_>, at: &At<'_>) -> Result<Lobes> {
         return Err(at("", "a factor is not a finite number".into()));
     }
     let f0 = sc.map(|c| (0.04 * c).clamp(0.0, 1.0) * sf.clamp(0.0, 1.0));
-    let fmax = f0.iter().copied().fold(0.0, f64::max);
-    let bmax = b.iter().copied().fold(0.0, f64::max);
-    let d_scale = b.map(|c| (1.0 - metal) * (1.0 - fmax) * c);
-    let s_scale = b.map(|c| metal * c);
-    let s_offset = f0.map(|c| (1.0 - metal) * c);
-    let d_hat = (1.0 - metal) * (1.0 - fmax) * bmax;
-    let s_hat = (0..3).map(|c| s_offset[c] + s_scale[c]).fold(0.0, f64::max);
-    Ok(Lobes {
+    Ok(Factors {
+        b,
+        metal,
         rough,
-        d_scale,
-        s_scale,
-        s_offset,
-        d_hat,
-        s_hat,
+        f0,
     })
+}
+
+impl Lobes {
+    /// The lobes of the factors, the metallic factor times the metalness
+    /// texture M when `metal_textured`. With m = metal · M and
+    /// F = max(F0):
+    ///
+    /// ```text
+    /// D = (1 − m)(1 − F) · b ⊙ t   = (1 − F) b ⊙ t − M · metal (1 − F) b ⊙ t
+    /// S = (1 − m) F0 + m · b ⊙ t   = F0 + M · (metal b ⊙ t − metal F0)
+    /// ```
+    ///
+    /// D̂ is D's largest value (m = 0 where M = 0), Ŝ S's: S is affine in m,
+    /// largest at m = 0 or m = metal.
+    fn of(factors: &Factors, metal_textured: bool) -> Lobes {
+        let Factors {
+            b,
+            metal,
+            rough,
+            f0,
+        } = *factors;
+        let fmax = f0.iter().copied().fold(0.0, f64::max);
+        let bmax = b.iter().copied().fold(0.0, f64::max);
+        let max = |v: [f64; 3]| v.iter().copied().fold(0.0, f64::max);
+        let at_metal = |m: f64| std::array::from_fn(|c| (1.0 - m) * f0[c] + m * b[c]);
+        if metal_textured {
+            Lobes {
+                rough,
+                metal_textured,
+                diffuse: Affine {
+                    scale: b.map(|c| (1.0 - fmax) * c),
+                    m_scale: b.map(|c| -metal * (1.0 - fmax) * c),
+                    ..Affine::default()
+                },
+                specular: Affine {
+                    offset: f0,
+                    m_offset: f0.map(|c| -metal * c),
+                    m_scale: b.map(|c| metal * c),
+                    ..Affine::default()
+                },
+                d_hat: (1.0 - fmax) * bmax,
+                s_hat: max(f0).max(max(at_metal(metal))),
+            }
+        } else {
+            let specular = Affine {
+                offset: f0.map(|c| (1.0 - metal) * c),
+                scale: b.map(|c| metal * c),
+                ..Affine::default()
+            };
+            Lobes {
+                rough,
+                metal_textured,
+                diffuse: Affine {
+                    scale: b.map(|c| (1.0 - metal) * (1.0 - fmax) * c),
+                    ..Affine::default()
+                },
+                specular,
+                d_hat: (1.0 - metal) * (1.0 - fmax) * bmax,
+                s_hat: max(at_metal(metal)),
+            }
+        }
+    }
 }
 
 /// The base colour texture as [`texture_info`] reads it.
 type BaseTexture = (usize, Sampling, UvTransform, SourceLocation);
 
+/// The textures of a material: base colour (sRGB), and the
+/// metallicRoughnessTexture's metalness (blue) and roughness (green),
+/// linear; each only where its factor is not 0.
+struct Textures {
+    base: Option<BaseTexture>,
+    metal: Option<BaseTexture>,
+    rough: Option<BaseTexture>,
+}
+
+impl Textures {
+    fn new(base: Option<BaseTexture>, mr: Option<BaseTexture>, factors: &Factors) -> Textures {
+        let channel = |k: u8, factor: f64| {
+            mr.as_ref()
+                .filter(|_| factor > 0.0)
+                .map(|(image, sampling, to_uv, location)| {
+                    let sampling = Sampling {
+                        raw: true,
+                        channel: Some(k),
+                        ..*sampling
+                    };
+                    (*image, sampling, *to_uv, location.clone())
+                })
+        };
+        Textures {
+            metal: channel(2, factors.metal),
+            rough: channel(1, factors.rough),
+            base,
+        }
+    }
+
+    /// The use of lobe `a` at `path` (`None` when no texture enters it).
+    fn lobe_use(
+        &self,
+        a: &Affine,
+        path: Vec<Branch>,
+        kind: SlotKind,
+        max: f64,
+    ) -> Option<TextureUse> {
+        let nonzero = |v: &[f64; 3]| v.iter().any(|&c| c != 0.0);
+        let add = |x: &[f64; 3], y: &[f64; 3]| std::array::from_fn(|c| x[c] + y[c]);
+        let make = |t: &BaseTexture, scale: [f64; 3], offset: [f64; 3]| TextureUse {
+            path: path.clone(),
+            kind,
+            image: t.0,
+            sampling: t.1,
+            scale,
+            offset,
+            to_uv: t.2,
+            location: t.3.clone(),
+            cutoff: None,
+            normal: None,
+            factor: None,
+            max,
+        };
+        match (&self.base, &self.metal) {
+            (Some(b), Some(m)) => (nonzero(&a.scale)
+                || nonzero(&a.m_offset)
+                || nonzero(&a.m_scale))
+            .then(|| TextureUse {
+                factor: Some(Box::new(make(m, a.m_scale, a.m_offset))),
+                ..make(b, a.scale, a.offset)
+            }),
+            (Some(b), None) => {
+                let scale = add(&a.scale, &a.m_scale);
+                nonzero(&scale).then(|| make(b, scale, add(&a.offset, &a.m_offset)))
+            }
+            (None, Some(m)) => {
+                let scale = add(&a.m_offset, &a.m_scale);
+                nonzero(&scale).then(|| make(m, scale, add(&a.offset, &a.scale)))
+            }
+            (None, None) => None,
+        }
+    }
+
+    /// The roughness texture's use on the conductor at `path`, and the
+    /// warning that the solve takes one α for the material.
+    fn rough_use(&self, rough: f64, path: Vec<Branch>) -> Option<(TextureUse, String)> {
+        let (image, sampling, to_uv, location) = self.rough.as_ref()?;
+        let warning = format!(
+            "{location}: the solve takes one GGX roughness for the material, α = max(r², 0.01) at the texture's mean r = roughnessFactor × mean green (the render takes each point's; docs/gltf.md)"
+        );
+        let t = TextureUse {
+            path,
+            kind: SlotKind::Roughness,
+            image: *image,
+            sampling: *sampling,
+            scale: [rough; 3],
+            offset: [0.0; 3],
+            to_uv: *to_uv,
+            location: location.clone(),
+            cutoff: None,
+            normal: None,
+            factor: None,
+            max: 1.0,
+        };
+        Some((t, warning))
+    }
+}
+
 /// The BSDF of the lobes (diffuse alone, conductor alone, or their blend),
-/// its BSDF type names, and the uses of the base colour texture (one per
-/// slot it scales).
+/// its BSDF type names, the texture uses (one per slot) and the warnings.
 fn lobe_bsdf(
     lobes: &Lobes,
-    base_texture: Option<&BaseTexture>,
-) -> (BsdfParams, Vec<&'static str>, Vec<TextureUse>) {
+    textures: &Textures,
+) -> (BsdfParams, Vec<&'static str>, Vec<TextureUse>, Vec<String>) {
     let Lobes {
         rough,
-        d_scale,
-        s_scale,
-        s_offset,
+        metal_textured,
+        diffuse,
+        specular,
         d_hat,
         s_hat,
+        ..
     } = *lobes;
     let conductor = |spec: [f64; 3]| {
         BsdfParams::RoughConductor(RoughConductorParams {
             distribution: Distribution::Ggx,
-            alpha: (rough * rough).max(MIN_ALPHA),
+            alpha: gltf_alpha(rough),
             eta_k: None,
-            specular_reflectance: ColorParam::Rgb(spec),
+            specular_reflectance: ColorParam::Rgb(spec.map(|c| c.clamp(0.0, 1.0))),
         })
     };
-    let mut textures = Vec::new();
-    let mut add = |path: Vec<Branch>, kind, scale: [f64; 3], offset: [f64; 3]| {
-        if let Some((image, sampling, to_uv, location)) = base_texture
-            && scale.iter().any(|&s| s > 0.0)
-        {
-            textures.push(TextureUse {
-                path,
-                kind,
-                image: *image,
-                sampling: *sampling,
-                scale,
-                offset,
-                to_uv: *to_uv,
-                location: location.clone(),
-                cutoff: None,
-                normal: None,
-            });
+    let diffuse_of = |a: &Affine| BsdfParams::Diffuse {
+        reflectance: ColorParam::Rgb(a.constant().map(|c| c.clamp(0.0, 1.0))),
+    };
+    let mut uses = Vec::new();
+    let mut warnings = Vec::new();
+    let mut rough_at = |path: Vec<Branch>, uses: &mut Vec<TextureUse>| {
+        if let Some((t, w)) = textures.rough_use(rough, path) {
+            uses.push(t);
+            warnings.push(w);
         }
     };
     let (bsdf, types) = if s_hat <= 0.0 {
-        add(vec![], SlotKind::Reflectance, d_scale, [0.0; 3]);
-        (
-            BsdfParams::Diffuse {
-                reflectance: ColorParam::Rgb(d_scale),
-            },
-            vec!["diffuse"],
-        )
+        uses.extend(textures.lobe_use(&diffuse, vec![], SlotKind::Reflectance, 1.0));
+        (diffuse_of(&diffuse), vec!["diffuse"])
     } else if d_hat <= 0.0 {
-        add(vec![], SlotKind::SpecularReflectance, s_scale, s_offset);
-        let s = std::array::from_fn(|c| s_offset[c] + s_scale[c]);
-        (conductor(s), vec!["roughconductor"])
+        let kind = SlotKind::SpecularReflectance;
+        uses.extend(textures.lobe_use(&specular, vec![], kind, 1.0));
+        rough_at(vec![], &mut uses);
+        (conductor(specular.constant()), vec!["roughconductor"])
     } else {
+        // blendbsdf(w, diffuse(D/(1 − w)), roughconductor(S/w)): with a
+        // metalness texture, D̂ + Ŝ may pass 1 (D̂ where m = 0, Ŝ where
+        // m = metal), so the inner values may pass 1 where (1 − w)·D ≤ 1
+        // and w·S ≤ 1 still hold: their bounds.
         let w = s_hat / (d_hat + s_hat);
-        let d = d_scale.map(|c| c / (1.0 - w));
-        let (ss, so) = (s_scale.map(|c| c / w), s_offset.map(|c| c / w));
-        add(vec![Branch::First], SlotKind::Reflectance, d, [0.0; 3]);
-        add(vec![Branch::Second], SlotKind::SpecularReflectance, ss, so);
-        let s = std::array::from_fn(|c| (so[c] + ss[c]).min(1.0));
+        let (d, sp) = (diffuse.map(|c| c / (1.0 - w)), specular.map(|c| c / w));
+        let (d_max, s_max) = if metal_textured {
+            (1.0 / (1.0 - w), 1.0 / w)
+        } else {
+            (1.0, 1.0)
+        };
+        let kind = SlotKind::Reflectance;
+        uses.extend(textures.lobe_use(&d, vec![Branch::First], kind, d_max));
+        let kind = SlotKind::SpecularReflectance;
+        uses.extend(textures.lobe_use(&sp, vec![Branch::Second], kind, s_max));
+        rough_at(vec![Branch::Second], &mut uses);
         let blend = BsdfParams::Blend {
             weight: w,
-            first: Box::new(BsdfParams::Diffuse {
-                reflectance: ColorParam::Rgb(d.map(|c| c.min(1.0))),
-            }),
-            second: Box::new(conductor(s)),
+            first: Box::new(diffuse_of(&d)),
+            second: Box::new(conductor(sp.constant())),
         };
         (blend, vec!["blendbsdf", "diffuse", "roughconductor"])
     };
-    (bsdf, types, textures)
+    (bsdf, types, uses, warnings)
 }
 
 type At<'a> = dyn Fn(&str, String) -> SceneError + 'a;
 
 fn refuse_unsupported(m: &gltf::Material<'_>, at: &At<'_>) -> Result<()> {
-    let pbr = m.pbr_metallic_roughness();
     let refused = [
-        (
-            pbr.metallic_roughness_texture().is_some(),
-            "/pbrMetallicRoughness/metallicRoughnessTexture",
-            "metallicRoughnessTexture is not supported (trilux's materials have one roughness and one metallic value; bake them into the factors)",
-        ),
         (
             m.emissive_texture().is_some(),
             "/emissiveTexture",
@@ -497,6 +703,8 @@ fn normal_texture(
         location,
         cutoff: None,
         normal: Some(NormalPerturbation::Normal { scale, flip: false }),
+        factor: None,
+        max: 1.0,
     })
 }
 
@@ -521,6 +729,7 @@ fn sampling(texture: &gltf::texture::Texture<'_>, at: &At<'_>, suffix: &str) -> 
         filter,
         raw: false,
         alpha: false,
+        channel: None,
     })
 }
 

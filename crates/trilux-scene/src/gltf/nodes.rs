@@ -302,6 +302,8 @@ impl Walk<'_> {
             for t in mapped.iter().flat_map(|m| &m.types) {
                 *self.bsdf_counts.entry((*t).to_string()).or_default() += 1;
             }
+            self.warnings
+                .extend(mapped.iter().flat_map(|m| m.warnings.iter().cloned()));
             self.materials.insert(key, mapped);
         }
         if p.mode() != gltf::mesh::Mode::Triangles {
@@ -556,27 +558,24 @@ impl GltfMeshes {
             if failed.contains(shape) {
                 continue;
             }
-            let source = match images.get(&t.image) {
-                Some(s) => s.clone(),
-                None => {
-                    let read = self.image_source(&mut buffers, &folder, t.image);
-                    let Some(s) = errors.keep(read) else {
+            let read = self.cached_source(&mut buffers, &folder, &mut images, t.image);
+            let Some(source) = errors.keep(read) else {
+                continue;
+            };
+            let factor = match &t.factor {
+                None => None,
+                Some(f) => {
+                    let read = self.cached_source(&mut buffers, &folder, &mut images, f.image);
+                    let Some(source) = errors.keep(read) else {
                         continue;
                     };
-                    images.insert(t.image, s.clone());
-                    s
+                    Some(Box::new(request(f, source)))
                 }
             };
             let request = TextureRequest {
-                path: t.path.clone(),
-                kind: t.kind,
-                source,
-                sampling: t.sampling,
-                scale: t.scale,
-                offset: t.offset,
-                to_uv: t.to_uv,
-                location: t.location.clone(),
-                normal: t.normal,
+                factor,
+                max: t.max,
+                ..request(t, source)
             };
             match t.cutoff {
                 Some(cutoff) => cutouts.push((
@@ -590,6 +589,22 @@ impl GltfMeshes {
             }
         }
         (out, cutouts)
+    }
+
+    /// [`Self::image_source`], read once per image.
+    fn cached_source(
+        &self,
+        buffers: &mut Buffers,
+        folder: &Path,
+        images: &mut HashMap<usize, ImageSource>,
+        index: usize,
+    ) -> Result<ImageSource> {
+        if let Some(s) = images.get(&index) {
+            return Ok(s.clone());
+        }
+        let s = self.image_source(buffers, folder, index)?;
+        images.insert(index, s.clone());
+        Ok(s)
     }
 
     fn image_source(
@@ -710,5 +725,22 @@ impl GltfMeshes {
             texcoords: texcoords
                 .map(|v| v.chunks_exact(2).map(|c| DVec2::new(c[0], c[1])).collect()),
         })
+    }
+}
+
+/// The request of texture use `t` reading `source` (no factor).
+fn request(t: &TextureUse, source: ImageSource) -> TextureRequest {
+    TextureRequest {
+        path: t.path.clone(),
+        kind: t.kind,
+        source,
+        sampling: t.sampling,
+        scale: t.scale,
+        offset: t.offset,
+        to_uv: t.to_uv,
+        location: t.location.clone(),
+        normal: t.normal,
+        factor: None,
+        max: 1.0,
     }
 }
