@@ -239,7 +239,7 @@ const UNIT_ALBEDO_CACHE: usize = 1 << 16;
 /// (Fresnel 1 times a `specular_reflectance`) usually share one roughness,
 /// and each albedo table costs 91 × 28k evaluations. The value is the same
 /// as computing it again (a pure function of the key).
-pub fn unit_albedo(microfacet: &Microfacet, cos_o: f64) -> f64 {
+pub(crate) fn unit_albedo(microfacet: &Microfacet, cos_o: f64) -> f64 {
     type Key = (Distribution, u64, u64);
     static CACHE: OnceLock<Mutex<HashMap<Key, f64>>> = OnceLock::new();
     let key = (
