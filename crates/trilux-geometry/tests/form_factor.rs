@@ -101,6 +101,24 @@ fn parallel_equal_rectangles_match_closed_form() {
     }
 }
 
+/// Two l-long rectangles meeting at a right angle along a common edge on
+/// the x axis: the sender w wide in y, the receiver h tall in z.
+fn perpendicular_pair(l: f64, h: f64, w: f64) -> ElementForest {
+    let sender = rect(
+        DVec3::new(0.5 * l, 0.5 * w, 0.0),
+        0.5 * l * X,
+        0.5 * w * Y,
+        false,
+    );
+    let receiver = rect(
+        DVec3::new(0.5 * l, 0.0, 0.5 * h),
+        0.5 * l * X,
+        -0.5 * h * Z,
+        false,
+    );
+    two(sender, receiver)
+}
+
 #[test]
 fn perpendicular_rectangles_with_common_edge_match_closed_form() {
     for (l, h, w, expected) in [
@@ -110,19 +128,7 @@ fn perpendicular_rectangles_with_common_edge_match_closed_form() {
         (2.0, 1.0, 1.0, 0.240636),
         (1.0, 0.5, 1.0, 0.146187),
     ] {
-        let sender = rect(
-            DVec3::new(0.5 * l, 0.5 * w, 0.0),
-            0.5 * l * X,
-            0.5 * w * Y,
-            false,
-        );
-        let receiver = rect(
-            DVec3::new(0.5 * l, 0.0, 0.5 * h),
-            0.5 * l * X,
-            -0.5 * h * Z,
-            false,
-        );
-        let g = two(sender, receiver);
+        let g = perpendicular_pair(l, h, w);
         let (s, r) = (g.root(SurfaceId(0)), g.root(SurfaceId(1)));
         assert!((g.element(r).normal - Y).length() < 1e-12);
         let f = form_factor_front(&g, s, r);
@@ -168,19 +174,7 @@ fn edge_sharing_pairs_are_within_loose_tolerances() {
         (2.0, 1.0, 1.0),
         (1.0, 0.5, 3.0),
     ] {
-        let sender = rect(
-            DVec3::new(0.5 * l, 0.5 * w, 0.0),
-            0.5 * l * X,
-            0.5 * w * Y,
-            false,
-        );
-        let receiver = rect(
-            DVec3::new(0.5 * l, 0.0, 0.5 * h),
-            0.5 * l * X,
-            -0.5 * h * Z,
-            false,
-        );
-        let g = two(sender, receiver);
+        let g = perpendicular_pair(l, h, w);
         let (s, r) = (g.root(SurfaceId(0)), g.root(SurfaceId(1)));
         let opts = FormFactorOptions {
             rel_tol: 1e-2,

@@ -25,7 +25,7 @@ use serde_json::Value;
 use trilux_render::Image;
 
 mod common;
-use common::{folder, scene, trilux};
+use common::{folder, gather_args, render, scene, trilux};
 
 fn mean(image: &Image) -> [f64; 3] {
     let px = image.pixels();
@@ -61,21 +61,10 @@ fn a_metal_rough_textured_box_matches_mitsuba_in_every_estimator() {
         ("preview", 0.02),
     ] {
         let out = dir.join(format!("{gather}.exr"));
-        let mut args = vec!["render", &file, "--solution", sol.to_str().unwrap()];
+        let mut args = vec!["--solution", sol.to_str().unwrap()];
         args.extend(["--spp", "16", "--width", "64", "--height", "64"]);
-        args.extend(["-o", out.to_str().unwrap()]);
-        if gather == "preview" {
-            args.push("--preview");
-        } else {
-            args.extend(["--gather", gather]);
-        }
-        let run = trilux(&args);
-        assert!(
-            run.status.success(),
-            "{}",
-            String::from_utf8_lossy(&run.stderr)
-        );
-        let m = mean(&Image::read_exr(&out).unwrap());
+        args.extend(gather_args(gather));
+        let m = mean(&render(&file, &args, &out));
         let rel: Vec<f64> = (0..3).map(|c| m[c] / r[c] - 1.0).collect();
         ok &= rel.iter().all(|e| e.abs() <= tol); // false for NaN
         report.push(format!(

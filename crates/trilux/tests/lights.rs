@@ -22,10 +22,9 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
 use serde_json::Value;
-use trilux_render::Image;
 
 mod common;
-use common::{folder, mean_rgb_sum as mean, scene, trilux};
+use common::{folder, gather_args, mean_rgb_sum as mean, render, scene, trilux};
 
 fn reference(name: &str) -> f64 {
     let text = std::fs::read_to_string(scene(&format!("lights/{name}.json"))).unwrap();
@@ -71,23 +70,12 @@ fn lights_without_area_match_mitsuba_in_every_estimator() {
                 continue;
             }
             let out = dir.join(format!("{name}-{gather}.exr"));
-            let mut args = vec!["render", &file, "--solution", sol.to_str().unwrap()];
-            args.extend(["--spp", "16", "-o", out.to_str().unwrap()]);
+            let mut args = vec!["--solution", sol.to_str().unwrap(), "--spp", "16"];
             if gltf {
                 args.extend(["--width", "64", "--height", "64"]);
             }
-            if gather == "preview" {
-                args.push("--preview");
-            } else {
-                args.extend(["--gather", gather]);
-            }
-            let run = trilux(&args);
-            assert!(
-                run.status.success(),
-                "{}",
-                String::from_utf8_lossy(&run.stderr)
-            );
-            let m = mean(&Image::read_exr(&out).unwrap());
+            args.extend(gather_args(gather));
+            let m = mean(&render(&file, &args, &out));
             let rel = m / r - 1.0;
             ok &= rel.abs() <= tol; // false for NaN
             report.push(format!(

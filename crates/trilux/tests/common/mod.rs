@@ -25,6 +25,16 @@ pub fn render(file: &str, extra: &[&str], out: &Path) -> trilux_render::Image {
     trilux_render::Image::read_exr(out).unwrap()
 }
 
+/// The render options that choose an estimator by the name the scene
+/// tests use: `preview` is `--preview`, any other `--gather NAME`.
+pub fn gather_args(gather: &str) -> Vec<&str> {
+    if gather == "preview" {
+        vec!["--preview"]
+    } else {
+        vec!["--gather", gather]
+    }
+}
+
 /// The mean over an image's pixels of R + G + B (the figure the scenes'
 /// Mitsuba references store as their `mean_rgb` summed).
 pub fn mean_rgb_sum(image: &trilux_render::Image) -> f64 {
