@@ -9,6 +9,8 @@ its relative standard error), which trilux's tests compare against.
 """
 import json
 import os
+import re
+import tempfile
 
 import numpy as np
 import mitsuba as mi
@@ -57,3 +59,18 @@ def write_reference(folder, name, scene_file, images, spp, extra=None):
         f.write("\n")
     print(json.dumps(rec), flush=True)
     return rec
+
+
+def load_gltf(path, size=64):
+    """A glTF scene converted for Mitsuba by gltf_to_mitsuba.py (beside
+    this file), its film set to size x size, loaded."""
+    import gltf_to_mitsuba  # noqa: E402
+
+    out = tempfile.mkdtemp()
+    xml = gltf_to_mitsuba.convert(path, out)
+    text = open(xml, encoding="utf-8").read()
+    text = re.sub(r'name="width" value="\d+"', f'name="width" value="{size}"', text)
+    text = re.sub(r'name="height" value="\d+"', f'name="height" value="{size}"', text)
+    with open(xml, "w", encoding="utf-8") as f:
+        f.write(text)
+    return mi.load_file(xml)

@@ -8,16 +8,14 @@ passes).
     python3 scenes/lights/make_references.py [SPP]   # default 4096
 """
 import os
-import re
 import sys
-import tempfile
 
 import mitsuba as mi
 
 mi.set_variant("llvm_ad_rgb")
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "..", "scripts"))
-from mitsuba_passes import render_passes, write_reference  # noqa: E402
+from mitsuba_passes import load_gltf, render_passes, write_reference  # noqa: E402
 
 SCENES = ["point-box", "spot-box", "sun-room", "point-glossy", "cornell-point"]
 
@@ -27,17 +25,7 @@ def load(name):
     xml = os.path.join(HERE, name + ".xml")
     if os.path.exists(xml):
         return mi.load_file(xml)
-    import gltf_to_mitsuba  # noqa: E402
-
-    out = tempfile.mkdtemp()
-    path = gltf_to_mitsuba.convert(os.path.join(HERE, name + ".gltf"), out)
-    text = open(path, encoding="utf-8").read()
-    text = re.sub(r'name="width" value="\d+"', 'name="width" value="64"', text)
-    text = re.sub(r'name="height" value="\d+"', 'name="height" value="64"', text)
-    with open(path, "w", encoding="utf-8") as f:
-        f.write(text)
-    return mi.load_file(path)
-
+    return load_gltf(os.path.join(HERE, name + ".gltf"))
 
 def main():
     spp = int(sys.argv[1]) if len(sys.argv) > 1 else 4096

@@ -29,10 +29,8 @@ error over 16 passes), the scene converted by scripts/gltf_to_mitsuba.py.
 """
 import json
 import os
-import re
 import struct
 import sys
-import tempfile
 
 import numpy as np
 import mitsuba as mi
@@ -40,7 +38,7 @@ import mitsuba as mi
 mi.set_variant("llvm_ad_rgb")
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "..", "scripts"))
-from mitsuba_passes import render_passes, write_reference  # noqa: E402
+from mitsuba_passes import load_gltf, render_passes, write_reference  # noqa: E402
 
 NAME = "metal-rough-box"
 N = 16
@@ -153,17 +151,7 @@ def write_gltf():
 
 def load():
     """The scene converted for Mitsuba at 64 x 64."""
-    import gltf_to_mitsuba  # noqa: E402
-
-    out = tempfile.mkdtemp()
-    path = gltf_to_mitsuba.convert(os.path.join(HERE, NAME + ".gltf"), out)
-    text = open(path, encoding="utf-8").read()
-    text = re.sub(r'name="width" value="\d+"', 'name="width" value="64"', text)
-    text = re.sub(r'name="height" value="\d+"', 'name="height" value="64"', text)
-    with open(path, "w", encoding="utf-8") as f:
-        f.write(text)
-    return mi.load_file(path)
-
+    return load_gltf(os.path.join(HERE, NAME + ".gltf"))
 
 def main():
     spp = int(sys.argv[1]) if len(sys.argv) > 1 else 4096
