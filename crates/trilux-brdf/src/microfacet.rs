@@ -248,12 +248,7 @@ pub(crate) fn unit_albedo(microfacet: &Microfacet, cos_o: f64) -> f64 {
         cos_o.to_bits(),
     );
     let cache = CACHE.get_or_init(Default::default);
-    if let Some(&v) = cache
-        .lock()
-        .ok()
-        .and_then(|c| c.get(&key).copied())
-        .as_ref()
-    {
+    if let Some(v) = cache.lock().ok().and_then(|c| c.get(&key).copied()) {
         return v;
     }
     let wo = DVec3::new((1.0 - cos_o * cos_o).max(0.0).sqrt(), 0.0, cos_o);

@@ -13,25 +13,16 @@
 //! conductors in a scene", which also gives the link gather's figure).
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
-use serde_json::Value;
-
 mod common;
-use common::{folder, mean_rgb_sum as mean, render, scene, trilux};
+use common::{folder, mean_rgb_sum as mean, reference_rgb, render, scene, solve};
 
 #[test]
 fn the_metal_box_matches_mitsuba() {
     let dir = folder("conductors");
     let file = scene("conductors/metal-box.xml");
-    let text = std::fs::read_to_string(scene("conductors/metal-box.json")).unwrap();
-    let v: Value = serde_json::from_str(&text).unwrap();
-    let r: f64 = (0..3).map(|c| v["mean_rgb"][c].as_f64().unwrap()).sum();
+    let r: f64 = reference_rgb("conductors/metal-box.json").iter().sum();
     let sol = dir.join("metal-box.sol");
-    let run = trilux(&["solve", &file, "-o", sol.to_str().unwrap()]);
-    assert!(
-        run.status.success(),
-        "{}",
-        String::from_utf8_lossy(&run.stderr)
-    );
+    solve(&file, &sol);
     // The default path gather (2 %: the bound of the daylight rooms' scene
     // comparisons; this scene is 1.7 % dark, a deficit not yet located,
     // docs/results.md "Smooth and named conductors in a scene").

@@ -21,37 +21,16 @@
 //! +0.12, +0.17 %; preview −0.58, −0.13, +0.10 %.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test may panic
 
-use serde_json::Value;
-use trilux_render::Image;
-
 mod common;
-use common::{folder, gather_args, render, scene, trilux};
-
-fn mean(image: &Image) -> [f64; 3] {
-    let px = image.pixels();
-    let mut m = [0.0; 3];
-    for p in px {
-        for c in 0..3 {
-            m[c] += f64::from(p[c]) / px.len() as f64;
-        }
-    }
-    m
-}
+use common::{folder, gather_args, mean_rgb, reference_rgb, render, scene, solve};
 
 #[test]
 fn a_metal_rough_textured_box_matches_mitsuba_in_every_estimator() {
     let dir = folder("metal-rough");
     let file = scene("metal-rough/metal-rough-box.gltf");
-    let text = std::fs::read_to_string(scene("metal-rough/metal-rough-box.json")).unwrap();
-    let v: Value = serde_json::from_str(&text).unwrap();
-    let r: Vec<f64> = (0..3).map(|c| v["mean_rgb"][c].as_f64().unwrap()).collect();
+    let r = reference_rgb("metal-rough/metal-rough-box.json");
     let sol = dir.join("box.sol");
-    let run = trilux(&["solve", &file, "-o", sol.to_str().unwrap()]);
-    assert!(
-        run.status.success(),
-        "{}",
-        String::from_utf8_lossy(&run.stderr)
-    );
+    solve(&file, &sol);
     let mut report = Vec::new();
     let mut ok = true;
     for (gather, tol) in [
@@ -64,7 +43,7 @@ fn a_metal_rough_textured_box_matches_mitsuba_in_every_estimator() {
         let mut args = vec!["--solution", sol.to_str().unwrap()];
         args.extend(["--spp", "16", "--width", "64", "--height", "64"]);
         args.extend(gather_args(gather));
-        let m = mean(&render(&file, &args, &out));
+        let m = mean_rgb(&render(&file, &args, &out));
         let rel: Vec<f64> = (0..3).map(|c| m[c] / r[c] - 1.0).collect();
         ok &= rel.iter().all(|e| e.abs() <= tol); // false for NaN
         report.push(format!(

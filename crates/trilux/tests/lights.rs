@@ -21,15 +21,13 @@
 //! area").
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
-use serde_json::Value;
-
 mod common;
-use common::{folder, gather_args, mean_rgb_sum as mean, render, scene, trilux};
+use common::{
+    folder, gather_args, mean_rgb_sum as mean, reference_rgb, render, scene, solve, trilux,
+};
 
 fn reference(name: &str) -> f64 {
-    let text = std::fs::read_to_string(scene(&format!("lights/{name}.json"))).unwrap();
-    let v: Value = serde_json::from_str(&text).unwrap();
-    (0..3).map(|c| v["mean_rgb"][c].as_f64().unwrap()).sum()
+    reference_rgb(&format!("lights/{name}.json")).iter().sum()
 }
 
 /// Every estimator's image mean against Mitsuba's, one solve per scene.
@@ -53,12 +51,7 @@ fn lights_without_area_match_mitsuba_in_every_estimator() {
             if gltf { "gltf" } else { "xml" }
         ));
         let sol = dir.join(format!("{name}.sol"));
-        let run = trilux(&["solve", &file, "-o", sol.to_str().unwrap()]);
-        assert!(
-            run.status.success(),
-            "{}",
-            String::from_utf8_lossy(&run.stderr)
-        );
+        solve(&file, &sol);
         let r = reference(name);
         for (gather, tol) in [
             ("paths", 0.01),

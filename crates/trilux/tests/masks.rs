@@ -9,10 +9,8 @@
 
 use std::path::Path;
 
-use serde_json::Value;
-
 mod common;
-use common::{folder, mean_rgb_sum, render, scene, trilux};
+use common::{folder, mean_rgb_sum, reference_rgb, render, scene, solve, trilux};
 
 /// A 2 × 2 m floor (ρ = 0.5) at y = 0 under a sun straight down
 /// (irradiance 2, 1.5, 1), `roof` (a `<shape>`'s BSDF, or nothing) on a
@@ -218,18 +216,11 @@ fn bad_cutouts_are_one_located_line() {
 /// −10 % here), a known deficit that they are not held to.
 #[test]
 fn the_leaf_box_matches_mitsuba() {
-    let text = std::fs::read_to_string(scene("masks/leaf-box.json")).unwrap();
-    let v: Value = serde_json::from_str(&text).unwrap();
-    let reference: f64 = (0..3).map(|c| v["mean_rgb"][c].as_f64().unwrap()).sum();
+    let reference: f64 = reference_rgb("masks/leaf-box.json").iter().sum();
     let dir = folder("masks-leaf-box");
     let file = scene("masks/leaf-box.xml");
     let sol = dir.join("leaf.sol");
-    let run = trilux(&["solve", &file, "-o", sol.to_str().unwrap()]);
-    assert!(
-        run.status.success(),
-        "{}",
-        String::from_utf8_lossy(&run.stderr)
-    );
+    solve(&file, &sol);
     let mean = |gather: &str| {
         let out = dir.join(format!("{gather}.exr"));
         let args = [

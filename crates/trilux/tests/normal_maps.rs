@@ -15,16 +15,15 @@
 //! - Bad maps are one located line and exit 1.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test, bench or example may panic
 
-use serde_json::Value;
 use trilux_render::Image;
 
 mod common;
-use common::{folder, mean_rgb_sum as mean, render, scene, trilux};
+use common::{folder, mean_rgb_sum as mean, reference_rgb, render, scene, trilux};
 
 fn reference(name: &str) -> f64 {
-    let text = std::fs::read_to_string(scene(&format!("normalmap/{name}.json"))).unwrap();
-    let v: Value = serde_json::from_str(&text).unwrap();
-    (0..3).map(|c| v["mean_rgb"][c].as_f64().unwrap()).sum()
+    reference_rgb(&format!("normalmap/{name}.json"))
+        .iter()
+        .sum()
 }
 
 /// A floor (scenes/normalmap/floor.obj) with `bsdf`, under a directional

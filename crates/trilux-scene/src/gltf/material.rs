@@ -159,22 +159,17 @@ pub(crate) fn map(file: &Arc<Path>, m: &gltf::Material<'_>) -> Result<Mapped> {
     refuse_unsupported(m, &at)?;
     let factors = factors(m, &at)?;
     let pbr = m.pbr_metallic_roughness();
-    let base_texture = pbr
-        .base_color_texture()
-        .map(|t| {
-            let suffix = "/pbrMetallicRoughness/baseColorTexture";
+    // A texture of `pbrMetallicRoughness` named by its JSON key.
+    let pbr_texture = |t: Option<gltf::texture::Info<'_>>, key: &str| {
+        t.map(|t| {
+            let suffix = format!("/pbrMetallicRoughness/{key}");
             let location = SourceLocation::json(file, format!("{base}{suffix}"));
-            texture_info(&t, &at, suffix, location)
+            texture_info(&t, &at, &suffix, location)
         })
-        .transpose()?;
-    let mr = pbr
-        .metallic_roughness_texture()
-        .map(|t| {
-            let suffix = "/pbrMetallicRoughness/metallicRoughnessTexture";
-            let location = SourceLocation::json(file, format!("{base}{suffix}"));
-            texture_info(&t, &at, suffix, location)
-        })
-        .transpose()?;
+        .transpose()
+    };
+    let base_texture = pbr_texture(pbr.base_color_texture(), "baseColorTexture")?;
+    let mr = pbr_texture(pbr.metallic_roughness_texture(), "metallicRoughnessTexture")?;
     let alpha = alpha(m, &at, base_texture.as_ref())?;
     let textures = Textures::new(base_texture, mr, &factors);
     let lobes = Lobes::of(&factors, textures.metal.is_some());

@@ -25,6 +25,36 @@ pub fn render(file: &str, extra: &[&str], out: &Path) -> trilux_render::Image {
     trilux_render::Image::read_exr(out).unwrap()
 }
 
+/// `trilux solve FILE -o SOLUTION`, which must succeed.
+pub fn solve(file: &str, solution: &Path) {
+    let run = trilux(&["solve", file, "-o", solution.to_str().unwrap()]);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+}
+
+/// The `mean_rgb` of a Mitsuba reference's JSON (`scenes/NAME`), as the
+/// scenes' make_references.py scripts write it.
+pub fn reference_rgb(name: &str) -> [f64; 3] {
+    let text = std::fs::read_to_string(scene(name)).unwrap();
+    let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    std::array::from_fn(|c| v["mean_rgb"][c].as_f64().unwrap())
+}
+
+/// The mean over an image's pixels per channel (R, G, B).
+pub fn mean_rgb(image: &trilux_render::Image) -> [f64; 3] {
+    let px = image.pixels();
+    let mut m = [0.0; 3];
+    for p in px {
+        for (c, mc) in m.iter_mut().enumerate() {
+            *mc += f64::from(p[c]) / px.len() as f64;
+        }
+    }
+    m
+}
+
 /// The render options that choose an estimator by the name the scene
 /// tests use: `preview` is `--preview`, any other `--gather NAME`.
 pub fn gather_args(gather: &str) -> Vec<&str> {
