@@ -220,9 +220,14 @@ impl<const N: usize> Solver<N> {
                 let is_self = h.is_self();
                 let hierarchy = if is_self {
                     // A face's interaction with itself receives from its own
-                    // shot: it stays in place, a copy sends.
+                    // shot: it stays in place, a copy sends. The copy
+                    // carries the unshot radiance, so the one in place drops
+                    // it now: a split there that cannot keep its flux must
+                    // not book as escaped light the copy is shooting.
                     h.push_pull();
-                    h.clone()
+                    let copy = h.clone();
+                    h.clear_unshot();
+                    copy
                 } else {
                     let mut h = slot.take()?;
                     h.push_pull();
@@ -325,15 +330,8 @@ impl<const N: usize> Solver<N> {
                     .field
                     .clear_unshot(self.setup.forest(), root, face.side());
             }
-            Sending::Stored {
-                index,
-                is_self: true,
-                ..
-            } => {
-                if let Some(h) = self.state.hierarchies[index as usize].as_mut() {
-                    h.clear_unshot();
-                }
-            }
+            // Its unshot radiance was cleared when it was taken.
+            Sending::Stored { is_self: true, .. } => {}
             Sending::Stored {
                 index,
                 mut hierarchy,
