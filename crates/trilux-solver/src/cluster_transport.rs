@@ -55,7 +55,7 @@ use std::sync::OnceLock;
 use glam::{DVec2, DVec3};
 use trilux_color::Spectrum;
 use trilux_geometry::{
-    BurialMap, ElementForest, FaceElement, FaceId, PerFace, Side, Sided, SurfaceId,
+    BurialMap, ElementForest, ElementId, FaceElement, FaceId, PerFace, Side, Sided, SurfaceId,
 };
 
 use crate::cluster::{ClusterId, ClusterTree};
@@ -122,6 +122,8 @@ pub(crate) struct Clusters {
     /// (`trilux_geometry::crossing`; not a matter of clustering, but read
     /// by refinement beside it).
     pub partly_cut: Sided<Vec<bool>>,
+    /// The ends of far blocks' shadow segments.
+    pub points: FarPoints,
 }
 
 /// Directions (about a face's normal) of the enclosure probe: the normal
@@ -176,9 +178,11 @@ pub(crate) fn is_enclosed(forest: &ElementForest, f: FaceId) -> bool {
 }
 
 impl Clusters {
-    /// Bytes held (tree and cuts).
+    /// Bytes held (tree, cuts and the far blocks' segment ends).
     pub fn bytes(&self) -> usize {
         self.tree.bytes()
+            + self.points.by_surface.capacity()
+                * std::mem::size_of::<[FarPoint; 2 * CLUSTER_RAYS as usize]>()
             + self
                 .cuts
                 .values()
@@ -268,6 +272,85 @@ pub(crate) struct FarContext<'a> {
     pub exposed_area: &'a Sided<Vec<f64>>,
     pub burial: Option<&'a BurialMap>,
     pub enclosed: &'a PerFace<bool>,
+    pub points: &'a FarPoints,
+}
+
+/// One end of a far block's shadow segment, with whether it lies on a
+/// buried part of either face of its surface.
+#[derive(Clone, Copy, Debug, Default)]
+struct FarPoint {
+    point: DVec3,
+    /// Buried on the front face, on the back face.
+    buried: [bool; 2],
+}
+
+impl FarPoint {
+    fn is_buried(&self, side: Side) -> bool {
+        self.buried[usize::from(side.is_back())]
+    }
+}
+
+/// Per input surface, the ends of the far blocks' shadow segments
+/// ([`FarContext::visibility`]). Segment k starts at the sender's point
+/// `r2(k, ½)` and ends at a member's point `r2(k, ¼)`: both depend only on
+/// the surface and k, so they are sampled once per surface here instead
+/// of once per far block (a face has hundreds of blocks in an interior, and
+/// sampling a mesh chart cost as much as tracing the segment). The
+/// segments are the same as sampling each time, bit for bit.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct FarPoints {
+    /// Per surface: the sender points, then the member points.
+    by_surface: Vec<[FarPoint; 2 * CLUSTER_RAYS as usize]>,
+}
+
+impl FarPoints {
+    /// The points of every input surface of `forest` (none when
+    /// `clustering` is off: no far block is made).
+    pub fn new(forest: &ElementForest, burial: Option<&BurialMap>, clustering: bool) -> Self {
+        use rayon::prelude::*;
+        if !clustering {
+            return FarPoints::default();
+        }
+        let count = forest.geometry().surfaces().len() as u32;
+        let by_surface = (0..count)
+            .into_par_iter()
+            .map(|s| {
+                let s = SurfaceId(s);
+                let point = |u: DVec2| {
+                    let x = forest.sample_surface(s, u);
+                    let buried = Side::BOTH.map(|side| {
+                        burial.is_some_and(|b| b.is_buried(FaceId::new(s, side), x.coord))
+                    });
+                    FarPoint {
+                        point: x.point,
+                        buried,
+                    }
+                };
+                let n = CLUSTER_RAYS;
+                std::array::from_fn(|i| {
+                    let k = i as u32;
+                    if k < n {
+                        point(r2(k, 0.5))
+                    } else {
+                        point(r2(k - n, 0.25))
+                    }
+                })
+            })
+            .collect();
+        FarPoints { by_surface }
+    }
+
+    /// Segment k's start on `surface` (as a sender) and end on it (as a
+    /// member).
+    fn sender(&self, surface: SurfaceId, k: u32) -> Option<&FarPoint> {
+        self.by_surface.get(surface.index())?.get(k as usize)
+    }
+
+    fn member(&self, surface: SurfaceId, k: u32) -> Option<&FarPoint> {
+        self.by_surface
+            .get(surface.index())?
+            .get((CLUSTER_RAYS + k) as usize)
+    }
 }
 
 /// One member face of a far block as a sender sees it.
@@ -353,28 +436,44 @@ impl FarContext<'_> {
             return 0.0;
         }
         let geom = self.forest.geometry();
+        let a_surface = self.forest.element(a.element).surface;
+        // The stored points serve a sender that is a whole surface.
+        let a_root = self.forest.root(a_surface) == a.element;
         let (mut seen, mut count) = (0.0, 0u32);
         let mut hint = None;
         for k in 0..CLUSTER_RAYS {
-            let u = r2(k, 0.5);
-            let w = r2(k, 0.25);
-            let x = self.forest.sample_element(a.element, u);
             let pick = (f64::from(k) + 0.5) / f64::from(CLUSTER_RAYS) * total;
             let m = members
                 .partition_point(|&(_, cum)| cum < pick)
                 .min(members.len() - 1);
             let face = members[m].0;
-            let y = self.forest.sample_surface(face.surface(), w);
-            let a_face = FaceId::new(self.forest.element(a.element).surface, a.side);
-            let buried = self
-                .burial
-                .is_some_and(|b| b.is_buried(a_face, x.coord) || b.is_buried(face, y.coord));
+            let x = match self.points.sender(a_surface, k).filter(|_| a_root) {
+                Some(x) => *x,
+                None => self.sample(a.element, r2(k, 0.5)),
+            };
+            let y = match self.points.member(face.surface(), k) {
+                Some(y) => *y,
+                None => self.sample(self.forest.root(face.surface()), r2(k, 0.25)),
+            };
             count += 1;
-            if !buried {
+            if !(x.is_buried(a.side) || y.is_buried(face.side())) {
                 seen += geom.transmittance_hint(x.point, y.point, &mut hint);
             }
         }
         seen / f64::from(count.max(1))
+    }
+
+    /// A segment end sampled on element `e` (when no stored point serves).
+    fn sample(&self, e: ElementId, u: DVec2) -> FarPoint {
+        let x = self.forest.sample_element(e, u);
+        let surface = self.forest.element(e).surface;
+        FarPoint {
+            point: x.point,
+            buried: Side::BOTH.map(|side| {
+                self.burial
+                    .is_some_and(|b| b.is_buried(FaceId::new(surface, side), x.coord))
+            }),
+        }
     }
 
     /// V of far block `block` of sender `a`, traced on first use.
@@ -625,5 +724,53 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// The stored segment ends are the points sampling gives, and every
+    /// far block's visible fraction from them is the sampled one, bit for
+    /// bit.
+    #[test]
+    fn stored_segment_ends_trace_the_sampled_segments() {
+        let setup = grids();
+        let cache = crate::throughput::ThroughputCache::new(16);
+        let stored = setup.refine_context(&cache).far();
+        assert!(
+            !stored.points.by_surface.is_empty(),
+            "clustering stores points"
+        );
+        let none = FarPoints::default();
+        let sampled = FarContext {
+            points: &none,
+            ..stored
+        };
+        let forest = setup.forest();
+        for s in 0..forest.geometry().surfaces().len() as u32 {
+            let s = SurfaceId(s);
+            for k in 0..CLUSTER_RAYS {
+                let x = forest.sample_surface(s, r2(k, 0.5)).point;
+                let y = forest.sample_surface(s, r2(k, 0.25)).point;
+                assert_eq!(stored.points.sender(s, k).map(|p| p.point), Some(x));
+                assert_eq!(stored.points.member(s, k).map(|p| p.point), Some(y));
+            }
+        }
+        let mut blocks = 0;
+        for (face, cut) in setup.clusters.cuts.iter() {
+            let a = face.of(setup.forest().root(face.surface()));
+            for b in &cut.far {
+                let (v, w) = (
+                    stored.visibility(a, b.cluster),
+                    sampled.visibility(a, b.cluster),
+                );
+                assert_eq!(
+                    v.to_bits(),
+                    w.to_bits(),
+                    "face {face:?}, cluster {}",
+                    b.cluster
+                );
+                assert!((0.0..=1.0).contains(&v));
+                blocks += 1;
+            }
+        }
+        assert!(blocks > 0, "the scene has far blocks");
     }
 }

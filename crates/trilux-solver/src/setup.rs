@@ -24,7 +24,7 @@ use trilux_geometry::{
 };
 
 use crate::cluster::ClusterTree;
-use crate::cluster_transport::{Clusters, Cut, cut_of};
+use crate::cluster_transport::{Clusters, Cut, FarPoints, cut_of};
 use crate::discretisation::Discretisation;
 use crate::error::SolverError;
 use crate::faces::{TransportFace, build_faces, eligible_pairs};
@@ -118,6 +118,8 @@ impl<const N: usize> Setup<N> {
         }
         let (mut clusters, partners) = clusters_and_partners(forest, &faces, &settings);
         clusters.partly_cut = partly_cut(&exposed_area, forest, plain.as_ref());
+        let far = clusters.cuts.values().any(|c| !c.far.is_empty());
+        clusters.points = FarPoints::new(forest, burial.as_ref(), far);
         let root_pairs = root_pairs(&faces, &partners);
         let mut emitted = Spectrum::zero();
         for (face, f) in faces.iter() {
@@ -397,6 +399,7 @@ fn clusters_and_partners<const N: usize>(
             cuts,
             enclosed,
             partly_cut: Sided::from_fn(|_| Vec::new()),
+            points: FarPoints::default(),
         },
         partners,
     )

@@ -91,6 +91,7 @@ fn far_fields<const N: usize>(setup: &Setup<N>) -> FarFields<N> {
         exposed_area: &setup.exposed_area,
         burial: setup.burial.as_ref(),
         enclosed: &clusters.enclosed,
+        points: &clusters.points,
     };
     let faces = &setup.faces;
     let ids: Vec<FaceId> = faces.iter().map(|(f, _)| f).collect();

@@ -97,6 +97,7 @@ impl<'a, const N: usize> RefineContext<'a, N> {
             exposed_area: self.exposed_area,
             burial: self.visibility.burial(),
             enclosed: &self.clusters.enclosed,
+            points: &self.clusters.points,
         }
     }
 }
