@@ -285,6 +285,18 @@ struct FarPoint {
 }
 
 impl FarPoint {
+    /// The point of element `e` at `u`, as `Visibility` samples it.
+    fn sample(forest: &ElementForest, burial: Option<&BurialMap>, e: ElementId, u: DVec2) -> Self {
+        let x = forest.sample_element(e, u);
+        let surface = forest.element(e).surface;
+        FarPoint {
+            point: x.point,
+            buried: Side::BOTH.map(|side| {
+                burial.is_some_and(|b| b.is_buried(FaceId::new(surface, side), x.coord))
+            }),
+        }
+    }
+
     fn is_buried(&self, side: Side) -> bool {
         self.buried[usize::from(side.is_back())]
     }
@@ -304,28 +316,20 @@ pub(crate) struct FarPoints {
 }
 
 impl FarPoints {
-    /// The points of every input surface of `forest` (none when
-    /// `clustering` is off: no far block is made).
-    pub fn new(forest: &ElementForest, burial: Option<&BurialMap>, clustering: bool) -> Self {
+    /// The points of every input surface of `forest`, or none when no
+    /// face has a far block (`any_far` false: clustering off, or a scene
+    /// too small for distant clusters).
+    pub fn new(forest: &ElementForest, burial: Option<&BurialMap>, any_far: bool) -> Self {
         use rayon::prelude::*;
-        if !clustering {
+        if !any_far {
             return FarPoints::default();
         }
         let count = forest.geometry().surfaces().len() as u32;
         let by_surface = (0..count)
             .into_par_iter()
             .map(|s| {
-                let s = SurfaceId(s);
-                let point = |u: DVec2| {
-                    let x = forest.sample_surface(s, u);
-                    let buried = Side::BOTH.map(|side| {
-                        burial.is_some_and(|b| b.is_buried(FaceId::new(s, side), x.coord))
-                    });
-                    FarPoint {
-                        point: x.point,
-                        buried,
-                    }
-                };
+                let root = forest.root(SurfaceId(s));
+                let point = |u: DVec2| FarPoint::sample(forest, burial, root, u);
                 let n = CLUSTER_RAYS;
                 std::array::from_fn(|i| {
                     let k = i as u32;
@@ -436,9 +440,6 @@ impl FarContext<'_> {
             return 0.0;
         }
         let geom = self.forest.geometry();
-        let a_surface = self.forest.element(a.element).surface;
-        // The stored points serve a sender that is a whole surface.
-        let a_root = self.forest.root(a_surface) == a.element;
         let (mut seen, mut count) = (0.0, 0u32);
         let mut hint = None;
         for k in 0..CLUSTER_RAYS {
@@ -447,14 +448,7 @@ impl FarContext<'_> {
                 .partition_point(|&(_, cum)| cum < pick)
                 .min(members.len() - 1);
             let face = members[m].0;
-            let x = match self.points.sender(a_surface, k).filter(|_| a_root) {
-                Some(x) => *x,
-                None => self.sample(a.element, r2(k, 0.5)),
-            };
-            let y = match self.points.member(face.surface(), k) {
-                Some(y) => *y,
-                None => self.sample(self.forest.root(face.surface()), r2(k, 0.25)),
-            };
+            let (x, y) = self.segment(a, face, k);
             count += 1;
             if !(x.is_buried(a.side) || y.is_buried(face.side())) {
                 seen += geom.transmittance_hint(x.point, y.point, &mut hint);
@@ -463,17 +457,22 @@ impl FarContext<'_> {
         seen / f64::from(count.max(1))
     }
 
-    /// A segment end sampled on element `e` (when no stored point serves).
-    fn sample(&self, e: ElementId, u: DVec2) -> FarPoint {
-        let x = self.forest.sample_element(e, u);
-        let surface = self.forest.element(e).surface;
-        FarPoint {
-            point: x.point,
-            buried: Side::BOTH.map(|side| {
-                self.burial
-                    .is_some_and(|b| b.is_buried(FaceId::new(surface, side), x.coord))
-            }),
-        }
+    /// Segment k from sender `a` to member face `to`: from `a`'s point
+    /// `r2(k, ½)` to the member's `r2(k, ¼)`, stored per surface
+    /// ([`FarPoints`]) for a sender that is a whole surface, else sampled.
+    fn segment(&self, a: FaceElement, to: FaceId, k: u32) -> (FarPoint, FarPoint) {
+        let sample = |e: ElementId, u: DVec2| FarPoint::sample(self.forest, self.burial, e, u);
+        let a_surface = self.forest.element(a.element).surface;
+        let a_root = self.forest.root(a_surface) == a.element;
+        let x = match self.points.sender(a_surface, k).filter(|_| a_root) {
+            Some(x) => *x,
+            None => sample(a.element, r2(k, 0.5)),
+        };
+        let y = match self.points.member(to.surface(), k) {
+            Some(y) => *y,
+            None => sample(self.forest.root(to.surface()), r2(k, 0.25)),
+        };
+        (x, y)
     }
 
     /// V of far block `block` of sender `a`, traced on first use.
@@ -618,6 +617,12 @@ mod tests {
     /// 3 × 3 grid of small squares at height 1, facing down: far enough
     /// apart that clusters of them are far from each other.
     fn grids() -> crate::setup::Setup<3> {
+        grids_with(false)
+    }
+
+    /// [`grids`], and with `blockers` four squares 0.3 wide halfway up
+    /// (facing up, at odd coordinates), which hide some far blocks in part.
+    fn grids_with(blockers: bool) -> crate::setup::Setup<3> {
         let mut shapes = Vec::new();
         for a in 0..5 {
             for b in 0..5 {
@@ -629,6 +634,12 @@ mod tests {
             for b in 0..3 {
                 let c = DVec3::new(2.0 * f64::from(a), 2.0 * f64::from(b), 1.0);
                 shapes.push(ts::square(c, 0.1, true));
+            }
+        }
+        for a in (0..2).filter(|_| blockers) {
+            for b in 0..2 {
+                let c = DVec3::new(2.0 * f64::from(a) + 1.0, 2.0 * f64::from(b) + 1.0, 0.5);
+                shapes.push(ts::square(c, 0.3, false));
             }
         }
         let n = shapes.len();
@@ -726,12 +737,12 @@ mod tests {
         }
     }
 
-    /// The stored segment ends are the points sampling gives, and every
-    /// far block's visible fraction from them is the sampled one, bit for
-    /// bit.
+    /// The stored segment ends are the points sampling gives, every far
+    /// block's segments are the sampled ones, and so is its visible
+    /// fraction, bit for bit (partly hidden blocks among them).
     #[test]
     fn stored_segment_ends_trace_the_sampled_segments() {
-        let setup = grids();
+        let setup = grids_with(true);
         let cache = crate::throughput::ThroughputCache::new(16);
         let stored = setup.refine_context(&cache).far();
         assert!(
@@ -753,7 +764,8 @@ mod tests {
                 assert_eq!(stored.points.member(s, k).map(|p| p.point), Some(y));
             }
         }
-        let mut blocks = 0;
+        let tree = &setup.clusters.tree;
+        let (mut blocks, mut partial) = (0, 0);
         for (face, cut) in setup.clusters.cuts.iter() {
             let a = face.of(setup.forest().root(face.surface()));
             for b in &cut.far {
@@ -768,9 +780,19 @@ mod tests {
                     b.cluster
                 );
                 assert!((0.0..=1.0).contains(&v));
+                for &m in tree.members_of(b.cluster) {
+                    let to = FaceId::new(m, Side::Front);
+                    for k in 0..CLUSTER_RAYS {
+                        let (p, q) = (stored.segment(a, to, k), sampled.segment(a, to, k));
+                        assert_eq!((p.0.point, p.1.point), (q.0.point, q.1.point));
+                        assert_eq!((p.0.buried, p.1.buried), (q.0.buried, q.1.buried));
+                    }
+                }
                 blocks += 1;
+                partial += u32::from(v > 0.0 && v < 1.0);
             }
         }
         assert!(blocks > 0, "the scene has far blocks");
+        assert!(partial > 0, "some far block is partly hidden");
     }
 }
