@@ -68,11 +68,7 @@ pub fn gather_args(gather: &str) -> Vec<&str> {
 /// The mean over an image's pixels of R + G + B (the figure the scenes'
 /// Mitsuba references store as their `mean_rgb` summed).
 pub fn mean_rgb_sum(image: &trilux_render::Image) -> f64 {
-    let px = image.pixels();
-    px.iter()
-        .map(|p| f64::from(p[0]) + f64::from(p[1]) + f64::from(p[2]))
-        .sum::<f64>()
-        / px.len() as f64
+    mean_rgb(image).iter().sum()
 }
 
 /// A thin slab's transmittance (1 − r)² / (1 − r²) at cos θ_i = `c`, r
