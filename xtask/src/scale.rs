@@ -13,9 +13,10 @@
 //!
 //! `cargo xtask scale [--boxes 4,16,64,256] [--meshes 4,16,64,256]
 //! [--grid 20000,200000] [--curtain] [--facets AROUND,ALONG] [--scene
-//! FILE.xml]... [--quality Q] [--no-clustering] [--plot FILE.svg] [--out
-//! DIR]`, or `--compare 4,16` (clustered against unclustered surface
-//! means on the boxes rooms).
+//! FILE.xml]... [--quality Q] [--no-clustering] [--cluster-angle θ] [--plot
+//! FILE.svg] [--out DIR]`, or `--compare 4,16 [--angles 0.25,0.5]`
+//! (clustered at each θ against unclustered surface means on the boxes
+//! rooms).
 
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -135,55 +136,82 @@ fn run_file(path: &std::path::Path, settings: &SolverSettings) -> Result<Row> {
     })
 }
 
-/// Solves `case` with clustering on and off (default quality) and prints,
-/// per input surface face that reflects light, the ratio of its mean
-/// Lambertian radiance with clustering to without, area-weighted
-/// statistics of those ratios, and the escaped share of the emitted flux
-/// (a closed room: light lost to estimation error).
-fn compare(case: Case, dir: &std::path::Path) -> Result<()> {
-    use trilux_geometry::{FaceId, Side};
-    use trilux_solver::Solver;
+/// Solves `case` without clustering and with it at each θ of `angles`
+/// (default quality) and prints, per θ, the ratio of each reflecting
+/// face's mean Lambertian radiance with clustering to without:
+/// area-weighted mean and spread, the worst face, and the escaped share
+/// of the emitted flux (a closed room: light lost to estimation error).
+fn compare(case: Case, dir: &std::path::Path, angles: &[f64]) -> Result<()> {
+    use trilux_solver::Solution;
     let path = write_case(case, dir)?;
     let scene = trilux_scene::load(&path).map_err(|e| anyhow::anyhow!("{e}"))?;
     let prepared = trilux::prepare::<3>(&scene)?;
-    let mut solutions = Vec::new();
-    for clustering in [true, false] {
+    let solve = |angle: Option<f64>| -> Result<Solution<3>> {
         let mut settings = SolverSettings::preset(Quality::Default);
-        settings.clustering = clustering;
+        settings.clustering = angle.is_some();
+        settings.cluster_angle = angle.unwrap_or(settings.cluster_angle);
         let start = Instant::now();
-        let solver = Solver::<3>::new(std::sync::Arc::clone(&prepared), settings)
+        let solver = trilux_solver::Solver::<3>::new(std::sync::Arc::clone(&prepared), settings)
             .map_err(|e| anyhow::anyhow!("{e}"))?;
         let solution = solver.solve(|_| {});
         let s = solution.stats();
         let escaped: f64 = s.escaped_flux.iter().sum::<f64>() / s.emitted_flux.iter().sum::<f64>();
         eprintln!(
-            "{}: clustering {clustering}: {:.2} s, {} shots, escaped {:.4} %",
+            "{}: cluster angle {angle:?}: {:.2} s, {} shots, escaped {:.4} %",
             case.name(),
             start.elapsed().as_secs_f64(),
             s.shots,
             100.0 * escaped
         );
-        solutions.push(solution);
+        Ok(solution)
+    };
+    let reference = solve(None)?;
+    for &angle in angles {
+        let clustered = solve(Some(angle))?;
+        let r = face_ratios(&clustered, &reference);
+        println!(
+            "{}: θ {angle}: surface mean radiance, clustered / unclustered: area-weighted mean {:.4}, sd {:.4}, worst face {:.4}, worst face above 1 m² {:.4}",
+            case.name(),
+            r.mean,
+            r.sd,
+            r.worst,
+            r.big_worst
+        );
     }
-    let geom = solutions[0].forest().geometry();
-    let (mut worst, mut sum_w, mut sum_wr, mut sum_wr2) = (1.0f64, 0.0, 0.0, 0.0);
-    let mut big_worst = 1.0f64;
+    Ok(())
+}
+
+/// Area-weighted statistics of per-face ratios of mean radiance.
+struct Ratios {
+    mean: f64,
+    sd: f64,
+    worst: f64,
+    big_worst: f64,
+}
+
+/// The ratio of every reflecting front face's mean radiance in `a` to the
+/// one in `b` (faces dark in `b` left out).
+fn face_ratios(a: &trilux_solver::Solution<3>, b: &trilux_solver::Solution<3>) -> Ratios {
+    use trilux_geometry::{FaceId, Side};
+    let geom = a.forest().geometry();
+    let (mut worst, mut big_worst) = (1.0f64, 1.0f64);
+    let (mut sum_w, mut sum_wr, mut sum_wr2) = (0.0, 0.0, 0.0);
     for s in 0..geom.surfaces().len() as u32 {
         let surface = trilux_geometry::SurfaceId(s);
         let area = geom.surface(surface).area();
         let face = FaceId::new(surface, Side::Front);
-        let (a, b) = (
-            solutions[0].surface_mean_radiance(face).sum(),
-            solutions[1].surface_mean_radiance(face).sum(),
+        let (x, y) = (
+            a.surface_mean_radiance(face).sum(),
+            b.surface_mean_radiance(face).sum(),
         );
-        if b <= 1e-9 {
+        if y <= 1e-9 {
             continue;
         }
-        let r = a / b;
+        let r = x / y;
         if (r - 1.0).abs() > 0.05 && std::env::var("SCALE_DEBUG").is_ok() {
             let sf = geom.surface(surface);
             eprintln!(
-                "  surface {s} shape {} piece {} area {area:.3} centre {:?}: {a:.4} vs {b:.4}",
+                "  surface {s} shape {} piece {} area {area:.3} centre {:?}: {x:.4} vs {y:.4}",
                 sf.shape,
                 sf.piece,
                 sf.bounds.centre()
@@ -201,11 +229,12 @@ fn compare(case: Case, dir: &std::path::Path) -> Result<()> {
     }
     let mean = sum_wr / sum_w;
     let sd = (sum_wr2 / sum_w - mean * mean).max(0.0).sqrt();
-    println!(
-        "{}: surface mean radiance, clustered / unclustered: area-weighted mean {mean:.4}, sd {sd:.4}, worst face {worst:.4}, worst face above 1 m² {big_worst:.4}",
-        case.name()
-    );
-    Ok(())
+    Ratios {
+        mean,
+        sd,
+        worst,
+        big_worst,
+    }
 }
 
 fn table(rows: &[Row]) -> String {
@@ -237,6 +266,9 @@ pub fn main(args: &[String]) -> Result<()> {
     let mut rows_extra: Vec<PathBuf> = Vec::new();
     let mut quality = Quality::Default;
     let mut clustering = true;
+    let mut cluster_angle: Option<f64> = None;
+    let mut compare_cases: Vec<u32> = Vec::new();
+    let mut angles: Vec<f64> = Vec::new();
     let mut plot: Option<PathBuf> = None;
     let mut out = root().join("target/scale");
     let mut it = args.iter();
@@ -257,11 +289,17 @@ pub fn main(args: &[String]) -> Result<()> {
                 let p = PathBuf::from(it.next().context("--scene needs a file")?);
                 rows_extra.push(p);
             }
-            "--compare" => {
-                for n in list(it.next())? {
-                    compare(Case::Boxes(n), &root().join("target/scale/scenes"))?;
-                }
-                return Ok(());
+            "--compare" => compare_cases = list(it.next())?,
+            "--angles" => {
+                let v = it.next().context("--angles needs θ,θ,...")?;
+                angles = v
+                    .split(',')
+                    .map(|x| x.parse::<f64>().with_context(|| format!("--angles: '{x}'")))
+                    .collect::<Result<_>>()?;
+            }
+            "--cluster-angle" => {
+                let v = it.next().context("--cluster-angle needs a value")?;
+                cluster_angle = Some(v.parse().with_context(|| format!("--cluster-angle: '{v}'"))?);
             }
             "--quality" => {
                 quality = it
@@ -276,12 +314,25 @@ pub fn main(args: &[String]) -> Result<()> {
             other => bail!("unknown argument {other}"),
         }
     }
+    if !compare_cases.is_empty() {
+        if angles.is_empty() {
+            angles.push(SolverSettings::preset(Quality::Default).cluster_angle);
+        }
+        for n in compare_cases {
+            compare(Case::Boxes(n), &root().join("target/scale/scenes"), &angles)?;
+        }
+        return Ok(());
+    }
     if cases.is_empty() {
         cases = [4, 16, 64, 256].into_iter().map(Case::Boxes).collect();
         cases.extend([4, 16, 64, 256].into_iter().map(Case::Meshes));
     }
     let mut settings = SolverSettings::preset(quality);
     settings.clustering = clustering;
+    if let Some(theta) = cluster_angle {
+        settings.cluster_angle = theta;
+        settings.validate().map_err(|e| anyhow::anyhow!(e))?;
+    }
     let scenes = out.join("scenes");
     let mut rows = Vec::new();
     for case in cases {

@@ -10,7 +10,8 @@
 //!
 //! r_C ≤ θ (d − r_A) and r_A ≤ θ_A d,
 //!
-//! i.e. C subtends less than [`FAR_ANGLE`] seen from any point of A, and A
+//! i.e. C subtends less than θ (`SolverSettings::cluster_angle`) seen
+//! from any point of A, and A
 //! less than [`SENDER_ANGLE`] from C. Far clusters get one *far block* of
 //! the cut; clusters that are not far are opened, down to single surfaces,
 //! whose faces become *near* partners of A (then tested exactly for
@@ -42,7 +43,7 @@
 //! keeps one radiance L_AC, the radiance A reflects towards C's direction,
 //! averaged over A's exposed area: the face seen as a point from C, with
 //! one direction per block of its cut (the cut's blocks are the bins of
-//! the directional distribution, each narrower than [`FAR_ANGLE`]). Light
+//! the directional distribution, each narrower than θ). Light
 //! arriving at element j of A from i adds
 //! ΔL_AC = π fr(i→j→C) T_ij δL_i / A_A (Eq. 4–5 with F_jC ≈ F_AC for a far
 //! C), whose flux π T_AC ΔL_AC is exactly what its later shot delivers
@@ -61,11 +62,7 @@ use trilux_geometry::{
 use crate::cluster::{ClusterId, ClusterTree};
 use crate::link::PairLink;
 
-/// θ: the largest angle (radians, r/d) a far cluster may subtend from
-/// its sender.
-pub(crate) const FAR_ANGLE: f64 = 0.25;
-
-/// θ for an emitter's cut (see [`cut_of`]).
+/// The largest θ of an emitter's cut (see [`cut_angle`]).
 pub(crate) const EMITTER_FAR_ANGLE: f64 = 0.1;
 
 /// θ_A: the largest angle a sender may subtend from a far cluster (its
@@ -208,24 +205,28 @@ fn is_far(tree: &ClusterTree, c: ClusterId, ca: DVec3, ra: f64, angle: f64) -> b
     d > ra + n.radius && n.radius <= angle * (d - ra) && ra <= SENDER_ANGLE * d
 }
 
-/// The cut of face `a` (module docs). With `clustering` off, every other
-/// face is a near candidate. An emitter's cut uses [`EMITTER_FAR_ANGLE`]:
-/// direct light is the largest transfer of a scene, so its far links
-/// (whose relative error grows like the angle squared) must be tighter
-/// (Smits et al.'s bound is the sender's flux times the kernel's).
+/// θ for the cut of a face: `None` with clustering off; an emitter's at
+/// most [`EMITTER_FAR_ANGLE`]: direct light is the largest transfer of a
+/// scene, so its far links (whose relative error grows like the angle
+/// squared) must be tighter (Smits et al.'s bound is the sender's flux
+/// times the kernel's).
+pub(crate) fn cut_angle(clustering: bool, theta: f64, emitter: bool) -> Option<f64> {
+    match (clustering, emitter) {
+        (false, _) => None,
+        (true, true) => Some(theta.min(EMITTER_FAR_ANGLE)),
+        (true, false) => Some(theta),
+    }
+}
+
+/// The cut of face `a` (module docs) for θ = `angle` ([`cut_angle`]);
+/// with `None` every other face is a near candidate.
 pub(crate) fn cut_of(
     forest: &ElementForest,
     tree: &ClusterTree,
     a: FaceId,
     planar: Option<(DVec3, DVec3)>,
-    clustering: bool,
-    emitter: bool,
+    angle: Option<f64>,
 ) -> Cut {
-    let angle = if emitter {
-        EMITTER_FAR_ANGLE
-    } else {
-        FAR_ANGLE
-    };
     let mut cut = Cut::default();
     let own = a.surface();
     let (ca, ra) = sphere(forest, own);
@@ -242,7 +243,7 @@ pub(crate) fn cut_of(
             continue;
         }
         let holds_own = tree.contains(c, own);
-        if clustering && !holds_own && is_far(tree, c, ca, ra, angle) {
+        if !holds_own && angle.is_some_and(|angle| is_far(tree, c, ca, ra, angle)) {
             cut.far.push(FarBlock {
                 cluster: c,
                 visibility: OnceLock::new(),
@@ -662,7 +663,8 @@ mod tests {
     ) -> (Vec<u32>, usize) {
         let root = forest.element(forest.root(a.surface()));
         let planar = Some((root.centre, root.normal * a.side().sign()));
-        let cut = cut_of(forest, tree, a, planar, clustering, false);
+        let theta = crate::settings::DEFAULT_CLUSTER_ANGLE;
+        let cut = cut_of(forest, tree, a, planar, cut_angle(clustering, theta, false));
         let mut count = vec![0u32; forest.geometry().surfaces().len()];
         for f in &cut.near {
             if f.side() == Side::Front {
@@ -725,7 +727,8 @@ mod tests {
             let (count, _) = coverage(forest, tree, a, true);
             let root = forest.element(forest.root(a.surface()));
             let planar = Some((root.centre, -root.normal));
-            let near = cut_of(forest, tree, a, planar, true, false).near;
+            let theta = crate::settings::DEFAULT_CLUSTER_ANGLE;
+            let near = cut_of(forest, tree, a, planar, Some(theta)).near;
             for (t, &c) in count.iter().enumerate() {
                 if t < 25 {
                     assert_eq!(c, u32::from(t != s as usize), "face {s} back, surface {t}");

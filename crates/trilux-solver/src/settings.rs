@@ -79,6 +79,13 @@ pub struct SolverSettings {
     /// tests that check the paper's algorithm alone.
     #[serde(default = "clustering_default")]
     pub clustering: bool,
+    /// θ, the clustering's error bound (radians): a cluster of radius r_C
+    /// is far from a face of radius r_A at distance d when r_C ≤ θ (d −
+    /// r_A) (docs/solver.md, "Clustering", where the default is measured
+    /// against unclustered solves). Emitters' cuts use the tighter of this
+    /// and 0.1.
+    #[serde(default = "cluster_angle_default")]
+    pub cluster_angle: f64,
     /// Stop shooting once this many seconds have passed since the solve's
     /// preparation began, with the best solution so far (progressive
     /// refinement's promise). The final gather's links are still made
@@ -91,6 +98,13 @@ pub struct SolverSettings {
 
 fn clustering_default() -> bool {
     true
+}
+
+/// The default θ of every preset.
+pub(crate) const DEFAULT_CLUSTER_ANGLE: f64 = 0.5;
+
+fn cluster_angle_default() -> f64 {
+    DEFAULT_CLUSTER_ANGLE
 }
 
 /// The longest time budget a solve accepts (a year, in seconds).
@@ -111,6 +125,7 @@ impl SolverSettings {
                 visibility_samples: 9,
                 transport: Transport::TwoPoint,
                 clustering: true,
+                cluster_angle: DEFAULT_CLUSTER_ANGLE,
                 time_budget_seconds: None,
             },
             Quality::Default => SolverSettings {
@@ -124,6 +139,7 @@ impl SolverSettings {
                 visibility_samples: 16,
                 transport: Transport::TwoPoint,
                 clustering: true,
+                cluster_angle: DEFAULT_CLUSTER_ANGLE,
                 time_budget_seconds: None,
             },
             Quality::High => SolverSettings {
@@ -137,6 +153,7 @@ impl SolverSettings {
                 visibility_samples: 25,
                 transport: Transport::TwoPoint,
                 clustering: true,
+                cluster_angle: DEFAULT_CLUSTER_ANGLE,
                 time_budget_seconds: None,
             },
         }
@@ -170,6 +187,9 @@ impl SolverSettings {
         if let Some(v) = lookup("TRILUX_CLUSTERING") {
             self.clustering = parse("TRILUX_CLUSTERING", &v)?;
         }
+        if let Some(v) = lookup("TRILUX_CLUSTER_ANGLE") {
+            self.cluster_angle = parse("TRILUX_CLUSTER_ANGLE", &v)?;
+        }
         self.validate()
     }
 
@@ -189,6 +209,13 @@ impl SolverSettings {
             if !(v.is_finite() && v > 0.0) {
                 return Err(format!("{name} must be positive, got {v}"));
             }
+        }
+        if !(self.cluster_angle.is_finite() && self.cluster_angle > 0.0 && self.cluster_angle <= 1.0)
+        {
+            return Err(format!(
+                "cluster_angle must be in (0, 1] radians, got {}",
+                self.cluster_angle
+            ));
         }
         if self.visibility_samples == 0 {
             return Err("visibility_samples must be at least 1".into());

@@ -24,7 +24,7 @@ use trilux_geometry::{
 };
 
 use crate::cluster::ClusterTree;
-use crate::cluster_transport::{Clusters, Cut, FarPoints, cut_of};
+use crate::cluster_transport::{Clusters, Cut, FarPoints, cut_angle, cut_of};
 use crate::discretisation::Discretisation;
 use crate::error::SolverError;
 use crate::faces::{TransportFace, build_faces, eligible_pairs};
@@ -371,14 +371,9 @@ fn clusters_and_partners<const N: usize>(
             let planar = s
                 .is_planar()
                 .then(|| (root.centre, root.normal * f.side().sign()));
-            cut_of(
-                forest,
-                &tree,
-                f,
-                planar,
-                clustering,
-                !faces[f].emission.is_black(),
-            )
+            let emitter = !faces[f].emission.is_black();
+            let angle = cut_angle(clustering, settings.cluster_angle, emitter);
+            cut_of(forest, &tree, f, planar, angle)
         })
         .collect();
     let candidates = PerFace::from(
