@@ -299,7 +299,10 @@ pub fn main(args: &[String]) -> Result<()> {
             }
             "--cluster-angle" => {
                 let v = it.next().context("--cluster-angle needs a value")?;
-                cluster_angle = Some(v.parse().with_context(|| format!("--cluster-angle: '{v}'"))?);
+                cluster_angle = Some(
+                    v.parse()
+                        .with_context(|| format!("--cluster-angle: '{v}'"))?,
+                );
             }
             "--quality" => {
                 quality = it

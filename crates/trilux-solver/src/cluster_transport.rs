@@ -618,23 +618,29 @@ mod tests {
     /// 3 × 3 grid of small squares at height 1, facing down: far enough
     /// apart that clusters of them are far from each other.
     fn grids() -> crate::setup::Setup<3> {
-        grids_with(false)
+        grids_sized(0.1, false)
     }
 
     /// [`grids`], and with `blockers` four squares 0.3 wide halfway up
     /// (facing up, at odd coordinates), which hide some far blocks in part.
     fn grids_with(blockers: bool) -> crate::setup::Setup<3> {
+        grids_sized(0.1, blockers)
+    }
+
+    /// The grids with squares `size` wide (0.6: close enough that which
+    /// of them are far depends on θ between 0.1 and 1).
+    fn grids_sized(size: f64, blockers: bool) -> crate::setup::Setup<3> {
         let mut shapes = Vec::new();
         for a in 0..5 {
             for b in 0..5 {
                 let c = DVec3::new(f64::from(a), f64::from(b), 0.0);
-                shapes.push(ts::square(c, 0.1, false));
+                shapes.push(ts::square(c, size, false));
             }
         }
         for a in 0..3 {
             for b in 0..3 {
                 let c = DVec3::new(2.0 * f64::from(a), 2.0 * f64::from(b), 1.0);
-                shapes.push(ts::square(c, 0.1, true));
+                shapes.push(ts::square(c, size, true));
             }
         }
         for a in (0..2).filter(|_| blockers) {
@@ -659,12 +665,11 @@ mod tests {
         forest: &ElementForest,
         tree: &ClusterTree,
         a: FaceId,
-        clustering: bool,
+        angle: Option<f64>,
     ) -> (Vec<u32>, usize) {
         let root = forest.element(forest.root(a.surface()));
         let planar = Some((root.centre, root.normal * a.side().sign()));
-        let theta = crate::settings::DEFAULT_CLUSTER_ANGLE;
-        let cut = cut_of(forest, tree, a, planar, cut_angle(clustering, theta, false));
+        let cut = cut_of(forest, tree, a, planar, angle);
         let mut count = vec![0u32; forest.geometry().surfaces().len()];
         for f in &cut.near {
             if f.side() == Side::Front {
@@ -685,32 +690,61 @@ mod tests {
 
     /// Every face of the floor grid (whose front sees everything above or
     /// beside it) meets every other surface exactly once and never its
-    /// own; with clustering on, some of them through far blocks.
+    /// own, at every θ; with clustering on, some of them through far
+    /// blocks. A looser θ only makes more far (a near face at θ' > θ is near
+    /// at θ), so the near sets are nested; with squares 0.6 wide they
+    /// shrink as θ grows.
     #[test]
     fn near_faces_and_far_blocks_partition_the_other_surfaces() {
-        let setup = grids();
-        let forest = setup.forest();
-        let tree = &setup.clusters.tree;
-        let mut far_blocks = 0;
-        for s in 0..25 {
-            let a = ts::front(s);
-            for clustering in [true, false] {
-                let (count, far) = coverage(forest, tree, a, clustering);
-                for (t, &c) in count.iter().enumerate() {
-                    let expected = u32::from(t != s as usize);
-                    assert_eq!(
-                        c, expected,
-                        "face {s}, surface {t}, clustering {clustering}"
-                    );
-                }
-                if clustering {
-                    far_blocks += far;
-                } else {
-                    assert_eq!(far, 0, "no far blocks without clustering");
+        let angles = [None, Some(0.1), Some(0.25), Some(0.5), Some(1.0)];
+        for size in [0.1, 0.6] {
+            let setup = grids_sized(size, false);
+            let forest = setup.forest();
+            let tree = &setup.clusters.tree;
+            let (mut far_blocks, mut shrank) = (0, 0);
+            for s in 0..25 {
+                let a = ts::front(s);
+                let mut tighter: Option<Vec<FaceId>> = None;
+                for angle in angles {
+                    let (count, far) = coverage(forest, tree, a, angle);
+                    for (t, &c) in count.iter().enumerate() {
+                        let expected = u32::from(t != s as usize);
+                        assert_eq!(c, expected, "face {s}, surface {t}, θ {angle:?}");
+                    }
+                    if angle.is_some() {
+                        far_blocks += far;
+                    } else {
+                        assert_eq!(far, 0, "no far blocks without clustering");
+                    }
+                    let near = near_of(forest, tree, a, angle);
+                    if let Some(w) = &tighter {
+                        assert!(
+                            near.iter().all(|f| w.contains(f)),
+                            "size {size}, face {s}: near at θ {angle:?} not within the tighter θ's"
+                        );
+                        shrank +=
+                            usize::from(near.len() < w.len() && angle.is_some_and(|a| a > 0.1));
+                    }
+                    tighter = Some(near);
                 }
             }
+            assert!(far_blocks > 0, "the scene exercises far blocks");
+            if size > 0.5 {
+                assert!(shrank > 0, "a looser θ leaves fewer near faces");
+            }
         }
-        assert!(far_blocks > 0, "the scene exercises far blocks");
+    }
+
+    /// The near faces of `a`'s cut at θ = `angle`.
+    fn near_of(
+        forest: &ElementForest,
+        tree: &ClusterTree,
+        a: FaceId,
+        angle: Option<f64>,
+    ) -> Vec<FaceId> {
+        let root = forest.element(forest.root(a.surface()));
+        let planar = Some((root.centre, root.normal * a.side().sign()));
+        cut_of(forest, tree, a, planar, angle).near
     }
 
     /// A planar face gets no near partner wholly behind it: the back of a
@@ -724,11 +758,9 @@ mod tests {
         let tree = &setup.clusters.tree;
         for s in 0..25u32 {
             let a = FaceId::new(trilux_geometry::SurfaceId(s), Side::Back);
-            let (count, _) = coverage(forest, tree, a, true);
-            let root = forest.element(forest.root(a.surface()));
-            let planar = Some((root.centre, -root.normal));
             let theta = crate::settings::DEFAULT_CLUSTER_ANGLE;
-            let near = cut_of(forest, tree, a, planar, Some(theta)).near;
+            let (count, _) = coverage(forest, tree, a, Some(theta));
+            let near = near_of(forest, tree, a, Some(theta));
             for (t, &c) in count.iter().enumerate() {
                 if t < 25 {
                     assert_eq!(c, u32::from(t != s as usize), "face {s} back, surface {t}");

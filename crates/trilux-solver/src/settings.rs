@@ -210,7 +210,9 @@ impl SolverSettings {
                 return Err(format!("{name} must be positive, got {v}"));
             }
         }
-        if !(self.cluster_angle.is_finite() && self.cluster_angle > 0.0 && self.cluster_angle <= 1.0)
+        if !(self.cluster_angle.is_finite()
+            && self.cluster_angle > 0.0
+            && self.cluster_angle <= 1.0)
         {
             return Err(format!(
                 "cluster_angle must be in (0, 1] radians, got {}",
@@ -245,5 +247,34 @@ impl SolverSettings {
 impl Default for SolverSettings {
     fn default() -> Self {
         SolverSettings::preset(Quality::Default)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    //! The clustering's θ: read from its variable, refused outside (0, 1].
+
+    use super::*;
+
+    #[test]
+    fn cluster_angle_is_read_and_bounded() {
+        let mut s = SolverSettings::preset(Quality::Default);
+        assert_eq!(s.cluster_angle, DEFAULT_CLUSTER_ANGLE);
+        let lookup =
+            |v: &'static str| move |n: &str| (n == "TRILUX_CLUSTER_ANGLE").then(|| v.to_string());
+        s.override_from(lookup("0.3"))
+            .unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(s.cluster_angle, 0.3);
+        for bad in ["0", "-0.5", "1.5", "NaN", "inf"] {
+            let mut s = SolverSettings::preset(Quality::Default);
+            let e = s.override_from(lookup(bad));
+            assert!(
+                e.as_ref().is_err_and(|e| e.contains("cluster_angle")),
+                "{bad}: {e:?}"
+            );
+        }
+        let mut s = SolverSettings::preset(Quality::Default);
+        let e = s.override_from(lookup("wide"));
+        assert!(e.is_err_and(|e| e.contains("TRILUX_CLUSTER_ANGLE")));
     }
 }
