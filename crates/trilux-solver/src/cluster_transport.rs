@@ -523,7 +523,7 @@ pub(crate) fn far_links<const N: usize>(
 
 /// The k-th point of the R2 low-discrepancy sequence (Roberts 2018),
 /// offset by `shift`.
-fn r2(k: u32, shift: f64) -> DVec2 {
+pub(crate) fn r2(k: u32, shift: f64) -> DVec2 {
     const G: f64 = 1.324_717_957_244_746;
     let (a1, a2) = (1.0 / G, 1.0 / (G * G));
     let k = f64::from(k);
@@ -584,11 +584,6 @@ impl<const N: usize> FarField<N> {
             blocks,
             unshot_flux: Spectrum::zero(),
         }
-    }
-
-    /// Σ T_AC: the throughput towards every far receiver.
-    pub fn throughput(&self) -> f64 {
-        self.blocks.iter().map(|b| b.t).sum()
     }
 }
 
