@@ -337,7 +337,10 @@ mod tests {
     fn middle(s: &Solver<3>) -> (trilux_geometry::FaceId, trilux_geometry::ElementId) {
         // Shape 0 is the emitter; the grid's middle is the 13th square.
         let face = ts::front(13);
-        assert!(s.state.far[face].is_some(), "the middle square has a far field");
+        assert!(
+            s.state.far[face].is_some(),
+            "the middle square has a far field"
+        );
         (face, s.setup.forest().root(face.surface()))
     }
 
