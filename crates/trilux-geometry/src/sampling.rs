@@ -34,6 +34,17 @@ pub struct SurfaceSample {
     pub coord: SurfaceCoord,
 }
 
+/// Point `k` of the `n`-point Hammersley set in [0, 1)²: (k + ½)/n and
+/// the base-2 radical inverse of k. A fixed, well-stratified set that,
+/// unlike cell midpoints of a grid, reaches the edges of the square (a
+/// hemisphere's grazing ring under the cosine map).
+pub fn hammersley(k: u32, n: u32) -> DVec2 {
+    DVec2::new(
+        (f64::from(k) + 0.5) / f64::from(n.max(1)),
+        f64::from(k.reverse_bits()) / 4_294_967_296.0,
+    )
+}
+
 /// Uniform point of a triangle from the unit square (square-root map):
 /// barycentrics (b0, b1, b2).
 #[inline]

@@ -58,15 +58,6 @@ pub mod dims {
 /// scene files are checked against too).
 pub const MAX_SAMPLES: u32 = trilux_files::film::MAX_SAMPLES_PER_PIXEL;
 
-/// Point `k` of the `n`-point Hammersley set in [0, 1)²: a fixed,
-/// well-stratified quadrature for the deterministic parts of the preview.
-pub fn hammersley(k: u32, n: u32) -> DVec2 {
-    DVec2::new(
-        (f64::from(k) + 0.5) / f64::from(n.max(1)),
-        f64::from(k.reverse_bits()) / 4_294_967_296.0,
-    )
-}
-
 /// The sample sequence of one pixel.
 #[derive(Clone, Copy, Debug)]
 pub struct PixelSampler {

@@ -751,9 +751,9 @@ mod tests {
         let setup = grids();
         let forest = setup.forest();
         let tree = &setup.clusters.tree;
+        let theta = crate::settings::DEFAULT_CLUSTER_ANGLE;
         for s in 0..25u32 {
             let a = FaceId::new(trilux_geometry::SurfaceId(s), Side::Back);
-            let theta = crate::settings::DEFAULT_CLUSTER_ANGLE;
             let (count, _) = coverage(forest, tree, a, Some(theta));
             let near = near_of(forest, tree, a, Some(theta));
             for (t, &c) in count.iter().enumerate() {

@@ -20,6 +20,7 @@ use glam::{DVec2, DVec3};
 use trilux_brdf::Frame;
 use trilux_brdf::frame::square_to_cosine_hemisphere;
 use trilux_color::Spectrum;
+use trilux_geometry::sampling::hammersley;
 use trilux_geometry::{ElementId, FaceId, Ray};
 
 use crate::link::PairLink;
@@ -255,12 +256,9 @@ impl<const N: usize> Solver<N> {
                 continue;
             }
             let normal = x.normal * sign;
-            // The Hammersley set: cell midpoints of a grid would never
-            // reach the grazing ring that open scenes lose light through.
-            let u = DVec2::new(
-                (f64::from(k) + 0.5) / f64::from(COVERAGE_RAYS),
-                f64::from(k.reverse_bits()) / 4_294_967_296.0,
-            );
+            // Cell midpoints of a grid would never reach the grazing ring
+            // that open scenes lose light through.
+            let u = hammersley(k, COVERAGE_RAYS);
             let ray = Ray {
                 origin: x.point + normal * eps,
                 dir: Frame::from_normal(normal).to_world(square_to_cosine_hemisphere(u)),

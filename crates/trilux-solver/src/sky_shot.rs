@@ -18,11 +18,6 @@ use crate::solver::Solver;
 /// Sky directions per point of a leaf (16 points: 128 shadow rays a leaf).
 pub(crate) const DIRECTIONS: u32 = 8;
 
-/// The van der Corput radical inverse of `k` in base 2.
-fn radical_inverse(k: u32) -> f64 {
-    f64::from(k.reverse_bits()) / 4_294_967_296.0
-}
-
 /// A hash of `k` to [0, 1)² (SplitMix64's finaliser).
 fn rotation(k: u32) -> DVec2 {
     let mut h = u64::from(k).wrapping_add(0x9E37_79B9_7F4A_7C15);
@@ -58,7 +53,7 @@ impl<const N: usize> Solver<N> {
                 for m in 0..DIRECTIONS {
                     // Point s takes every n²-th point of the set.
                     let t = m * n * n + s;
-                    let h = DVec2::new((f64::from(t) + 0.5) / f64::from(total), radical_inverse(t));
+                    let h = trilux_geometry::sampling::hammersley(t, total);
                     let h = (h + shift).fract();
                     let Some(smp) = sky.sample(h) else {
                         continue;
