@@ -43,7 +43,8 @@
 //!   transfer into every leaf; [`sky`]: an environment map (Mitsuba's
 //!   `envmap`), its lookup and its importance sampling, shot as they are.
 //! - [`solver`]: the progressive loop (§4, Fig. 7 and 9); `shot`: one
-//!   shot's phases; `glossy`: the glossy renormalisation.
+//!   shot's phases; `glossy`: the glossy renormalisation; `deferred`:
+//!   the glossy share of small links, summed per pair until it counts.
 //! - [`gather_links`]: the final gather's links, kept for rendering;
 //!   `final_gather`: the refinement that makes them.
 //! - [`ledger`]: where the energy went.
@@ -57,6 +58,7 @@
 mod ambient;
 mod cluster;
 mod cluster_transport;
+mod deferred;
 mod discretisation;
 mod divergence;
 pub mod error;

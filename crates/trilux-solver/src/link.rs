@@ -48,6 +48,13 @@ pub(crate) enum Sender<'a, const N: usize> {
         /// δL towards every input surface.
         by_surface: &'a [Spectrum<N>],
     },
+    /// A pair link's glossy share summed over shots (`deferred`): the
+    /// pair's average δL, the same from every sub-element of i towards
+    /// every sub-element of j, as the pair link carried it.
+    Uniform {
+        /// δL.
+        unshot: Spectrum<N>,
+    },
 }
 
 impl<const N: usize> Sender<'_, N> {
@@ -82,6 +89,7 @@ impl<const N: usize> Sender<'_, N> {
                 .get(forest.element(j).surface.index())
                 .copied()
                 .unwrap_or_else(Spectrum::zero),
+            Sender::Uniform { unshot } => unshot,
         }
     }
 }

@@ -86,6 +86,12 @@ pub struct SolverSettings {
     /// and 0.1.
     #[serde(default = "cluster_angle_default")]
     pub cluster_angle: f64,
+    /// Deferred glossy reception (`deferred`, docs/solver.md, "Deferred
+    /// glossy reception"): the glossy share of a link below the
+    /// photometric threshold waits at its face, summed per sender, until
+    /// the sum reaches the threshold. On in every preset; off for ablation.
+    #[serde(default = "defer_glossy_default")]
+    pub defer_glossy: bool,
     /// Stop shooting once this many seconds have passed since the solve's
     /// preparation began, with the best solution so far (progressive
     /// refinement's promise). The final gather's links are still made
@@ -97,6 +103,10 @@ pub struct SolverSettings {
 }
 
 fn clustering_default() -> bool {
+    true
+}
+
+fn defer_glossy_default() -> bool {
     true
 }
 
@@ -126,6 +136,7 @@ impl SolverSettings {
                 transport: Transport::TwoPoint,
                 clustering: true,
                 cluster_angle: DEFAULT_CLUSTER_ANGLE,
+                defer_glossy: true,
                 time_budget_seconds: None,
             },
             Quality::Default => SolverSettings {
@@ -140,6 +151,7 @@ impl SolverSettings {
                 transport: Transport::TwoPoint,
                 clustering: true,
                 cluster_angle: DEFAULT_CLUSTER_ANGLE,
+                defer_glossy: true,
                 time_budget_seconds: None,
             },
             Quality::High => SolverSettings {
@@ -154,6 +166,7 @@ impl SolverSettings {
                 transport: Transport::TwoPoint,
                 clustering: true,
                 cluster_angle: DEFAULT_CLUSTER_ANGLE,
+                defer_glossy: true,
                 time_budget_seconds: None,
             },
         }
@@ -161,7 +174,7 @@ impl SolverSettings {
 
     /// Overrides single settings from `TRILUX_MAX_DEPTH`, `TRILUX_FF_EPS`,
     /// `TRILUX_FR_EPS`, `TRILUX_FLUX_EPS`, `TRILUX_VISIBILITY_SAMPLES` and
-    /// `TRILUX_CLUSTERING` (`true` or `false`)
+    /// `TRILUX_CLUSTERING` and `TRILUX_DEFER_GLOSSY` (`true` or `false`)
     /// as `lookup` returns them (the examples pass `std::env::var`): a way
     /// to run experiments on one parameter at a time. The message names
     /// the variable that does not parse.
@@ -186,6 +199,9 @@ impl SolverSettings {
         }
         if let Some(v) = lookup("TRILUX_CLUSTERING") {
             self.clustering = parse("TRILUX_CLUSTERING", &v)?;
+        }
+        if let Some(v) = lookup("TRILUX_DEFER_GLOSSY") {
+            self.defer_glossy = parse("TRILUX_DEFER_GLOSSY", &v)?;
         }
         if let Some(v) = lookup("TRILUX_CLUSTER_ANGLE") {
             self.cluster_angle = parse("TRILUX_CLUSTER_ANGLE", &v)?;

@@ -24,6 +24,7 @@ use trilux_color::Spectrum;
 use trilux_geometry::{ElementId, FaceId, PerFace};
 
 use crate::cluster_transport::{FarField, far_links};
+use crate::deferred::GlossyIn;
 use crate::interaction::Hierarchy;
 use crate::link::{NodeLink, PairLink, PairShot, Sender, Sent};
 use crate::refine::{Incidence, IncidenceMemo, Lateness, RefineContext, TripleTask};
@@ -124,12 +125,65 @@ fn stage_one<const N: usize>(
 /// splits could not keep.
 type StageTwo<const N: usize> = Vec<(Vec<NodeLink<N>>, u32, Spectrum<N>)>;
 
+/// A shot's groups: its pair links, what becomes of each one's glossy
+/// share (`deferred`), and the shot's scale (phase 3).
+struct Groups<const N: usize> {
+    links: Vec<PairLink<N>>,
+    plan: Vec<GlossyIn<N>>,
+    scale: Spectrum<N>,
+}
+
+/// The pair links whose glossy shares a shot refines (δL zero for one
+/// that waits), each with the scale of its node links.
+struct Glossy<const N: usize> {
+    links: Vec<PairLink<N>>,
+    scales: Vec<Spectrum<N>>,
+}
+
+impl<const N: usize> Groups<N> {
+    fn glossy(&self) -> Glossy<N> {
+        let (links, scales) = self
+            .plan
+            .iter()
+            .zip(&self.links)
+            .map(|(p, l)| p.link(l, self.scale))
+            .unzip();
+        Glossy { links, scales }
+    }
+}
+
+/// The sender of a shot's own light; a release of waiting light (`None`)
+/// has none: each of its groups sends its sum.
+fn shot_sender<'a, const N: usize>(
+    sending: Option<&'a Sending<N>>,
+    field: &'a crate::radiosity::ElementRadiance<N>,
+) -> Sender<'a, N> {
+    match sending {
+        Some(Sending::Radiosity(f)) => Sender::Radiosity {
+            field,
+            side: f.side(),
+            sent: Sent::Unshot,
+            emission: Spectrum::zero(),
+        },
+        Some(Sending::Stored { hierarchy, .. }) => Sender::Stored {
+            hierarchy,
+            sent: Sent::Unshot,
+        },
+        Some(Sending::Far { by_surface, .. }) => Sender::Far { by_surface },
+        None => Sender::Uniform {
+            unshot: Spectrum::zero(),
+        },
+    }
+}
+
 impl<const N: usize> Solver<N> {
     /// One shot from `source` (module docs); returns the number of links it
     /// made.
     pub(crate) fn shoot(&mut self, source: Source) -> usize {
-        if let Source::Light(k) = source {
-            return self.shoot_light(k as usize);
+        match source {
+            Source::Light(k) => return self.shoot_light(k as usize),
+            Source::Deferred(face) => return self.release_deferred(face),
+            _ => {}
         }
         let Some((phi, sending)) = self.take_source(source) else {
             return 0;
@@ -143,8 +197,33 @@ impl<const N: usize> Solver<N> {
         };
         let share = crate::ambient::Interreflection::reflected_share(phi, emission);
         self.state.interreflection.book_shot(phi, share);
+        let (links, near) = self.pair_links(&sending);
+        let scale = shot_scale(&links, phi, matches!(source, Source::Stored(_)));
+        let plan = self.plan_glossy(&links, near, send_face, (scale, share));
+        let groups = Groups { links, plan, scale };
+        let live = self.transfer(Some(&sending), &groups, (phi, share));
+        self.unlink(sending);
+        live
+    }
+
+    /// The glossy light waiting at `face` (`deferred`) refined into its
+    /// hierarchies: a shot that carries no new light.
+    fn release_deferred(&mut self, face: FaceId) -> usize {
+        let (links, plan) = self.take_deferred(face);
+        let groups = Groups {
+            links,
+            plan,
+            scale: Spectrum::splat(1.0),
+        };
+        self.transfer(None, &groups, (Spectrum::zero(), Spectrum::zero()))
+    }
+
+    /// Phase 2: the pair links of the source, and how many of them are
+    /// stage 1's (the far links follow).
+    fn pair_links(&mut self, sending: &Sending<N>) -> (Vec<PairLink<N>>, usize) {
+        let send_face = sending.face();
         let root_of = |f: FaceId| self.setup.forest().root(f.surface());
-        let pairs: Vec<(ElementId, FaceId, ElementId)> = match &sending {
+        let pairs: Vec<(ElementId, FaceId, ElementId)> = match sending {
             Sending::Radiosity(f) => self.setup.partners[*f]
                 .iter()
                 .map(|&r| (root_of(*f), r, root_of(r)))
@@ -154,44 +233,71 @@ impl<const N: usize> Solver<N> {
             }
             Sending::Far { .. } => Vec::new(),
         };
-        let (pair_links, incidences, stage_two, late) = {
+        let (links, near, late) = {
+            let (mut ctx, _) = self.split_for_shot();
+            let sender = shot_sender(Some(sending), ctx.field);
+            let mut links = stage_one(&ctx.refine, &sender, send_face, &pairs);
+            let near = links.len();
+            links.extend(far_stage_one(&ctx.refine, ctx.field, sending));
+            (links, near, std::mem::take(&mut ctx.refine.late))
+        };
+        self.book_late(late);
+        (links, near)
+    }
+
+    /// Phases 4–6 for a shot's groups: three-point links into the glossy
+    /// receivers' hierarchies (of the glossy shares refined now), what
+    /// every group delivers, the node links applied. `sending` is `None`
+    /// for a release of waiting light. Returns the number of links.
+    fn transfer(
+        &mut self,
+        sending: Option<&Sending<N>>,
+        groups: &Groups<N>,
+        (phi, share): (Spectrum<N>, Spectrum<N>),
+    ) -> usize {
+        let glossy = groups.glossy();
+        let uniform: Vec<Option<Sender<'static, N>>> = groups
+            .plan
+            .iter()
+            .map(|p| match p {
+                GlossyIn::Flush { unshot, .. } => Some(Sender::Uniform { unshot: *unshot }),
+                _ => None,
+            })
+            .collect();
+        let shot_face = sending.map(Sending::face);
+        let (incidences, stage_two, late) = {
             let (mut ctx, hierarchies) = self.split_for_shot();
-            let sender = match &sending {
-                Sending::Radiosity(f) => Sender::Radiosity {
-                    field: ctx.field,
-                    side: f.side(),
-                    sent: Sent::Unshot,
-                    emission: Spectrum::zero(),
-                },
-                Sending::Stored { hierarchy, .. } => Sender::Stored {
-                    hierarchy,
-                    sent: Sent::Unshot,
-                },
-                Sending::Far { by_surface, .. } => Sender::Far { by_surface },
-            };
-            let mut pair_links = stage_one(&ctx.refine, &sender, send_face, &pairs);
-            pair_links.extend(far_stage_one(&ctx.refine, ctx.field, &sending));
-            let incidences = incidences(&ctx.refine, &sender, send_face, &pair_links);
+            let shot = shot_sender(sending, ctx.field);
+            let senders: Vec<(&Sender<'_, N>, FaceId)> = groups
+                .plan
+                .iter()
+                .zip(&uniform)
+                .zip(&groups.links)
+                .map(|((p, u), l)| {
+                    (
+                        u.as_ref().unwrap_or(&shot),
+                        p.send_face(shot_face.unwrap_or(l.face)),
+                    )
+                })
+                .collect();
+            let incidences = incidences(&ctx.refine, &senders, &glossy.links);
             let stage_two = stage_two(
                 &ctx.refine,
-                &sender,
-                send_face,
+                &senders,
                 (hierarchies, ctx.stored_from),
-                &pair_links,
+                &glossy.links,
                 &incidences,
             );
             let late = std::mem::take(&mut ctx.refine.late);
-            (pair_links, incidences, stage_two, late)
+            (incidences, stage_two, late)
         };
         self.book_late(late);
-        let scale = shot_scale(&pair_links, phi, matches!(source, Source::Stored(_)));
         let node_links = self.book_lost(stage_two);
-        let group_scale = self.receive(&pair_links, &incidences, &node_links, scale, (phi, share));
-        self.apply_node_links(&node_links, scale, &group_scale);
-        let live = pair_links.len() + node_links.len();
+        let group_scale = self.receive(groups, &glossy, &incidences, &node_links, (phi, share));
+        self.apply_node_links(&node_links, &glossy.scales, &group_scale);
+        let live = groups.links.len() + node_links.len();
         self.state.stats.links_peak = self.state.stats.links_peak.max(live);
         self.state.stats.links_total += live as u64;
-        self.unlink(sending);
         live
     }
 
@@ -253,8 +359,8 @@ impl<const N: usize> Solver<N> {
                 }
                 Some((phi, Sending::Far { field, by_surface }))
             }
-            // Shot by `shoot_light`.
-            Source::Light(_) => None,
+            // Shot by `shoot_light` and `release_deferred`.
+            Source::Light(_) | Source::Deferred(_) => None,
         }
     }
 
@@ -298,13 +404,13 @@ impl<const N: usize> Solver<N> {
         node_links
     }
 
-    /// Phase 6a: every node link adds its radiance, scaled by the shot and
-    /// its group, to its node's L^G and the node's flux to its hierarchy's
+    /// Phase 6a: every node link adds its radiance, scaled by its group's
+    /// shot scale (`scales`) and renormalisation, to its node's L^G and the node's flux to its hierarchy's
     /// key (the renormalisation applies to both alike).
     fn apply_node_links(
         &mut self,
         node_links: &[NodeLink<N>],
-        shot_scale: Spectrum<N>,
+        scales: &[Spectrum<N>],
         group_scale: &[(Spectrum<N>, Spectrum<N>)],
     ) {
         for nl in node_links {
@@ -313,7 +419,9 @@ impl<const N: usize> Solver<N> {
             };
             let node = &mut hier.nodes[nl.node as usize];
             let (midpoint, sampled) = group_scale[nl.group as usize];
-            let dl = nl.gathered * shot_scale * if nl.sampled { sampled } else { midpoint };
+            let dl = nl.gathered
+                * scales[nl.group as usize]
+                * if nl.sampled { sampled } else { midpoint };
             node.gathered += dl;
             let t = node.t;
             hier.unshot_flux += dl * (PI * t);
@@ -361,24 +469,24 @@ pub(crate) struct ShotContext<'a, const N: usize> {
 
 /// Each pair link's part of its three-point links, once for all the
 /// hierarchies that leave its receiving face (`None` for a link into a
-/// face without stored interactions, or one that carries no light).
+/// face without stored interactions, or one that carries no light, such as
+/// a glossy share that waits: `deferred`). Each group has its sender.
 fn incidences<const N: usize>(
     ctx: &RefineContext<'_, N>,
-    sender: &Sender<'_, N>,
-    send_face: FaceId,
+    senders: &[(&Sender<'_, N>, FaceId)],
     pair_links: &[PairLink<N>],
 ) -> Vec<Option<Incidence<N>>> {
     pair_links
         .par_iter()
-        .map(|l| {
+        .zip(senders)
+        .map(|(l, &(sender, send_face))| {
             let tij = crate::throughput::Throughput {
                 t: l.t,
                 v: 1.0,
                 f: 0.0,
                 spread: 0.0,
             };
-            ctx.faces[l.face]
-                .stored
+            (ctx.faces[l.face].stored && !l.unshot.is_black())
                 .then(|| ctx.incidence_with(sender, send_face.of(l.i), l.face.of(l.j), tij))
                 .flatten()
         })
@@ -413,15 +521,14 @@ fn far_stage_one<const N: usize>(
 /// hierarchy, so the receiving trees grow without locks).
 fn stage_two<const N: usize>(
     ctx: &RefineContext<'_, N>,
-    sender: &Sender<'_, N>,
-    send_face: FaceId,
+    senders: &[(&Sender<'_, N>, FaceId)],
     (hierarchies, stored_from): (&mut [Option<Hierarchy<N>>], &PerFace<Range<usize>>),
     pair_links: &[PairLink<N>],
     incidences: &[Option<Incidence<N>>],
 ) -> StageTwo<N> {
     let mut groups_of_face: HashMap<FaceId, Vec<u32>> = HashMap::new();
-    for (g, l) in pair_links.iter().enumerate() {
-        if ctx.faces[l.face].stored {
+    for (g, (l, inc)) in pair_links.iter().zip(incidences).enumerate() {
+        if inc.is_some() {
             groups_of_face.entry(l.face).or_default().push(g as u32);
         }
     }
@@ -443,10 +550,11 @@ fn stage_two<const N: usize>(
     tasks
         .into_par_iter()
         .map(|(h, hier)| {
-            let from = hier.from;
+            let groups = &groups_of_face[&hier.from];
+            let (sender, si) = senders[groups[0] as usize];
             let mut task = TripleTask {
                 sender,
-                si: send_face,
+                si,
                 h: hier,
                 h_index: h as u32,
                 group: 0,
@@ -455,13 +563,16 @@ fn stage_two<const N: usize>(
                 memo: &memo,
                 local: Default::default(),
             };
-            for &g in &groups_of_face[&from] {
+            let mut nodes = Vec::new();
+            for &g in groups {
                 let l = &pair_links[g as usize];
                 let Some(incidence) = &incidences[g as usize] else {
                     continue;
                 };
                 task.group = g;
-                for n in ctx.nodes_for(task.h, l.j, &mut task.lost) {
+                (task.sender, task.si) = senders[g as usize];
+                ctx.nodes_for(task.h, l.j, &mut task.lost, &mut nodes);
+                for &n in &nodes {
                     // l.j, or past the deadline a stored node's coarser
                     // sender element above it.
                     let j = task.h.nodes[n as usize].from;
@@ -493,90 +604,153 @@ impl<const N: usize> Solver<N> {
     /// element j. The flux π T_ij δL arrives; its Lambertian share ρ_d goes
     /// straight into j's two-point radiance; the glossy share is what the
     /// group's node links gathered, renormalised (`glossy`) so that j never
-    /// reflects more than arrived; the rest is absorbed. Books absorbed and
+    /// reflects more than arrived; the rest is absorbed. A glossy share
+    /// that waits (`deferred`) is neither reflected nor absorbed yet; a
+    /// released sum is reflected and absorbed now. Books absorbed and
     /// escaped flux in the ledger, what was reflected in the
     /// interreflection estimate (`share` of the shot's flux `phi` being
     /// reflected light), and returns each group's glossy scale.
     fn receive(
         &mut self,
-        pair_links: &[PairLink<N>],
+        groups: &Groups<N>,
+        glossy: &Glossy<N>,
         incidences: &[Option<Incidence<N>>],
         node_links: &[NodeLink<N>],
-        shot_scale: Spectrum<N>,
         (phi, share): (Spectrum<N>, Spectrum<N>),
     ) -> Vec<(Spectrum<N>, Spectrum<N>)> {
-        // Per group, the glossy flux of midpoint-rule links (renormalised)
-        // and of sampled links (already conserving: docs/solver.md,
-        // "Narrow lobes").
-        let mut glossy_flux = vec![Spectrum::<N>::zero(); pair_links.len()];
-        let mut sampled_flux = vec![Spectrum::<N>::zero(); pair_links.len()];
+        let (glossy_flux, sampled_flux, far_adds) =
+            self.glossy_fluxes(glossy, incidences, node_links);
+        let late = self.past_deadline();
+        let targets = self.glossy_targets(glossy, incidences, (&glossy_flux, late));
+        let mut group_scale =
+            vec![(Spectrum::<N>::splat(1.0), Spectrum::splat(1.0)); groups.links.len()];
+        let mut total_arrived = Spectrum::<N>::zero();
+        let mut absorbed = Spectrum::<N>::zero();
+        for (g, l) in groups.links.iter().enumerate() {
+            let arrived = l.unshot * groups.scale * (PI * l.t);
+            let rho_d = self.receive_lambertian(l, groups.scale);
+            // Light spreads over j's exposed area. (No transfer reaches an
+            // element that is wholly buried, whose segments all count as
+            // blocked; if one did, its light would be absorbed.)
+            let aj = self.setup.exposed_area[l.face.side()][l.j.index()];
+            let kept = |arrived: Spectrum<N>| {
+                let diffuse = if aj > 0.0 {
+                    arrived * rho_d
+                } else {
+                    Spectrum::zero()
+                };
+                (diffuse, (arrived - diffuse).max(Spectrum::zero()))
+            };
+            let (diffuse, room_own) = kept(arrived);
+            // What an element reflects may not exceed what arrived there
+            // (of a released sum: all that waited).
+            let room = match &groups.plan[g] {
+                GlossyIn::Now => room_own,
+                GlossyIn::Wait { from } => {
+                    self.book_waiting(l.face, *from, room_own);
+                    Spectrum::zero()
+                }
+                GlossyIn::Flush { waited, .. } => *waited + room_own,
+            };
+            let (glossy_g, sampled) = (glossy_flux[g], sampled_flux[g]);
+            let target = targets[g];
+            self.state.stats.late_groups += u64::from(late && target.is_some());
+            let scale = crate::glossy::group_scale(target, glossy_g, sampled, room);
+            group_scale[g] = scale;
+            let reflected_glossy = glossy_g * scale.0 + sampled * scale.1;
+            let absorbed_g = room - reflected_glossy;
+            // (A share that waits has absorbed nothing yet.)
+            if !matches!(groups.plan[g], GlossyIn::Wait { .. }) {
+                let base = (arrived + room).max_value().max(1e-300);
+                self.state.ledger.min_element_absorbed = self
+                    .state
+                    .ledger
+                    .min_element_absorbed
+                    .min(absorbed_g.min_value() / base);
+            }
+            total_arrived += arrived;
+            absorbed += absorbed_g;
+            let ir = &mut self.state.interreflection;
+            match &groups.plan[g] {
+                GlossyIn::Flush {
+                    share: released, ..
+                } => {
+                    ir.book_group(l.face, arrived, diffuse, share);
+                    ir.book_group(l.face, Spectrum::zero(), reflected_glossy, *released);
+                }
+                _ => ir.book_group(l.face, arrived, diffuse + reflected_glossy, share),
+            }
+            self.state.used[l.i.index()] = true;
+            self.state.used[l.j.index()] = true;
+        }
+        self.add_far_reflection(&groups.links, far_adds, &group_scale);
+        let escaped = phi - total_arrived;
+        for b in 0..N {
+            self.state.ledger.escaped[b] += escaped[b];
+            self.state.ledger.absorbed[b] += absorbed[b];
+        }
+        let rel = escaped.min_value() / phi.max_value().max(1e-300);
+        self.state.ledger.min_shot_escaped = self.state.ledger.min_shot_escaped.min(rel);
+        group_scale
+    }
+
+    /// Per group, the glossy flux its node links carry (midpoint-rule
+    /// links, renormalised, and sampled ones, already conserving:
+    /// docs/solver.md, "Narrow lobes"), with what it reflects into its
+    /// face's far field (per far block, before the renormalisation).
+    #[allow(clippy::type_complexity)]
+    fn glossy_fluxes(
+        &self,
+        glossy: &Glossy<N>,
+        incidences: &[Option<Incidence<N>>],
+        node_links: &[NodeLink<N>],
+    ) -> (
+        Vec<Spectrum<N>>,
+        Vec<Spectrum<N>>,
+        Vec<Option<Vec<Spectrum<N>>>>,
+    ) {
+        let n = glossy.links.len();
+        let mut glossy_flux = vec![Spectrum::<N>::zero(); n];
+        let mut sampled_flux = vec![Spectrum::<N>::zero(); n];
         for nl in node_links {
             if let Some(h) = &self.state.hierarchies[nl.hierarchy as usize] {
                 let t = h.nodes[nl.node as usize].t;
-                let flux = nl.gathered * shot_scale * (PI * t);
+                let g = nl.group as usize;
+                let flux = nl.gathered * glossy.scales[g] * (PI * t);
                 if nl.sampled {
-                    sampled_flux[nl.group as usize] += flux;
+                    sampled_flux[g] += flux;
                 } else {
-                    glossy_flux[nl.group as usize] += flux;
+                    glossy_flux[g] += flux;
                 }
             }
         }
-        // The glossy share each group reflects into its face's far field
-        // (per far block, before the group's renormalisation).
-        let far_adds: Vec<Option<Vec<Spectrum<N>>>> = pair_links
+        let far_adds: Vec<Option<Vec<Spectrum<N>>>> = glossy
+            .links
             .par_iter()
+            .zip(&glossy.scales)
             .zip(incidences)
-            .map(|(l, inc)| self.far_reflection(l, inc.as_ref(), shot_scale))
+            .map(|((l, &scale), inc)| self.far_reflection(l, inc.as_ref(), scale))
             .collect();
         for (g, adds) in far_adds.iter().enumerate() {
-            if let (Some(adds), Some(field)) = (adds, &self.state.far[pair_links[g].face]) {
+            if let (Some(adds), Some(field)) = (adds, &self.state.far[glossy.links[g].face]) {
                 for (b, dl) in field.blocks.iter().zip(adds) {
                     glossy_flux[g] += *dl * (PI * b.t);
                 }
             }
         }
-        let late = self.past_deadline();
-        let targets = self.glossy_targets(pair_links, incidences, shot_scale, (&glossy_flux, late));
-        let mut group_scale =
-            vec![(Spectrum::<N>::splat(1.0), Spectrum::splat(1.0)); pair_links.len()];
-        let mut total_arrived = Spectrum::<N>::zero();
-        let mut absorbed = Spectrum::<N>::zero();
-        for (g, l) in pair_links.iter().enumerate() {
-            let arrived = l.unshot * shot_scale * (PI * l.t);
-            let rho_d = self.receive_lambertian(l, shot_scale);
-            // Light spreads over j's exposed area. (No transfer reaches an
-            // element that is wholly buried, whose segments all count as
-            // blocked; if one did, its light would be absorbed.)
-            let aj = self.setup.exposed_area[l.face.side()][l.j.index()];
-            let diffuse = if aj > 0.0 {
-                arrived * rho_d
-            } else {
-                Spectrum::zero()
-            };
-            // What an element reflects may not exceed what arrived there.
-            let room = (arrived - diffuse).max(Spectrum::zero());
-            let (glossy, sampled) = (glossy_flux[g], sampled_flux[g]);
-            let target = targets[g];
-            self.state.stats.late_groups += u64::from(late && target.is_some());
-            let scale = crate::glossy::group_scale(target, glossy, sampled, room);
-            group_scale[g] = scale;
-            let absorbed_g = arrived - diffuse - glossy * scale.0 - sampled * scale.1;
-            self.state.ledger.min_element_absorbed = self
-                .state
-                .ledger
-                .min_element_absorbed
-                .min(absorbed_g.min_value() / arrived.max_value().max(1e-300));
-            total_arrived += arrived;
-            absorbed += absorbed_g;
-            self.state
-                .interreflection
-                .book_group(l.face, arrived, arrived - absorbed_g, share);
-            self.state.used[l.i.index()] = true;
-            self.state.used[l.j.index()] = true;
-        }
+        (glossy_flux, sampled_flux, far_adds)
+    }
+
+    /// Each group's far-field increments, renormalised with its group.
+    fn add_far_reflection(
+        &mut self,
+        links: &[PairLink<N>],
+        far_adds: Vec<Option<Vec<Spectrum<N>>>>,
+        group_scale: &[(Spectrum<N>, Spectrum<N>)],
+    ) {
         for (g, adds) in far_adds.into_iter().enumerate() {
             let Some(adds) = adds else { continue };
-            let Some(field) = self.state.far[pair_links[g].face].as_mut() else {
+            let Some(field) = self.state.far[links[g].face].as_mut() else {
                 continue;
             };
             for (b, dl) in field.blocks.iter_mut().zip(adds) {
@@ -586,14 +760,6 @@ impl<const N: usize> Solver<N> {
                 field.unshot_flux += dl * (PI * b.t);
             }
         }
-        let escaped = phi - total_arrived;
-        for b in 0..N {
-            self.state.ledger.escaped[b] += escaped[b];
-            self.state.ledger.absorbed[b] += absorbed[b];
-        }
-        let rel = escaped.min_value() / phi.max_value().max(1e-300);
-        self.state.ledger.min_shot_escaped = self.state.ledger.min_shot_escaped.min(rel);
-        group_scale
     }
 
     /// The radiance increments ΔL_AC = π fr(i→j→C) T_ij δL_i / A_A that
@@ -637,18 +803,19 @@ impl<const N: usize> Solver<N> {
     /// its hemisphere coverage traces rays.
     fn glossy_targets(
         &self,
-        pair_links: &[PairLink<N>],
+        glossy: &Glossy<N>,
         incidences: &[Option<Incidence<N>>],
-        shot_scale: Spectrum<N>,
         (glossy_flux, late): (&[Spectrum<N>], bool),
     ) -> Vec<Option<Spectrum<N>>> {
-        pair_links
+        glossy
+            .links
             .par_iter()
+            .zip(&glossy.scales)
             .zip(incidences)
             .zip(glossy_flux)
-            .map(|((l, inc), &glossy)| {
-                let arrived = l.unshot * shot_scale * (PI * l.t);
-                self.glossy_target(l, inc.as_ref(), arrived, (glossy, late))
+            .map(|(((l, &scale), inc), &flux)| {
+                let arrived = l.unshot * scale * (PI * l.t);
+                self.glossy_target(l, inc.as_ref(), arrived, (flux, late))
             })
             .collect()
     }

@@ -75,6 +75,8 @@ pub(crate) enum Source {
     Far(FaceId),
     /// A light without area (`lights`), by its index.
     Light(u32),
+    /// The glossy light waiting at a face (`deferred`).
+    Deferred(FaceId),
 }
 
 /// A prepared solve: its setup, fixed before the first shot, and the state
@@ -158,7 +160,7 @@ impl<const N: usize> Solver<N> {
             .map(|f| f.unshot_flux)
             .sum::<Spectrum<N>>();
         r += state.light_flux.iter().copied().sum::<Spectrum<N>>();
-        r
+        r + state.deferred.total()
     }
 
     /// CR: the share of all the light the scene's surfaces will reflect
@@ -202,6 +204,9 @@ impl<const N: usize> Solver<N> {
                 consider(Source::Stored(h as u32), hier.unshot_flux.sum());
             }
         }
+        for (face, f) in self.state.deferred.room.iter() {
+            consider(Source::Deferred(face), f.sum());
+        }
         for (face, f) in self.state.far.iter() {
             if let Some(f) = f {
                 consider(Source::Far(face), f.unshot_flux.sum());
@@ -241,6 +246,7 @@ impl<const N: usize> Solver<N> {
             + partners
             + self.state.cache.bytes()
             + self.setup.clusters.bytes()
+            + self.state.deferred.bytes()
             + links * link) as u64
     }
 
@@ -260,6 +266,7 @@ impl<const N: usize> Solver<N> {
     pub fn solve(mut self, mut progress: impl FnMut(&Progress)) -> Solution<N> {
         let start = Instant::now();
         let reason = self.shoot_until_stopped(&mut progress);
+        self.release_all_deferred();
         self.state.stats.stop_reason = reason;
         self.warn_if_short(reason);
         self.finish(start.elapsed().as_secs_f64())

@@ -15,6 +15,7 @@ use trilux_geometry::{ElementForest, ElementId, FaceId, PerFace};
 
 use crate::ambient::Interreflection;
 use crate::cluster_transport::{FarContext, FarField, FarFields};
+use crate::deferred::Deferred;
 use crate::interaction::Hierarchy;
 use crate::ledger::Ledger;
 use crate::radiosity::ElementRadiance;
@@ -52,6 +53,8 @@ pub(crate) struct ShotState<const N: usize> {
     pub used: Vec<bool>,
     /// Unshot flux of every light without area (`lights`).
     pub light_flux: Vec<Spectrum<N>>,
+    /// Glossy light waiting at its faces (`deferred`).
+    pub deferred: Deferred<N>,
 }
 
 impl<const N: usize> ShotState<N> {
@@ -78,6 +81,7 @@ impl<const N: usize> ShotState<N> {
             face_flux,
             stats,
             light_flux: setup.light_flux.clone(),
+            deferred: Deferred::new(surfaces),
         }
     }
 }

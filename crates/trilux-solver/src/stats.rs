@@ -59,6 +59,14 @@ pub struct SolveStats {
     /// inside a shot").
     #[serde(default)]
     pub late_groups: u64,
+    /// Pair links whose glossy share waited at its face, summed with its
+    /// pair's earlier ones (docs/solver.md, "Deferred glossy reception").
+    #[serde(default)]
+    pub deferred_links: u64,
+    /// Shots that released a face's waiting glossy light (counted in
+    /// `shots`).
+    #[serde(default)]
+    pub deferred_releases: u64,
     /// Root throughputs the shots made after the time budget ran out (the
     /// part of a cut-short shot that refinement does not bound).
     #[serde(default)]

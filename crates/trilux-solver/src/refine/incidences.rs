@@ -13,7 +13,7 @@
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex};
 
-use trilux_geometry::{ElementId, FaceElement};
+use trilux_geometry::FaceElement;
 
 use crate::shards::Padded;
 use crate::throughput::BuildKeyHasher;
@@ -22,13 +22,15 @@ use crate::throughput::BuildKeyHasher;
 /// want the same one at once (each on its own cache lines).
 const SHARDS: usize = 128;
 
-/// One shard: incidences by i · 2³³ + j's key (2 × element + side;
-/// element ids stay far below 2³¹, whose forest would need hundreds of
-/// gigabytes), hashed as the throughput cache hashes its keys.
+/// One shard: incidences by i's key · 2³² + j's key (each 2 × element +
+/// side; element ids stay far below 2³¹, whose forest would need hundreds
+/// of gigabytes), hashed as the throughput cache hashes its keys. i's side
+/// counts: a flush of deferred glossy light (`deferred`) refines links
+/// from both sides of one surface in the same pass.
 type Table<T> = HashMap<u64, Option<Arc<T>>, BuildKeyHasher>;
 
-/// One shot's incidences `T` (stage 2's `Incidence`) by (i, j and j's
-/// side); `None` records a sub-pair that carries no light.
+/// One shot's incidences `T` (stage 2's `Incidence`) by (i, j and their
+/// sides); `None` records a sub-pair that carries no light.
 pub(crate) struct IncidenceMemo<T> {
     shards: Vec<Padded<Mutex<Table<T>>>>,
 }
@@ -52,11 +54,11 @@ impl<T> IncidenceMemo<T> {
     pub fn get_or_make(
         &self,
         local: &mut LocalMemo<T>,
-        i: ElementId,
+        i: FaceElement,
         j: FaceElement,
         make: impl FnOnce() -> Option<T>,
     ) -> Option<Arc<T>> {
-        let key = (u64::from(i.0) << 33) | j.key();
+        let key = (i.key() << 32) | j.key();
         if let Some(found) = local.0.get(&key) {
             return found.clone();
         }
@@ -105,9 +107,10 @@ mod tests {
             Some(v)
         };
         let j = FaceElement::new(ElementId(7), Side::Back);
-        let a = memo.get_or_make(&mut first, ElementId(3), j, || make(30));
-        let again = memo.get_or_make(&mut first, ElementId(3), j, || make(99));
-        let other_task = memo.get_or_make(&mut second, ElementId(3), j, || make(98));
+        let i = |e: u32| FaceElement::new(ElementId(e), Side::Front);
+        let a = memo.get_or_make(&mut first, i(3), j, || make(30));
+        let again = memo.get_or_make(&mut first, i(3), j, || make(99));
+        let other_task = memo.get_or_make(&mut second, i(3), j, || make(98));
         assert_eq!(
             (a.as_deref(), again.as_deref(), other_task.as_deref()),
             (Some(&30), Some(&30), Some(&30))
@@ -116,21 +119,25 @@ mod tests {
         // The other side of j, and another i, are other incidences.
         let front = FaceElement::new(ElementId(7), Side::Front);
         assert_eq!(
-            memo.get_or_make(&mut first, ElementId(3), front, || make(31))
+            memo.get_or_make(&mut first, i(3), front, || make(31))
                 .as_deref(),
             Some(&31)
         );
         assert_eq!(
-            memo.get_or_make(&mut second, ElementId(4), j, || make(40))
+            memo.get_or_make(&mut second, i(4), j, || make(40))
                 .as_deref(),
             Some(&40)
         );
-        // A sub-pair that carries no light is remembered as such.
-        assert_eq!(memo.get_or_make(&mut first, ElementId(5), j, || None), None);
+        // So is the other side of i.
+        let back = FaceElement::new(ElementId(3), Side::Back);
         assert_eq!(
-            memo.get_or_make(&mut second, ElementId(5), j, || make(50)),
-            None
+            memo.get_or_make(&mut first, back, j, || make(32))
+                .as_deref(),
+            Some(&32)
         );
-        assert_eq!(made.get(), 3);
+        // A sub-pair that carries no light is remembered as such.
+        assert_eq!(memo.get_or_make(&mut first, i(5), j, || None), None);
+        assert_eq!(memo.get_or_make(&mut second, i(5), j, || make(50)), None);
+        assert_eq!(made.get(), 4);
     }
 }

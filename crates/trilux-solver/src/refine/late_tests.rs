@@ -122,7 +122,7 @@ fn after_the_deadline_a_hierarchy_is_not_split_down_to_the_receiver() {
     let nodes = |deadline| {
         let mut found = Vec::new();
         let (h, _, late) = stage_two(0.0, deadline, |ctx, task| {
-            found = ctx.nodes_for(task.h, leaf, &mut task.lost);
+            ctx.nodes_for(task.h, leaf, &mut task.lost, &mut found);
         });
         let from: Vec<_> = found.iter().map(|&n| h.nodes[n as usize].from).collect();
         (h, found, from, late)

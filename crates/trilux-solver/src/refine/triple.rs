@@ -307,9 +307,11 @@ impl<const N: usize> RefineContext<'_, N> {
             Some(k) => k,
             None => {
                 let sender = task.sender;
-                let made = task.memo.get_or_make(&mut task.local, i, sj.of(j), || {
-                    self.incidence(sender, si.of(i), sj.of(j))
-                });
+                let made = task
+                    .memo
+                    .get_or_make(&mut task.local, si.of(i), sj.of(j), || {
+                        self.incidence(sender, si.of(i), sj.of(j))
+                    });
                 let Some(k) = made else {
                     return;
                 };
@@ -439,7 +441,9 @@ impl<const N: usize> RefineContext<'_, N> {
     /// A node whose elements were found not to see each other: as in stage
     /// 1, near the roots a few shadow rays may miss a gap, so look one
     /// level further (splitting the larger of J and K) before giving the
-    /// pair up, unless the deadline has passed.
+    /// pair up, unless the deadline has passed or the whole pair link
+    /// carries less than the photometric threshold (as in
+    /// [`Self::split_across_plane`]: the group's renormalisation makes up).
     fn retry_unseen_node(
         &self,
         task: &mut TripleTask<'_, N>,
@@ -451,7 +455,8 @@ impl<const N: usize> RefineContext<'_, N> {
         let k = task.h.nodes[n as usize].to;
         let (ej, ek) = (self.forest.element(j), self.forest.element(k));
         let near_roots = ej.depth + ek.depth < 2 && !self.past_deadline();
-        if near_roots && self.throughput(task.h.to.of(k), task.h.from.of(j)).f > 0.0 {
+        let worth = PI * known.tij.t * known.unshot.sum() >= self.flux_threshold;
+        if near_roots && worth && self.throughput(task.h.to.of(k), task.h.from.of(j)).f > 0.0 {
             let side = if ej.area >= ek.area {
                 Driver::J
             } else {
@@ -647,34 +652,44 @@ impl<const N: usize> RefineContext<'_, N> {
         h.children(n)
     }
 
-    /// The nodes of `h` whose sender element is exactly `j`, splitting on
-    /// the sender side down to `j` where needed and descending through
-    /// receiver-side splits (they keep the same sender element). Past the
-    /// deadline a leaf above `j` is not split: it is returned as it stands
-    /// (its sender element above `j`), and counted late.
+    /// The nodes of `h` whose sender element is exactly `j`, into `out`
+    /// (cleared first), splitting on the sender side down to `j` where
+    /// needed and descending through receiver-side splits (they keep the
+    /// same sender element). Past the deadline a leaf above `j` is not
+    /// split: it is returned as it stands (its sender element above `j`),
+    /// and counted late. Stage 2 calls this once per pair link and
+    /// hierarchy, so it allocates nothing but `out`'s growth.
     pub fn nodes_for(
         &self,
         h: &mut Hierarchy<N>,
         j: ElementId,
         lost: &mut Spectrum<N>,
-    ) -> Vec<u32> {
+        out: &mut Vec<u32>,
+    ) {
+        out.clear();
         self.make_root(h);
-        // The chain of elements from the surface's root down to j.
-        let mut chain = vec![j];
-        let mut cur = j;
-        while let Some(p) = self.forest.element(cur).parent {
-            chain.push(p);
-            cur = p;
+        // A link to the whole surface (every link of a shot below the
+        // photometric threshold) is the root node's.
+        if h.nodes[0].from == j {
+            out.push(0);
+            return;
         }
-        chain.reverse();
-        let mut out = Vec::new();
+        let target = self.forest.element(j).depth as usize;
+        // The element on the chain from the surface's root down to j at
+        // `depth` (j's ancestor; elements are a few levels deep).
+        let on_chain = |depth: usize| {
+            let mut e = j;
+            for _ in depth..target {
+                e = self.forest.element(e).parent.unwrap_or(e);
+            }
+            e
+        };
         let mut stack = vec![(0u32, 0usize)];
         while let Some((n, depth)) = stack.pop() {
-            let from = h.nodes[n as usize].from;
-            if from != chain[depth] {
+            if h.nodes[n as usize].from != on_chain(depth) {
                 continue;
             }
-            if depth + 1 == chain.len() {
+            if depth == target {
                 out.push(n);
                 continue;
             }
@@ -695,6 +710,5 @@ impl<const N: usize> RefineContext<'_, N> {
                 }
             }
         }
-        out
     }
 }
