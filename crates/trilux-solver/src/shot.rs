@@ -29,6 +29,8 @@ use crate::interaction::Hierarchy;
 use crate::link::{NodeLink, PairLink, PairShot, Sender, Sent};
 use crate::refine::{Incidence, IncidenceMemo, Lateness, RefineContext, TripleTask};
 use crate::solver::{Solver, Source};
+use crate::state::RootThroughputs;
+use crate::throughput::Throughput;
 
 /// The most a stored interaction's shot is scaled up to carry its whole
 /// unshot flux (see [`shot_scale`]).
@@ -104,19 +106,48 @@ fn stage_one<const N: usize>(
     ctx: &RefineContext<'_, N>,
     sender: &Sender<'_, N>,
     send_face: FaceId,
-    pairs: &[(ElementId, FaceId, ElementId)],
+    (pairs, roots): (&[(ElementId, FaceId, ElementId)], &[Throughput]),
 ) -> Vec<PairLink<N>> {
     pairs
         .par_iter()
-        .flat_map_iter(|&(i, r, j)| {
+        .enumerate()
+        .flat_map_iter(|(k, &(i, r, j))| {
             let mut out = Vec::new();
             let shot = PairShot {
                 sender,
                 si: send_face,
                 sj: r,
             };
-            ctx.refine_pair(shot, i, j, ctx.settings.ff_eps, &mut out);
+            let budget = ctx.settings.ff_eps;
+            match roots.get(k) {
+                Some(&th) => ctx.refine_pair_with(shot, (i, j, th), budget, &mut out),
+                None => ctx.refine_pair(shot, i, j, budget, &mut out),
+            }
             out
+        })
+        .collect()
+}
+
+/// The root pairs' throughputs of a face's shot, in the order of its
+/// near partners (`pairs`): those not yet made are made in parallel and
+/// kept in `slots` (`state::RootThroughputs`).
+fn root_throughputs<const N: usize>(
+    ctx: &RefineContext<'_, N>,
+    slots: &mut Vec<Option<Throughput>>,
+    send_face: FaceId,
+    pairs: &[(ElementId, FaceId, ElementId)],
+) -> Vec<Throughput> {
+    if slots.len() != pairs.len() {
+        *slots = vec![None; pairs.len()];
+    }
+    if slots.iter().all(Option::is_some) {
+        return slots.iter().map(|t| t.unwrap_or_default()).collect();
+    }
+    slots
+        .par_iter_mut()
+        .zip(pairs)
+        .map(|(slot, &(i, r, j))| {
+            *slot.get_or_insert_with(|| ctx.throughput(r.of(j), send_face.of(i)))
         })
         .collect()
 }
@@ -234,9 +265,15 @@ impl<const N: usize> Solver<N> {
             Sending::Far { .. } => Vec::new(),
         };
         let (links, near, late) = {
-            let (mut ctx, _) = self.split_for_shot();
+            let (mut ctx, _, roots) = self.split_for_shot();
+            let roots = match sending {
+                Sending::Radiosity(f) => {
+                    root_throughputs(&ctx.refine, &mut roots.0[*f], send_face, &pairs)
+                }
+                _ => Vec::new(),
+            };
             let sender = shot_sender(Some(sending), ctx.field);
-            let mut links = stage_one(&ctx.refine, &sender, send_face, &pairs);
+            let mut links = stage_one(&ctx.refine, &sender, send_face, (&pairs, &roots));
             let near = links.len();
             links.extend(far_stage_one(&ctx.refine, ctx.field, sending));
             (links, near, std::mem::take(&mut ctx.refine.late))
@@ -266,7 +303,7 @@ impl<const N: usize> Solver<N> {
             .collect();
         let shot_face = sending.map(Sending::face);
         let (incidences, stage_two, late) = {
-            let (mut ctx, hierarchies) = self.split_for_shot();
+            let (mut ctx, hierarchies, _) = self.split_for_shot();
             let shot = shot_sender(sending, ctx.field);
             let senders: Vec<(&Sender<'_, N>, FaceId)> = groups
                 .plan
@@ -366,7 +403,14 @@ impl<const N: usize> Solver<N> {
 
     /// The refinement context (the setup and the throughput cache) beside
     /// the stored hierarchies that stage 2 refines.
-    fn split_for_shot(&mut self) -> (ShotContext<'_, N>, &mut Vec<Option<Hierarchy<N>>>) {
+    #[allow(clippy::type_complexity)]
+    fn split_for_shot(
+        &mut self,
+    ) -> (
+        ShotContext<'_, N>,
+        &mut Vec<Option<Hierarchy<N>>>,
+        &mut RootThroughputs,
+    ) {
         let deadline = self.deadline();
         let state = &mut self.state;
         let mut refine = self.setup.refine_context(&state.cache);
@@ -376,7 +420,7 @@ impl<const N: usize> Solver<N> {
             field: &state.field,
             stored_from: &self.setup.stored_from,
         };
-        (ctx, &mut state.hierarchies)
+        (ctx, &mut state.hierarchies, &mut state.roots)
     }
 
     /// What the shot's refinement cut short at the deadline, into the

@@ -167,22 +167,30 @@ impl<const N: usize> Solver<N> {
     /// that they have reflected so far (`ambient`); 1 for a scene that
     /// emits nothing.
     pub fn convergence_ratio(&self) -> f64 {
+        self.convergence_ratio_of(self.residual())
+    }
+
+    /// CR for the residual `residual` (the loop sums it once a shot).
+    fn convergence_ratio_of(&self, residual: Spectrum<N>) -> f64 {
         if self.setup.emitted.sum() <= 0.0 {
             return 1.0;
         }
-        self.state
-            .interreflection
-            .convergence_ratio(self.residual())
+        self.state.interreflection.convergence_ratio(residual)
     }
 
     /// The paper's CR = (IF − RF)/IF (§6), which counts light that left
     /// the scene as converged; 1 for a scene that emits nothing.
     pub fn paper_convergence_ratio(&self) -> f64 {
+        self.paper_convergence_ratio_of(self.residual())
+    }
+
+    /// The paper's CR for the residual `residual`.
+    fn paper_convergence_ratio_of(&self, residual: Spectrum<N>) -> f64 {
         let emitted = self.setup.emitted.sum();
         if emitted <= 0.0 {
             return 1.0;
         }
-        ((emitted - self.residual().sum()) / emitted).clamp(0.0, 1.0)
+        ((emitted - residual.sum()) / emitted).clamp(0.0, 1.0)
     }
 
     /// The source with the greatest unshot flux (band sum), if any has some.
@@ -247,6 +255,7 @@ impl<const N: usize> Solver<N> {
             + self.state.cache.bytes()
             + self.setup.clusters.bytes()
             + self.state.deferred.bytes()
+            + self.state.roots.bytes()
             + links * link) as u64
     }
 
@@ -279,8 +288,9 @@ impl<const N: usize> Solver<N> {
             self.setup.settings.max_shots,
         );
         let mut next_trace = 1u64;
+        let mut cr = self.convergence_ratio();
         loop {
-            if self.convergence_ratio() >= target {
+            if cr >= target {
                 return StopReason::Converged;
             }
             if self.state.stats.shots >= u64::from(max_shots) {
@@ -302,14 +312,21 @@ impl<const N: usize> Solver<N> {
             let Some(source) = self.next_source() else {
                 return StopReason::NothingUnshot;
             };
-            let live = self.shoot(source);
+            // On a worker of the thread pool, so that the shot's parallel
+            // phases start there instead of being handed over from this
+            // thread one by one (the handovers were a tenth of a large
+            // scene's solve).
+            let live = rayon::scope(|_| self.shoot(source));
             self.state.stats.shots += 1;
             let bytes = self.arena_bytes(live);
             self.state.stats.peak_memory_bytes = self.state.stats.peak_memory_bytes.max(bytes);
+            // The residual sums every source's key: once a shot.
+            let residual = self.residual();
+            cr = self.convergence_ratio_of(residual);
             let p = Progress {
                 shots: self.state.stats.shots,
-                convergence_ratio: self.convergence_ratio(),
-                paper_convergence_ratio: self.paper_convergence_ratio(),
+                convergence_ratio: cr,
+                paper_convergence_ratio: self.paper_convergence_ratio_of(residual),
                 target,
                 interactions: self.interaction_count(),
                 live_links: live,

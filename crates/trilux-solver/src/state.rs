@@ -21,7 +21,7 @@ use crate::ledger::Ledger;
 use crate::radiosity::ElementRadiance;
 use crate::setup::{Setup, emitted_flux};
 use crate::stats::SolveStats;
-use crate::throughput::ThroughputCache;
+use crate::throughput::{Throughput, ThroughputCache};
 
 /// What the shots change (module docs).
 pub(crate) struct ShotState<const N: usize> {
@@ -55,6 +55,26 @@ pub(crate) struct ShotState<const N: usize> {
     pub light_flux: Vec<Spectrum<N>>,
     /// Glossy light waiting at its faces (`deferred`).
     pub deferred: Deferred<N>,
+    /// T of every face's root pairs with its near partners.
+    pub roots: RootThroughputs,
+}
+
+/// T of the root pair (a face's root, a near partner's root), by face and
+/// in the order of its near partners (`Setup::partners`): every shot of
+/// a face starts stage 1 from all of them, and reading them here instead
+/// of the throughput cache saves a locked hash lookup per partner per
+/// shot (a tenth of boxes-256's solve). Made the first time the face
+/// shoots; `None` until then.
+pub(crate) struct RootThroughputs(pub PerFace<Vec<Option<Throughput>>>);
+
+impl RootThroughputs {
+    /// Bytes held.
+    pub fn bytes(&self) -> usize {
+        self.0
+            .values()
+            .map(|v| v.capacity() * std::mem::size_of::<Option<Throughput>>())
+            .sum()
+    }
 }
 
 impl<const N: usize> ShotState<N> {
@@ -82,6 +102,7 @@ impl<const N: usize> ShotState<N> {
             stats,
             light_flux: setup.light_flux.clone(),
             deferred: Deferred::new(surfaces),
+            roots: RootThroughputs(PerFace::from_fn(surfaces, |_| Vec::new())),
         }
     }
 }

@@ -13,6 +13,7 @@ use trilux_geometry::{ElementId, FaceElement};
 
 use super::context::{RefineContext, disc_estimate};
 use crate::link::{PairLink, PairShot, Sender};
+use crate::throughput::Throughput;
 
 /// Largest relative error, from the sender's unshot radiance varying over
 /// it, that a pair link may carry (see `RefineContext::sender_varies`).
@@ -31,8 +32,20 @@ impl<const N: usize> RefineContext<'_, N> {
         budget: f64,
         out: &mut Vec<PairLink<N>>,
     ) {
+        let th = self.throughput(shot.sj.of(j), shot.si.of(i));
+        self.refine_pair_with(shot, (i, j, th), budget, out);
+    }
+
+    /// [`Self::refine_pair`] with T_ij already known (a root pair's, kept
+    /// by the shot's state: `state::RootThroughputs`).
+    pub fn refine_pair_with(
+        &self,
+        shot: PairShot<'_, N>,
+        (i, j, th): (ElementId, ElementId, Throughput),
+        budget: f64,
+        out: &mut Vec<PairLink<N>>,
+    ) {
         let PairShot { sender, si, sj } = shot;
-        let th = self.throughput(sj.of(j), si.of(i));
         let (ei, ej) = (self.forest.element(i), self.forest.element(j));
         if th.t <= 0.0 {
             // Fully occluded or facing away. Near the roots a handful of
