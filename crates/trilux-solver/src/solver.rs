@@ -275,7 +275,11 @@ impl<const N: usize> Solver<N> {
     pub fn solve(mut self, mut progress: impl FnMut(&Progress)) -> Solution<N> {
         let start = Instant::now();
         let reason = self.shoot_until_stopped(&mut progress);
-        self.release_all_deferred();
+        // Not past a time budget or a request to stop: the waiting light
+        // then stays in the residual, with the rest of the unshot light.
+        if !matches!(reason, StopReason::TimeBudget | StopReason::Interrupted) {
+            self.release_all_deferred();
+        }
         self.state.stats.stop_reason = reason;
         self.warn_if_short(reason);
         self.finish(start.elapsed().as_secs_f64())
