@@ -18,15 +18,15 @@
 //! pair carrying the sum. Light waiting counts in the residual (it is
 //! arrived light not yet reflected), and a face's waiting light is a
 //! source like any other: when it is the largest, all of it is refined
-//! ([`crate::solver::Source::Deferred`]).
+//! (`Source::Deferred`). `Solver::plan_glossy` (in `shot`) decides which
+//! links may wait.
 
 use std::collections::HashMap;
 
 use trilux_color::Spectrum;
-use trilux_geometry::{FaceElement, FaceId, PerFace};
+use trilux_geometry::{ElementId, FaceElement, FaceId, PerFace};
 
 use crate::link::PairLink;
-use crate::solver::Solver;
 use crate::throughput::BuildKeyHasher;
 
 /// A pair's glossy light waiting at its receiving face.
@@ -137,46 +137,10 @@ impl<const N: usize> GlossyIn<N> {
     }
 }
 
-impl<const N: usize> Solver<N> {
-    /// Decides, for every pair link of a shot from `send_face`, whether
-    /// its glossy share is refined now, waits, or releases its pair's sum
-    /// (module docs). Only links from the root of a sending face to the
-    /// root of another glossy face (`near` first links: stage 1's, not
-    /// the far links, whose pairs are not bounded by the near pairs) wait.
-    pub(crate) fn plan_glossy(
-        &mut self,
-        pair_links: &[PairLink<N>],
-        near: usize,
-        send_face: FaceId,
-        (shot_scale, share): (Spectrum<N>, Spectrum<N>),
-    ) -> Vec<GlossyIn<N>> {
-        let threshold = self.setup.refine_context(&self.state.cache).flux_threshold;
-        // The uniform mode stays the paper's algorithm.
-        let on = self.setup.settings.defer_glossy
-            && self.setup.settings.transport == crate::settings::Transport::TwoPoint;
-        let send_root = self.setup.forest().root(send_face.surface());
-        pair_links
-            .iter()
-            .enumerate()
-            .map(|(g, l)| {
-                let root = self.setup.forest().root(l.face.surface());
-                let eligible = on
-                    && g < near
-                    && self.setup.faces[l.face].stored
-                    && l.face != send_face
-                    && l.i == send_root
-                    && l.j == root;
-                if !eligible {
-                    return GlossyIn::Now;
-                }
-                self.wait_or_release(l, send_face, threshold, (shot_scale, share))
-            })
-            .collect()
-    }
-
-    /// One eligible link: adds it to its pair's sum, which is released
-    /// when it reaches `threshold`.
-    fn wait_or_release(
+impl<const N: usize> Deferred<N> {
+    /// One link that may wait (`Solver::plan_glossy` decides which): adds
+    /// it to its pair's sum, released when it reaches `threshold`.
+    pub fn wait_or_release(
         &mut self,
         l: &PairLink<N>,
         send_face: FaceId,
@@ -185,7 +149,7 @@ impl<const N: usize> Solver<N> {
     ) -> GlossyIn<N> {
         let from = send_face.of(l.i);
         let own = l.unshot * shot_scale * l.t;
-        let pending = self.state.deferred.faces[l.face]
+        let pending = self.faces[l.face]
             .entry(from.key())
             .or_insert_with(|| Pending {
                 face: send_face,
@@ -199,67 +163,55 @@ impl<const N: usize> Solver<N> {
         pending.reflected += own * share;
         pending.t = l.t;
         if std::f64::consts::PI * pending.sum.sum() < threshold {
-            self.state.stats.deferred_links += 1;
             return GlossyIn::Wait { from };
         }
-        let Some(p) = self.state.deferred.faces[l.face].remove(&from.key()) else {
+        let Some(p) = self.faces[l.face].remove(&from.key()) else {
             return GlossyIn::Now;
         };
-        self.state.deferred.room[l.face] -= p.room;
+        self.room[l.face] -= p.room;
         released(p)
     }
 
-    /// Everything waiting at `face`, as pair links that carry no new light
-    /// (their own δL zero) and release their sums: the groups of the
-    /// source [`crate::solver::Source::Deferred`].
-    pub(crate) fn take_deferred(&mut self, face: FaceId) -> (Vec<PairLink<N>>, Vec<GlossyIn<N>>) {
-        self.state.stats.deferred_releases += 1;
-        let waiting = std::mem::take(&mut self.state.deferred.faces[face]);
-        self.state.deferred.room[face] = Spectrum::zero();
-        let j = self.setup.forest().root(face.surface());
-        let mut links = Vec::with_capacity(waiting.len());
-        let mut plan = Vec::with_capacity(waiting.len());
+    /// Everything waiting at `face` (whose root element is `j`), as pair
+    /// links that carry no new light (their own δL zero) and release their
+    /// sums: the groups of the source `Source::Deferred`.
+    pub fn take(&mut self, face: FaceId, j: ElementId) -> (Vec<PairLink<N>>, Vec<GlossyIn<N>>) {
+        let waiting = std::mem::take(&mut self.faces[face]);
+        self.room[face] = Spectrum::zero();
         let mut pending: Vec<Pending<N>> = waiting.into_values().collect();
         // A fixed order (the map's is not): solves repeat exactly.
         pending.sort_by_key(|p| p.from.key());
-        for p in pending {
-            links.push(PairLink {
-                i: p.from.element,
-                j,
-                face,
-                t: p.t,
-                unshot: Spectrum::zero(),
-            });
-            plan.push(released(p));
-        }
-        (links, plan)
-    }
-
-    /// After the last shot, every face's waiting light into its
-    /// hierarchies: the solution then holds all the glossy light that
-    /// arrived, as it would without deferral, and only what that light
-    /// has not yet sent on stays in the residual.
-    pub(crate) fn release_all_deferred(&mut self) {
-        let waiting: Vec<FaceId> = self
-            .state
-            .deferred
-            .faces
-            .iter()
-            .filter(|(_, m)| !m.is_empty())
-            .map(|(f, _)| f)
-            .collect();
-        for face in waiting {
-            self.shoot(crate::solver::Source::Deferred(face));
-        }
+        pending
+            .into_iter()
+            .map(|p| {
+                let link = PairLink {
+                    i: p.from.element,
+                    j,
+                    face,
+                    t: p.t,
+                    unshot: Spectrum::zero(),
+                };
+                (link, released(p))
+            })
+            .unzip()
     }
 
     /// Books the flux a waiting link adds at its face (what arrived less
     /// its Lambertian share): it stays in the residual until released.
-    pub(crate) fn book_waiting(&mut self, face: FaceId, from: FaceElement, room: Spectrum<N>) {
-        if let Some(p) = self.state.deferred.faces[face].get_mut(&from.key()) {
+    pub fn book_waiting(&mut self, face: FaceId, from: FaceElement, room: Spectrum<N>) {
+        if let Some(p) = self.faces[face].get_mut(&from.key()) {
             p.room += room;
-            self.state.deferred.room[face] += room;
+            self.room[face] += room;
         }
+    }
+
+    /// The faces where light waits.
+    pub fn waiting_faces(&self) -> Vec<FaceId> {
+        self.faces
+            .iter()
+            .filter(|(_, m)| !m.is_empty())
+            .map(|(f, _)| f)
+            .collect()
     }
 }
 

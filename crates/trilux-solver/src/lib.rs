@@ -43,8 +43,9 @@
 //!   transfer into every leaf; [`sky`]: an environment map (Mitsuba's
 //!   `envmap`), its lookup and its importance sampling, shot as they are.
 //! - [`solver`]: the progressive loop (§4, Fig. 7 and 9); `shot`: one
-//!   shot's phases; `glossy`: the glossy renormalisation; `deferred`:
-//!   the glossy share of small links, summed per pair until it counts.
+//!   shot's phases, `receive` its fifth (what each link delivers);
+//!   `glossy`: the glossy renormalisation; `deferred`: the glossy share of
+//!   small links, summed per pair until it counts.
 //! - [`gather_links`]: the final gather's links, kept for rendering;
 //!   `final_gather`: the refinement that makes them.
 //! - [`ledger`]: where the energy went.
@@ -74,6 +75,7 @@ pub mod lights;
 mod link;
 pub mod prepared;
 mod radiosity;
+mod receive;
 mod refine;
 pub mod settings;
 mod setup;

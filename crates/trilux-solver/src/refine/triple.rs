@@ -306,15 +306,11 @@ impl<const N: usize> RefineContext<'_, N> {
         let known = match known {
             Some(k) => k,
             None => {
-                let sender = task.sender;
-                let made = task
-                    .memo
-                    .get_or_make(&mut task.local, si.of(i), sj.of(j), || {
-                        self.incidence(sender, si.of(i), sj.of(j))
-                    });
-                let Some(k) = made else {
-                    return;
-                };
+                let (sender, pair) = (task.sender, (si.of(i), sj.of(j)));
+                let made = task.memo.get_or_make(&mut task.local, pair.0, pair.1, || {
+                    self.incidence(sender, pair.0, pair.1)
+                });
+                let Some(k) = made else { return };
                 owned = k;
                 &*owned
             }
