@@ -79,6 +79,10 @@ pub(crate) enum Source {
     Deferred(FaceId),
 }
 
+/// How often the solve loop sums the arenas and the interaction count
+/// over every hierarchy (for `peak_memory_bytes` and the progress).
+const REFRESH_SHOTS: u64 = 64;
+
 /// A prepared solve: its setup, fixed before the first shot, and the state
 /// the shooting loop changes.
 pub struct Solver<const N: usize> {
@@ -194,33 +198,45 @@ impl<const N: usize> Solver<N> {
     }
 
     /// The source with the greatest unshot flux (band sum), if any has some.
+    #[cfg(test)]
     pub(crate) fn next_source(&self) -> Option<Source> {
+        self.next_source_and_residual().0
+    }
+
+    /// [`Self::next_source`] and [`Self::residual`] in one pass over every
+    /// source's key (the loop needs both after every shot).
+    fn next_source_and_residual(&self) -> (Option<Source>, Spectrum<N>) {
         let mut best: Option<(Source, f64)> = None;
-        let mut consider = |s: Source, flux: f64| {
-            if flux > 0.0 && best.is_none_or(|(_, f)| flux > f) {
-                best = Some((s, flux));
+        // Summed by kind, in `residual`'s order (the same bits).
+        let mut sums = [Spectrum::<N>::zero(); 5];
+        let mut consider = |s: Source, kind: usize, flux: Spectrum<N>| {
+            sums[kind] += flux;
+            let sum = flux.sum();
+            if sum > 0.0 && best.is_none_or(|(_, f)| sum > f) {
+                best = Some((s, sum));
             }
         };
         for (k, f) in self.state.light_flux.iter().enumerate() {
-            consider(Source::Light(k as u32), f.sum());
+            consider(Source::Light(k as u32), 3, *f);
         }
         for (face, f) in self.state.face_flux.iter() {
-            consider(Source::Radiosity(face), f.sum());
+            consider(Source::Radiosity(face), 0, *f);
         }
         for (h, hier) in self.state.hierarchies.iter().enumerate() {
             if let Some(hier) = hier {
-                consider(Source::Stored(h as u32), hier.unshot_flux.sum());
+                consider(Source::Stored(h as u32), 1, hier.unshot_flux);
             }
         }
         for (face, f) in self.state.deferred.room.iter() {
-            consider(Source::Deferred(face), f.sum());
+            consider(Source::Deferred(face), 4, *f);
         }
         for (face, f) in self.state.far.iter() {
             if let Some(f) = f {
-                consider(Source::Far(face), f.unshot_flux.sum());
+                consider(Source::Far(face), 2, f.unshot_flux);
             }
         }
-        best.map(|(s, _)| s)
+        let [face, stored, far, light, deferred] = sums;
+        (best.map(|(s, _)| s), face + stored + far + light + deferred)
     }
 
     /// Summed bytes of the solver's arenas now (stats'
@@ -228,6 +244,14 @@ impl<const N: usize> Solver<N> {
     /// exposed areas and sample points, the stored interaction nodes, the
     /// throughput cache, the cluster hierarchy, plus `links` live links.
     pub(crate) fn arena_bytes(&self, links: usize) -> u64 {
+        let link = std::mem::size_of::<PairLink<N>>().max(std::mem::size_of::<NodeLink<N>>());
+        self.arena_base_bytes() + (links * link) as u64
+    }
+
+    /// [`Self::arena_bytes`] without the live links: it only grows, and
+    /// summing it visits every hierarchy, so the loop refreshes it every
+    /// [`REFRESH_SHOTS`] shots.
+    fn arena_base_bytes(&self) -> u64 {
         use std::mem::size_of;
         let elements = self.setup.forest().element_count();
         let per_element = size_of::<trilux_geometry::Element>()
@@ -247,7 +271,6 @@ impl<const N: usize> Solver<N> {
             .sum();
         let hierarchies = self.state.hierarchies.len() * size_of::<Option<Hierarchy<N>>>();
         let partners: usize = self.setup.partners.values().map(|p| p.capacity() * 4).sum();
-        let link = size_of::<PairLink<N>>().max(size_of::<NodeLink<N>>());
         (elements * per_element
             + nodes * size_of::<crate::interaction::Node<N>>()
             + hierarchies
@@ -255,8 +278,7 @@ impl<const N: usize> Solver<N> {
             + self.state.cache.bytes()
             + self.setup.clusters.bytes()
             + self.state.deferred.bytes()
-            + self.state.roots.bytes()
-            + links * link) as u64
+            + self.state.roots.bytes()) as u64
     }
 
     /// Stored interaction nodes, over every hierarchy.
@@ -292,7 +314,9 @@ impl<const N: usize> Solver<N> {
             self.setup.settings.max_shots,
         );
         let mut next_trace = 1u64;
-        let mut cr = self.convergence_ratio();
+        let (mut next, residual) = self.next_source_and_residual();
+        let mut cr = self.convergence_ratio_of(residual);
+        let (mut base, mut interactions) = (self.arena_base_bytes(), self.interaction_count());
         loop {
             if cr >= target {
                 return StopReason::Converged;
@@ -313,7 +337,7 @@ impl<const N: usize> Solver<N> {
             {
                 return StopReason::Interrupted;
             }
-            let Some(source) = self.next_source() else {
+            let Some(source) = next else {
                 return StopReason::NothingUnshot;
             };
             // On a worker of the thread pool, so that the shot's parallel
@@ -322,17 +346,25 @@ impl<const N: usize> Solver<N> {
             // scene's solve).
             let live = rayon::scope(|_| self.shoot(source));
             self.state.stats.shots += 1;
-            let bytes = self.arena_bytes(live);
+            // The sums over every hierarchy, refreshed now and then (the
+            // arenas only grow; `finish` sums them once more).
+            if self.state.stats.shots.is_multiple_of(REFRESH_SHOTS) {
+                (base, interactions) = (self.arena_base_bytes(), self.interaction_count());
+            }
+            let link = std::mem::size_of::<PairLink<N>>().max(std::mem::size_of::<NodeLink<N>>());
+            let bytes = base + (live * link) as u64;
             self.state.stats.peak_memory_bytes = self.state.stats.peak_memory_bytes.max(bytes);
-            // The residual sums every source's key: once a shot.
-            let residual = self.residual();
+            // One pass over every source's key a shot: the next source and
+            // the residual.
+            let residual;
+            (next, residual) = self.next_source_and_residual();
             cr = self.convergence_ratio_of(residual);
             let p = Progress {
                 shots: self.state.stats.shots,
                 convergence_ratio: cr,
                 paper_convergence_ratio: self.paper_convergence_ratio_of(residual),
                 target,
-                interactions: self.interaction_count(),
+                interactions,
                 live_links: live,
                 elapsed_seconds: self.started.elapsed().as_secs_f64(),
                 time_budget_seconds: self.time_budget.map(|b| b.as_secs_f64()),
