@@ -22,6 +22,7 @@
 //! links may wait.
 
 use std::collections::HashMap;
+use std::collections::hash_map::Entry;
 
 use trilux_color::Spectrum;
 use trilux_geometry::{ElementId, FaceElement, FaceId, PerFace};
@@ -149,25 +150,25 @@ impl<const N: usize> Deferred<N> {
     ) -> GlossyIn<N> {
         let from = send_face.of(l.i);
         let own = l.unshot * shot_scale * l.t;
-        let pending = self.faces[l.face]
-            .entry(from.key())
-            .or_insert_with(|| Pending {
+        let mut slot = match self.faces[l.face].entry(from.key()) {
+            Entry::Occupied(o) => o,
+            Entry::Vacant(v) => v.insert_entry(Pending {
                 face: send_face,
                 from,
                 sum: Spectrum::zero(),
                 reflected: Spectrum::zero(),
                 t: l.t,
                 room: Spectrum::zero(),
-            });
+            }),
+        };
+        let pending = slot.get_mut();
         pending.sum += own;
         pending.reflected += own * share;
         pending.t = l.t;
         if std::f64::consts::PI * pending.sum.sum() < threshold {
             return GlossyIn::Wait { from };
         }
-        let Some(p) = self.faces[l.face].remove(&from.key()) else {
-            return GlossyIn::Now;
-        };
+        let p = slot.remove();
         self.room[l.face] -= p.room;
         released(p)
     }

@@ -10,6 +10,7 @@
 //! closed scene (it then measures the form-factor error).
 
 use serde::{Deserialize, Serialize};
+use trilux_color::Spectrum;
 
 /// Per-band flux totals in watts.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -29,6 +30,24 @@ pub struct Ledger {
 }
 
 impl Ledger {
+    /// Books one shot of flux `phi`: what did not arrive anywhere escaped,
+    /// `absorbed` of what arrived was absorbed; keeps the smallest share
+    /// that escaped (negative would mean the shot created energy).
+    pub(crate) fn book_shot<const N: usize>(
+        &mut self,
+        phi: Spectrum<N>,
+        arrived: Spectrum<N>,
+        absorbed: Spectrum<N>,
+    ) {
+        let escaped = phi - arrived;
+        for b in 0..N {
+            self.escaped[b] += escaped[b];
+            self.absorbed[b] += absorbed[b];
+        }
+        let rel = escaped.min_value() / phi.max_value().max(1e-300);
+        self.min_shot_escaped = self.min_shot_escaped.min(rel);
+    }
+
     /// An empty ledger for `bands` bands with the given emitted flux.
     pub fn new(emitted: Vec<f64>) -> Self {
         let n = emitted.len();

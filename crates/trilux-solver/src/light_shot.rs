@@ -62,13 +62,7 @@ impl<const N: usize> Solver<N> {
                 .interreflection
                 .book_group(d.face, d.arrived, reflected, Spectrum::zero());
         }
-        let escaped = phi - total;
-        for b in 0..N {
-            self.state.ledger.escaped[b] += escaped[b];
-            self.state.ledger.absorbed[b] += absorbed[b];
-        }
-        let rel = escaped.min_value() / phi.max_value().max(1e-300);
-        self.state.ledger.min_shot_escaped = self.state.ledger.min_shot_escaped.min(rel);
+        self.state.ledger.book_shot(phi, total, absorbed);
         deposits.len()
     }
 

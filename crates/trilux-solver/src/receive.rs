@@ -100,13 +100,7 @@ impl<const N: usize> Solver<N> {
             self.state.used[l.j.index()] = true;
         }
         self.add_far_reflection(&groups.links, far_adds, &group_scale);
-        let escaped = phi - total_arrived;
-        for b in 0..N {
-            self.state.ledger.escaped[b] += escaped[b];
-            self.state.ledger.absorbed[b] += absorbed[b];
-        }
-        let rel = escaped.min_value() / phi.max_value().max(1e-300);
-        self.state.ledger.min_shot_escaped = self.state.ledger.min_shot_escaped.min(rel);
+        self.state.ledger.book_shot(phi, total_arrived, absorbed);
         group_scale
     }
 

@@ -79,6 +79,11 @@ pub(crate) enum Source {
     Deferred(FaceId),
 }
 
+/// Bytes of one live link of a shot (pair or node link).
+fn link_bytes<const N: usize>() -> usize {
+    std::mem::size_of::<PairLink<N>>().max(std::mem::size_of::<NodeLink<N>>())
+}
+
 /// How often the solve loop sums the arenas and the interaction count
 /// over every hierarchy (for `peak_memory_bytes` and the progress).
 const REFRESH_SHOTS: u64 = 64;
@@ -242,16 +247,11 @@ impl<const N: usize> Solver<N> {
     /// Summed bytes of the solver's arenas now (stats'
     /// `peak_memory_bytes`): the element trees, per-element radiance,
     /// exposed areas and sample points, the stored interaction nodes, the
-    /// throughput cache, the cluster hierarchy, plus `links` live links.
-    pub(crate) fn arena_bytes(&self, links: usize) -> u64 {
-        let link = std::mem::size_of::<PairLink<N>>().max(std::mem::size_of::<NodeLink<N>>());
-        self.arena_base_bytes() + (links * link) as u64
-    }
-
-    /// [`Self::arena_bytes`] without the live links: it only grows, and
-    /// summing it visits every hierarchy, so the loop refreshes it every
-    /// [`REFRESH_SHOTS`] shots.
-    fn arena_base_bytes(&self) -> u64 {
+    /// throughput cache, the cluster hierarchy, the deferred glossy light
+    /// and the root throughputs; a shot's live links come on top. It only
+    /// grows, and summing it visits every hierarchy, so the loop refreshes
+    /// it every [`REFRESH_SHOTS`] shots.
+    pub(crate) fn arena_bytes(&self) -> u64 {
         use std::mem::size_of;
         let elements = self.setup.forest().element_count();
         let per_element = size_of::<trilux_geometry::Element>()
@@ -316,7 +316,7 @@ impl<const N: usize> Solver<N> {
         let mut next_trace = 1u64;
         let (mut next, residual) = self.next_source_and_residual();
         let mut cr = self.convergence_ratio_of(residual);
-        let (mut base, mut interactions) = (self.arena_base_bytes(), self.interaction_count());
+        let (mut base, mut interactions) = (self.arena_bytes(), self.interaction_count());
         loop {
             if cr >= target {
                 return StopReason::Converged;
@@ -349,10 +349,9 @@ impl<const N: usize> Solver<N> {
             // The sums over every hierarchy, refreshed now and then (the
             // arenas only grow; `finish` sums them once more).
             if self.state.stats.shots.is_multiple_of(REFRESH_SHOTS) {
-                (base, interactions) = (self.arena_base_bytes(), self.interaction_count());
+                (base, interactions) = (self.arena_bytes(), self.interaction_count());
             }
-            let link = std::mem::size_of::<PairLink<N>>().max(std::mem::size_of::<NodeLink<N>>());
-            let bytes = base + (live * link) as u64;
+            let bytes = base + (live * link_bytes::<N>()) as u64;
             self.state.stats.peak_memory_bytes = self.state.stats.peak_memory_bytes.max(bytes);
             // One pass over every source's key a shot: the next source and
             // the residual.
@@ -476,7 +475,7 @@ impl<const N: usize> Solver<N> {
             .filter(|h| !h.pending)
             .count();
         let gather_bytes = links.bytes() as u64;
-        let bytes = self.arena_bytes(0) + gather_bytes;
+        let bytes = self.arena_bytes() + gather_bytes;
         self.state.stats.peak_memory_bytes = self.state.stats.peak_memory_bytes.max(bytes);
         let residual = self.residual();
         let convergence_ratio = self.convergence_ratio();
