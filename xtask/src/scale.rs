@@ -334,8 +334,12 @@ pub fn main(args: &[String]) -> Result<()> {
     settings.clustering = clustering;
     if let Some(theta) = cluster_angle {
         settings.cluster_angle = theta;
-        settings.validate().map_err(|e| anyhow::anyhow!(e))?;
     }
+    // Experiments on one setting at a time (`TRILUX_MAX_SHOTS` and the
+    // others `SolverSettings::override_from` names); unset, the preset.
+    settings
+        .override_from(|name| std::env::var(name).ok())
+        .map_err(|e| anyhow::anyhow!(e))?;
     let scenes = out.join("scenes");
     let mut rows = Vec::new();
     for case in cases {

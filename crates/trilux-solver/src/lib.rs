@@ -74,6 +74,7 @@ mod light_shot;
 pub mod lights;
 mod link;
 pub mod prepared;
+mod queue;
 mod radiosity;
 mod receive;
 mod refine;

@@ -17,7 +17,7 @@ use trilux_color::Spectrum;
 use trilux_geometry::{ElementId, FaceId, SurfaceSample};
 
 use crate::lights::PreparedLight;
-use crate::solver::Solver;
+use crate::solver::{Solver, Source};
 
 /// Stratified points per leaf element and light (4 × 4).
 pub(crate) const POINTS_PER_SIDE: u32 = 4;
@@ -38,6 +38,7 @@ impl<const N: usize> Solver<N> {
     /// lit.
     pub(crate) fn shoot_light(&mut self, k: usize) -> usize {
         let phi = std::mem::take(&mut self.state.light_flux[k]);
+        self.state.queue.touch(Source::Light(k as u32));
         // Every watt a light shoots is emission.
         self.state.interreflection.book_shot(phi, Spectrum::zero());
         let faces: Vec<FaceId> = self.setup.faces.iter().map(|(f, _)| f).collect();
@@ -172,6 +173,7 @@ impl<const N: usize> Solver<N> {
             let dl = reflected * (1.0 / (std::f64::consts::PI * aj));
             self.state.field.gathered[side][d.leaf.index()] += dl;
             self.state.face_flux[d.face] += reflected;
+            self.state.queue.touch(Source::Radiosity(d.face));
         }
         self.state.used[d.leaf.index()] = true;
         let min = (d.arrived - reflected).min_value() / d.arrived.max_value().max(1e-300);

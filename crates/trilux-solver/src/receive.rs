@@ -13,7 +13,7 @@ use crate::deferred::GlossyIn;
 use crate::link::{NodeLink, PairLink};
 use crate::refine::Incidence;
 use crate::shot::{Glossy, Groups};
-use crate::solver::Solver;
+use crate::solver::{Solver, Source};
 
 impl<const N: usize> Solver<N> {
     /// Phase 5: what every pair link (a group) delivers to its receiving
@@ -64,6 +64,7 @@ impl<const N: usize> Solver<N> {
                 GlossyIn::Now => room_own,
                 GlossyIn::Wait { from } => {
                     self.state.deferred.book_waiting(l.face, *from, room_own);
+                    self.state.queue.touch(Source::Deferred(l.face));
                     Spectrum::zero()
                 }
                 GlossyIn::Flush { waited, .. } => *waited + room_own,
@@ -169,6 +170,7 @@ impl<const N: usize> Solver<N> {
                 b.unshot += dl;
                 field.unshot_flux += dl * (PI * b.t);
             }
+            self.state.queue.touch(Source::Far(links[g].face));
         }
     }
 
@@ -248,6 +250,7 @@ impl<const N: usize> Solver<N> {
             let dl = l.unshot * shot_scale * rho_d * (l.t / aj);
             self.state.field.gathered[side][l.j.index()] += dl;
             self.state.face_flux[l.face] += dl * (PI * aj);
+            self.state.queue.touch(Source::Radiosity(l.face));
         }
         rho_d
     }

@@ -51,7 +51,10 @@ pub struct SolverSettings {
     /// surfaces will reflect that they have reflected; the paper's §6
     /// figure in a closed scene) reaches this.
     pub convergence: f64,
-    /// Stop after this many shots whatever the convergence ratio.
+    /// Stop after this many shots whatever the convergence ratio: a guard
+    /// against a scene that converges too slowly, not a way to end early
+    /// (a room of 6 151 input surfaces takes 206 183 shots to CR 0.999;
+    /// `time_budget_seconds` bounds the time).
     pub max_shots: u32,
     /// Depth limit of element trees (the paper's tables imply 3 to 4).
     pub max_depth: u32,
@@ -126,7 +129,7 @@ impl SolverSettings {
         match quality {
             Quality::Draft => SolverSettings {
                 convergence: 0.95,
-                max_shots: 20_000,
+                max_shots: 100_000,
                 max_depth: 4,
                 min_area_fraction: 1e-5,
                 ff_eps: 0.02,
@@ -141,7 +144,7 @@ impl SolverSettings {
             },
             Quality::Default => SolverSettings {
                 convergence: 0.999,
-                max_shots: 100_000,
+                max_shots: 1_000_000,
                 max_depth: 5,
                 min_area_fraction: 1e-6,
                 ff_eps: 0.005,
@@ -156,7 +159,7 @@ impl SolverSettings {
             },
             Quality::High => SolverSettings {
                 convergence: 0.9999,
-                max_shots: 500_000,
+                max_shots: 5_000_000,
                 max_depth: 6,
                 min_area_fraction: 1e-7,
                 ff_eps: 0.001,
@@ -172,7 +175,7 @@ impl SolverSettings {
         }
     }
 
-    /// Overrides single settings from `TRILUX_MAX_DEPTH`, `TRILUX_FF_EPS`,
+    /// Overrides single settings from `TRILUX_MAX_SHOTS`, `TRILUX_MAX_DEPTH`, `TRILUX_FF_EPS`,
     /// `TRILUX_FR_EPS`, `TRILUX_FLUX_EPS`, `TRILUX_VISIBILITY_SAMPLES` and
     /// `TRILUX_CLUSTERING` and `TRILUX_DEFER_GLOSSY` (`true` or `false`)
     /// as `lookup` returns them (the examples pass `std::env::var`): a way
@@ -181,6 +184,9 @@ impl SolverSettings {
     pub fn override_from(&mut self, lookup: impl Fn(&str) -> Option<String>) -> Result<(), String> {
         fn parse<T: std::str::FromStr>(name: &str, v: &str) -> Result<T, String> {
             v.parse().map_err(|_| format!("{name}: cannot parse '{v}'"))
+        }
+        if let Some(v) = lookup("TRILUX_MAX_SHOTS") {
+            self.max_shots = parse("TRILUX_MAX_SHOTS", &v)?;
         }
         if let Some(v) = lookup("TRILUX_MAX_DEPTH") {
             self.max_depth = parse("TRILUX_MAX_DEPTH", &v)?;

@@ -266,6 +266,7 @@ impl<const N: usize> Solver<N> {
                 && l.i == send_root
                 && l.j == forest.root(l.face.surface());
             let p = if may_wait {
+                self.state.queue.touch(Source::Deferred(l.face));
                 let deferred = &mut self.state.deferred;
                 deferred.wait_or_release(l, send_face, threshold, scales)
             } else {
@@ -293,6 +294,7 @@ impl<const N: usize> Solver<N> {
         self.state.stats.deferred_releases += 1;
         let root = self.setup.forest().root(face.surface());
         let (links, plan) = self.state.deferred.take(face, root);
+        self.state.queue.touch(Source::Deferred(face));
         let groups = Groups {
             links,
             plan,
@@ -394,6 +396,7 @@ impl<const N: usize> Solver<N> {
     /// pushed and pulled, and its sender is made (`None` for a hierarchy
     /// that is not in place, which the loop never picks).
     fn take_source(&mut self, source: Source) -> Option<(Spectrum<N>, Sending<N>)> {
+        self.state.queue.touch(source);
         match source {
             Source::Radiosity(face) => {
                 let phi = std::mem::take(&mut self.state.face_flux[face]);
@@ -491,6 +494,7 @@ impl<const N: usize> Solver<N> {
         for (links, h, lost) in stage_two {
             if let Some(hier) = self.state.hierarchies[h as usize].as_mut() {
                 hier.unshot_flux = (hier.unshot_flux - lost).max(Spectrum::zero());
+                self.state.queue.touch(Source::Stored(h));
             }
             for b in 0..N {
                 self.state.ledger.escaped[b] += lost[b];
@@ -521,6 +525,7 @@ impl<const N: usize> Solver<N> {
             node.gathered += dl;
             let t = node.t;
             hier.unshot_flux += dl * (PI * t);
+            self.state.queue.touch(Source::Stored(nl.hierarchy));
         }
     }
 
@@ -543,6 +548,7 @@ impl<const N: usize> Solver<N> {
             } => {
                 hierarchy.clear_unshot();
                 self.state.hierarchies[index as usize] = Some(hierarchy);
+                self.state.queue.touch(Source::Stored(index));
             }
             Sending::Far { mut field, .. } => {
                 for b in &mut field.blocks {
@@ -550,6 +556,7 @@ impl<const N: usize> Solver<N> {
                 }
                 let face = field.face;
                 self.state.far[face] = Some(field);
+                self.state.queue.touch(Source::Far(face));
             }
         }
     }

@@ -32,6 +32,7 @@ use crate::gather_links::GatherLinks;
 use crate::interaction::Hierarchy;
 use crate::link::{NodeLink, PairLink};
 use crate::prepared::PreparedScene;
+pub(crate) use crate::queue::Source;
 use crate::settings::SolverSettings;
 use crate::setup::Setup;
 use crate::solution::{FarRecord, Parts, Solution};
@@ -62,21 +63,6 @@ pub struct Progress {
     /// The time budget, if the solve has one
     /// ([`SolverSettings::time_budget_seconds`]).
     pub time_budget_seconds: Option<f64>,
-}
-
-/// A light source for shooting.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum Source {
-    /// The two-point tree of a face.
-    Radiosity(FaceId),
-    /// A stored interaction hierarchy.
-    Stored(u32),
-    /// A glossy face's far field (`cluster_transport`).
-    Far(FaceId),
-    /// A light without area (`lights`), by its index.
-    Light(u32),
-    /// The glossy light waiting at a face (`deferred`).
-    Deferred(FaceId),
 }
 
 /// Bytes of one live link of a shot (pair or node link).
@@ -204,44 +190,77 @@ impl<const N: usize> Solver<N> {
 
     /// The source with the greatest unshot flux (band sum), if any has some.
     #[cfg(test)]
-    pub(crate) fn next_source(&self) -> Option<Source> {
+    pub(crate) fn next_source(&mut self) -> Option<Source> {
         self.next_source_and_residual().0
     }
 
-    /// [`Self::next_source`] and [`Self::residual`] in one pass over every
-    /// source's key (the loop needs both after every shot).
-    fn next_source_and_residual(&self) -> (Option<Source>, Spectrum<N>) {
+    /// [`Self::next_source`] and [`Self::residual`] (the loop needs both
+    /// after every shot), from the source queue once the sources the last
+    /// shot changed are read again (`queue`). With debug assertions the
+    /// choice is checked against a pass over every source.
+    fn next_source_and_residual(&mut self) -> (Option<Source>, Spectrum<N>) {
+        let mut queue = std::mem::take(&mut self.state.queue);
+        queue.refresh(|s| self.unshot_of(s));
+        self.state.queue = queue;
+        let (next, residual) = self.state.queue.next_and_residual();
+        #[cfg(debug_assertions)]
+        assert_eq!(next, self.scan_sources(), "a source changed unmarked");
+        (next, residual)
+    }
+
+    /// The unshot flux of `s` now (zero while it sends).
+    fn unshot_of(&self, s: Source) -> Spectrum<N> {
+        let state = &self.state;
+        let zero = Spectrum::zero();
+        match s {
+            Source::Light(k) => state.light_flux.get(k as usize).copied().unwrap_or(zero),
+            Source::Radiosity(f) => state.face_flux.get(f).copied().unwrap_or(zero),
+            Source::Stored(h) => state
+                .hierarchies
+                .get(h as usize)
+                .and_then(Option::as_ref)
+                .map_or(zero, |h| h.unshot_flux),
+            Source::Deferred(f) => state.deferred.room.get(f).copied().unwrap_or(zero),
+            Source::Far(f) => state
+                .far
+                .get(f)
+                .and_then(Option::as_ref)
+                .map_or(zero, |f| f.unshot_flux),
+        }
+    }
+
+    /// The next source by a pass over every source's key (the queue's
+    /// check).
+    #[cfg(debug_assertions)]
+    fn scan_sources(&self) -> Option<Source> {
         let mut best: Option<(Source, f64)> = None;
-        // Summed by kind, in `residual`'s order (the same bits).
-        let mut sums = [Spectrum::<N>::zero(); 5];
-        let mut consider = |s: Source, kind: usize, flux: Spectrum<N>| {
-            sums[kind] += flux;
+        let mut consider = |s: Source, flux: Spectrum<N>| {
             let sum = flux.sum();
             if sum > 0.0 && best.is_none_or(|(_, f)| sum > f) {
                 best = Some((s, sum));
             }
         };
-        for (k, f) in self.state.light_flux.iter().enumerate() {
-            consider(Source::Light(k as u32), 3, *f);
+        let state = &self.state;
+        for (k, f) in state.light_flux.iter().enumerate() {
+            consider(Source::Light(k as u32), *f);
         }
-        for (face, f) in self.state.face_flux.iter() {
-            consider(Source::Radiosity(face), 0, *f);
+        for (face, f) in state.face_flux.iter() {
+            consider(Source::Radiosity(face), *f);
         }
-        for (h, hier) in self.state.hierarchies.iter().enumerate() {
+        for (h, hier) in state.hierarchies.iter().enumerate() {
             if let Some(hier) = hier {
-                consider(Source::Stored(h as u32), 1, hier.unshot_flux);
+                consider(Source::Stored(h as u32), hier.unshot_flux);
             }
         }
-        for (face, f) in self.state.deferred.room.iter() {
-            consider(Source::Deferred(face), 4, *f);
+        for (face, f) in state.deferred.room.iter() {
+            consider(Source::Deferred(face), *f);
         }
-        for (face, f) in self.state.far.iter() {
+        for (face, f) in state.far.iter() {
             if let Some(f) = f {
-                consider(Source::Far(face), 2, f.unshot_flux);
+                consider(Source::Far(face), f.unshot_flux);
             }
         }
-        let [face, stored, far, light, deferred] = sums;
-        (best.map(|(s, _)| s), face + stored + far + light + deferred)
+        best.map(|(s, _)| s)
     }
 
     /// Summed bytes of the solver's arenas now (stats'
@@ -278,6 +297,7 @@ impl<const N: usize> Solver<N> {
             + self.state.cache.bytes()
             + self.setup.clusters.bytes()
             + self.state.deferred.bytes()
+            + self.state.queue.bytes()
             + self.state.roots.bytes()) as u64
     }
 
@@ -353,8 +373,8 @@ impl<const N: usize> Solver<N> {
             }
             let bytes = base + (live * link_bytes::<N>()) as u64;
             self.state.stats.peak_memory_bytes = self.state.stats.peak_memory_bytes.max(bytes);
-            // One pass over every source's key a shot: the next source and
-            // the residual.
+            // The next source and the residual, from the sources the shot
+            // changed.
             let residual;
             (next, residual) = self.next_source_and_residual();
             cr = self.convergence_ratio_of(residual);

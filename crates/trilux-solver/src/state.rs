@@ -18,6 +18,7 @@ use crate::cluster_transport::{FarContext, FarField, FarFields};
 use crate::deferred::Deferred;
 use crate::interaction::Hierarchy;
 use crate::ledger::Ledger;
+use crate::queue::SourceQueue;
 use crate::radiosity::ElementRadiance;
 use crate::setup::{Setup, emitted_flux};
 use crate::stats::SolveStats;
@@ -57,6 +58,8 @@ pub(crate) struct ShotState<const N: usize> {
     pub deferred: Deferred<N>,
     /// T of every face's root pairs with its near partners.
     pub roots: RootThroughputs,
+    /// The sources' keys: the next source and the residual (`queue`).
+    pub queue: SourceQueue<N>,
 }
 
 /// T of the root pair (a face's root, a near partner's root), by face and
@@ -86,6 +89,7 @@ impl<const N: usize> ShotState<N> {
         let hierarchies = root_interactions(forest, &setup.root_pairs);
         let (field, face_flux) = emission(setup);
         let stats = initial_stats(setup, hierarchies.len());
+        let hierarchies_len = hierarchies.len();
         let count = forest.element_count();
         let surfaces = forest.geometry().surfaces().len();
         ShotState {
@@ -100,6 +104,7 @@ impl<const N: usize> ShotState<N> {
             field,
             face_flux,
             stats,
+            queue: SourceQueue::new(setup.light_flux.len(), 2 * surfaces, hierarchies_len),
             light_flux: setup.light_flux.clone(),
             deferred: Deferred::new(surfaces),
             roots: RootThroughputs(PerFace::from_fn(surfaces, |_| Vec::new())),
