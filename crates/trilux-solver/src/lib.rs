@@ -45,7 +45,8 @@
 //! - [`solver`]: the progressive loop (§4, Fig. 7 and 9); `shot`: one
 //!   shot's phases, `receive` its fifth (what each link delivers);
 //!   `glossy`: the glossy renormalisation; `deferred`: the glossy share of
-//!   small links, summed per pair until it counts.
+//!   small links, summed per pair until it counts; `queue`: the next
+//!   source and the residual from the sources a shot changed.
 //! - [`gather_links`]: the final gather's links, kept for rendering;
 //!   `final_gather`: the refinement that makes them.
 //! - [`ledger`]: where the energy went.
