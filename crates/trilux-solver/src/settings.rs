@@ -129,7 +129,7 @@ impl SolverSettings {
         match quality {
             Quality::Draft => SolverSettings {
                 convergence: 0.95,
-                max_shots: 100_000,
+                max_shots: 20_000,
                 max_depth: 4,
                 min_area_fraction: 1e-5,
                 ff_eps: 0.02,
