@@ -108,7 +108,9 @@ impl<const N: usize> KeyTree<N> {
 
     /// Sums the marked blocks again from `flux` and mends their paths.
     fn refresh(&mut self, flux: impl Fn(usize) -> Spectrum<N>) {
-        for b in std::mem::take(&mut self.pending) {
+        // Taken and put back, so that its allocation serves every shot.
+        let mut pending = std::mem::take(&mut self.pending);
+        for &b in &pending {
             let b = b as usize;
             self.dirty[b] = false;
             let mut leaf = Node::EMPTY;
@@ -127,6 +129,8 @@ impl<const N: usize> KeyTree<N> {
                 self.nodes[n] = Node::join(self.nodes[2 * n], self.nodes[2 * n + 1]);
             }
         }
+        pending.clear();
+        self.pending = pending;
     }
 
     fn root(&self) -> Node<N> {

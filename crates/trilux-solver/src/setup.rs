@@ -181,6 +181,12 @@ impl<const N: usize> Setup<N> {
         Visibility::new(self.forest(), self.burial.as_ref())
     }
 
+    /// The photometric threshold (paper §4.3): `flux_eps` of the emitted
+    /// flux, summed over the bands.
+    pub fn flux_threshold(&self) -> f64 {
+        self.settings.flux_eps * self.emitted.sum()
+    }
+
     /// Everything refinement reads: this setup and the throughput cache.
     pub fn refine_context<'a>(&'a self, cache: &'a ThroughputCache) -> RefineContext<'a, N> {
         RefineContext {
@@ -190,7 +196,7 @@ impl<const N: usize> Setup<N> {
             faces: &self.faces,
             materials: self.scene.materials(),
             cache,
-            flux_threshold: self.settings.flux_eps * self.emitted.sum(),
+            flux_threshold: self.flux_threshold(),
             points: &self.points,
             interior: &self.interior,
             exposed_area: &self.exposed_area,

@@ -251,7 +251,7 @@ impl<const N: usize> Solver<N> {
         send_face: FaceId,
         scales: (Spectrum<N>, Spectrum<N>),
     ) -> Vec<GlossyIn<N>> {
-        let threshold = self.setup.settings.flux_eps * self.setup.emitted.sum();
+        let threshold = self.setup.flux_threshold();
         // The uniform mode stays the paper's algorithm.
         let on = self.setup.settings.defer_glossy
             && self.setup.settings.transport == crate::settings::Transport::TwoPoint;
