@@ -539,6 +539,8 @@ pub(crate) struct FarField<const N: usize> {
     pub blocks: Vec<FarRadiance<N>>,
     /// Unshot flux Σ π T_AC δL_AC (the selection key).
     pub unshot_flux: Spectrum<N>,
+    /// Whether the blocks' T_AC are made ([`FarField::trace`]).
+    pub traced: bool,
 }
 
 /// The light a glossy face sends towards one far cluster.
@@ -546,7 +548,7 @@ pub(crate) struct FarField<const N: usize> {
 pub(crate) struct FarRadiance<const N: usize> {
     /// The far cluster.
     pub cluster: ClusterId,
-    /// T_AC = Σ over its members of T_Af.
+    /// T_AC = Σ over its members of T_Af (0 until the field is traced).
     pub t: f64,
     /// Unit direction from the face's centre to the cluster's centre.
     pub direction: DVec3,
@@ -557,33 +559,43 @@ pub(crate) struct FarRadiance<const N: usize> {
 }
 
 impl<const N: usize> FarField<N> {
-    /// The far field of `face` over its cut's far blocks.
-    pub fn new(ctx: &FarContext<'_>, face: FaceId, cut: &Cut) -> Self {
-        let root = ctx.forest.root(face.surface());
-        let a = face.of(root);
-        let centre = ctx.forest.element(root).centre;
+    /// The far field of `face` over its cut's far blocks, dark and not
+    /// yet traced: most glossy faces of an interior (the charts of a
+    /// chair's metal legs) never receive light in a solve, and their
+    /// blocks' visible fractions were most of its preparation.
+    pub fn new(forest: &ElementForest, tree: &ClusterTree, face: FaceId, cut: &Cut) -> Self {
+        let centre = forest.element(forest.root(face.surface())).centre;
         let blocks = cut
             .far
             .iter()
-            .map(|b| {
-                let v = ctx.block_visibility(a, b);
-                let mut t = 0.0;
-                ctx.members(a, b.cluster, |m| t += m.t_open * v);
-                FarRadiance {
-                    cluster: b.cluster,
-                    t,
-                    direction: (ctx.tree.nodes[b.cluster as usize].centre - centre)
-                        .normalize_or_zero(),
-                    radiance: Spectrum::zero(),
-                    unshot: Spectrum::zero(),
-                }
+            .map(|b| FarRadiance {
+                cluster: b.cluster,
+                t: 0.0,
+                direction: (tree.nodes[b.cluster as usize].centre - centre).normalize_or_zero(),
+                radiance: Spectrum::zero(),
+                unshot: Spectrum::zero(),
             })
             .collect();
         FarField {
             face,
             blocks,
             unshot_flux: Spectrum::zero(),
+            traced: false,
         }
+    }
+
+    /// Makes every block's T_AC = V_AC Σ T_Af (its visible fraction traced
+    /// once, shared with the face's Lambertian far links): done when
+    /// light first arrives at the face, before anything reads T_AC.
+    pub fn trace(&mut self, ctx: &FarContext<'_>, cut: &Cut) {
+        let a = self.face.of(ctx.forest.root(self.face.surface()));
+        for (r, b) in self.blocks.iter_mut().zip(&cut.far) {
+            let v = ctx.block_visibility(a, b);
+            let mut t = 0.0;
+            ctx.members(a, b.cluster, |m| t += m.t_open * v);
+            r.t = t;
+        }
+        self.traced = true;
     }
 }
 

@@ -7,8 +7,9 @@ use std::f64::consts::PI;
 
 use rayon::prelude::*;
 use trilux_color::Spectrum;
-use trilux_geometry::ElementId;
+use trilux_geometry::{ElementId, FaceId};
 
+use crate::cluster_transport::FarField;
 use crate::deferred::GlossyIn;
 use crate::link::{NodeLink, PairLink};
 use crate::refine::Incidence;
@@ -34,6 +35,7 @@ impl<const N: usize> Solver<N> {
         node_links: &[NodeLink<N>],
         (phi, share): (Spectrum<N>, Spectrum<N>),
     ) -> Vec<(Spectrum<N>, Spectrum<N>)> {
+        self.trace_far_fields(glossy);
         let (glossy_flux, sampled_flux, far_adds) =
             self.glossy_fluxes(glossy, incidences, node_links);
         let late = self.past_deadline();
@@ -103,6 +105,29 @@ impl<const N: usize> Solver<N> {
         self.add_far_reflection(&groups.links, far_adds, &group_scale);
         self.state.ledger.book_shot(phi, total_arrived, absorbed);
         group_scale
+    }
+
+    /// Traces the far fields of the faces that this shot's glossy light
+    /// reaches for the first time (`FarField::trace`), in parallel over
+    /// the faces, before anything reads their T_AC.
+    fn trace_far_fields(&mut self, glossy: &Glossy<N>) {
+        let far = &mut self.state.far;
+        let mut faces: Vec<FaceId> = (glossy.links.iter().map(|l| l.face))
+            .filter(|&f| far[f].as_ref().is_some_and(|field| !field.traced))
+            .collect();
+        if faces.is_empty() {
+            return;
+        }
+        faces.sort_unstable();
+        faces.dedup();
+        let mut fields: Vec<FarField<N>> = faces.iter().filter_map(|&f| far[f].take()).collect();
+        let ctx = self.setup.refine_context(&self.state.cache).far();
+        let cuts = &self.setup.clusters.cuts;
+        (fields.par_iter_mut()).for_each(|field| field.trace(&ctx, &cuts[field.face]));
+        for field in fields {
+            let face = field.face;
+            far[face] = Some(field);
+        }
     }
 
     /// Per group, the glossy flux its node links carry (midpoint-rule

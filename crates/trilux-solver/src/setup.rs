@@ -204,6 +204,7 @@ impl<const N: usize> Setup<N> {
             clusters: &self.clusters,
             albedo: &self.albedo,
             deadline: None,
+            final_release: false,
             late: Default::default(),
         }
     }

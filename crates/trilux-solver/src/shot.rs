@@ -283,9 +283,11 @@ impl<const N: usize> Solver<N> {
     /// arrived, as it would without deferral, and only what that light
     /// has not yet sent on stays in the residual.
     pub(crate) fn release_all_deferred(&mut self) {
+        self.final_release = true;
         for face in self.state.deferred.waiting_faces() {
             self.shoot(Source::Deferred(face));
         }
+        self.final_release = false;
     }
 
     /// The glossy light waiting at `face` (`deferred`) refined into its
@@ -440,6 +442,7 @@ impl<const N: usize> Solver<N> {
             }
             Source::Far(face) => {
                 let mut field = self.state.far[face].take()?;
+                debug_assert!(field.traced, "a far field with flux is traced");
                 let phi = std::mem::take(&mut field.unshot_flux);
                 let mut by_surface =
                     vec![Spectrum::zero(); self.setup.forest().geometry().surfaces().len()];
@@ -470,6 +473,7 @@ impl<const N: usize> Solver<N> {
         let state = &mut self.state;
         let mut refine = self.setup.refine_context(&state.cache);
         refine.deadline = deadline;
+        refine.final_release = self.final_release;
         let ctx = ShotContext {
             refine,
             field: &state.field,

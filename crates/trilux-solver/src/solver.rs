@@ -86,6 +86,10 @@ pub struct Solver<const N: usize> {
     /// Stop shooting once this is set (by another thread or a signal
     /// handler): an interrupted solve keeps the best solution so far.
     stop: Option<Arc<AtomicBool>>,
+    /// Set while the waiting glossy light is released after the last shot
+    /// (`release_all_deferred`): root throughputs are then made with the
+    /// base rays.
+    pub(crate) final_release: bool,
 }
 
 impl<const N: usize> Solver<N> {
@@ -107,6 +111,7 @@ impl<const N: usize> Solver<N> {
             started,
             time_budget: budget.map(Duration::from_secs_f64),
             stop: None,
+            final_release: false,
         })
     }
 

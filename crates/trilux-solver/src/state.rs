@@ -14,7 +14,7 @@ use trilux_color::Spectrum;
 use trilux_geometry::{ElementForest, ElementId, FaceId, PerFace};
 
 use crate::ambient::Interreflection;
-use crate::cluster_transport::{FarContext, FarField, FarFields};
+use crate::cluster_transport::{FarField, FarFields};
 use crate::deferred::Deferred;
 use crate::interaction::Hierarchy;
 use crate::ledger::Ledger;
@@ -112,24 +112,18 @@ impl<const N: usize> ShotState<N> {
     }
 }
 
-/// The far field of every glossy face that has far blocks.
+/// The far field of every glossy face that has far blocks, dark and not
+/// yet traced (`FarField::new`).
 fn far_fields<const N: usize>(setup: &Setup<N>) -> FarFields<N> {
     let clusters = &setup.clusters;
-    let ctx = FarContext {
-        forest: setup.forest(),
-        tree: &clusters.tree,
-        exposed_area: &setup.exposed_area,
-        burial: setup.burial.as_ref(),
-        enclosed: &clusters.enclosed,
-        points: &clusters.points,
-    };
     let faces = &setup.faces;
     let ids: Vec<FaceId> = faces.iter().map(|(f, _)| f).collect();
     let fields: Vec<Option<FarField<N>>> = ids
         .par_iter()
         .map(|&f| {
             let cut = &clusters.cuts[f];
-            (faces[f].stored && !cut.far.is_empty()).then(|| FarField::new(&ctx, f, cut))
+            (faces[f].stored && !cut.far.is_empty())
+                .then(|| FarField::new(setup.forest(), &clusters.tree, f, cut))
         })
         .collect();
     PerFace::from(fields)
@@ -237,5 +231,63 @@ mod tests {
         assert!(stats.root_interactions >= 2, "{stats:?}");
         assert_eq!(stats.root_throughputs, stats.root_interactions - 1);
         assert_eq!(solution.interaction_flux(g, d).map(|f| f.sum()), Some(0.0));
+    }
+
+    /// Far fields trace nothing before the first shot and are traced when
+    /// light first reaches their face: the lit glossy floor R's after the
+    /// light's shot, never the hidden glossy plate G's, and every field
+    /// that sends light (has radiance) is traced. Small black plates far
+    /// off (x = 40 … 47, above R and below G, facing them) make the far
+    /// blocks of both and send nothing back.
+    #[test]
+    fn far_fields_are_traced_only_where_light_arrives() {
+        let mut shapes = vec![
+            ts::square(DVec3::new(0.0, 0.0, 2.0), 1.0, true), // E
+            ts::square(DVec3::ZERO, 2.0, false),              // R
+            ts::square(DVec3::new(0.0, 0.0, -5.0), 1.0, false), // D
+            ts::square(DVec3::new(0.0, 0.0, -3.0), 1.0, true), // G
+        ];
+        let mut bsdfs = vec![
+            ts::diffuse(0.0),
+            ts::glossy(0.3),
+            ts::diffuse(0.5),
+            ts::glossy(0.3),
+        ];
+        let mut emission = vec![Some(ColorParam::Float(1.0)), None, None, None];
+        for (k, z) in (0..16).map(|k| (k % 8, if k < 8 { 10.0 } else { -10.0 })) {
+            let centre = DVec3::new(40.0 + f64::from(k), 0.0, z);
+            shapes.push(ts::square(centre, 0.2, z > 0.0));
+            bsdfs.push(ts::diffuse(0.0));
+            emission.push(None);
+        }
+        let desc = SceneDescription {
+            shapes: &shapes,
+            bsdfs: &bsdfs,
+            emission: &emission,
+        };
+        let scene = Arc::new(PreparedScene::<3>::new(&desc).expect("prepares"));
+        let mut solver = Solver::new(scene, ts::settings(2)).expect("sets up");
+        let (r, g) = (ts::front(1), ts::front(3));
+        let traced = |s: &Solver<3>, f| s.state.far[f].as_ref().map(|field| field.traced);
+        assert_eq!(traced(&solver, r), Some(false), "R has a far field");
+        assert_eq!(traced(&solver, g), Some(false), "G has a far field");
+        assert!(
+            (solver.state.far.values().flatten())
+                .all(|f| !f.traced && f.blocks.iter().all(|b| b.t == 0.0)),
+            "nothing traced before the first shot"
+        );
+        let light = solver.next_source().expect("the light shoots");
+        solver.shoot(light);
+        assert_eq!(traced(&solver, r), Some(true));
+        let field = solver.state.far[r].as_ref().expect("R's field");
+        assert!(field.blocks.iter().any(|b| b.t > 0.0), "R sees the plates");
+        while let Some(source) = solver.next_source() {
+            solver.shoot(source);
+        }
+        assert_eq!(traced(&solver, g), Some(false), "no light reaches G");
+        for f in solver.state.far.values().flatten() {
+            let lit = f.blocks.iter().any(|b| !b.radiance.is_black());
+            assert!(f.traced || !lit, "{:?} sends light untraced", f.face);
+        }
     }
 }

@@ -72,6 +72,10 @@ pub(crate) struct RefineContext<'a, const N: usize> {
     pub deadline: Option<Instant>,
     /// What refinement cut short because the deadline had passed.
     pub late: Lateness,
+    /// The release of the waiting glossy light after the last shot
+    /// (docs/solver.md, "Deferred glossy reception"): its roots are made
+    /// with the base rays, as past the deadline.
+    pub final_release: bool,
 }
 
 /// What a shot's refinement did after the deadline (the stats' `late_*`
@@ -213,9 +217,10 @@ impl<const N: usize> RefineContext<'_, N> {
         // were most of what a cut-short shot still spent (docs/results.md,
         // "Real interiors"); timed there.
         let late = self.past_deadline().then(Instant::now);
-        h.make_root(match late {
-            None => compute_throughput(&self.visibility, pair[0], pair[1], samples, false),
-            Some(_) => throughput_with_rays(&self.visibility, pair[0], pair[1], samples, false),
+        h.make_root(if late.is_some() || self.final_release {
+            throughput_with_rays(&self.visibility, pair[0], pair[1], samples, false)
+        } else {
+            compute_throughput(&self.visibility, pair[0], pair[1], samples, false)
         });
         if let Some(start) = late {
             let nanos = u64::try_from(start.elapsed().as_nanos()).unwrap_or(u64::MAX);
