@@ -316,9 +316,20 @@ fn probe_triangles(geom: &Geometry, face: FaceId, mesh: u32) -> FaceBurial {
     FaceBurial::Triangles { buried }
 }
 
+/// The largest reach, as a fraction of the scene's bounding diagonal.
+/// Burial is contact (a box on the floor, a cupboard against a wall); a
+/// cell's size stands for contact only while cells are small. A floor
+/// that runs 220 m out under the sky as two triangles has probes reaching
+/// 78 m, and every one of them met the ceiling 3 m up: the whole classroom
+/// floor was buried, and with it the light it reflects (docs/solver.md,
+/// "Buried parts of faces").
+const MAX_REACH: f64 = 0.01;
+
 /// True if every probe ray from `p` into the hemisphere of `n` meets
-/// another shape within `reach`.
+/// another shape within `reach` (at most [`MAX_REACH`] of the scene's
+/// diagonal).
 fn probe(geom: &Geometry, p: DVec3, n: DVec3, own_shape: u32, reach: f64) -> bool {
+    let reach = reach.min(MAX_REACH * geom.bounds().diagonal().length());
     if !(p.is_finite() && n.is_finite() && reach > 0.0) {
         return false;
     }

@@ -111,3 +111,41 @@ fn segments_from_the_covered_part_are_blocked() {
     let v = vis.fraction(FaceElement::front(e), FaceElement::new(top, Side::Back), 64);
     assert_eq!(v, 0.0, "segments from a buried element must be blocked");
 }
+
+/// Burial is contact, whatever the cells' size: on a 200 × 200 m ground
+/// probed in cells of 100 m, a ceiling 4 m up (a building on the
+/// ground) buries nothing under it, while a 30 m cube resting on the
+/// ground still buries its footprint (where the outline's finer cells
+/// fall inside it). With the cells' size as the reach, every
+/// probe ray under the ceiling met it within 8 m and that part of the
+/// ground counted as covered (the classroom's floor, results.md).
+#[test]
+fn a_ceiling_high_above_coarse_cells_covers_nothing() {
+    let rect = |centre: DVec3, half: f64, down: bool| Shape {
+        kind: ShapeKind::Rectangle,
+        world_from_object: DMat4::from_translation(centre)
+            * DMat4::from_rotation_x(if down { std::f64::consts::PI } else { 0.0 })
+            * DMat4::from_scale(DVec3::new(half, half, 1.0)),
+        flip_normals: false,
+    };
+    let cube = Shape {
+        kind: ShapeKind::Cube,
+        world_from_object: DMat4::from_translation(DVec3::new(50.0, 50.0, 15.0))
+            * DMat4::from_scale(DVec3::splat(15.0)),
+        flip_normals: false,
+    };
+    let shapes = [
+        rect(DVec3::ZERO, 100.0, false),
+        rect(DVec3::new(-50.0, -50.0, 4.0), 20.0, true),
+        cube,
+    ];
+    let g = ElementForest::new(Geometry::build_shared(&shapes).expect("valid scene"));
+    let map = floor_burial(&g, 2);
+    let uv =
+        |x: f64, y: f64| SurfaceCoord::Uv(DVec2::new((x + 100.0) / 200.0, (y + 100.0) / 200.0));
+    assert!(
+        !map.is_buried(FLOOR_FRONT, uv(-50.0, -50.0)),
+        "under the ceiling"
+    );
+    assert!(map.is_buried(FLOOR_FRONT, uv(45.0, 45.0)), "under the cube");
+}
