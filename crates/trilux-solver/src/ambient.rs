@@ -207,30 +207,34 @@ impl<const N: usize> Interreflection<N> {
     }
 
     /// The stats' account of the remainder for residual `residual` and
-    /// reflecting area `area`; no ambient radiance until a shot of
-    /// reflected light has measured a.
+    /// reflecting area `area`: the return fraction and future reflected
+    /// flux that CR is made of, and the ambient radiance, which spreads
+    /// the future light at the *measured* return (none until a shot of
+    /// reflected light has measured it).
     pub fn ambient(&self, residual: Spectrum<N>, area: Spectrum<N>) -> Ambient {
-        // The measured return, without the prior for the residual: the
-        // term adds light to every lit face, and where the shots say that
-        // little comes back (the classroom's sky-lit ground, whose light
-        // mostly leaves) the prior would add it anyway: 4.1 times
-        // Mitsuba's mean there, against 1.5 (results.md). The prior keeps
-        // the solve from stopping too soon (CR); the bathroom, which it
-        // was for, reads 0.987 either way.
         let a = self
-            .return_fraction(Spectrum::zero())
+            .return_fraction(residual)
             .unwrap_or_else(Spectrum::zero);
         let future: Vec<f64> = (0..N)
             .map(|b| future_reflected(residual[b], a[b]))
             .collect();
-        // Only a measured a: after the emitters' shots alone, the closed-
-        // scene guess that keeps CR from passing too soon could add far too
+        // The term adds light to every lit face, so it takes the measured
+        // return, without the prior for the residual: where the shots say
+        // that little comes back (the classroom's sky-lit ground, whose
+        // light mostly leaves) the prior would add it anyway, 4.1 times
+        // Mitsuba's mean there against 1.5 (results.md). The prior keeps
+        // the solve from stopping too soon; the bathroom, which it was
+        // for, reads 0.987 either way. And only a measured a: after the
+        // emitters' shots alone, the closed-scene guess could add far too
         // much light to an open scene.
         let measured = self.shot.max_value() > 0.0;
+        let a_shot = self
+            .return_fraction(Spectrum::zero())
+            .unwrap_or_else(Spectrum::zero);
         let radiance = (0..N)
             .map(|b| {
                 if measured {
-                    ambient_radiance(future[b], area[b])
+                    ambient_radiance(future_reflected(residual[b], a_shot[b]), area[b])
                 } else {
                     0.0
                 }
@@ -413,11 +417,14 @@ mod tests {
         assert!((cr - want).abs() < 1e-12, "CR {cr}, want {want}");
         assert!(cr < 0.95);
         // The ambient term spreads what the shots measured (a = 0.05),
-        // not the prior: it adds light everywhere.
-        let future = t
-            .ambient(residual, Spectrum::splat(1.0))
-            .future_reflected_flux[0];
-        let want = 0.4 * 0.05 / 0.95;
+        // not the prior: it adds light everywhere. Over S = 1 m²:
+        let amb = t.ambient(residual, Spectrum::splat(1.0));
+        let want = 0.4 * 0.05 / 0.95 / std::f64::consts::PI;
+        let got = amb.radiance[0];
+        assert!((got - want).abs() < 1e-12, "A_amb {got}, want {want}");
+        // The stats' remainder is CR's.
+        let future = amb.future_reflected_flux[0];
+        let want = 0.4 * want_a / (1.0 - want_a);
         assert!(
             (future - want).abs() < 1e-12,
             "future {future}, want {want}"

@@ -195,7 +195,9 @@ pub struct Ambient {
     /// will reflect (band sum): 1 − CR.
     pub share: f64,
     /// The fraction a of a shot of reflected light that comes back as
-    /// reflected light (measured on the solve's shots).
+    /// reflected light (measured on the solve's shots, the unshot residual
+    /// counted at the lit faces' reflectance: what CR uses; the ambient
+    /// radiance uses the measured part alone).
     pub return_fraction: Vec<f64>,
     /// Light the scene's surfaces reflected during the solve (W).
     pub reflected_flux: Vec<f64>,
