@@ -218,26 +218,17 @@ impl<const N: usize> Interreflection<N> {
         let future: Vec<f64> = (0..N)
             .map(|b| future_reflected(residual[b], a[b]))
             .collect();
-        // The term adds light to every lit face, so it takes the measured
-        // return, without the prior for the residual: where the shots say
-        // that little comes back (the classroom's sky-lit ground, whose
-        // light mostly leaves) the prior would add it anyway, 4.1 times
-        // Mitsuba's mean there against 1.5 (results.md). The prior keeps
-        // the solve from stopping too soon; the bathroom, which it was
-        // for, reads 0.987 either way. And only a measured a: after the
-        // emitters' shots alone, the closed-scene guess could add far too
-        // much light to an open scene.
-        let measured = self.shot.max_value() > 0.0;
-        let a_shot = self
-            .return_fraction(Spectrum::zero())
-            .unwrap_or_else(Spectrum::zero);
+        // The term adds light to every lit face, so it spreads the future
+        // light at the measured return (returned / shot), without the
+        // prior: where the shots say little comes back (the classroom's
+        // sky-lit ground) the prior would add it anyway (results.md,
+        // "Real interiors"). Before a shot of reflected light the measured
+        // return is 0, and so is the term: the closed-scene guess could add
+        // far too much light to an open scene.
         let radiance = (0..N)
             .map(|b| {
-                if measured {
-                    ambient_radiance(future_reflected(residual[b], a_shot[b]), area[b])
-                } else {
-                    0.0
-                }
+                let measured = ratio(self.returned[b], self.shot[b]);
+                ambient_radiance(future_reflected(residual[b], measured), area[b])
             })
             .collect();
         Ambient {

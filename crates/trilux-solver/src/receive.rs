@@ -7,7 +7,7 @@ use std::f64::consts::PI;
 
 use rayon::prelude::*;
 use trilux_color::Spectrum;
-use trilux_geometry::{ElementId, FaceId};
+use trilux_geometry::ElementId;
 
 use crate::cluster_transport::FarField;
 use crate::deferred::GlossyIn;
@@ -112,15 +112,13 @@ impl<const N: usize> Solver<N> {
     /// the faces, before anything reads their T_AC.
     fn trace_far_fields(&mut self, glossy: &Glossy<N>) {
         let far = &mut self.state.far;
-        let mut faces: Vec<FaceId> = (glossy.links.iter().map(|l| l.face))
-            .filter(|&f| far[f].as_ref().is_some_and(|field| !field.traced))
+        // Taking a field out leaves `None`, so each face is taken once.
+        let mut fields: Vec<FarField<N>> = (glossy.links.iter())
+            .filter_map(|l| far[l.face].take_if(|field| !field.traced))
             .collect();
-        if faces.is_empty() {
+        if fields.is_empty() {
             return;
         }
-        faces.sort_unstable();
-        faces.dedup();
-        let mut fields: Vec<FarField<N>> = faces.iter().filter_map(|&f| far[f].take()).collect();
         let ctx = self.setup.refine_context(&self.state.cache).far();
         let cuts = &self.setup.clusters.cuts;
         (fields.par_iter_mut()).for_each(|field| field.trace(&ctx, &cuts[field.face]));

@@ -265,8 +265,7 @@ mod tests {
             bsdfs: &bsdfs,
             emission: &emission,
         };
-        let scene = Arc::new(PreparedScene::<3>::new(&desc).expect("prepares"));
-        let mut solver = Solver::new(scene, ts::settings(2)).expect("sets up");
+        let mut solver = Solver::<3>::from_description(&desc, ts::settings(2)).expect("sets up");
         let (r, g) = (ts::front(1), ts::front(3));
         let traced = |s: &Solver<3>, f| s.state.far[f].as_ref().map(|field| field.traced);
         assert_eq!(traced(&solver, r), Some(false), "R has a far field");
