@@ -20,7 +20,8 @@ use glam::{DVec2, DVec3};
 
 use crate::bounds::Bounds;
 use crate::bvh::{Analytic, AnalyticKind, Bvh, Prim, TriOwner};
-use crate::chart::{MeshData, Piece, build_charts, cluster_element};
+use crate::chart::{MeshData, Piece, build_charts, build_charts_around, cluster_element};
+use crate::contact::{Cuts, cut_mesh, find_cuts};
 use crate::element::rect_element;
 use crate::error::{GeometryError, ShapeProblem};
 use crate::geometry::Geometry;
@@ -41,26 +42,18 @@ impl Geometry {
     /// shape (a sphere becomes an exact ellipsoid, a disk an exact
     /// ellipse).
     pub fn build(shapes: &[Shape]) -> Result<Geometry, GeometryError> {
-        let mut b = Builder::default();
-        let mut reach = Vec::with_capacity(shapes.len());
-        for (index, shape) in shapes.iter().enumerate() {
-            b.shape = index as u32;
-            let first = b.surfaces.len();
-            let err = |problem| GeometryError {
-                shape: index,
-                problem,
-            };
-            b.add_shape(shape).map_err(err)?;
-            let bounds = b.surfaces[first..]
-                .iter()
-                .fold(Bounds::EMPTY, |acc, s| acc.union(s.bounds));
-            let coordinate = largest_coordinate(&bounds);
-            if !within(coordinate) {
-                return Err(err(ShapeProblem::BeyondCoordinateLimit { coordinate }));
-            }
-            reach.push((coordinate, bounds.diagonal().length()));
-        }
+        let (b, reach) = add_shapes(shapes, Cuts::new())?;
         check_scale(&b, &reach)?;
+        // Mesh triangles that other surfaces end on are cut along those
+        // contacts ([`crate::contact`]), which needs every shape's
+        // triangles: the shapes are added again with the cuts, only when
+        // there are any.
+        let cuts = find_cuts(&b.prims);
+        let b = if cuts.is_empty() {
+            b
+        } else {
+            add_shapes(shapes, cuts)?.0
+        };
         Ok(b.finish())
     }
 
@@ -68,6 +61,34 @@ impl Geometry {
     pub fn build_shared(shapes: &[Shape]) -> Result<Arc<Geometry>, GeometryError> {
         Geometry::build(shapes).map(Arc::new)
     }
+}
+
+/// Every shape added to a builder that makes `cuts`, and each shape's
+/// (largest coordinate, diagonal).
+fn add_shapes(shapes: &[Shape], cuts: Cuts) -> Result<(Builder, Vec<(f64, f64)>), GeometryError> {
+    let mut b = Builder {
+        cuts,
+        ..Builder::default()
+    };
+    let mut reach = Vec::with_capacity(shapes.len());
+    for (index, shape) in shapes.iter().enumerate() {
+        b.shape = index as u32;
+        let first = b.surfaces.len();
+        let err = |problem| GeometryError {
+            shape: index,
+            problem,
+        };
+        b.add_shape(shape).map_err(err)?;
+        let bounds = b.surfaces[first..]
+            .iter()
+            .fold(Bounds::EMPTY, |acc, s| acc.union(s.bounds));
+        let coordinate = largest_coordinate(&bounds);
+        if !within(coordinate) {
+            return Err(err(ShapeProblem::BeyondCoordinateLimit { coordinate }));
+        }
+        reach.push((coordinate, bounds.diagonal().length()));
+    }
+    Ok((b, reach))
 }
 
 /// The largest absolute coordinate of a box (0 for an empty one).
@@ -121,6 +142,8 @@ struct Builder {
     meshes: Vec<MeshData>,
     analytic: Vec<Analytic>,
     prims: Vec<Prim>,
+    /// The cuts of mesh triangles to make ([`crate::contact`]).
+    cuts: Cuts,
 }
 
 impl Builder {
@@ -373,7 +396,13 @@ impl Builder {
         check_mesh(mesh)?;
         let mut data = world_mesh(mesh, xf, sign)?;
         let mesh_id = self.meshes.len() as u32;
-        let charts = build_charts(&data);
+        let charts = match self.cuts.remove(&self.shape) {
+            Some(cuts) => {
+                let cells = cut_mesh(&mut data, &cuts);
+                build_charts_around(&data, cells)
+            }
+            None => build_charts(&data),
+        };
         let first = self.next_surface();
         for (k, chart) in charts.iter().enumerate() {
             for &t in chart {

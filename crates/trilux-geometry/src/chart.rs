@@ -226,21 +226,39 @@ impl Piece {
 
 /// Groups the non-degenerate triangles of a mesh into charts (module docs).
 pub(crate) fn build_charts(mesh: &MeshData) -> Vec<Vec<u32>> {
-    build_charts_counted(mesh).0
+    build_charts_counted(mesh, Vec::new()).0
+}
+
+/// [`build_charts`] around `fixed` charts made beforehand (the regions of
+/// cut triangles, [`crate::contact`]): their triangles join no other
+/// chart, and they come last.
+pub(crate) fn build_charts_around(mesh: &MeshData, fixed: Vec<Vec<u32>>) -> Vec<Vec<u32>> {
+    build_charts_counted(mesh, fixed).0
 }
 
 /// [`build_charts`], and the number of neighbours it visited: the work of
 /// growing and merging charts, at most 3 × ([`CHART_MAX_EDGE_TRIANGLES`] − 1)
 /// for each time a triangle is added to a chart or tried for a merge.
-pub(crate) fn build_charts_counted(mesh: &MeshData) -> (Vec<Vec<u32>>, usize) {
+pub(crate) fn build_charts_counted(
+    mesh: &MeshData,
+    fixed: Vec<Vec<u32>>,
+) -> (Vec<Vec<u32>>, usize) {
     let adjacency = Adjacency::new(mesh);
     let cos_cone = CHART_CONE_DEG.to_radians().cos();
-    let (mut charts, mut chart_of) = grow_charts(mesh, &adjacency, cos_cone);
+    let mut chart_of = vec![u32::MAX; mesh.triangles.len()];
+    for &t in fixed.iter().flatten() {
+        chart_of[t as usize] = FIXED;
+    }
+    let mut charts = grow_charts(mesh, &adjacency, cos_cone, &mut chart_of);
     merge_small_charts(mesh, &adjacency, cos_cone, &mut charts, &mut chart_of);
     charts.retain(|c| !c.is_empty());
-    let charts = group_small_charts(mesh, charts, cos_cone);
+    let mut charts = group_small_charts(mesh, charts, cos_cone);
+    charts.extend(fixed);
     (charts, adjacency.visited.get())
 }
+
+/// The chart of a triangle that belongs to a fixed chart.
+const FIXED: u32 = u32::MAX - 1;
 
 /// Which triangles share an edge, after welding vertices by exact position
 /// (a loader may duplicate vertices for normals or texture coordinates).
@@ -318,14 +336,15 @@ fn centroid(mesh: &MeshData, t: u32) -> DVec3 {
 
 /// Grows charts from seeds in file order, always adding the connected
 /// candidate nearest the seed's centroid within the normal cone, up to the
-/// cap. Returns the charts and the chart of every triangle.
+/// cap. Returns the charts; `chart_of` (unassigned: `u32::MAX`) gets the
+/// chart of every triangle.
 fn grow_charts(
     mesh: &MeshData,
     adjacency: &Adjacency<'_>,
     cos_cone: f64,
-) -> (Vec<Vec<u32>>, Vec<u32>) {
+    chart_of: &mut [u32],
+) -> Vec<Vec<u32>> {
     let n = mesh.triangles.len();
-    let mut chart_of = vec![u32::MAX; n];
     let mut charts: Vec<Vec<u32>> = Vec::new();
     for seed in 0..n as u32 {
         if chart_of[seed as usize] != u32::MAX || mesh.tri_area[seed as usize] <= 0.0 {
@@ -358,7 +377,7 @@ fn grow_charts(
         }
         charts.push(members);
     }
-    (charts, chart_of)
+    charts
 }
 
 /// Merges every chart smaller than an eighth of the cap into a neighbouring
@@ -392,7 +411,7 @@ fn merge_small_charts(
                 .neighbours(t)
                 .into_iter()
                 .map(|o| chart_of[o as usize] as usize)
-                .find(|&oc| fits(oc))
+                .find(|&oc| oc < charts.len() && fits(oc))
         });
         if let Some(oc) = target {
             let moved = std::mem::take(&mut charts[c]);
@@ -689,7 +708,7 @@ mod tests {
     /// The charts of `mesh`, checked to partition its triangles within the
     /// cap, and the work of making them.
     fn charts(mesh: &MeshData) -> (usize, usize) {
-        let (charts, work) = build_charts_counted(mesh);
+        let (charts, work) = build_charts_counted(mesh, Vec::new());
         let mut seen = vec![false; mesh.triangles.len()];
         for c in &charts {
             let cap = CHART_MAX_TRIANGLES * 3 / 2; // merging allows 1.5×
@@ -764,14 +783,14 @@ mod tests {
             }
             m
         };
-        let (_, work) = build_charts_counted(&mesh(CHART_MAX_EDGE_TRIANGLES));
+        let (_, work) = build_charts_counted(&mesh(CHART_MAX_EDGE_TRIANGLES), Vec::new());
         // Growing visits the 7 others from each of the 8, and so does the
         // try to merge the small chart into another (there is none).
         assert_eq!(
             work,
             2 * CHART_MAX_EDGE_TRIANGLES * (CHART_MAX_EDGE_TRIANGLES - 1)
         );
-        let (charts, work) = build_charts_counted(&mesh(CHART_MAX_EDGE_TRIANGLES + 1));
+        let (charts, work) = build_charts_counted(&mesh(CHART_MAX_EDGE_TRIANGLES + 1), Vec::new());
         assert_eq!(work, 0);
         assert_eq!(charts.len(), 1);
     }

@@ -71,6 +71,9 @@
 //! - [`chart`]: triangle meshes as charts (≤ 512 triangles, 60° normal cone,
 //!   grown compactly over shared edges), chart elements as clusters of
 //!   triangle pieces (the rules are documented there).
+//! - `contact` (private): mesh triangles that other surfaces end on (a
+//!   ground plane under the walls of a room) cut along those contacts
+//!   before their charts are made, so that no element straddles a wall.
 //! - [`element`] and [`forest`]: the element trees ([`Element`],
 //!   [`ElementId`]) of an [`ElementForest`], lazily subdivided into 4
 //!   children on the true surface, with `locate`, `element_contains` and
@@ -118,6 +121,7 @@ pub mod build;
 pub mod burial;
 mod bvh;
 pub mod chart;
+mod contact;
 pub mod crossing;
 pub mod element;
 pub mod error;

@@ -551,3 +551,41 @@ fn round_up(x: f64) -> f32 {
     let f = x as f32;
     if f64::from(f) < x { f.next_up() } else { f }
 }
+
+/// A binary tree over boxes for overlap queries (the contact search of
+/// [`crate::contact`]): obvhs's PLOC tree as [`ploc`] builds it, without
+/// the wide collapse that ray queries need.
+pub(crate) struct BoxTree {
+    tree: obvhs::bvh2::Bvh2,
+}
+
+impl BoxTree {
+    /// The tree over `boxes` (the boxes rounded outwards to f32).
+    pub(crate) fn new(boxes: &[Bounds]) -> BoxTree {
+        let boxes: Vec<Aabb> = boxes.iter().map(f32_box).collect();
+        BoxTree {
+            tree: ploc::build(&boxes).0,
+        }
+    }
+
+    /// Calls `visit` with the index of every box that overlaps `query`.
+    pub(crate) fn overlapping(&self, query: &Bounds, mut visit: impl FnMut(usize)) {
+        let tree = &self.tree;
+        tree.aabb_traverse(f32_box(query), |t, node| {
+            let node = &t.nodes[node as usize];
+            let first = node.first_index as usize;
+            for &p in &t.primitive_indices[first..first + node.prim_count as usize] {
+                visit(p as usize);
+            }
+            true
+        });
+    }
+}
+
+/// A box rounded outwards to f32.
+fn f32_box(b: &Bounds) -> Aabb {
+    Aabb::new(
+        b.min.to_array().map(round_down).into(),
+        b.max.to_array().map(round_up).into(),
+    )
+}
