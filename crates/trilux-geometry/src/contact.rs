@@ -33,8 +33,11 @@
 //! **Cells.** Every cut divides every cell it crosses (T's barycentric
 //! coordinates; a split point is computed from its edge's ends in one
 //! order, so the two cells on either side of an edge share it bit for
-//! bit), and each convex cell is fanned into triangles and made a chart of
-//! its own. Cells are not joined into regions bounded by the contacts:
+//! bit), unless one part would reach less than [`MIN_PIECE`] of T's size
+//! from the line; a cell's corner within [`SNAP_CELL`] of T's size from
+//! the line counts as on it. So no cell is a sliver (a 32-bit bake cannot
+//! resolve its elements, and they mean nothing). Each convex cell is fanned
+//! into triangles and made a chart of its own. Cells are not joined into regions bounded by the contacts:
 //! a door leaves a gap in a room's walls, and one chart for the inside and
 //! the outside would let a link at its coarse elements carry the sky's
 //! light to both alike (the classroom's, grown that way, read 1.12).
@@ -61,12 +64,18 @@ pub(crate) const MERGE: f64 = 1e-4;
 /// The least total contact length of a cut, relative to the triangle's
 /// size.
 pub(crate) const MIN_CONTACT: f64 = 0.02;
-/// The least extent of the triangle on each side of a cut, relative to its
-/// size.
-pub(crate) const MIN_PIECE: f64 = 1e-3;
-/// The least size of a triangle that is cut, relative to the scene's
-/// diagonal.
+/// The least extent of the triangle on each side of a cut, and of a cell
+/// on each side of a line that splits it, relative to the triangle's size.
+pub(crate) const MIN_PIECE: f64 = 1e-2;
+/// The least size of a triangle that is cut, relative to the diagonal of
+/// the box around every planar triangle of the scene.
 pub(crate) const MIN_SIZE: f64 = 0.2;
+/// Corners of a cell closer to a cut's line than this fraction of the
+/// triangle's size count as on it.
+pub(crate) const SNAP_CELL: f64 = 2e-3;
+/// Fan triangles of less than this fraction of the cut triangle's area are
+/// left out (three corners on one line, up to rounding).
+pub(crate) const FAN_MIN_AREA: f64 = 1e-9;
 /// Most cuts per triangle (the longest are kept): 16 lines make at most
 /// 137 cells.
 pub(crate) const MAX_CUTS: usize = 16;
@@ -95,7 +104,8 @@ struct Receiver {
 }
 
 /// The cuts of every mesh triangle of `prims` (module docs); empty when
-/// no surface ends on another's mesh triangle.
+/// no surface ends on another's large mesh triangle. Scenes without
+/// large mesh triangles cost a pass over the boxes.
 pub(crate) fn find_cuts(prims: &[Prim]) -> Cuts {
     let boxes: Vec<Bounds> = prims
         .iter()
@@ -109,32 +119,23 @@ pub(crate) fn find_cuts(prims: &[Prim]) -> Cuts {
         .fold(Bounds::EMPTY, |a, b| a.union(*b))
         .diagonal()
         .length();
-    let tree = BoxTree::new(&boxes);
-    let found: Vec<(u32, u32, Vec<Cut>)> = prims
-        .par_iter()
+    let receivers: Vec<(usize, u32, u32, Receiver)> = prims
+        .iter()
         .enumerate()
         .filter_map(|(i, p)| {
-            let Prim::Tri {
-                v,
-                normal,
-                owner: TriOwner::Mesh { tri, .. },
-                shape,
-                ..
-            } = *p
-            else {
-                return None;
-            };
-            let cross = (v[1] - v[0]).cross(v[2] - v[0]).length();
-            let t = Receiver {
-                v,
-                normal,
-                size: cross.sqrt(),
-            };
-            if t.size < MIN_SIZE * scene {
-                return None;
-            }
-            let cuts = cuts_of(&t, i, prims, &tree);
-            (!cuts.is_empty()).then_some((shape, tri, cuts))
+            let (shape, tri, t) = receiver(p)?;
+            (t.size >= MIN_SIZE * scene).then_some((i, shape, tri, t))
+        })
+        .collect();
+    if receivers.is_empty() {
+        return Cuts::new();
+    }
+    let tree = BoxTree::new(&boxes);
+    let found: Vec<(u32, u32, Vec<Cut>)> = receivers
+        .par_iter()
+        .filter_map(|(i, shape, tri, t)| {
+            let cuts = cuts_of(t, *i, prims, &tree);
+            (!cuts.is_empty()).then_some((*shape, *tri, cuts))
         })
         .collect();
     let mut out = Cuts::new();
@@ -142,6 +143,23 @@ pub(crate) fn find_cuts(prims: &[Prim]) -> Cuts {
         out.entry(shape).or_default().insert(tri, cuts);
     }
     out
+}
+
+/// A mesh triangle as a receiver of cuts, with its shape and index in its
+/// mesh (`None` for anything else).
+fn receiver(p: &Prim) -> Option<(u32, u32, Receiver)> {
+    let Prim::Tri {
+        v,
+        normal,
+        owner: TriOwner::Mesh { tri, .. },
+        shape,
+        ..
+    } = *p
+    else {
+        return None;
+    };
+    let size = (v[1] - v[0]).cross(v[2] - v[0]).length().sqrt();
+    Some((shape, tri, Receiver { v, normal, size }))
 }
 
 /// The cuts of one triangle (index `me` in `prims`).
@@ -281,23 +299,35 @@ type Cell = Vec<DVec2>;
 /// The cells of triangle `t` after every cut.
 fn cells(mesh: &MeshData, t: u32, cuts: &[Cut]) -> Vec<Cell> {
     let [a, b, c] = mesh.vertices(t);
+    let size = (b - a).cross(c - a).length().sqrt();
+    let (width, snap) = (MIN_PIECE * size, SNAP_CELL * size);
     let mut cells = vec![vec![DVec2::ZERO, DVec2::X, DVec2::Y]];
     for cut in cuts {
-        // The cut's signed distance is affine in the barycentrics.
+        // The cut's signed distance (m) is affine in the barycentrics. A
+        // corner within `snap` of the line counts as on it: the cut then
+        // passes through the corner instead of leaving a sliver beside it
+        // (a box's side that passes 6 mm from a floor triangle's corner).
         let s0 = cut.normal.dot(a) - cut.offset;
         let (sx, sy) = (cut.normal.dot(b - a), cut.normal.dot(c - a));
-        let dist = |p: DVec2| s0 + sx * p.x + sy * p.y;
+        let dist = |p: DVec2| {
+            let d = s0 + sx * p.x + sy * p.y;
+            if d.abs() <= snap { 0.0 } else { d }
+        };
         cells = cells
             .into_iter()
-            .flat_map(|cell| split(cell, &dist))
+            .flat_map(|cell| split(cell, &dist, width))
             .collect();
     }
     cells
 }
 
 /// A convex cell split by the line dist = 0: one cell, or two when both
-/// parts have an area (relative to the triangle's 1/2) of at least 1e-9.
-fn split(cell: Cell, dist: &impl Fn(DVec2) -> f64) -> Vec<Cell> {
+/// parts reach at least `width` (m) from the line. A line that only clips
+/// a corner of the cell, or runs along an edge close by, would leave a
+/// sliver whose elements are too thin to mean anything (and which a 32-bit
+/// bake cannot resolve); the cell is then left whole, the line's vertex
+/// on its neighbour's edge lying on this cell's edge.
+fn split(cell: Cell, dist: &impl Fn(DVec2) -> f64, width: f64) -> Vec<Cell> {
     let (mut neg, mut pos) = (Vec::new(), Vec::new());
     let n = cell.len();
     for i in 0..n {
@@ -315,7 +345,8 @@ fn split(cell: Cell, dist: &impl Fn(DVec2) -> f64) -> Vec<Cell> {
             pos.push(x);
         }
     }
-    if polygon_area(&neg) < 1e-9 || polygon_area(&pos) < 1e-9 {
+    let reach = |part: &[DVec2]| part.iter().fold(0.0_f64, |m, &p| m.max(dist(p).abs()));
+    if neg.len() < 3 || pos.len() < 3 || reach(&neg) < width || reach(&pos) < width {
         return vec![cell];
     }
     vec![neg, pos]
@@ -328,13 +359,6 @@ fn edge_point(p: DVec2, q: DVec2, dist: &impl Fn(DVec2) -> f64) -> DVec2 {
     let (u, v) = if key(p) <= key(q) { (p, q) } else { (q, p) };
     let (du, dv) = (dist(u), dist(v));
     u + (v - u) * (du / (du - dv))
-}
-
-/// The area of a polygon (shoelace).
-fn polygon_area(p: &[DVec2]) -> f64 {
-    let n = p.len();
-    let twice: f64 = (0..n).map(|i| p[i].perp_dot(p[(i + 1) % n])).sum();
-    0.5 * twice.abs()
 }
 
 /// Fans every cell into triangles appended to `mesh` (their corners new
@@ -359,7 +383,7 @@ fn fan(mesh: &mut MeshData, t: u32, cells: &[Cell]) -> Vec<Vec<u32>> {
             let tri = [ids[0], ids[k], ids[k + 1]];
             let [p, q, r] = tri.map(|v| mesh.positions[v as usize]);
             let area = 0.5 * (q - p).cross(r - p).length();
-            if area > 0.0 {
+            if area > FAN_MIN_AREA * mesh.tri_area[t as usize] {
                 tris.push(mesh.triangles.len() as u32);
                 mesh.triangles.push(tri);
                 mesh.tri_normal.push(normal);
