@@ -19,10 +19,13 @@
 //! floor), and the segment where W meets the plane, projected on it and
 //! clipped to T, is the contact. Contacts on one line (within
 //! [`MERGE`] × T's size) are one **cut**: the plane through that line
-//! normal to T. A cut is made when its contacts add up to at least
-//! [`MIN_CONTACT`] of T's size √(2 area) and it leaves at least
-//! [`MIN_PIECE`] of T's size on both sides; at most [`MAX_CUTS`] per
-//! triangle, the longest. Only triangles of at least [`MIN_SIZE`] of the
+//! normal to T. Contacts are pooled over the coplanar large triangles of
+//! T's shape (a wall crossing a ground of two triangles counts whole on
+//! both), and a line cuts when its contacts add up to at least
+//! [`MIN_CONTACT`] of the largest one's size √(2 area) (at most
+//! [`MAX_CUTS`], the longest); it cuts each of those triangles that it
+//! leaves at least [`MIN_PIECE`] of the triangle's size on both sides
+//! of. Only triangles of at least [`MIN_SIZE`] of the
 //! scene's diagonal are cut: a ground plane or a floor slab, not the
 //! furniture (at 5 % the committed living room gained 893 charts and took
 //! twice as long, for the same image). A table leg on a large floor
@@ -70,6 +73,9 @@ pub(crate) const MIN_PIECE: f64 = 1e-2;
 /// The least size of a triangle that is cut, relative to the diagonal of
 /// the box around every planar triangle of the scene.
 pub(crate) const MIN_SIZE: f64 = 0.2;
+/// The least reach of a part of a split cell from the line, relative to
+/// the triangle's size.
+pub(crate) const MIN_CELL: f64 = 1e-4;
 /// Corners of a cell closer to a cut's line than this fraction of the
 /// triangle's size count as on it.
 pub(crate) const SNAP_CELL: f64 = 2e-3;
@@ -131,18 +137,94 @@ pub(crate) fn find_cuts(prims: &[Prim]) -> Cuts {
         return Cuts::new();
     }
     let tree = BoxTree::new(&boxes);
-    let found: Vec<(u32, u32, Vec<Cut>)> = receivers
+    let lines: Vec<Vec<Cut>> = receivers
         .par_iter()
-        .filter_map(|(i, shape, tri, t)| {
-            let cuts = cuts_of(t, *i, prims, &tree);
-            (!cuts.is_empty()).then_some((*shape, *tri, cuts))
-        })
+        .map(|(i, _, _, t)| lines_of(t, *i, prims, &tree))
         .collect();
+    let mut planes: Vec<Plane> = Vec::new();
+    for ((_, shape, tri, t), lines) in receivers.into_iter().zip(lines) {
+        let k = match planes.iter().position(|p| p.holds(shape, &t)) {
+            Some(k) => k,
+            None => {
+                planes.push(Plane::new(shape, &t));
+                planes.len() - 1
+            }
+        };
+        planes[k].add(tri, t, lines);
+    }
     let mut out = Cuts::new();
-    for (shape, tri, cuts) in found {
-        out.entry(shape).or_default().insert(tri, cuts);
+    for plane in planes {
+        plane.cuts(&mut out);
     }
     out
+}
+
+/// The coplanar large triangles of one shape (a ground of two triangles)
+/// and the lines of contacts on them: a wall's contact counts over the
+/// whole plane, not only the part on one triangle, so that every
+/// triangle it crosses is cut along it.
+struct Plane {
+    shape: u32,
+    normal: DVec3,
+    offset: f64,
+    /// The largest triangle's size.
+    size: f64,
+    triangles: Vec<(u32, Receiver)>,
+    lines: Vec<Cut>,
+}
+
+impl Plane {
+    fn new(shape: u32, t: &Receiver) -> Plane {
+        Plane {
+            shape,
+            normal: t.normal,
+            offset: t.normal.dot(t.v[0]),
+            size: t.size,
+            triangles: Vec::new(),
+            lines: Vec::new(),
+        }
+    }
+
+    /// Whether triangle `t` of `shape` lies in this plane.
+    fn holds(&self, shape: u32, t: &Receiver) -> bool {
+        shape == self.shape
+            && self.normal.dot(t.normal) >= 1.0 - 1e-9
+            && t.v
+                .iter()
+                .all(|v| (self.normal.dot(*v) - self.offset).abs() <= MERGE * self.size.max(t.size))
+    }
+
+    fn add(&mut self, tri: u32, t: Receiver, lines: Vec<Cut>) {
+        self.size = self.size.max(t.size);
+        for line in lines {
+            merge_line(&mut self.lines, line, MERGE * self.size);
+        }
+        self.triangles.push((tri, t));
+    }
+
+    /// The cuts of each triangle: the plane's lines whose contacts add up
+    /// to [`MIN_CONTACT`] of its largest triangle (at most [`MAX_CUTS`],
+    /// the longest) that leave [`MIN_PIECE`] of the triangle on both sides.
+    fn cuts(mut self, out: &mut Cuts) {
+        self.lines.retain(|c| c.length >= MIN_CONTACT * self.size);
+        self.lines.sort_by(|a, b| b.length.total_cmp(&a.length));
+        self.lines.truncate(MAX_CUTS);
+        for (tri, t) in &self.triangles {
+            let margin = MIN_PIECE * t.size;
+            let cuts: Vec<Cut> = self
+                .lines
+                .iter()
+                .filter(|c| {
+                    let side = t.v.map(|v| c.normal.dot(v) - c.offset);
+                    side.iter().any(|&x| x < -margin) && side.iter().any(|&x| x > margin)
+                })
+                .cloned()
+                .collect();
+            if !cuts.is_empty() {
+                out.entry(self.shape).or_default().insert(*tri, cuts);
+            }
+        }
+    }
 }
 
 /// A mesh triangle as a receiver of cuts, with its shape and index in its
@@ -162,25 +244,29 @@ fn receiver(p: &Prim) -> Option<(u32, u32, Receiver)> {
     Some((shape, tri, Receiver { v, normal, size }))
 }
 
-/// The cuts of one triangle (index `me` in `prims`).
-fn cuts_of(t: &Receiver, me: usize, prims: &[Prim], tree: &BoxTree) -> Vec<Cut> {
+/// The lines of the contacts on one triangle (index `me` in `prims`), each
+/// with its contacts' total length.
+fn lines_of(t: &Receiver, me: usize, prims: &[Prim], tree: &BoxTree) -> Vec<Cut> {
     let query = Bounds::from_points(t.v).padded(MIN_PIECE * t.size);
-    let mut cuts: Vec<Cut> = Vec::new();
+    let mut lines: Vec<Cut> = Vec::new();
     tree.overlapping(&query, |j| {
         if j == me {
             return;
         }
         if let Prim::Tri { v, normal, .. } = prims[j]
             && normal.dot(t.normal).abs() <= MAX_COS
-            && let Some(segment) = contact(t, &v)
+            && let Some([p, q]) = contact(t, &v)
+            && let Some(normal) = (q - p).cross(t.normal).try_normalize()
         {
-            add_contact(&mut cuts, t, segment);
+            let line = Cut {
+                normal,
+                offset: normal.dot(p),
+                length: p.distance(q),
+            };
+            merge_line(&mut lines, line, MERGE * t.size);
         }
     });
-    cuts.retain(|c| c.length >= MIN_CONTACT * t.size);
-    cuts.sort_by(|a, b| b.length.total_cmp(&a.length));
-    cuts.truncate(MAX_CUTS);
-    cuts
+    lines
 }
 
 /// Where triangle `w` meets the plane of `t`, projected on it and clipped
@@ -246,31 +332,17 @@ fn clip_to_triangle(t: &Receiver, p: DVec3, q: DVec3) -> Option<[DVec3; 2]> {
     (hi > lo).then(|| [p + (q - p) * lo, p + (q - p) * hi])
 }
 
-/// Adds a contact segment to the cut of its line, or starts a cut when it
-/// leaves enough of `t` on both sides.
-fn add_contact(cuts: &mut Vec<Cut>, t: &Receiver, [p, q]: [DVec3; 2]) {
-    let Some(normal) = (q - p).cross(t.normal).try_normalize() else {
-        return;
-    };
-    let offset = normal.dot(p);
-    let length = p.distance(q);
-    let tol = MERGE * t.size;
-    for c in cuts.iter_mut() {
-        let cos = c.normal.dot(normal);
-        if cos.abs() >= 1.0 - 1e-9 && (c.offset - cos.signum() * offset).abs() <= tol {
-            c.length += length;
+/// Adds `line` to the one of `lines` it lies on (within `tol`), or to the
+/// list.
+fn merge_line(lines: &mut Vec<Cut>, line: Cut, tol: f64) {
+    for c in lines.iter_mut() {
+        let cos = c.normal.dot(line.normal);
+        if cos.abs() >= 1.0 - 1e-9 && (c.offset - cos.signum() * line.offset).abs() <= tol {
+            c.length += line.length;
             return;
         }
     }
-    let side = t.v.map(|v| normal.dot(v) - offset);
-    let margin = MIN_PIECE * t.size;
-    if side.iter().any(|&x| x < -margin) && side.iter().any(|&x| x > margin) {
-        cuts.push(Cut {
-            normal,
-            offset,
-            length,
-        });
-    }
+    lines.push(line);
 }
 
 /// Cuts the triangles of `mesh` named in `cuts` (module docs): their cells
@@ -300,7 +372,7 @@ type Cell = Vec<DVec2>;
 fn cells(mesh: &MeshData, t: u32, cuts: &[Cut]) -> Vec<Cell> {
     let [a, b, c] = mesh.vertices(t);
     let size = (b - a).cross(c - a).length().sqrt();
-    let (width, snap) = (MIN_PIECE * size, SNAP_CELL * size);
+    let (width, snap) = (MIN_CELL * size, SNAP_CELL * size);
     let mut cells = vec![vec![DVec2::ZERO, DVec2::X, DVec2::Y]];
     for cut in cuts {
         // The cut's signed distance (m) is affine in the barycentrics. A
