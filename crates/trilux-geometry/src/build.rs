@@ -20,7 +20,7 @@ use glam::{DVec2, DVec3};
 
 use crate::bounds::Bounds;
 use crate::bvh::{Analytic, AnalyticKind, Bvh, Prim, TriOwner};
-use crate::chart::{MeshData, Piece, build_charts, build_charts_around, cluster_element};
+use crate::chart::{MeshData, Piece, build_charts, cluster_element};
 use crate::contact::{Cuts, cut_mesh, find_cuts};
 use crate::element::rect_element;
 use crate::error::{GeometryError, ShapeProblem};
@@ -396,13 +396,11 @@ impl Builder {
         check_mesh(mesh)?;
         let mut data = world_mesh(mesh, xf, sign)?;
         let mesh_id = self.meshes.len() as u32;
-        let charts = match self.cuts.remove(&self.shape) {
-            Some(cuts) => {
-                let cells = cut_mesh(&mut data, &cuts);
-                build_charts_around(&data, cells)
-            }
-            None => build_charts(&data),
+        let cells = match self.cuts.remove(&self.shape) {
+            Some(cuts) => cut_mesh(&mut data, &cuts),
+            None => Vec::new(),
         };
+        let charts = build_charts(&data, cells);
         let first = self.next_surface();
         for (k, chart) in charts.iter().enumerate() {
             for &t in chart {

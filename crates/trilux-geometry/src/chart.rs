@@ -224,15 +224,11 @@ impl Piece {
     }
 }
 
-/// Groups the non-degenerate triangles of a mesh into charts (module docs).
-pub(crate) fn build_charts(mesh: &MeshData) -> Vec<Vec<u32>> {
-    build_charts_counted(mesh, Vec::new()).0
-}
-
-/// [`build_charts`] around `fixed` charts made beforehand (the regions of
-/// cut triangles, [`crate::contact`]): their triangles join no other
-/// chart, and they come last.
-pub(crate) fn build_charts_around(mesh: &MeshData, fixed: Vec<Vec<u32>>) -> Vec<Vec<u32>> {
+/// Groups the non-degenerate triangles of a mesh into charts (module
+/// docs), around `fixed` charts made beforehand (the cells of cut
+/// triangles, [`crate::contact`]): their triangles join no other chart,
+/// and they come last.
+pub(crate) fn build_charts(mesh: &MeshData, fixed: Vec<Vec<u32>>) -> Vec<Vec<u32>> {
     build_charts_counted(mesh, fixed).0
 }
 

@@ -36,14 +36,15 @@
 //! **Cells.** Every cut divides every cell it crosses (T's barycentric
 //! coordinates; a split point is computed from its edge's ends in one
 //! order, so the two cells on either side of an edge share it bit for
-//! bit), unless one part would reach less than [`MIN_PIECE`] of T's size
+//! bit), unless one part would reach less than [`MIN_CELL`] of T's size
 //! from the line; a cell's corner within [`SNAP_CELL`] of T's size from
 //! the line counts as on it. So no cell is a sliver (a 32-bit bake cannot
 //! resolve its elements, and they mean nothing). Each convex cell is fanned
-//! into triangles and made a chart of its own. Cells are not joined into regions bounded by the contacts:
-//! a door leaves a gap in a room's walls, and one chart for the inside and
-//! the outside would let a link at its coarse elements carry the sky's
-//! light to both alike (the classroom's, grown that way, read 1.12).
+//! into triangles and made a chart of its own. Cells are not joined into
+//! regions bounded by the contacts: a door leaves a gap in a room's walls,
+//! and one chart for the inside and the outside would let a link at its
+//! coarse elements carry the sky's light to both alike (the classroom's,
+//! grown that way, read 1.12).
 //! Only large triangles are cut, so the charts this adds are few.
 
 use std::collections::HashMap;
@@ -67,8 +68,8 @@ pub(crate) const MERGE: f64 = 1e-4;
 /// The least total contact length of a cut, relative to the triangle's
 /// size.
 pub(crate) const MIN_CONTACT: f64 = 0.02;
-/// The least extent of the triangle on each side of a cut, and of a cell
-/// on each side of a line that splits it, relative to the triangle's size.
+/// The least extent of the triangle on each side of a cut, relative to its
+/// size.
 pub(crate) const MIN_PIECE: f64 = 1e-2;
 /// The least size of a triangle that is cut, relative to the diagonal of
 /// the box around every planar triangle of the scene.
@@ -136,7 +137,19 @@ pub(crate) fn find_cuts(prims: &[Prim]) -> Cuts {
     if receivers.is_empty() {
         return Cuts::new();
     }
-    let tree = BoxTree::new(&boxes);
+    // A contact's vertices within SNAP of its height count as on the plane:
+    // its box, grown by that, meets the plane's triangle wherever it could.
+    let reach: Vec<Bounds> = boxes
+        .iter()
+        .map(|b| {
+            if b.is_empty() {
+                *b
+            } else {
+                b.padded(SNAP * b.diagonal().length())
+            }
+        })
+        .collect();
+    let tree = BoxTree::new(&reach);
     let lines: Vec<Vec<Cut>> = receivers
         .par_iter()
         .map(|(i, _, _, t)| lines_of(t, *i, prims, &tree))
@@ -247,7 +260,7 @@ fn receiver(p: &Prim) -> Option<(u32, u32, Receiver)> {
 /// The lines of the contacts on one triangle (index `me` in `prims`), each
 /// with its contacts' total length.
 fn lines_of(t: &Receiver, me: usize, prims: &[Prim], tree: &BoxTree) -> Vec<Cut> {
-    let query = Bounds::from_points(t.v).padded(MIN_PIECE * t.size);
+    let query = Bounds::from_points(t.v);
     let mut lines: Vec<Cut> = Vec::new();
     tree.overlapping(&query, |j| {
         if j == me {
@@ -278,16 +291,20 @@ fn contact(t: &Receiver, w: &[DVec3; 3]) -> Option<[DVec3; 2]> {
         return None;
     }
     let s = d.map(|x| if x.abs() <= SNAP * height { 0.0 } else { x });
-    let mut on: Vec<DVec3> = Vec::with_capacity(3);
+    // At most three points: a vertex on the plane, or a crossing of the
+    // edge after it.
+    let (mut on, mut count) = ([DVec3::ZERO; 3], 0);
     for i in 0..3 {
         let j = (i + 1) % 3;
         if s[i] == 0.0 {
-            on.push(w[i]);
+            on[count] = w[i];
+            count += 1;
         } else if s[j] != 0.0 && (s[i] > 0.0) != (s[j] > 0.0) {
-            on.push(w[i] + (w[j] - w[i]) * (d[i] / (d[i] - d[j])));
+            on[count] = w[i] + (w[j] - w[i]) * (d[i] / (d[i] - d[j]));
+            count += 1;
         }
     }
-    let (p, q) = farthest_pair(&on)?;
+    let (p, q) = farthest_pair(&on[..count])?;
     let project = |x: DVec3| x - t.normal * t.normal.dot(x - t.v[0]);
     clip_to_triangle(t, project(p), project(q))
 }
@@ -353,9 +370,6 @@ pub(crate) fn cut_mesh(mesh: &mut MeshData, cuts: &HashMap<u32, Vec<Cut>>) -> Ve
     order.sort_unstable();
     let mut charts = Vec::new();
     for t in order {
-        if mesh.tri_area[t as usize] <= 0.0 {
-            continue;
-        }
         let cells = cells(mesh, t, &cuts[&t]);
         charts.extend(fan(mesh, t, &cells).into_iter().filter(|c| !c.is_empty()));
         mesh.tri_area[t as usize] = 0.0;
@@ -437,7 +451,6 @@ fn edge_point(p: DVec2, q: DVec2, dist: &impl Fn(DVec2) -> f64) -> DVec2 {
 /// vertices, shading normals and texture coordinates interpolated from
 /// triangle `t`'s); returns each cell's new triangles.
 fn fan(mesh: &mut MeshData, t: u32, cells: &[Cell]) -> Vec<Vec<u32>> {
-    let corners = mesh.triangles[t as usize];
     let normal = mesh.tri_normal[t as usize];
     let mut index: HashMap<(u64, u64), u32> = HashMap::new();
     let mut out = Vec::with_capacity(cells.len());
@@ -447,7 +460,7 @@ fn fan(mesh: &mut MeshData, t: u32, cells: &[Cell]) -> Vec<Vec<u32>> {
             .map(|&p| {
                 *index
                     .entry((p.x.to_bits(), p.y.to_bits()))
-                    .or_insert_with(|| vertex(mesh, corners, p))
+                    .or_insert_with(|| vertex(mesh, t, p))
             })
             .collect();
         let mut tris = Vec::new();
@@ -468,20 +481,22 @@ fn fan(mesh: &mut MeshData, t: u32, cells: &[Cell]) -> Vec<Vec<u32>> {
     out
 }
 
-/// A new vertex at barycentrics `p` of the triangle with vertex indices
-/// `corners` (its own corners reused), its attributes interpolated.
-fn vertex(mesh: &mut MeshData, corners: [u32; 3], p: DVec2) -> u32 {
+/// A new vertex at barycentrics `p` of triangle `t` (its own corners
+/// reused), its attributes interpolated.
+fn vertex(mesh: &mut MeshData, t: u32, p: DVec2) -> u32 {
+    let corners = mesh.triangles[t as usize];
     let w = [1.0 - p.x - p.y, p.x, p.y];
     if let Some(k) = w.iter().position(|&x| x == 1.0) {
         return corners[k];
     }
-    let mix3 = |v: &[DVec3]| (0..3).map(|k| v[corners[k] as usize] * w[k]).sum::<DVec3>();
-    let position = mix3(&mesh.positions);
+    let position = mesh.point(t, p);
     mesh.positions.push(position);
     if let Some(ns) = &mut mesh.shading_normals {
         // Left unnormalised, as the mesh's own: a hit interpolates and
         // normalises, so the cells shade exactly as the triangle did.
-        let n = mix3(ns);
+        let n = (0..3)
+            .map(|k| ns[corners[k] as usize] * w[k])
+            .sum::<DVec3>();
         ns.push(n);
     }
     if let Some(uv) = &mut mesh.texcoords {

@@ -102,14 +102,21 @@ fn the_cut_ground_has_no_holes_and_shades_as_before() {
     let g = Geometry::build(&[ground(), wall()]).unwrap();
     let (_, n) = ground_vertices();
     let ground = g.surfaces_of_shape(0);
-    // Rays straight down on a grid that runs through the wall's foot and
-    // the cells' corners, and between them.
+    // Rays straight down on a grid between the seams, and two columns on
+    // them: the cut along the wall's line (exactly on it beyond the wall,
+    // 1 mm beside it where the wall stands) and the original triangles'
+    // diagonal y = x, which both triangles' cells share, each cut on its
+    // own side (through (WALL_X, WALL_X) too).
     let steps = 400;
     for i in 0..=steps {
         for j in 0..=steps {
-            let x = -HALF + 2.0 * HALF * (i as f64 + 0.37) / (steps as f64 + 1.0);
             let y = -HALF + 2.0 * HALF * j as f64 / steps as f64;
-            let x = if i == 7 { WALL_X + 1e-3 } else { x };
+            let x = match i {
+                7 if y.abs() > 4.0 => WALL_X,
+                7 => WALL_X + 1e-3,
+                8 => y,
+                _ => -HALF + 2.0 * HALF * (i as f64 + 0.37) / (steps as f64 + 1.0),
+            };
             let ray = Ray {
                 origin: DVec3::new(x, y, 10.0),
                 dir: DVec3::NEG_Z,

@@ -234,10 +234,7 @@ impl Bvh {
                     Prim::Analytic { index, .. } => analytic[*index as usize].bounds(),
                 }
                 .padded(pad);
-                Aabb::new(
-                    b.min.to_array().map(round_down).into(),
-                    b.max.to_array().map(round_up).into(),
-                )
+                f32_box(&b)
             })
             .collect();
         let (mut bvh2, visits) = ploc::build(&boxes);
