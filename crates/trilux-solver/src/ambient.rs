@@ -163,17 +163,38 @@ impl<const N: usize> Interreflection<N> {
         None
     }
 
-    /// CR for the residual `residual` (module docs): 0 while nothing has
-    /// arrived anywhere.
-    pub fn convergence_ratio(&self, residual: Spectrum<N>) -> f64 {
-        match self.return_fraction(residual) {
+    /// CR for the residual `residual`, `emission` of it emitted light not
+    /// yet shot (module docs): 0 while nothing has arrived anywhere.
+    pub fn convergence_ratio(&self, residual: Spectrum<N>, emission: Spectrum<N>) -> f64 {
+        match self.return_fraction(reflected_part(residual, emission)) {
             Some(a) => {
-                let future: f64 = (0..N).map(|b| future_reflected(residual[b], a[b])).sum();
+                let future: f64 = (0..N)
+                    .map(|b| self.future_of(residual[b], emission[b], a[b], b))
+                    .sum();
                 convergence_ratio(self.reflected.sum(), future)
             }
             None if residual.sum() > 0.0 => 0.0,
             None => 1.0,
         }
+    }
+
+    /// The light band `b` will still reflect from a residual `residual`,
+    /// `emission` of it emitted light not yet shot, at return `a`: the
+    /// reflected part returns a/(1 − a) of itself; emitted light is
+    /// reflected first at the reflectance of the lit reflecting faces (the
+    /// prior a₀), then returns as reflected light does: a₀/(1 − a). Taken
+    /// as reflected light, unshot emission would count only at the return
+    /// a, which is small where the shots so far found an open scene: a sky
+    /// box's four sides, 7 % of its emission and all of the light that
+    /// enters a room's windows level, were left unshot at CR 0.989
+    /// (docs/solver.md, "Convergence ratio and ambient term").
+    /// `a` is the return of the reflected part alone (its prior counts
+    /// for that part only).
+    fn future_of(&self, residual: f64, emission: f64, a: f64, b: usize) -> f64 {
+        let emission = emission.clamp(0.0, residual.max(0.0));
+        let prior = ratio(self.reflected[b], self.arrived_reflecting[b]);
+        let a = a.clamp(0.0, MAX_RETURN);
+        future_reflected(residual - emission, a) + emission * prior / (1.0 - a)
     }
 
     /// The lit reflecting area S = Σ ρ A per band, as the participation of
@@ -211,12 +232,17 @@ impl<const N: usize> Interreflection<N> {
     /// flux that CR is made of, and the ambient radiance, which spreads
     /// the future light at the *measured* return (none until a shot of
     /// reflected light has measured it).
-    pub fn ambient(&self, residual: Spectrum<N>, area: Spectrum<N>) -> Ambient {
+    pub fn ambient(
+        &self,
+        residual: Spectrum<N>,
+        emission: Spectrum<N>,
+        area: Spectrum<N>,
+    ) -> Ambient {
         let a = self
-            .return_fraction(residual)
+            .return_fraction(reflected_part(residual, emission))
             .unwrap_or_else(Spectrum::zero);
         let future: Vec<f64> = (0..N)
-            .map(|b| future_reflected(residual[b], a[b]))
+            .map(|b| self.future_of(residual[b], emission[b], a[b], b))
             .collect();
         // The term adds light to every lit face, so it spreads the future
         // light at the measured return (returned / shot), without the
@@ -233,13 +259,24 @@ impl<const N: usize> Interreflection<N> {
             .collect();
         Ambient {
             radiance,
-            share: 1.0 - self.convergence_ratio(residual),
+            share: 1.0 - self.convergence_ratio(residual, emission),
             return_fraction: a.to_array().to_vec(),
             reflected_flux: self.reflected.to_array().to_vec(),
             future_reflected_flux: future,
+            unshot_emission_flux: emission.to_array().to_vec(),
+            first_reflectance: (0..N)
+                .map(|b| ratio(self.reflected[b], self.arrived_reflecting[b]))
+                .collect(),
             reflecting_area: area.to_array().to_vec(),
         }
     }
+}
+
+/// The residual less the emitted light in it, per band, not negative.
+fn reflected_part<const N: usize>(residual: Spectrum<N>, emission: Spectrum<N>) -> Spectrum<N> {
+    Spectrum::new(std::array::from_fn(|b| {
+        (residual[b] - emission[b]).max(0.0)
+    }))
 }
 
 /// n / d, 0 when d is not positive.
@@ -308,11 +345,11 @@ mod tests {
                 Side::Back => 0.0,
             };
             let s = tracker.reflecting_area(area_of, Spectrum::splat(rho * total));
-            let amb = tracker.ambient(Spectrum::splat(residual), s);
+            let amb = tracker.ambient(Spectrum::splat(residual), Spectrum::zero(), s);
             // The paper's CR and this one agree in a closed uniform scene.
             let emitted = le * PI * areas[0];
             let paper = (emitted - residual) / emitted;
-            let cr = tracker.convergence_ratio(Spectrum::splat(residual));
+            let cr = tracker.convergence_ratio(Spectrum::splat(residual), Spectrum::zero());
             assert!(
                 (cr - paper).abs() <= 1e-9,
                 "{shots} shots: CR {cr} against the paper's {paper}"
@@ -373,7 +410,7 @@ mod tests {
         assert!((a - want).abs() < 1e-12, "a {a}, want {want}");
         let future = residual * a / (1.0 - a);
         let reflected = 0.3 * rho + arrived * rho;
-        let cr = t.convergence_ratio(Spectrum::splat(residual));
+        let cr = t.convergence_ratio(Spectrum::splat(residual), Spectrum::zero());
         assert!((cr - reflected / (reflected + future)).abs() < 1e-12);
         let paper = 1.0 - residual;
         assert!(cr < paper, "CR {cr} should be below the paper's {paper}");
@@ -403,13 +440,13 @@ mod tests {
         let want_a = (0.005 + prior * 0.4) / 0.5;
         let a = t.return_fraction(residual).unwrap()[0];
         assert!((a - want_a).abs() < 1e-12, "a {a}, want {want_a}");
-        let cr = t.convergence_ratio(residual);
+        let cr = t.convergence_ratio(residual, Spectrum::zero());
         let want = 0.505 / (0.505 + 0.4 * want_a / (1.0 - want_a));
         assert!((cr - want).abs() < 1e-12, "CR {cr}, want {want}");
         assert!(cr < 0.95);
         // The ambient term spreads what the shots measured (a = 0.05),
         // not the prior: it adds light everywhere. Over S = 1 m²:
-        let amb = t.ambient(residual, Spectrum::splat(1.0));
+        let amb = t.ambient(residual, Spectrum::zero(), Spectrum::splat(1.0));
         let want = 0.4 * 0.05 / 0.95 / std::f64::consts::PI;
         let got = amb.radiance[0];
         assert!((got - want).abs() < 1e-12, "A_amb {got}, want {want}");
@@ -425,7 +462,30 @@ mod tests {
     #[test]
     fn nothing_arrived_yet_is_not_converged() {
         let t = Interreflection::<3>::new(2);
-        assert_eq!(t.convergence_ratio(Spectrum::splat(1.0)), 0.0);
-        assert_eq!(t.convergence_ratio(Spectrum::zero()), 1.0);
+        let none = Spectrum::zero();
+        assert_eq!(t.convergence_ratio(Spectrum::splat(1.0), none), 0.0);
+        assert_eq!(t.convergence_ratio(none, none), 1.0);
+    }
+
+    /// An open scene whose reflected light all leaves (a = 0): lamp A's
+    /// 1 W arrives on a face of reflectance ½ and is reflected once, 0.5
+    /// W; lamp B's 0.1 W, not shot yet, will land the same way and be
+    /// reflected once, 0.05 W, and nothing after: CR = 0.5 / 0.55. Taken
+    /// as reflected light (returning a, about 0 here) it would count for
+    /// almost nothing (CR 0.98: the sky box's sides left unshot).
+    #[test]
+    fn unshot_emission_counts_as_light_still_to_be_reflected_once() {
+        let mut t = Interreflection::<1>::new(1);
+        let face = FaceId::new(SurfaceId(0), Side::Front);
+        let one = Spectrum::splat(1.0);
+        t.book_shot(one, Interreflection::reflected_share(one, one));
+        t.book_group(face, one, Spectrum::splat(0.5), Spectrum::zero());
+        let phi = Spectrum::splat(0.5);
+        t.book_shot(phi, Interreflection::reflected_share(phi, Spectrum::zero()));
+        let lamp = Spectrum::splat(0.1);
+        let cr = t.convergence_ratio(lamp, lamp);
+        let want = 0.5 / 0.55;
+        assert!((cr - want).abs() < 1e-12, "CR {cr}, want {want}");
+        assert!(t.convergence_ratio(lamp, Spectrum::zero()) > 0.98);
     }
 }

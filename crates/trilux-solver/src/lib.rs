@@ -49,6 +49,8 @@
 //!   source and the residual from the sources a shot changed.
 //! - [`gather_links`]: the final gather's links, kept for rendering;
 //!   `final_gather`: the refinement that makes them.
+//! - `ambient`: CR and Cohen's uniform ambient term; `local_ambient`: the
+//!   residual's later bounces over the final links, which replace it.
 //! - [`ledger`]: where the energy went.
 //! - [`solution`]: the radiance query for final gathering and the file
 //!   format (checksummed, every field validated).
@@ -74,6 +76,7 @@ pub mod ledger;
 mod light_shot;
 pub mod lights;
 mod link;
+mod local_ambient;
 pub mod prepared;
 mod queue;
 mod radiosity;

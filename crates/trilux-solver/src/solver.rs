@@ -175,7 +175,18 @@ impl<const N: usize> Solver<N> {
         if self.setup.emitted.sum() <= 0.0 {
             return 1.0;
         }
-        self.state.interreflection.convergence_ratio(residual)
+        self.state
+            .interreflection
+            .convergence_ratio(residual, self.unshot_emission())
+    }
+
+    /// The emitted light not shot yet, per band: faces' emission before
+    /// their first shot and lights without area (`ambient`: it will be
+    /// reflected at least once).
+    fn unshot_emission(&self) -> Spectrum<N> {
+        let state = &self.state;
+        let faces: Spectrum<N> = state.unshot_emission.values().copied().sum();
+        faces + state.light_flux.iter().copied().sum::<Spectrum<N>>()
     }
 
     /// The paper's CR = (IF − RF)/IF (§6), which counts light that left
@@ -548,12 +559,19 @@ impl<const N: usize> Solver<N> {
             .state
             .interreflection
             .reflecting_area(exposed, fallback);
-        self.state.interreflection.ambient(residual, area)
+        self.state
+            .interreflection
+            .ambient(residual, self.unshot_emission(), area)
     }
 
     /// The solution of the finished solve: its discretisation, radiance,
     /// hierarchies, far fields and gather links.
     fn into_solution(self, links: GatherLinks) -> Solution<N> {
+        let local_ambient = Some(crate::local_ambient::future_irradiance(
+            &self.setup,
+            &self.state,
+            &links,
+        ));
         let Solver { setup, state, .. } = self;
         let hierarchies: Vec<Hierarchy<N>> = state.hierarchies.into_iter().flatten().collect();
         let far = state
@@ -584,6 +602,7 @@ impl<const N: usize> Solver<N> {
             far,
             links,
             stats,
+            local_ambient,
         })
     }
 

@@ -187,9 +187,11 @@ pub struct TracePoint {
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[non_exhaustive]
 pub struct Ambient {
-    /// The ambient radiance A_amb: an element of reflectance ρ sends
-    /// ρ · A_amb more than the stopped solve gave it (empty for a solution
-    /// saved before the term existed: no ambient).
+    /// Cohen's ambient radiance A_amb: an element of reflectance ρ would
+    /// send ρ · A_amb more than the stopped solve gave it. The solution's
+    /// readers use it only where the residual's later bounces were not
+    /// gathered over the final links (`crate::local_ambient`; a solution
+    /// file without them).
     pub radiance: Vec<f64>,
     /// The future reflected light as a share of all the light the scene
     /// will reflect (band sum): 1 − CR.
@@ -201,8 +203,16 @@ pub struct Ambient {
     pub return_fraction: Vec<f64>,
     /// Light the scene's surfaces reflected during the solve (W).
     pub reflected_flux: Vec<f64>,
-    /// Light the residual will still be reflected: RF · a / (1 − a) (W).
+    /// Light the residual will still be reflected (W): its reflected part
+    /// R returns R · a / (1 − a), its emitted part E (not shot yet) is
+    /// reflected first at the lit faces' reflectance a₀, E · a₀ / (1 − a).
     pub future_reflected_flux: Vec<f64>,
+    /// E, the emitted light in the residual (W).
+    #[serde(default)]
+    pub unshot_emission_flux: Vec<f64>,
+    /// a₀, the reflectance unshot emission is first reflected at.
+    #[serde(default)]
+    pub first_reflectance: Vec<f64>,
     /// The lit reflecting area Σ ρ A the ambient light spreads over (m²).
     pub reflecting_area: Vec<f64>,
 }

@@ -165,7 +165,12 @@ fn check_ledger(solution: &Solution<3>) -> Result<(), TestCaseError> {
         let a = amb.return_fraction[b];
         prop_assert!((0.0..=1.0).contains(&a), "return fraction {}", a);
         prop_assert!(amb.reflected_flux[b] >= 0.0 && amb.radiance[b] >= 0.0);
-        let expect = stats.residual_flux[b] * a / (1.0 - a).max(1e-9);
+        // The residual's emitted part E is reflected first at a₀, then
+        // returns as reflected light does; the rest returns a of itself.
+        let e = amb.unshot_emission_flux[b].clamp(0.0, stats.residual_flux[b].max(0.0));
+        let a0 = amb.first_reflectance[b];
+        prop_assert!((0.0..=1.0).contains(&a0), "first reflectance {}", a0);
+        let expect = ((stats.residual_flux[b] - e) * a + e * a0) / (1.0 - a).max(1e-9);
         prop_assert!((amb.future_reflected_flux[b] - expect).abs() <= 1e-9 * expect.max(1e-12));
         reflected += amb.reflected_flux[b];
         future += amb.future_reflected_flux[b];

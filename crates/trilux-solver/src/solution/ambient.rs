@@ -7,7 +7,7 @@
 
 use glam::{DVec2, DVec3};
 use trilux_color::Spectrum;
-use trilux_geometry::{ElementId, FaceId, Side, SurfaceCoord};
+use trilux_geometry::{ElementId, FaceId, Side, Sided, SurfaceCoord};
 
 use super::{FarRecord, Parts};
 use crate::prepared::PreparedScene;
@@ -19,10 +19,16 @@ const ALBEDO_ANGLES: [f64; 4] = [20.705, 37.761, 52.239, 69.295];
 /// What the readers need to add the ambient term.
 #[derive(Clone, Debug, Default)]
 pub(super) struct AmbientTerm<const N: usize> {
-    /// A_amb per band (zero: no term).
+    /// Cohen's A_amb per band (zero: no term), used where `local` is not.
     pub radiance: Spectrum<N>,
     /// Whether the readers add it.
     pub on: bool,
+    /// Per side and element, the local term's E / (1 − a)
+    /// (`crate::local_ambient`): when present it replaces `radiance`.
+    local: Option<Sided<Vec<Spectrum<N>>>>,
+    /// Per face index, the local term's mean over the face's leaves (what
+    /// a glossy part, read per face, takes).
+    local_face: Vec<Spectrum<N>>,
     /// Per face index: the solve lit the face.
     lit: Vec<bool>,
     /// Per shape, [front, back]: the glossy part's albedo, averaged over
@@ -31,8 +37,9 @@ pub(super) struct AmbientTerm<const N: usize> {
 }
 
 impl<const N: usize> AmbientTerm<N> {
-    /// The term of a solution's parts: A_amb from its stats (none for a
-    /// solution saved before the term existed), the faces it lit.
+    /// The term of a solution's parts: the local term when the parts hold
+    /// it, else A_amb from its stats (none for a solution saved before the
+    /// term existed); the faces it lit.
     pub fn new(p: &Parts<N>) -> Self {
         let a = &p.stats.ambient.radiance;
         let radiance = if a.len() == N && a.iter().all(|x| x.is_finite() && *x >= 0.0) {
@@ -40,10 +47,18 @@ impl<const N: usize> AmbientTerm<N> {
         } else {
             Spectrum::zero()
         };
-        if radiance.is_black() {
+        let forest = p.discretisation.forest();
+        let local = p.local_ambient.clone().filter(|l| {
+            Side::BOTH
+                .iter()
+                .all(|&s| l[s].len() == forest.element_count())
+                && Side::BOTH
+                    .iter()
+                    .any(|&s| l[s].iter().any(|x| x.max_value() > 0.0))
+        });
+        if radiance.is_black() && local.is_none() {
             return AmbientTerm::default();
         }
-        let forest = p.discretisation.forest();
         let surfaces = forest.geometry().surfaces().len();
         let mut lit = vec![false; 2 * surfaces];
         for (k, l) in lit.iter_mut().enumerate() {
@@ -61,11 +76,58 @@ impl<const N: usize> AmbientTerm<N> {
                 lit[face.index()] = true;
             }
         }
+        if let Some(l) = &local {
+            for (k, v) in lit.iter_mut().enumerate() {
+                let side = if k % 2 == 0 { Side::Front } else { Side::Back };
+                let root = forest.root(trilux_geometry::SurfaceId((k / 2) as u32));
+                *v = *v || l[side][root.index()].max_value() > 0.0;
+            }
+        }
+        let local_face = match &local {
+            Some(l) => face_means(forest, &p.exposed_area, l),
+            None => Vec::new(),
+        };
         AmbientTerm {
             radiance,
             on: true,
+            local,
+            local_face,
             lit,
             glossy_albedo: p.scene.materials().iter().map(glossy_albedo).collect(),
+        }
+    }
+
+    /// The local term's per-element values, when the solution has them.
+    pub fn local(&self) -> Option<&Sided<Vec<Spectrum<N>>>> {
+        self.local.as_ref()
+    }
+
+    /// True when the term adds nothing anywhere.
+    pub fn is_empty(&self) -> bool {
+        self.radiance.is_black() && self.local.is_none()
+    }
+
+    /// The term's radiance at element `e` of `face` (before the face's
+    /// reflectance).
+    fn level(&self, face: FaceId, e: ElementId) -> Spectrum<N> {
+        match &self.local {
+            Some(l) => l[face.side()]
+                .get(e.index())
+                .copied()
+                .unwrap_or_else(Spectrum::zero),
+            None => self.radiance,
+        }
+    }
+
+    /// The term's radiance over the whole of `face`.
+    fn face_level(&self, face: FaceId) -> Spectrum<N> {
+        match &self.local {
+            Some(_) => self
+                .local_face
+                .get(face.index())
+                .copied()
+                .unwrap_or_else(Spectrum::zero),
+            None => self.radiance,
         }
     }
 
@@ -73,12 +135,14 @@ impl<const N: usize> AmbientTerm<N> {
         self.on && self.lit.get(face.index()).copied().unwrap_or(false)
     }
 
-    /// ρ_d · A_amb at the point `coord` gives of `face` (a textured
-    /// material is read there; `coord` is called only then).
+    /// ρ_d · A_amb at the point `coord` gives of `face`, in its element
+    /// `e` (a textured material is read there; `coord` is called only
+    /// then).
     pub fn lambertian(
         &self,
         scene: &PreparedScene<N>,
         face: FaceId,
+        e: ElementId,
         coord: impl FnOnce() -> SurfaceCoord,
     ) -> Spectrum<N> {
         if !self.active(face) {
@@ -91,7 +155,7 @@ impl<const N: usize> AmbientTerm<N> {
                 .diffuse_albedo(face.side()),
             None => scene.material(shape).diffuse_albedo(face.side()),
         };
-        rho * self.radiance
+        rho * self.level(face, e)
     }
 
     /// ρ_d · A_amb at element `e` of `face` (read at its middle).
@@ -102,7 +166,7 @@ impl<const N: usize> AmbientTerm<N> {
         face: FaceId,
         e: ElementId,
     ) -> Spectrum<N> {
-        self.lambertian(scene, face, || {
+        self.lambertian(scene, face, e, || {
             forest.sample_element(e, DVec2::splat(0.5)).coord
         })
     }
@@ -116,13 +180,40 @@ impl<const N: usize> AmbientTerm<N> {
         let side = usize::from(face.side() == Side::Back);
         self.glossy_albedo
             .get(shape)
-            .map_or(Spectrum::zero(), |a| a[side] * self.radiance)
+            .map_or(Spectrum::zero(), |a| a[side] * self.face_level(face))
     }
+}
+
+/// Per face index, the exposed-area mean of `local` over the face's leaf
+/// elements.
+fn face_means<const N: usize>(
+    forest: &trilux_geometry::ElementForest,
+    exposed: &Sided<Vec<f64>>,
+    local: &Sided<Vec<Spectrum<N>>>,
+) -> Vec<Spectrum<N>> {
+    let surfaces = forest.geometry().surfaces().len();
+    (0..2 * surfaces)
+        .map(|k| {
+            let side = if k % 2 == 0 { Side::Front } else { Side::Back };
+            let root = forest.root(trilux_geometry::SurfaceId((k / 2) as u32));
+            let (mut sum, mut area) = (Spectrum::<N>::zero(), 0.0);
+            for leaf in forest.leaves(root) {
+                let a = exposed[side][leaf.index()];
+                sum += local[side][leaf.index()] * a;
+                area += a;
+            }
+            if area > 0.0 {
+                sum * (1.0 / area)
+            } else {
+                Spectrum::zero()
+            }
+        })
+        .collect()
 }
 
 /// The glossy part's directional albedo (less ρ_d), averaged over the
 /// hemisphere with cosine weights, per side.
-fn glossy_albedo<const N: usize>(b: &trilux_brdf::Bsdf<N>) -> [Spectrum<N>; 2] {
+pub(crate) fn glossy_albedo<const N: usize>(b: &trilux_brdf::Bsdf<N>) -> [Spectrum<N>; 2] {
     Side::BOTH.map(|side| {
         if !b.has_glossy(side) {
             return Spectrum::zero();

@@ -17,6 +17,8 @@
 //!          source face or hierarchy u32, node u32, visibility f32
 //!          far fields (version 5): count u32; per field: sender face u32,
 //!          block count u32, and per block: cluster u32, radiance N × f32
+//!          the residual's later bounces (version 6, `crate::local_ambient`):
+//!          u8 0 (none) or 1, then front then back, N × f32 per element
 //! ```
 //!
 //! The solve hash covers the scene description, the band count and the
@@ -45,7 +47,7 @@ use crate::stats::SolveStats;
 
 const MAGIC: &[u8; 8] = b"TRILUXS\0";
 /// Version of the solution file format.
-pub const FORMAT_VERSION: u32 = 5;
+pub const FORMAT_VERSION: u32 = 6;
 /// Bytes of the header before the payload.
 const HEADER_LEN: usize = 8 + 4 + 8 + 4 + 8 + 8;
 /// The largest statistics block a reader accepts (64 MiB).
@@ -240,6 +242,15 @@ impl<const N: usize> Solution<N> {
                 w.spectrum(l);
             }
         }
+        match self.ambient.local() {
+            Some(local) => {
+                w.u8(1);
+                for (_, side) in local.iter() {
+                    side.iter().for_each(|s| w.spectrum(s));
+                }
+            }
+            None => w.u8(0),
+        }
         Ok(w.0)
     }
 
@@ -323,6 +334,15 @@ impl<const N: usize> Solution<N> {
         let links = read_links(&mut r, faces, elements as u32, &hierarchies)?;
         let clusters = (2 * surfaces).saturating_sub(1) as u32;
         let far = read_far::<N>(&mut r, faces, clusters)?;
+        let local_ambient = match r.u8()? {
+            0 => None,
+            1 => Some(read_sided(
+                &mut r,
+                |r| r.radiance::<N>(),
+                forest.element_count(),
+            )?),
+            _ => return Err("corrupt ambient block".into()),
+        };
         if r.pos != payload.len() {
             return Err("trailing bytes after the solution".into());
         }
@@ -336,6 +356,7 @@ impl<const N: usize> Solution<N> {
             far,
             links,
             stats,
+            local_ambient,
         }))
     }
 }

@@ -2,6 +2,7 @@
 //! final gathering (paper §4.5). Its file format is in [`file`].
 
 mod ambient;
+pub(crate) use ambient::glossy_albedo;
 mod file;
 
 use std::collections::HashMap;
@@ -94,6 +95,9 @@ pub(crate) struct Parts<const N: usize> {
     pub far: Vec<FarRecord<N>>,
     pub links: GatherLinks,
     pub stats: SolveStats,
+    /// The local ambient term (`crate::local_ambient`), when the solve or
+    /// the file gives it.
+    pub local_ambient: Option<Sided<Vec<Spectrum<N>>>>,
 }
 
 /// The stored hierarchies' index by (sender face, receiver face).
@@ -182,15 +186,16 @@ impl<const N: usize> Solution<N> {
     /// the stopped solve's light alone). Every reader follows: radiance
     /// queries, face and surface means, the gather links' senders.
     pub fn set_ambient(&mut self, on: bool) {
-        if self.ambient.on != on && !self.ambient.radiance.is_black() {
+        if self.ambient.on != on && !self.ambient.is_empty() {
             self.ambient.on = on;
             self.link_radiance = self.sender_radiance();
         }
     }
 
-    /// The ambient radiance A_amb the readers add (times each face's
-    /// reflectance) for the light the solve left unshot; zero when off or
-    /// when the solve left nothing (stats' `ambient`).
+    /// Cohen's uniform ambient radiance A_amb (stats' `ambient`); zero
+    /// when off or when the solve left nothing. The readers add it (times
+    /// each face's reflectance) only to a solution without the residual's
+    /// later bounces (`crate::local_ambient`), which replace it.
     pub fn ambient_radiance(&self) -> Spectrum<N> {
         if self.ambient.on {
             self.ambient.radiance
@@ -315,7 +320,7 @@ impl<const N: usize> Solution<N> {
         self.radiance[from.face.side()][leaf.index()]
             + self
                 .ambient
-                .lambertian(&self.scene, from.face, || from.coord)
+                .lambertian(&self.scene, from.face, leaf, || from.coord)
     }
 
     /// Area mean of the Lambertian (two-point) reflected radiance over one
