@@ -147,7 +147,7 @@ impl<const N: usize> Interreflection<N> {
     /// "Real interiors"). a tends to the measured value as RF is shot;
     /// `None` before anything arrived.
     pub fn return_fraction(&self, residual: Spectrum<N>) -> Option<Spectrum<N>> {
-        let prior = |b: usize| ratio(self.reflected[b], self.arrived_reflecting[b]);
+        let prior = |b: usize| self.prior(b);
         if self.shot.max_value() > 0.0 {
             return Some(Spectrum::new(std::array::from_fn(|b| {
                 let pending = residual[b].max(0.0);
@@ -161,6 +161,13 @@ impl<const N: usize> Interreflection<N> {
             return Some(Spectrum::new(std::array::from_fn(prior)));
         }
         None
+    }
+
+    /// a₀ in band `b`: what the receivers that reflect some light
+    /// reflected over what arrived on them (the lit reflecting faces'
+    /// reflectance, as if the scene were closed).
+    fn prior(&self, b: usize) -> f64 {
+        ratio(self.reflected[b], self.arrived_reflecting[b])
     }
 
     /// CR for the residual `residual`, `emission` of it emitted light not
@@ -192,7 +199,7 @@ impl<const N: usize> Interreflection<N> {
     /// for that part only).
     fn future_of(&self, residual: f64, emission: f64, a: f64, b: usize) -> f64 {
         let emission = emission.clamp(0.0, residual.max(0.0));
-        let prior = ratio(self.reflected[b], self.arrived_reflecting[b]);
+        let prior = self.prior(b);
         let a = a.clamp(0.0, MAX_RETURN);
         future_reflected(residual - emission, a) + emission * prior / (1.0 - a)
     }
@@ -264,9 +271,7 @@ impl<const N: usize> Interreflection<N> {
             reflected_flux: self.reflected.to_array().to_vec(),
             future_reflected_flux: future,
             unshot_emission_flux: emission.to_array().to_vec(),
-            first_reflectance: (0..N)
-                .map(|b| ratio(self.reflected[b], self.arrived_reflecting[b]))
-                .collect(),
+            first_reflectance: (0..N).map(|b| self.prior(b)).collect(),
             reflecting_area: area.to_array().to_vec(),
         }
     }
@@ -424,11 +429,7 @@ mod tests {
     /// interreflection still to come (the bathroom, results.md).
     #[test]
     fn one_shot_into_a_black_lamp_does_not_converge_the_room() {
-        let mut t = Interreflection::<1>::new(1);
-        let face = FaceId::new(SurfaceId(0), Side::Front);
-        let one = Spectrum::splat(1.0);
-        t.book_shot(one, Interreflection::reflected_share(one, one));
-        t.book_group(face, one, Spectrum::splat(0.5), Spectrum::zero());
+        let (mut t, face) = lamp_shot_onto_one_half_grey_face();
         let phi = Spectrum::splat(0.1);
         let share = Interreflection::reflected_share(phi, Spectrum::zero());
         t.book_shot(phi, share);
@@ -475,11 +476,7 @@ mod tests {
     /// almost nothing (CR 0.98: the sky box's sides left unshot).
     #[test]
     fn unshot_emission_counts_as_light_still_to_be_reflected_once() {
-        let mut t = Interreflection::<1>::new(1);
-        let face = FaceId::new(SurfaceId(0), Side::Front);
-        let one = Spectrum::splat(1.0);
-        t.book_shot(one, Interreflection::reflected_share(one, one));
-        t.book_group(face, one, Spectrum::splat(0.5), Spectrum::zero());
+        let (mut t, _) = lamp_shot_onto_one_half_grey_face();
         let phi = Spectrum::splat(0.5);
         t.book_shot(phi, Interreflection::reflected_share(phi, Spectrum::zero()));
         let lamp = Spectrum::splat(0.1);
@@ -487,5 +484,16 @@ mod tests {
         let want = 0.5 / 0.55;
         assert!((cr - want).abs() < 1e-12, "CR {cr}, want {want}");
         assert!(t.convergence_ratio(lamp, Spectrum::zero()) > 0.98);
+    }
+
+    /// A lamp's 1 W shot, all of it arriving on one face that reflects
+    /// half: the start of the two tests above.
+    fn lamp_shot_onto_one_half_grey_face() -> (Interreflection<1>, FaceId) {
+        let mut t = Interreflection::<1>::new(1);
+        let face = FaceId::new(SurfaceId(0), Side::Front);
+        let one = Spectrum::splat(1.0);
+        t.book_shot(one, Interreflection::reflected_share(one, one));
+        t.book_group(face, one, Spectrum::splat(0.5), Spectrum::zero());
+        (t, face)
     }
 }

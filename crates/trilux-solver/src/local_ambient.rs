@@ -18,8 +18,9 @@
 //!   I_e = Σ_links F_es V_es S_s,
 //!
 //! with S the radiance the senders send in this bounce (δL for the first)
-//! and F the pair's form factor (refinement's own where the throughput
-//! cache holds it, else the point-to-disc estimate); the next bounce sends
+//! and F the pair's form factor (`form_factor`: exact from the smaller
+//! element's middle for near pairs, point-to-disc for far ones); the
+//! next bounce sends
 //! S_e = ρ_e I_e, pulled up the element trees by exposed area. The sum of
 //! the I over the bounces is what a Lambertian element of reflectance ρ
 //! adds ρ times. Glossy senders (links to stored nodes) send their face's
@@ -39,6 +40,7 @@ use trilux_geometry::{
 };
 
 use crate::gather_links::{GatherLinks, LinkSource};
+use crate::refine::disc_facing;
 use crate::setup::Setup;
 use crate::state::ShotState;
 
@@ -119,6 +121,8 @@ struct Plan<'a, const N: usize> {
     links: Vec<Weighted>,
     /// Per receiver key: Σ F V of its row.
     coverage: Vec<f64>,
+    /// Per side and element: ρ_d (a textured element its own).
+    rho: Sided<Vec<Spectrum<N>>>,
     /// Per face: the glossy part's albedo (hemisphere mean).
     glossy_albedo: PerFace<Spectrum<N>>,
 }
@@ -171,6 +175,7 @@ impl<'a, const N: usize> Plan<'a, N> {
             offsets,
             links: weighted,
             coverage: Vec::new(),
+            rho: element_reflectance(setup),
             glossy_albedo,
         };
         plan.coverage = (0..offsets.len().saturating_sub(1))
@@ -259,37 +264,18 @@ impl<'a, const N: usize> Plan<'a, N> {
     /// times the face's mean.
     fn reflect(&self, incident: &Sided<Vec<Spectrum<N>>>) -> Sending<N> {
         let forest = self.forest;
-        let surfaces = forest.geometry().surfaces().len();
         let element = Sided::from_fn(|side| {
-            let mut v = incident[side].clone();
-            for surface in 0..surfaces as u32 {
-                let face = FaceId::new(SurfaceId(surface), side);
-                let rho = self.setup.faces[face].rho_d;
-                self.scale_tree(forest.root(SurfaceId(surface)), face, rho, &mut v);
-            }
-            v
+            incident[side]
+                .iter()
+                .zip(&self.rho[side])
+                .map(|(i, r)| *i * *r)
+                .collect()
         });
-        let glossy = PerFace::from_fn(surfaces, |face| {
+        let glossy = PerFace::from_fn(forest.geometry().surfaces().len(), |face| {
             let root = forest.root(face.surface());
             self.glossy_albedo[face] * incident[face.side()][root.index()]
         });
         Sending { element, glossy }
-    }
-
-    /// Multiplies the values of `face`'s tree under `e` by their ρ_d.
-    fn scale_tree(&self, e: ElementId, face: FaceId, rho: Spectrum<N>, v: &mut [Spectrum<N>]) {
-        let r = self
-            .setup
-            .textures
-            .as_ref()
-            .and_then(|t| t.rho(face, e))
-            .unwrap_or(rho);
-        v[e.index()] = v[e.index()] * r;
-        if let Some(children) = self.forest.element(e).children() {
-            for c in children {
-                self.scale_tree(c, face, rho, v);
-            }
-        }
     }
 
     /// Flux of one bounce's incident light over every face (band sum).
@@ -303,6 +289,25 @@ impl<'a, const N: usize> Plan<'a, N> {
             })
             .sum()
     }
+}
+
+/// ρ_d of every element and side: its face's, or a textured element's own
+/// (`crate::textures`).
+fn element_reflectance<const N: usize>(setup: &Setup<N>) -> Sided<Vec<Spectrum<N>>> {
+    let forest = setup.forest();
+    Sided::from_fn(|side| {
+        (0..forest.element_count() as u32)
+            .map(|e| {
+                let e = ElementId(e);
+                let face = FaceId::new(forest.element(e).surface, side);
+                setup
+                    .textures
+                    .as_ref()
+                    .and_then(|t| t.rho(face, e))
+                    .unwrap_or(setup.faces[face].rho_d)
+            })
+            .collect()
+    })
 }
 
 /// The receiving face element of row `k` (`FaceElement::key`'s inverse).
@@ -349,25 +354,16 @@ fn form_factor<const N: usize>(
     }
 }
 
-/// The point-to-disc form factor A cos θ_r cos θ_s / (π r² + A) from
-/// centre to centre (the sender's exposed area), zero where the centres
-/// do not face each other.
+/// The point-to-disc form factor from centre to centre (the sender's
+/// exposed area), zero where the centres do not face each other
+/// (refinement's estimate takes both cosines as 1 there, a bound, which
+/// here would count coplanar neighbours).
 fn disc_form_factor<const N: usize>(setup: &Setup<N>, recv: FaceElement, send: FaceElement) -> f64 {
     let forest = setup.forest();
     let (er, es) = (forest.element(recv.element), forest.element(send.element));
     let area = setup.exposed_area[send.side][send.element.index()];
-    let d = es.centre - er.centre;
-    let r2 = d.length_squared();
-    if area <= 0.0 || r2 <= 0.0 {
-        return 0.0;
-    }
-    let r = r2.sqrt();
-    let cr = (er.normal * recv.side.sign()).dot(d) / r;
-    let cs = -(es.normal * send.side.sign()).dot(d) / r;
-    if cr <= 0.0 || cs <= 0.0 {
-        return 0.0;
-    }
-    (area * cr * cs / (std::f64::consts::PI * r2 + area)).min(1.0)
+    let (nr, ns) = (er.normal * recv.side.sign(), es.normal * send.side.sign());
+    disc_facing(er.centre, nr, es.centre, ns, area).unwrap_or(0.0)
 }
 
 /// Per face, the unshot light of its stored (glossy) transport as a

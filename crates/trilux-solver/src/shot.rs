@@ -224,7 +224,11 @@ impl<const N: usize> Solver<N> {
         // The emission a face's first shot carries (the rest is reflected
         // light: `ambient`).
         let emission = match source {
-            Source::Radiosity(face) => std::mem::take(&mut self.state.unshot_emission[face]),
+            Source::Radiosity(face) => self
+                .state
+                .unshot_emission
+                .remove(&face)
+                .unwrap_or_else(Spectrum::zero),
             _ => Spectrum::zero(),
         };
         let share = crate::ambient::Interreflection::reflected_share(phi, emission);

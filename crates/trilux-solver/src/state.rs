@@ -6,7 +6,7 @@
 //! emitters' unshot light (paper §6) and root interactions of zero
 //! radiance; what is fixed before the first shot is in `setup`.
 
-use std::collections::HashMap;
+use std::collections::{BTreeMap, HashMap};
 use std::sync::Mutex;
 
 use rayon::prelude::*;
@@ -43,9 +43,10 @@ pub(crate) struct ShotState<const N: usize> {
     pub coverage: Mutex<HashMap<(FaceId, ElementId), f64>>,
     /// Where the energy went.
     pub ledger: Ledger,
-    /// Emitted flux of every face not yet shot (a shot's share of
-    /// emission, for the interreflection estimate).
-    pub unshot_emission: PerFace<Spectrum<N>>,
+    /// Emitted flux of every emitting face not yet shot (a shot's share
+    /// of emission, for the interreflection estimate; summed for CR once
+    /// a shot, so only those faces are kept, in face order).
+    pub unshot_emission: BTreeMap<FaceId, Spectrum<N>>,
     /// What the shots tell about interreflection (`ambient`).
     pub interreflection: Interreflection<N>,
     /// Statistics so far.
@@ -93,7 +94,11 @@ impl<const N: usize> ShotState<N> {
         let count = forest.element_count();
         let surfaces = forest.geometry().surfaces().len();
         ShotState {
-            unshot_emission: face_flux.clone(),
+            unshot_emission: face_flux
+                .iter()
+                .filter(|(_, f)| !f.is_black())
+                .map(|(face, f)| (face, *f))
+                .collect(),
             interreflection: Interreflection::new(surfaces),
             hierarchies: hierarchies.into_iter().map(Some).collect(),
             used: vec![false; count],

@@ -109,22 +109,29 @@ impl<'a, const N: usize> RefineContext<'a, N> {
 /// Point-to-disc estimate of F_{a→b} (Hanrahan, Salzman & Aupperle 1991): b seen from a's
 /// centre as a disc of the same area.
 pub(super) fn disc_estimate(pa: DVec3, na: DVec3, pb: DVec3, nb: DVec3, area_b: f64) -> f64 {
+    if (pb - pa).length_squared() <= 0.0 {
+        return 1.0;
+    }
+    // Elements that do not face each other at their centres may still
+    // exchange light near their edges: use the larger cosines' bound.
+    disc_facing(pa, na, pb, nb, area_b).unwrap_or_else(|| {
+        let r2 = (pb - pa).length_squared();
+        (area_b / (PI * r2 + area_b)).min(1.0)
+    })
+}
+
+/// A cos θ_a cos θ_b / (π r² + A) from `pa` to a disc of area `area_b`
+/// at `pb`, when the two face each other (both cosines positive); `None`
+/// otherwise, and for coincident points.
+pub(crate) fn disc_facing(pa: DVec3, na: DVec3, pb: DVec3, nb: DVec3, area_b: f64) -> Option<f64> {
     let d = pb - pa;
     let r2 = d.length_squared();
     if r2 <= 0.0 {
-        return 1.0;
+        return None;
     }
     let r = r2.sqrt();
-    let ca = (na.dot(d) / r).max(0.0);
-    let cb = (-nb.dot(d) / r).max(0.0);
-    // Elements that do not face each other at their centres may still
-    // exchange light near their edges: use the larger cosines' bound.
-    let (ca, cb) = if ca == 0.0 || cb == 0.0 {
-        (1.0, 1.0)
-    } else {
-        (ca, cb)
-    };
-    (area_b * ca * cb / (PI * r2 + area_b)).min(1.0)
+    let (ca, cb) = (na.dot(d) / r, -nb.dot(d) / r);
+    (ca > 0.0 && cb > 0.0).then(|| (area_b * ca * cb / (PI * r2 + area_b)).min(1.0))
 }
 
 impl<const N: usize> RefineContext<'_, N> {

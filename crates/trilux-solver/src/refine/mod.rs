@@ -39,6 +39,6 @@ mod triple;
 #[cfg(test)]
 mod triple_tests;
 
-pub(crate) use context::{Lateness, RefineContext};
+pub(crate) use context::{Lateness, RefineContext, disc_facing};
 pub(crate) use incidences::IncidenceMemo;
 pub(crate) use triple::{Incidence, TripleTask};

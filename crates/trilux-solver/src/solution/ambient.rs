@@ -40,7 +40,7 @@ impl<const N: usize> AmbientTerm<N> {
     /// The term of a solution's parts: the local term when the parts hold
     /// it, else A_amb from its stats (none for a solution saved before the
     /// term existed); the faces it lit.
-    pub fn new(p: &Parts<N>) -> Self {
+    pub fn new(p: &Parts<N>, local: Option<Sided<Vec<Spectrum<N>>>>) -> Self {
         let a = &p.stats.ambient.radiance;
         let radiance = if a.len() == N && a.iter().all(|x| x.is_finite() && *x >= 0.0) {
             Spectrum::new(std::array::from_fn(|b| a[b]))
@@ -48,7 +48,7 @@ impl<const N: usize> AmbientTerm<N> {
             Spectrum::zero()
         };
         let forest = p.discretisation.forest();
-        let local = p.local_ambient.clone().filter(|l| {
+        let local = local.filter(|l| {
             Side::BOTH
                 .iter()
                 .all(|&s| l[s].len() == forest.element_count())
@@ -59,13 +59,19 @@ impl<const N: usize> AmbientTerm<N> {
         if radiance.is_black() && local.is_none() {
             return AmbientTerm::default();
         }
+        // A face is lit when the solve left light at its root, or the
+        // residual's bounces reach it.
         let surfaces = forest.geometry().surfaces().len();
-        let mut lit = vec![false; 2 * surfaces];
-        for (k, l) in lit.iter_mut().enumerate() {
-            let side = if k % 2 == 0 { Side::Front } else { Side::Back };
-            let root = forest.root(trilux_geometry::SurfaceId((k / 2) as u32));
-            *l = p.radiance[side][root.index()].max_value() > 0.0;
-        }
+        let mut lit: Vec<bool> = (0..2 * surfaces as u32)
+            .map(|k| {
+                let face = FaceId(k);
+                let root = forest.root(face.surface()).index();
+                p.radiance[face.side()][root].max_value() > 0.0
+                    || local
+                        .as_ref()
+                        .is_some_and(|l| l[face.side()][root].max_value() > 0.0)
+            })
+            .collect();
         for h in &p.hierarchies {
             if h.nodes.iter().any(|n| n.radiance.max_value() > 0.0) {
                 lit[h.from.index()] = true;
@@ -74,13 +80,6 @@ impl<const N: usize> AmbientTerm<N> {
         for FarRecord { face, blocks } in &p.far {
             if blocks.iter().any(|(_, l)| l.max_value() > 0.0) {
                 lit[face.index()] = true;
-            }
-        }
-        if let Some(l) = &local {
-            for (k, v) in lit.iter_mut().enumerate() {
-                let side = if k % 2 == 0 { Side::Front } else { Side::Back };
-                let root = forest.root(trilux_geometry::SurfaceId((k / 2) as u32));
-                *v = *v || l[side][root.index()].max_value() > 0.0;
             }
         }
         let local_face = match &local {
@@ -191,15 +190,13 @@ fn face_means<const N: usize>(
     exposed: &Sided<Vec<f64>>,
     local: &Sided<Vec<Spectrum<N>>>,
 ) -> Vec<Spectrum<N>> {
-    let surfaces = forest.geometry().surfaces().len();
-    (0..2 * surfaces)
+    (0..2 * forest.geometry().surfaces().len() as u32)
         .map(|k| {
-            let side = if k % 2 == 0 { Side::Front } else { Side::Back };
-            let root = forest.root(trilux_geometry::SurfaceId((k / 2) as u32));
+            let face = FaceId(k);
             let (mut sum, mut area) = (Spectrum::<N>::zero(), 0.0);
-            for leaf in forest.leaves(root) {
-                let a = exposed[side][leaf.index()];
-                sum += local[side][leaf.index()] * a;
+            for leaf in forest.leaves(forest.root(face.surface())) {
+                let a = exposed[face.side()][leaf.index()];
+                sum += local[face.side()][leaf.index()] * a;
                 area += a;
             }
             if area > 0.0 {

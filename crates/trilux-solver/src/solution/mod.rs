@@ -112,7 +112,7 @@ fn index_by_faces<const N: usize>(hierarchies: &[Hierarchy<N>]) -> HashMap<(Face
 impl<const N: usize> Solution<N> {
     /// A solution from its parts (a solve's or a file's), with the indexes
     /// derived from them.
-    pub(crate) fn assemble(p: Parts<N>) -> Self {
+    pub(crate) fn assemble(mut p: Parts<N>) -> Self {
         let forest = p.discretisation.forest();
         let far_index = p
             .far
@@ -125,7 +125,8 @@ impl<const N: usize> Solution<N> {
                 *f = true;
             }
         }
-        let ambient = ambient::AmbientTerm::new(&p);
+        let local = p.local_ambient.take();
+        let ambient = ambient::AmbientTerm::new(&p, local);
         let mut s = Solution {
             tree: ClusterTree::build(forest.geometry()),
             far: p.far,
