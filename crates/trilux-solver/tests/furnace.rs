@@ -179,3 +179,44 @@ fn furnace_stopped_early_is_completed_by_the_residuals_bounces() {
         without.1
     );
 }
+
+/// The residual's bounces survive the solution file: the stopped furnace
+/// saved and read back gives the same radiance at every probe point, to
+/// the file's f32 (relative 1e-6), the term included (with it off, the
+/// read-back solution is far from the saved one's answer).
+#[test]
+fn the_residuals_bounces_are_kept_by_the_solution_file() {
+    let solution = solve_with::<3>(|s| s.max_shots = 3);
+    let bytes = solution.to_bytes().expect("serialises");
+    let mut loaded = Solution::<3>::from_bytes(
+        &bytes,
+        std::sync::Arc::clone(solution.scene()),
+        solution.settings(),
+    )
+    .expect("reads back");
+    let probe = |s: &Solution<3>, f: u32, uv: DVec2| {
+        let from = SurfaceSite::new(SurfaceId(f), Side::Front, SurfaceCoord::Uv(uv));
+        let to = SurfaceSite::new(
+            SurfaceId((f + 1) % 6),
+            Side::Front,
+            SurfaceCoord::Uv(DVec2::splat(0.5)),
+        );
+        s.radiance(&from, &to)[0]
+    };
+    let points: Vec<(u32, DVec2)> = (0..6)
+        .flat_map(|f| (0..5).map(move |a| (f, DVec2::new(0.1 + 0.2 * a as f64, 0.3))))
+        .collect();
+    for &(f, uv) in &points {
+        let (want, got) = (probe(&solution, f, uv), probe(&loaded, f, uv));
+        assert!(
+            (got - want).abs() <= 1e-6 * want,
+            "face {f} at {uv}: {got} against {want}"
+        );
+    }
+    loaded.set_ambient(false);
+    let off = probe(&loaded, 0, DVec2::splat(0.5));
+    assert!(
+        off < 0.7 * probe(&solution, 0, DVec2::splat(0.5)),
+        "without the term: {off}"
+    );
+}
