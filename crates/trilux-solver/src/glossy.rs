@@ -97,7 +97,10 @@ impl<const N: usize> Solver<N> {
             return None;
         }
         let to_light = incidence.and_then(Incidence::direction)?;
-        let covered = self.hemisphere_coverage(l.face, l.j, late);
+        // A faint glossy share (received above j) takes the face's mean
+        // coverage, as past the deadline.
+        let coarse = incidence.is_some_and(|inc| inc.coarse);
+        let covered = self.hemisphere_coverage(l.face, l.j, late || coarse);
         // A textured j reflects g(j) times the nominal glossy part.
         let g = self
             .setup

@@ -74,6 +74,8 @@ impl<const N: usize> Solver<N> {
             let (glossy_g, sampled) = (glossy_flux[g], sampled_flux[g]);
             let target = targets[g];
             self.state.stats.late_groups += u64::from(late && target.is_some());
+            self.state.stats.coarse_groups +=
+                u64::from(target.is_some() && incidences[g].as_ref().is_some_and(|i| i.coarse));
             let scale = crate::glossy::group_scale(target, glossy_g, sampled, room);
             group_scale[g] = scale;
             let reflected_glossy = glossy_g * scale.0 + sampled * scale.1;

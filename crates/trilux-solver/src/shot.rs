@@ -377,7 +377,7 @@ impl<const N: usize> Solver<N> {
                     )
                 })
                 .collect();
-            let incidences = incidences(&ctx.refine, &senders, &glossy.links);
+            let incidences = incidences(&ctx.refine, ctx.stored_from, &senders, &glossy.links);
             let stage_two = stage_two(
                 &ctx.refine,
                 &senders,
@@ -578,12 +578,20 @@ pub(crate) struct ShotContext<'a, const N: usize> {
     pub stored_from: &'a PerFace<Range<usize>>,
 }
 
+/// The fewest stored hierarchies a face needs for its faint glossy shares
+/// to be received at the stored nodes above their element
+/// (docs/solver.md, "Faint glossy shares"): below it, splitting each
+/// hierarchy down to the element costs little, and the finer light is
+/// kept (the coarser one moved a golden image; measured there).
+const FAINT_MIN_HIERARCHIES: usize = 64;
+
 /// Each pair link's part of its three-point links, once for all the
 /// hierarchies that leave its receiving face (`None` for a link into a
 /// face without stored interactions, or one that carries no light, such as
 /// a glossy share that waits: `deferred`). Each group has its sender.
 fn incidences<const N: usize>(
     ctx: &RefineContext<'_, N>,
+    stored_from: &PerFace<Range<usize>>,
     senders: &[(&Sender<'_, N>, FaceId)],
     pair_links: &[PairLink<N>],
 ) -> Vec<Option<Incidence<N>>> {
@@ -597,9 +605,12 @@ fn incidences<const N: usize>(
                 f: 0.0,
                 spread: 0.0,
             };
-            (ctx.faces[l.face].stored && !l.unshot.is_black())
+            let mut inc = (ctx.faces[l.face].stored && !l.unshot.is_black())
                 .then(|| ctx.incidence_with(sender, send_face.of(l.i), l.face.of(l.j), tij))
-                .flatten()
+                .flatten()?;
+            inc.coarse = stored_from[l.face].len() >= FAINT_MIN_HIERARCHIES
+                && ctx.glossy_negligible(l.face, &inc);
+            Some(inc)
         })
         .collect()
 }
@@ -682,7 +693,7 @@ fn stage_two<const N: usize>(
                 };
                 task.group = g;
                 (task.sender, task.si) = senders[g as usize];
-                ctx.nodes_for(task.h, l.j, &mut task.lost, &mut nodes);
+                ctx.nodes_for(task.h, (l.j, incidence.coarse), &mut task.lost, &mut nodes);
                 for &n in &nodes {
                     // l.j, or past the deadline a stored node's coarser
                     // sender element above it.

@@ -59,6 +59,12 @@ pub struct SolveStats {
     /// inside a shot").
     #[serde(default)]
     pub late_groups: u64,
+    /// Pair links into glossy faces whose glossy share was below the
+    /// photometric threshold, received at the stored nodes above their
+    /// element with the face's mean coverage (docs/solver.md, "Faint
+    /// glossy shares").
+    #[serde(default)]
+    pub coarse_groups: u64,
     /// Pair links whose glossy share waited at its face, summed with its
     /// pair's earlier ones (docs/solver.md, "Deferred glossy reception").
     #[serde(default)]

@@ -1,8 +1,8 @@
 //! Stage 2 after the solve's deadline (docs/solver.md, "The deadline
-//! inside a shot"): a three-point link is linked where it stands, and a
-//! stored hierarchy is not split down to a pair link's receiver. Answers
-//! from the definition: the link made is the one the photometric
-//! criterion makes.
+//! inside a shot") and for a faint glossy share ("Faint glossy shares"):
+//! a three-point link is linked where it stands, and a stored hierarchy is
+//! not split down to a pair link's receiver. Answers from the definition:
+//! the link made is the one the photometric criterion makes.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // tests may panic
 
 use std::sync::atomic::Ordering;
@@ -122,7 +122,7 @@ fn after_the_deadline_a_hierarchy_is_not_split_down_to_the_receiver() {
     let nodes = |deadline| {
         let mut found = Vec::new();
         let (h, _, late) = stage_two(0.0, deadline, |ctx, task| {
-            ctx.nodes_for(task.h, leaf, &mut task.lost, &mut found);
+            ctx.nodes_for(task.h, (leaf, false), &mut task.lost, &mut found);
         });
         let from: Vec<_> = found.iter().map(|&n| h.nodes[n as usize].from).collect();
         (h, found, from, late)
@@ -165,4 +165,51 @@ fn a_root_made_after_the_deadline_takes_the_base_rays() {
     assert_eq!((early, late), (0, 1));
     assert!(full > 0.0 && full.is_finite());
     assert_eq!(cheap, full);
+}
+
+/// A faint pair (its glossy share below the photometric threshold) finds
+/// the stored root node as it stands, as after the deadline, but counts
+/// no late link; the same pair not faint splits R's hierarchy down to j.
+#[test]
+fn a_faint_glossy_share_is_received_at_the_stored_nodes() {
+    let (_, root) = roots();
+    let (setup, _) = mirror_scene();
+    let leaf = *ts::leaves(setup.forest(), root).first().unwrap();
+    let nodes = |coarse| {
+        let mut found = Vec::new();
+        let (h, _, late) = stage_two(0.0, None, |ctx, task| {
+            ctx.nodes_for(task.h, (leaf, coarse), &mut task.lost, &mut found);
+        });
+        let from: Vec<_> = found.iter().map(|&n| h.nodes[n as usize].from).collect();
+        (h.nodes.len(), found, from, late)
+    };
+    assert_eq!(nodes(true), (1, vec![0], vec![root], 0));
+    let (grown, _, from, late) = nodes(false);
+    assert!(grown > 1 && from.iter().all(|&f| f == leaf) && late == 0);
+}
+
+/// The bound that makes a pair faint bounds what its three-point links
+/// carry: E's root pair into the glossy floor R, refined towards the plate
+/// K with every error bound nearly zero (down to the depth limit, where
+/// the midpoint rule is close to the integral), sends on to K at most
+/// π T_ER (δL · ρ_g): K is one part of the hemisphere ρ_g integrates over.
+#[test]
+fn the_faint_bound_bounds_what_the_pairs_links_carry() {
+    let (i, j) = roots();
+    let mut bound = 0.0;
+    let (h, links, _) = stage_two(0.0, None, |ctx, task| {
+        let inc = ctx
+            .incidence(task.sender, task.si.of(i), task.h.from.of(j))
+            .expect("light passes from E to R");
+        bound = ctx.glossy_flux_bound(task.h.from, &inc).unwrap();
+        assert!(!ctx.glossy_negligible(task.h.from, &inc), "threshold 0");
+        ctx.refine_triple(task, i, j, 0, Some(&inc));
+    });
+    let carried: f64 = links
+        .iter()
+        .map(|l| std::f64::consts::PI * h.nodes[l.node as usize].t * l.gathered.sum())
+        .sum();
+    assert!(h.nodes.len() > 1, "refined");
+    assert!(carried > 0.0 && bound.is_finite());
+    assert!(carried <= bound, "links carry {carried}, bound {bound}");
 }

@@ -44,6 +44,11 @@ pub(crate) struct Incidence<const N: usize> {
     /// traced when a link first needs it and shared by every hierarchy the
     /// pair link feeds (they borrow one incidence).
     lobe: OnceLock<Vec<LobeHit<N>>>,
+    /// The pair's whole glossy share is below the photometric threshold
+    /// ([`RefineContext::glossy_negligible`]): stage 2 receives it at the
+    /// stored nodes above j, unsplit (docs/solver.md, "Faint glossy
+    /// shares").
+    pub(crate) coarse: bool,
 }
 
 impl<const N: usize> Incidence<N> {
@@ -285,7 +290,40 @@ impl<const N: usize> RefineContext<'_, N> {
                 .map(|wi| Incoming { frame, wi }),
             straddle_i: self.straddles(i.element, j.element),
             lobe: OnceLock::new(),
+            coarse: false,
         })
+    }
+
+    /// True when the glossy flux the pair brings to j, π T_ij (δL_i ·
+    /// ρ_g(ω_i)) with ρ_g the glossy albedo (directional albedo less ρ_d,
+    /// times j's texture) for the light's direction at j's centre, is below
+    /// the photometric threshold. Every three-point link of the pair then
+    /// carries less (the group's links together reflect at most ρ_g of
+    /// what arrived), so the paper's criterion would link each where it
+    /// stands. Two-point transport only (the uniform mode's links carry
+    /// the whole fr).
+    pub fn glossy_negligible(&self, face: FaceId, inc: &Incidence<N>) -> bool {
+        self.glossy_flux_bound(face, inc)
+            .is_some_and(|bound| bound < self.flux_threshold)
+    }
+
+    /// π T_ij (δL_i · ρ_g(ω_i)) of [`Self::glossy_negligible`] (band sum);
+    /// `None` when no part of i is in front of j, or in uniform mode.
+    pub fn glossy_flux_bound(&self, face: FaceId, inc: &Incidence<N>) -> Option<f64> {
+        let incoming = inc.incoming?;
+        if self.settings.transport != Transport::TwoPoint {
+            return None;
+        }
+        let shape = self.faces[face].shape;
+        let bsdf = &self.materials[shape];
+        let g = self
+            .textures
+            .map_or(Spectrum::splat(1.0), |t| t.glossy(face, inc.j));
+        let glossy_albedo = (self.albedo[shape].albedo(incoming.wi)
+            - bsdf.diffuse_albedo(face.side()))
+        .max(Spectrum::zero())
+            * g;
+        Some(PI * inc.tij.t * (inc.unshot * glossy_albedo).sum())
     }
     /// Stage 2: refines the three-point link (i j) → node `n` of the task's
     /// hierarchy (whose sender element is j) and appends node links.
@@ -358,8 +396,10 @@ impl<const N: usize> RefineContext<'_, N> {
             gathered,
             sampled: false,
         };
-        // Past the deadline: linked as it stands, before the costly oracle.
-        if self.below_photometric(bsdf, known, j, &task.h.nodes[n as usize], aj, gathered)
+        // A faint glossy share, or past the deadline: linked as it stands,
+        // before the costly oracle.
+        if known.coarse
+            || self.below_photometric(bsdf, known, j, &task.h.nodes[n as usize], aj, gathered)
             || self.cut_short()
         {
             task.push(link);
@@ -451,7 +491,7 @@ impl<const N: usize> RefineContext<'_, N> {
         let k = task.h.nodes[n as usize].to;
         let (ej, ek) = (self.forest.element(j), self.forest.element(k));
         let near_roots = ej.depth + ek.depth < 2 && !self.past_deadline();
-        let worth = PI * known.tij.t * known.unshot.sum() >= self.flux_threshold;
+        let worth = !known.coarse && PI * known.tij.t * known.unshot.sum() >= self.flux_threshold;
         if near_roots && worth && self.throughput(task.h.to.of(k), task.h.from.of(j)).f > 0.0 {
             let side = if ej.area >= ek.area {
                 Driver::J
@@ -480,7 +520,10 @@ impl<const N: usize> RefineContext<'_, N> {
         // Not past the deadline, nor when the whole pair link carries less
         // than the photometric threshold (docs/solver.md, "Refinement"):
         // the group's renormalisation makes up.
-        if self.past_deadline() || PI * known.tij.t * known.unshot.sum() < self.flux_threshold {
+        if known.coarse
+            || self.past_deadline()
+            || PI * known.tij.t * known.unshot.sum() < self.flux_threshold
+        {
             return;
         }
         let k = task.h.nodes[n as usize].to;
@@ -653,12 +696,14 @@ impl<const N: usize> RefineContext<'_, N> {
     /// needed and descending through receiver-side splits (they keep the
     /// same sender element). Past the deadline a leaf above `j` is not
     /// split: it is returned as it stands (its sender element above `j`),
-    /// and counted late. Stage 2 calls this once per pair link and
-    /// hierarchy, so it allocates nothing but `out`'s growth.
+    /// and counted late; so is it, uncounted, for a `coarse` pair (a
+    /// glossy share below the photometric threshold). Stage 2 calls this
+    /// once per pair link and hierarchy, so it allocates nothing but
+    /// `out`'s growth.
     pub fn nodes_for(
         &self,
         h: &mut Hierarchy<N>,
-        j: ElementId,
+        (j, coarse): (ElementId, bool),
         lost: &mut Spectrum<N>,
         out: &mut Vec<u32>,
     ) {
@@ -695,6 +740,7 @@ impl<const N: usize> RefineContext<'_, N> {
                         stack.extend(c.iter().map(|&c| (c, depth)));
                     }
                 }
+                Split::None if coarse => out.push(n),
                 Split::None if self.past_deadline() => {
                     self.count_late_link();
                     out.push(n);
