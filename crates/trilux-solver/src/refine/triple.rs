@@ -477,9 +477,8 @@ impl<const N: usize> RefineContext<'_, N> {
     /// A node whose elements were found not to see each other: as in stage
     /// 1, near the roots a few shadow rays may miss a gap, so look one
     /// level further (splitting the larger of J and K) before giving the
-    /// pair up, unless the deadline has passed or the whole pair link
-    /// carries less than the photometric threshold (as in
-    /// [`Self::split_across_plane`]: the group's renormalisation makes up).
+    /// pair up, when the pair's light is worth it
+    /// ([`Self::searches_further`]).
     fn retry_unseen_node(
         &self,
         task: &mut TripleTask<'_, N>,
@@ -490,9 +489,11 @@ impl<const N: usize> RefineContext<'_, N> {
     ) {
         let k = task.h.nodes[n as usize].to;
         let (ej, ek) = (self.forest.element(j), self.forest.element(k));
-        let near_roots = ej.depth + ek.depth < 2 && !self.past_deadline();
-        let worth = !known.coarse && PI * known.tij.t * known.unshot.sum() >= self.flux_threshold;
-        if near_roots && worth && self.throughput(task.h.to.of(k), task.h.from.of(j)).f > 0.0 {
+        let near_roots = ej.depth + ek.depth < 2;
+        if near_roots
+            && self.searches_further(known)
+            && self.throughput(task.h.to.of(k), task.h.from.of(j)).f > 0.0
+        {
             let side = if ej.area >= ek.area {
                 Driver::J
             } else {
@@ -500,6 +501,18 @@ impl<const N: usize> RefineContext<'_, N> {
             };
             self.split_triple(side, task, i, j, n, known);
         }
+    }
+
+    /// Whether a pair's light is worth a search beyond its links' own
+    /// elements (an unseen pair retried one level down, an element
+    /// straddling j's plane split for its part in front): not past the
+    /// deadline, not for a faint glossy share, nor when the whole pair
+    /// link carries less than the photometric threshold (docs/solver.md,
+    /// "Refinement"); the group's renormalisation makes up.
+    fn searches_further(&self, known: &Incidence<N>) -> bool {
+        !known.coarse
+            && !self.past_deadline()
+            && PI * known.tij.t * known.unshot.sum() >= self.flux_threshold
     }
 
     /// No sample point of i or K on the receiving side of j: an element
@@ -517,13 +530,7 @@ impl<const N: usize> RefineContext<'_, N> {
         known: &Incidence<N>,
         straddle_k: bool,
     ) {
-        // Not past the deadline, nor when the whole pair link carries less
-        // than the photometric threshold (docs/solver.md, "Refinement"):
-        // the group's renormalisation makes up.
-        if known.coarse
-            || self.past_deadline()
-            || PI * known.tij.t * known.unshot.sum() < self.flux_threshold
-        {
+        if !self.searches_further(known) {
             return;
         }
         let k = task.h.nodes[n as usize].to;

@@ -7,7 +7,7 @@
 
 use glam::{DVec2, DVec3};
 use trilux_color::Spectrum;
-use trilux_geometry::{ElementId, FaceId, Side, Sided, SurfaceCoord};
+use trilux_geometry::{ElementForest, ElementId, FaceId, Side, Sided, SurfaceCoord};
 
 use super::{FarRecord, Parts};
 use crate::prepared::PreparedScene;
@@ -24,11 +24,10 @@ pub(super) struct AmbientTerm<const N: usize> {
     /// Whether the readers add it.
     pub on: bool,
     /// Per side and element, the local term's E / (1 − a)
-    /// (`crate::local_ambient`): when present it replaces `radiance`.
+    /// (`crate::local_ambient`): when present it replaces `radiance`. An
+    /// element above the leaves holds their exposed-area mean, so a
+    /// face's root holds the face's.
     local: Option<Sided<Vec<Spectrum<N>>>>,
-    /// Per face index, the local term's mean over the face's leaves (what
-    /// a glossy part, read per face, takes).
-    local_face: Vec<Spectrum<N>>,
     /// Per face index: the solve lit the face.
     lit: Vec<bool>,
     /// Per shape, [front, back]: the glossy part's albedo, averaged over
@@ -82,15 +81,10 @@ impl<const N: usize> AmbientTerm<N> {
                 lit[face.index()] = true;
             }
         }
-        let local_face = match &local {
-            Some(l) => face_means(forest, &p.exposed_area, l),
-            None => Vec::new(),
-        };
         AmbientTerm {
             radiance,
             on: true,
             local,
-            local_face,
             lit,
             glossy_albedo: p.scene.materials().iter().map(glossy_albedo).collect(),
         }
@@ -118,16 +112,10 @@ impl<const N: usize> AmbientTerm<N> {
         }
     }
 
-    /// The term's radiance over the whole of `face`.
-    fn face_level(&self, face: FaceId) -> Spectrum<N> {
-        match &self.local {
-            Some(_) => self
-                .local_face
-                .get(face.index())
-                .copied()
-                .unwrap_or_else(Spectrum::zero),
-            None => self.radiance,
-        }
+    /// The term's radiance over the whole of `face` (its root's: the
+    /// exposed-area mean of its leaves).
+    fn face_level(&self, forest: &ElementForest, face: FaceId) -> Spectrum<N> {
+        self.level(face, forest.root(face.surface()))
     }
 
     fn active(&self, face: FaceId) -> bool {
@@ -161,7 +149,7 @@ impl<const N: usize> AmbientTerm<N> {
     pub fn lambertian_element(
         &self,
         scene: &PreparedScene<N>,
-        forest: &trilux_geometry::ElementForest,
+        forest: &ElementForest,
         face: FaceId,
         e: ElementId,
     ) -> Spectrum<N> {
@@ -171,41 +159,21 @@ impl<const N: usize> AmbientTerm<N> {
     }
 
     /// The glossy part's albedo · A_amb on `face`.
-    pub fn glossy(&self, scene: &PreparedScene<N>, face: FaceId) -> Spectrum<N> {
+    pub fn glossy(
+        &self,
+        scene: &PreparedScene<N>,
+        forest: &ElementForest,
+        face: FaceId,
+    ) -> Spectrum<N> {
         if !self.active(face) {
             return Spectrum::zero();
         }
         let shape = scene.geometry().surface(face.surface()).shape as usize;
         let side = usize::from(face.side() == Side::Back);
-        self.glossy_albedo
-            .get(shape)
-            .map_or(Spectrum::zero(), |a| a[side] * self.face_level(face))
-    }
-}
-
-/// Per face index, the exposed-area mean of `local` over the face's leaf
-/// elements.
-fn face_means<const N: usize>(
-    forest: &trilux_geometry::ElementForest,
-    exposed: &Sided<Vec<f64>>,
-    local: &Sided<Vec<Spectrum<N>>>,
-) -> Vec<Spectrum<N>> {
-    (0..2 * forest.geometry().surfaces().len() as u32)
-        .map(|k| {
-            let face = FaceId(k);
-            let (mut sum, mut area) = (Spectrum::<N>::zero(), 0.0);
-            for leaf in forest.leaves(forest.root(face.surface())) {
-                let a = exposed[face.side()][leaf.index()];
-                sum += local[face.side()][leaf.index()] * a;
-                area += a;
-            }
-            if area > 0.0 {
-                sum * (1.0 / area)
-            } else {
-                Spectrum::zero()
-            }
+        self.glossy_albedo.get(shape).map_or(Spectrum::zero(), |a| {
+            a[side] * self.face_level(forest, face)
         })
-        .collect()
+    }
 }
 
 /// The glossy part's directional albedo (less ρ_d), averaged over the

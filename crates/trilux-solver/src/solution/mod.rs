@@ -176,7 +176,7 @@ impl<const N: usize> Solution<N> {
                         .hierarchies
                         .get(hierarchy as usize)
                         .map_or(Spectrum::zero(), |h| {
-                            self.ambient.glossy(&self.scene, h.from)
+                            self.ambient.glossy(&self.scene, forest, h.from)
                         }),
                 }
             })
@@ -263,7 +263,7 @@ impl<const N: usize> Solution<N> {
     /// radiance towards that block (`cluster_transport`); zero where
     /// neither exists.
     pub fn stored_radiance(&self, from: &SurfaceSite, to: &SurfaceSite) -> Spectrum<N> {
-        let ambient = self.ambient.glossy(&self.scene, from.face);
+        let ambient = self.ambient.glossy(&self.scene, self.forest(), from.face);
         if let Some(&h) = self.by_faces.get(&(from.face, to.face)) {
             return self.hierarchies[h as usize].radiance_at(self.forest(), from.coord, to.coord)
                 + ambient;
