@@ -34,6 +34,7 @@ use crate::directional::{
     GlossyForm, GlossyLight, GlossyPoint, GlossyRecord, GlossySamples, fit_vertices,
 };
 use crate::error::BakeError;
+use crate::gathered::{DiffuseLight, GatheredLight};
 use crate::glb::Document;
 use crate::reconstruct::{baked_flux, vertex_values};
 use crate::tessellate::{ShapeMesh, tessellate};
@@ -53,6 +54,9 @@ pub struct BakeInput<'a, const N: usize> {
     /// The glossy light of glossy sides (module `directional`); without,
     /// it is left out as before.
     pub glossy: Option<&'a dyn GlossyLight>,
+    /// The diffuse light as the renderer reads it at points (module
+    /// `gathered`); without, every leaf shows its constant.
+    pub irradiance: Option<&'a dyn GatheredLight>,
 }
 
 /// How to bake.
@@ -89,6 +93,8 @@ pub struct BakeOptions {
     /// (gather rays + light samples)): a larger bake takes fewer per
     /// vertex, down to a quarter of each (at least one).
     pub glossy_budget: u64,
+    /// How the diffuse light is read at the vertices (module `gathered`).
+    pub diffuse: DiffuseLight,
 }
 
 /// Fewest directions a vertex's glossy light is fitted over.
@@ -107,6 +113,7 @@ impl Default for BakeOptions {
             glossy_light_samples: FIT_LIGHT_SAMPLES,
             glossy_links: false,
             glossy_budget: 8_000_000,
+            diffuse: DiffuseLight::default(),
         }
     }
 }
@@ -163,6 +170,12 @@ pub fn bake<const N: usize>(
     for mesh in meshes.iter().filter(|m| !m.triangles.is_empty()) {
         let sides = Side::BOTH.map(|side| {
             let mut light = SideLight::new(input.solution, textures.as_ref(), mesh, side);
+            if let Some(gathered) = input
+                .irradiance
+                .filter(|_| options.diffuse == DiffuseLight::Gathered)
+            {
+                light.gather(input.solution, gathered, mesh, vertices);
+            }
             flux.add(input.solution, mesh, side, &light);
             light.sh = glossy.fit(input, options, mesh, side, vertices);
             light
@@ -250,6 +263,44 @@ impl<'t, const N: usize> SideLight<'t, N> {
         );
         light.values = values;
         light
+    }
+
+    /// The light as the renderer reads it at each vertex (module
+    /// `gathered`); `first` numbers the mesh's vertices in the bake. A
+    /// side that reflects nothing, and an emitting textured side, keep
+    /// the leaves' values.
+    fn gather(
+        &mut self,
+        solution: &Solution<N>,
+        gathered: &dyn GatheredLight,
+        mesh: &ShapeMesh,
+        first: usize,
+    ) {
+        let scene = solution.scene();
+        let le = match self.side {
+            Side::Front => scene.emission()[mesh.shape as usize].to_linear_srgb(),
+            Side::Back => [0.0; 3],
+        };
+        // E/π times what the side shows it with: its albedo, or 1 on a
+        // textured side (whose values are the light).
+        let scale = match self.map {
+            Some(_) if le != [0.0; 3] => return,
+            Some(_) => [1.0; 3],
+            None => {
+                let rho = scene
+                    .material(mesh.shape as usize)
+                    .diffuse_albedo(self.side);
+                rho.to_linear_srgb().map(|x| x.max(0.0))
+            }
+        };
+        if scale == [0.0; 3] {
+            return;
+        }
+        let points = mesh_points(mesh, self.side, first);
+        let only: Vec<GlossyPoint> = points.iter().map(|(_, p)| *p).collect();
+        for ((v, _), e) in points.iter().zip(gathered.irradiance(&only)) {
+            self.values[*v] = std::array::from_fn(|c| (le[c] + scale[c] * e[c]).max(0.0));
+        }
     }
 
     /// The leaf's mean albedo on a textured side.
@@ -345,27 +396,7 @@ impl GlossyCount {
             return None;
         }
         let start = Instant::now();
-        let mut used = vec![false; mesh.positions.len()];
-        for &v in mesh.triangles.iter().flatten() {
-            used[v as usize] = true;
-        }
-        let points: Vec<(usize, GlossyPoint)> = (0..mesh.positions.len())
-            .filter(|&v| used[v])
-            .map(|v| {
-                let (surface, coord) = mesh.sites[v];
-                let key = 2 * (first + v) as u64 + u64::from(side == Side::Back);
-                let point = GlossyPoint {
-                    shape: mesh.shape,
-                    surface,
-                    coord,
-                    side,
-                    point: mesh.positions[v],
-                    normal: mesh.normals[v],
-                    key,
-                };
-                (v, point)
-            })
-            .collect();
+        let points = mesh_points(mesh, side, first);
         if options.glossy_samples == 0 {
             return None;
         }
@@ -375,6 +406,33 @@ impl GlossyCount {
         self.seconds += start.elapsed().as_secs_f64();
         Some(sh)
     }
+}
+
+/// Every vertex a triangle of `mesh` uses, as a point of `side`, with
+/// its index; `first` numbers the mesh's vertices in the bake (the
+/// points' keys).
+fn mesh_points(mesh: &ShapeMesh, side: Side, first: usize) -> Vec<(usize, GlossyPoint)> {
+    let mut used = vec![false; mesh.positions.len()];
+    for &v in mesh.triangles.iter().flatten() {
+        used[v as usize] = true;
+    }
+    (0..mesh.positions.len())
+        .filter(|&v| used[v])
+        .map(|v| {
+            let (surface, coord) = mesh.sites[v];
+            let key = 2 * (first + v) as u64 + u64::from(side == Side::Back);
+            let point = GlossyPoint {
+                shape: mesh.shape,
+                surface,
+                coord,
+                side,
+                point: mesh.positions[v],
+                normal: mesh.normals[v],
+                key,
+            };
+            (v, point)
+        })
+        .collect()
 }
 
 /// One shape's node, mesh, materials and accessors.

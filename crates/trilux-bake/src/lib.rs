@@ -18,6 +18,8 @@
 //!   T-junctions split so that neighbours share vertices.
 //! - [`reconstruct`]: vertex colours from the leaves' radiance by
 //!   flux-conserving averaging (the rule and its error bound are there).
+//! - [`gathered`]: the diffuse light as the renderer reads it at each
+//!   vertex ([`GatheredLight`]), on request ([`DiffuseLight`]).
 //! - `albedo`: textured materials as an albedo map times the light.
 //! - `camera`: the scene's camera ([`BakeCamera`]) as a glTF camera node.
 //! - [`directional`]: the glossy light of glossy sides per vertex,
@@ -35,6 +37,7 @@ pub mod bake;
 mod camera;
 pub mod directional;
 pub mod error;
+pub mod gathered;
 mod glb;
 pub mod reconstruct;
 mod tessellate;
@@ -43,6 +46,7 @@ pub use bake::{BakeInput, BakeOptions, BakeStats, Baked, MIN_GLOSSY_DIRECTIONS, 
 pub use camera::BakeCamera;
 pub use directional::{GlossyForm, GlossyLight, GlossyPoint, GlossySamples};
 pub use error::BakeError;
+pub use gathered::{DiffuseLight, GatheredLight};
 pub use tessellate::ShapeMesh;
 /// The fitting code, shared with the renderer's preview
 /// (`trilux_geometry::glossy_fit`).

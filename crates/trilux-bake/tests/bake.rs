@@ -161,6 +161,7 @@ fn a_baked_closed_box_keeps_its_flux_and_is_valid_gltf() {
         names: &names,
         camera: None,
         glossy: None,
+        irradiance: None,
     };
     let baked = bake(&input, &BakeOptions::default()).expect("the box bakes");
     assert_eq!(baked.stats.bytes, baked.glb.len());
@@ -313,6 +314,7 @@ fn a_glossy_floor_carries_its_glossy_light_as_harmonics_and_a_lobe() {
         names: &names,
         camera: None,
         glossy: Some(&Quadratic),
+        irradiance: None,
     };
     // Without: the glossy light is left out and the floor marked.
     let mut without = BakeOptions::default();

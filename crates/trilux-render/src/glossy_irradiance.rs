@@ -70,10 +70,21 @@ fn corner<S: SolutionGather<N>, const N: usize>(
     site: &FitSite<S::Locator>,
     stats: &mut GatherStats,
 ) -> Spectrum<N> {
-    let x = &site.point;
-    let side = if site.key.back { -1.0 } else { 1.0 };
-    let up = x.normal * side;
-    let mut sampler = fit_sampler(site.key.seed());
+    glossy_irradiance_at(scene, &site.point, site.key.back, site.key.seed(), stats)
+}
+
+/// E_g at the Lambertian point `x` on its back side when `back`, else its
+/// front (module docs): [`COSINE_RAYS`] cosine rays drawn from the
+/// sequence `seed` names. The bake reads its vertices' light with it.
+pub fn glossy_irradiance_at<S: SolutionGather<N>, const N: usize>(
+    scene: &S,
+    x: &SurfacePoint<S::Locator>,
+    back: bool,
+    seed: u64,
+    stats: &mut GatherStats,
+) -> Spectrum<N> {
+    let up = x.normal * if back { -1.0 } else { 1.0 };
+    let mut sampler = fit_sampler(seed);
     let mut sum = Spectrum::zero();
     for k in 0..COSINE_RAYS {
         sampler.start_sample(k);

@@ -9,7 +9,7 @@ use crate::options::{Product, SolveOptions, parse_exposure, parse_threads};
 use crate::output::{DEFAULT_FOLDER, Kind, Outputs, bake_stats_json, default_output, named};
 use anyhow::{Context, Result};
 use clap::Args;
-use trilux_bake::BakeOptions;
+use trilux_bake::{BakeOptions, DiffuseLight};
 
 /// Arguments of `trilux bake`.
 #[derive(Debug, Args)]
@@ -59,6 +59,12 @@ pub struct BakeArgs {
     /// full render does (slower), instead of the solution's radiance there.
     #[arg(long)]
     pub glossy_links: bool,
+    /// Show the diffuse light the renderer reads at each vertex (as
+    /// `trilux render --preview` does) instead of each leaf element's
+    /// constant light averaged at the vertices (docs/bake.md, "What is
+    /// baked"); slower, and the file no longer holds the solution's flux.
+    #[arg(long)]
+    pub gathered_light: bool,
     /// Write solve and bake statistics (file size, vertices, triangles) as
     /// JSON.
     #[arg(long)]
@@ -109,6 +115,9 @@ pub fn run(args: &BakeArgs) -> Result<()> {
     options.glossy_samples = args.glossy_samples;
     options.glossy_light_samples = args.glossy_light_samples;
     options.glossy_links = args.glossy_links;
+    if args.gathered_light {
+        options.diffuse = DiffuseLight::Gathered;
+    }
     let bake = Product::Bake(options);
     let plan = args
         .options

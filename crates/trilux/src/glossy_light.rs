@@ -9,15 +9,24 @@
 //! Its samples are seeded as the preview's fits are
 //! (`trilux_render::glossy_fit::fit_sampler`), which fit the same form at
 //! the corners of leaf elements.
+//!
+//! It is also the bake's [`trilux_bake::GatheredLight`]: at a vertex, the
+//! link sum with the visibility the solve measured (no rays) and E_g
+//! (`trilux_render::glossy_irradiance`), as the preview reads a diffuse
+//! hit.
 
 use glam::DVec3;
 use rayon::prelude::*;
-use trilux_bake::{GlossyLight, GlossyPoint, GlossySamples};
+use trilux_bake::{GatheredLight, GlossyLight, GlossyPoint, GlossySamples};
+use trilux_color::Spectrum;
+use trilux_geometry::Side;
 use trilux_render::gather::{ExtraBounce, FinalGather};
 use trilux_render::glossy_fit::fit_sampler;
+use trilux_render::glossy_irradiance::glossy_irradiance_at;
 use trilux_render::link_gather::{Caches, IncidentSamples, LinkGather};
+use trilux_render::scene::SolutionGather;
 use trilux_render::solved::HitLocator;
-use trilux_render::{GatherStats, SolvedScene, SurfacePoint};
+use trilux_render::{GatherStats, LinkVisibility, SolvedScene, SurfacePoint};
 use trilux_solver::Solution;
 
 /// The render's glossy light over a solution.
@@ -49,18 +58,7 @@ impl<'a, const N: usize> RenderedGlossy<'a, N> {
             },
             glossy_scene: true,
         };
-        let x = SurfacePoint {
-            point: p.point,
-            normal: p.normal,
-            t: 0.0,
-            locator: HitLocator {
-                surface: p.surface,
-                coord: p.coord,
-                shading_normal: p.normal,
-                shape: p.shape,
-                through: 1.0,
-            },
-        };
+        let x = surface_point(p);
         let mut stats = GatherStats::default();
         let mut sampler = fit_sampler(p.key);
         let counts = IncidentSamples {
@@ -72,6 +70,51 @@ impl<'a, const N: usize> RenderedGlossy<'a, N> {
             .glossy_directions(&x, dirs, counts, &mut sampler, caches, &mut stats)
             .iter()
             .map(|l| l.to_linear_srgb())
+            .collect()
+    }
+}
+
+/// The renderer's surface point at the bake's point `p`.
+fn surface_point(p: &GlossyPoint) -> SurfacePoint<HitLocator> {
+    SurfacePoint {
+        point: p.point,
+        normal: p.normal,
+        t: 0.0,
+        locator: HitLocator {
+            surface: p.surface,
+            coord: p.coord,
+            shading_normal: p.normal,
+            shape: p.shape,
+            through: 1.0,
+        },
+    }
+}
+
+impl<const N: usize> GatheredLight for RenderedGlossy<'_, N> {
+    fn irradiance(&self, points: &[GlossyPoint]) -> Vec<[f64; 3]> {
+        let glossy = self.scene.has_glossy_faces();
+        points
+            .par_iter()
+            .map_init(Caches::<N>::default, |caches, p| {
+                let x = surface_point(p);
+                let wo = p.normal * p.side.sign();
+                let mut stats = GatherStats::default();
+                let Some(e) = self.scene.solution_irradiance(
+                    &x,
+                    wo,
+                    LinkVisibility::Cached,
+                    &mut caches.pixel,
+                    &mut stats,
+                ) else {
+                    return [0.0; 3];
+                };
+                let back = p.side == Side::Back;
+                let e_g = match glossy {
+                    true => glossy_irradiance_at(&self.scene, &x, back, p.key, &mut stats),
+                    false => Spectrum::zero(),
+                };
+                (e + e_g).to_linear_srgb()
+            })
             .collect()
     }
 }
