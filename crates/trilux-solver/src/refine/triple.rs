@@ -432,7 +432,7 @@ impl<const N: usize> RefineContext<'_, N> {
     /// (docs/solver.md, "Narrow lobes"): its radiance from the sampled
     /// `share` of the lobe landing in K, refined where the hits `inside` K
     /// land unevenly over it.
-    fn link_sampled(
+    pub(super) fn link_sampled(
         &self,
         task: &mut TripleTask<'_, N>,
         (i, j, n): (ElementId, ElementId, u32),
@@ -447,8 +447,12 @@ impl<const N: usize> RefineContext<'_, N> {
             .textures
             .map_or(Spectrum::splat(1.0), |t| t.glossy(sj, j));
         // The flux on towards k is π T_ij δL · share, so ΔL^G = δL ·
-        // share · T_ij / T_jk.
-        let gathered = known.unshot * share * g * (known.tij.t / tjk);
+        // share · T_ij / T_jk, at most δL: no direction reflects more of
+        // the light from i than arrives (∫ fr cos dω ≤ 1), where a T_jk
+        // estimated low (surfaces in contact) would make it unbounded.
+        let ratio = known.tij.t / tjk;
+        let reflected = Spectrum::from_fn(|b| (share[b] * ratio).min(1.0));
+        let gathered = known.unshot * reflected * g;
         let link = NodeLink {
             hierarchy: task.h_index,
             node: n,

@@ -228,3 +228,30 @@ fn a_link_splits_the_element_its_errors_point_to() {
         }
     }
 }
+
+/// A sampled link (docs/solver.md, "Narrow lobes") adds at most the
+/// sender's δL to its node's radiance, whatever T_jk: no direction
+/// reflects more of the light from i than arrives (∫ fr cos dω ≤ 1).
+/// Here T_jk is set a billion times below T_ij (as a point-sampled T_jk
+/// of surfaces in contact can come out) with half the lobe landing in K:
+/// δL · S_K · T_ij / T_jk would be 5·10⁸ δL.
+#[test]
+fn a_sampled_link_reflects_at_most_the_light_that_arrives() {
+    let (setup, mut state) = mirror_scene(1.0, 1.0, 2, 0.01);
+    let (i, j) = roots(&setup);
+    let mut unshot = Spectrum::zero();
+    let (_, links) = with_task(&setup, &mut state, f64::INFINITY, |ctx, task, inc| {
+        unshot = inc.unshot;
+        task.h.nodes[0].t = 1e-9 * inc.tij.t;
+        ctx.link_sampled(task, (i, j, 0), inc, (Spectrum::splat(0.5), &[]), false);
+    });
+    assert_eq!(links.len(), 1);
+    for b in 0..3 {
+        let got = links[0].gathered[b];
+        assert!(
+            got > 0.0 && got <= unshot[b] * (1.0 + 1e-12),
+            "band {b}: {got} against δL {}",
+            unshot[b]
+        );
+    }
+}
