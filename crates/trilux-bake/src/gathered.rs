@@ -28,8 +28,10 @@
 //! `BakeStats::max_flux_error`, and it counts buried parts, which the
 //! leaves show black and a vertex reads as lit. Not yet the default: it
 //! costs several times the bake (link sums and 64 rays a vertex; 3.2 s
-//! on paper-scene3 against 0.4 s) and a far link is read at its leaf's
-//! resolution, so a vertex is not the exact direct light.
+//! on paper-scene3 against 0.4 s), it gives up the leaves' exact flux
+//! (a closed issue's gate for the default bake), and the link sum is not
+//! the exact direct light at a point: far from a sender, some vertices
+//! read it as an element's average.
 
 use crate::directional::GlossyPoint;
 

@@ -725,8 +725,9 @@ fn lambert_form_factor(x: DVec3, n: DVec3, corners: &[DVec3]) -> f64 {
 /// floor (ρ = 0.5) under a black square lamp (L_e = 10), nothing else, so
 /// that its light is the lamp's alone, ρ·L_e·F(x) at every vertex (F by
 /// Lambert's formula, independent of trilux's form factors). The link
-/// sum reads far links at their leaf's resolution (docs/rendering.md), so
-/// the vertices are not exact: their mean relative error must be under
+/// sum is not exact at every point (far from the lamp some vertices read
+/// it as an element's average: docs/rendering.md, "Where the error comes
+/// from"), so their mean relative error must be under
 /// 5 % (measured 3.7 %) and under half the leaves' constants' (measured
 /// 10.5 %, the default).
 #[test]
