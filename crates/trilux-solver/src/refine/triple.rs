@@ -24,6 +24,15 @@ use crate::link::{NodeLink, Sender};
 use crate::settings::Transport;
 use crate::throughput::Throughput;
 
+/// The most a sampled link's radiance increment may be of its sender's
+/// δL (docs/solver.md, "Narrow lobes"). Its expectation is at most the
+/// glossy albedo (≤ 1), but S_K · T_ij / T_jk is a ratio of two sampled
+/// estimates whose fluctuations above 1 are real light: held to 1,
+/// metal-box's mirrors lost 0.14 % of its image, to 2 0.06 %, to 4 0.02 %.
+/// 4 still bounds surfaces in contact, where T_jk came out 800 times too
+/// low.
+const MAX_SAMPLED_GAIN: f64 = 4.0;
+
 /// What a three-point link (i j) → (j k) takes from its pair (i, j), the
 /// same for every receiver node k: computed once per pair link and handed
 /// down the K-side recursion.
@@ -447,11 +456,11 @@ impl<const N: usize> RefineContext<'_, N> {
             .textures
             .map_or(Spectrum::splat(1.0), |t| t.glossy(sj, j));
         // The flux on towards k is π T_ij δL · share, so ΔL^G = δL ·
-        // share · T_ij / T_jk, at most δL: no direction reflects more of
-        // the light from i than arrives (∫ fr cos dω ≤ 1), where a T_jk
+        // share · T_ij / T_jk, at most MAX_SAMPLED_GAIN δL (its
+        // expectation is at most δL: ∫ fr cos dω ≤ 1), where a T_jk
         // estimated low (surfaces in contact) would make it unbounded.
         let ratio = known.tij.t / tjk;
-        let reflected = Spectrum::from_fn(|b| (share[b] * ratio).min(1.0));
+        let reflected = Spectrum::from_fn(|b| (share[b] * ratio).min(MAX_SAMPLED_GAIN));
         let gathered = known.unshot * reflected * g;
         let link = NodeLink {
             hierarchy: task.h_index,
