@@ -56,7 +56,7 @@ pub struct BakeInput<'a, const N: usize> {
     pub glossy: Option<&'a dyn GlossyLight>,
     /// The diffuse light as the renderer reads it at points (module
     /// `gathered`); without, every leaf shows its constant.
-    pub irradiance: Option<&'a dyn GatheredLight>,
+    pub gathered: Option<&'a dyn GatheredLight>,
 }
 
 /// How to bake.
@@ -171,7 +171,7 @@ pub fn bake<const N: usize>(
         let sides = Side::BOTH.map(|side| {
             let mut light = SideLight::new(input.solution, textures.as_ref(), mesh, side);
             if let Some(gathered) = input
-                .irradiance
+                .gathered
                 .filter(|_| options.diffuse == DiffuseLight::Gathered)
             {
                 light.gather(input.solution, gathered, mesh, vertices);
@@ -267,8 +267,8 @@ impl<'t, const N: usize> SideLight<'t, N> {
 
     /// The light as the renderer reads it at each vertex (module
     /// `gathered`); `first` numbers the mesh's vertices in the bake. A
-    /// side that reflects nothing, and an emitting textured side, keep
-    /// the leaves' values.
+    /// side that reflects nothing, an emitting textured side, and a
+    /// solution without links keep the leaves' values.
     fn gather(
         &mut self,
         solution: &Solution<N>,
@@ -298,7 +298,10 @@ impl<'t, const N: usize> SideLight<'t, N> {
         }
         let points = mesh_points(mesh, self.side, first);
         let only: Vec<GlossyPoint> = points.iter().map(|(_, p)| *p).collect();
-        for ((v, _), e) in points.iter().zip(gathered.irradiance(&only)) {
+        let Some(light) = gathered.irradiance(&only) else {
+            return;
+        };
+        for ((v, _), e) in points.iter().zip(light) {
             self.values[*v] = std::array::from_fn(|c| (le[c] + scale[c] * e[c]).max(0.0));
         }
     }

@@ -51,6 +51,7 @@ pub enum DiffuseLight {
 pub trait GatheredLight: Sync {
     /// E/π at each of `points` on its side (irradiance over π, linear
     /// Rec. 709): the link sum of the point's leaf, the lights without
-    /// area and the light glossy senders reflect onto it.
-    fn irradiance(&self, points: &[GlossyPoint]) -> Vec<[f64; 3]>;
+    /// area and the light glossy senders reflect onto it; `None` when the
+    /// solution has no links to read (the bake keeps the leaves').
+    fn irradiance(&self, points: &[GlossyPoint]) -> Option<Vec<[f64; 3]>>;
 }

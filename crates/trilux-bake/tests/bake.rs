@@ -161,7 +161,7 @@ fn a_baked_closed_box_keeps_its_flux_and_is_valid_gltf() {
         names: &names,
         camera: None,
         glossy: None,
-        irradiance: None,
+        gathered: None,
     };
     let baked = bake(&input, &BakeOptions::default()).expect("the box bakes");
     assert_eq!(baked.stats.bytes, baked.glb.len());
@@ -314,7 +314,7 @@ fn a_glossy_floor_carries_its_glossy_light_as_harmonics_and_a_lobe() {
         names: &names,
         camera: None,
         glossy: Some(&Quadratic),
-        irradiance: None,
+        gathered: None,
     };
     // Without: the glossy light is left out and the floor marked.
     let mut without = BakeOptions::default();
@@ -379,4 +379,36 @@ fn a_glossy_floor_carries_its_glossy_light_as_harmonics_and_a_lobe() {
     }
     assert_eq!(glossy_primitives, 1);
     assert!(baked.stats.glossy_vertices > 0);
+}
+
+/// A renderer that has no links to read (a solution without gather
+/// links) answers `None`.
+struct NoLinks;
+
+impl trilux_bake::GatheredLight for NoLinks {
+    fn irradiance(&self, _points: &[trilux_bake::GlossyPoint]) -> Option<Vec<[f64; 3]>> {
+        None
+    }
+}
+
+/// Asked for the gathered light where there is none, the bake keeps the
+/// leaves' values: the same file as the default bake, not black sides.
+#[test]
+fn gathered_light_without_links_keeps_the_leaves() {
+    let (solution, bsdfs) = solve();
+    let names: Vec<Option<String>> = vec![None; 6];
+    let input = |gathered: Option<&'static dyn trilux_bake::GatheredLight>| BakeInput {
+        solution: &solution,
+        materials: &bsdfs,
+        names: &names,
+        camera: None,
+        glossy: None,
+        gathered,
+    };
+    let leaves = bake(&input(None), &BakeOptions::default()).expect("the box bakes");
+    let mut asked = BakeOptions::default();
+    asked.diffuse = trilux_bake::DiffuseLight::Gathered;
+    let fallback = bake(&input(Some(&NoLinks)), &asked).expect("the box bakes");
+    assert_eq!(leaves.glb, fallback.glb);
+    assert!(fallback.stats.max_flux_error < 1e-9, "{:?}", fallback.stats);
 }

@@ -91,9 +91,12 @@ fn surface_point(p: &GlossyPoint) -> SurfacePoint<HitLocator> {
 }
 
 impl<const N: usize> GatheredLight for RenderedGlossy<'_, N> {
-    fn irradiance(&self, points: &[GlossyPoint]) -> Vec<[f64; 3]> {
+    fn irradiance(&self, points: &[GlossyPoint]) -> Option<Vec<[f64; 3]>> {
+        if !self.scene.has_links() {
+            return None;
+        }
         let glossy = self.scene.has_glossy_faces();
-        points
+        let light = points
             .par_iter()
             .map_init(Caches::<N>::default, |caches, p| {
                 let x = surface_point(p);
@@ -115,7 +118,8 @@ impl<const N: usize> GatheredLight for RenderedGlossy<'_, N> {
                 };
                 (e + e_g).to_linear_srgb()
             })
-            .collect()
+            .collect();
+        Some(light)
     }
 }
 

@@ -372,7 +372,7 @@ fn bake<const N: usize>(
         camera,
         glossy: (options.glossy && options.glossy_samples > 0)
             .then_some(&glossy as &dyn trilux_bake::GlossyLight),
-        irradiance: Some(&glossy as &dyn trilux_bake::GatheredLight),
+        gathered: Some(&glossy as &dyn trilux_bake::GatheredLight),
     };
     Ok(trilux_bake::bake(&input, options)?)
 }
