@@ -43,7 +43,8 @@
 //!   transfer into every leaf; [`sky`]: an environment map (Mitsuba's
 //!   `envmap`), its lookup and its importance sampling, shot as they are.
 //! - [`solver`]: the progressive loop (§4, Fig. 7 and 9); `shot`: one
-//!   shot's phases, `receive` its fifth (what each link delivers);
+//!   shot's phases (its tests in `shot_tests`), `receive` its fifth (what
+//!   each link delivers), `batch` the receiving faces in batches;
 //!   `glossy`: the glossy renormalisation; `deferred`: the glossy share of
 //!   small links, summed per pair until it counts; `queue`: the next
 //!   source and the residual from the sources a shot changed.
@@ -60,6 +61,7 @@
 #![allow(clippy::needless_range_loop)]
 
 mod ambient;
+mod batch;
 mod cluster;
 mod cluster_transport;
 mod deferred;
@@ -86,6 +88,8 @@ pub mod settings;
 mod setup;
 mod shards;
 mod shot;
+#[cfg(test)]
+mod shot_tests;
 pub mod sky;
 mod sky_shot;
 pub mod solution;

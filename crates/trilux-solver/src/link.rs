@@ -121,12 +121,11 @@ pub(crate) struct PairLink<const N: usize> {
     pub unshot: Spectrum<N>,
 }
 
-/// A transient link of stage 2: a radiance increment for one node.
+/// A transient link of stage 2: a radiance increment for one node of the
+/// hierarchy whose list holds it (`shot::StageTwo`).
 #[derive(Clone, Debug)]
 pub(crate) struct NodeLink<const N: usize> {
-    /// Index of the receiving hierarchy.
-    pub hierarchy: u32,
-    /// Node within it.
+    /// Node within its hierarchy.
     pub node: u32,
     /// The pair link (stage 1) this transfer belongs to.
     pub group: u32,
@@ -137,3 +136,6 @@ pub(crate) struct NodeLink<const N: usize> {
     /// renormalised.
     pub sampled: bool,
 }
+
+/// A shot's node links, per receiving hierarchy (its index).
+pub(crate) type NodeLinks<const N: usize> = Vec<(u32, Vec<NodeLink<N>>)>;

@@ -11,102 +11,192 @@ use trilux_geometry::ElementId;
 
 use crate::cluster_transport::FarField;
 use crate::deferred::GlossyIn;
-use crate::link::{NodeLink, PairLink};
+use crate::link::{NodeLinks, PairLink};
 use crate::refine::Incidence;
 use crate::shot::{Glossy, Groups};
 use crate::solver::{Solver, Source};
 
+/// What the glossy shares of a shot's groups reflect, per group: filled
+/// batch by batch of receiving faces (`Solver::reflect_batch`), booked once
+/// for the whole shot (`Solver::receive`).
+pub(crate) struct Reception<const N: usize> {
+    /// The flux of the midpoint-rule node links and far-field increments.
+    glossy_flux: Vec<Spectrum<N>>,
+    /// The flux of the sampled node links (docs/solver.md, "Narrow lobes").
+    sampled_flux: Vec<Spectrum<N>>,
+    /// The far-field increments, before the renormalisation.
+    far_adds: Vec<Option<Vec<Spectrum<N>>>>,
+    /// Each group's scales of its midpoint-rule and sampled links.
+    pub scales: Vec<(Spectrum<N>, Spectrum<N>)>,
+}
+
+/// What arrives through one group and what its glossy share may reflect.
+struct GroupRoom<const N: usize> {
+    /// π T_ij δL, the flux that arrives at j.
+    arrived: Spectrum<N>,
+    /// Its Lambertian share.
+    diffuse: Spectrum<N>,
+    /// What the glossy share may reflect of its own light.
+    own: Spectrum<N>,
+    /// What it may reflect now (none for a share that waits; for a
+    /// released sum, all that waited too).
+    now: Spectrum<N>,
+}
+
 impl<const N: usize> Solver<N> {
-    /// Phase 5: what every pair link (a group) delivers to its receiving
-    /// element j. The flux π T_ij δL arrives; its Lambertian share ρ_d goes
-    /// straight into j's two-point radiance; the glossy share is what the
-    /// group's node links gathered, renormalised (`glossy`) so that j never
-    /// reflects more than arrived; the rest is absorbed. A glossy share
-    /// that waits (`deferred`) is neither reflected nor absorbed yet; a
-    /// released sum is reflected and absorbed now. Books absorbed and
-    /// escaped flux in the ledger, what was reflected in the
-    /// interreflection estimate (`share` of the shot's flux `phi` being
-    /// reflected light), and returns each group's glossy scale.
-    pub(crate) fn receive(
+    /// Before a shot's batches: the far fields its glossy light reaches
+    /// are traced and what each group adds to them is its first glossy
+    /// flux.
+    pub(crate) fn begin_reception(
         &mut self,
-        groups: &Groups<N>,
         glossy: &Glossy<N>,
         incidences: &[Option<Incidence<N>>],
-        node_links: &[NodeLink<N>],
-        (phi, share): (Spectrum<N>, Spectrum<N>),
-    ) -> Vec<(Spectrum<N>, Spectrum<N>)> {
+    ) -> Reception<N> {
         self.trace_far_fields(glossy);
-        let (glossy_flux, sampled_flux, far_adds) =
-            self.glossy_fluxes(glossy, incidences, node_links);
-        let late = self.past_deadline();
-        let targets = self.glossy_targets(glossy, incidences, (&glossy_flux, late));
-        let mut group_scale =
-            vec![(Spectrum::<N>::splat(1.0), Spectrum::splat(1.0)); groups.links.len()];
-        let mut total_arrived = Spectrum::<N>::zero();
-        let mut absorbed = Spectrum::<N>::zero();
-        for (g, l) in groups.links.iter().enumerate() {
-            let arrived = l.unshot * groups.scale * (PI * l.t);
-            let rho_d = self.receive_lambertian(l, groups.scale);
-            // Light spreads over j's exposed area. (No transfer reaches an
-            // element that is wholly buried, whose segments all count as
-            // blocked; if one did, its light would be absorbed.)
-            let aj = self.setup.exposed_area[l.face.side()][l.j.index()];
-            let kept = |arrived: Spectrum<N>| {
-                let diffuse = if aj > 0.0 {
-                    arrived * rho_d
-                } else {
-                    Spectrum::zero()
-                };
-                (diffuse, (arrived - diffuse).max(Spectrum::zero()))
-            };
-            let (diffuse, room_own) = kept(arrived);
-            // What an element reflects may not exceed what arrived there
-            // (of a released sum: all that waited).
-            let room = match &groups.plan[g] {
-                GlossyIn::Now => room_own,
-                GlossyIn::Wait { from } => {
-                    self.state.deferred.book_waiting(l.face, *from, room_own);
-                    self.state.queue.touch(Source::Deferred(l.face));
-                    Spectrum::zero()
+        let n = glossy.links.len();
+        let far_adds: Vec<Option<Vec<Spectrum<N>>>> = glossy
+            .links
+            .par_iter()
+            .zip(&glossy.scales)
+            .zip(incidences)
+            .map(|((l, &scale), inc)| self.far_reflection(l, inc.as_ref(), scale))
+            .collect();
+        let mut glossy_flux = vec![Spectrum::<N>::zero(); n];
+        for (g, adds) in far_adds.iter().enumerate() {
+            if let (Some(adds), Some(field)) = (adds, &self.state.far[glossy.links[g].face]) {
+                for (b, dl) in field.blocks.iter().zip(adds) {
+                    glossy_flux[g] += *dl * (PI * b.t);
                 }
-                GlossyIn::Flush { waited, .. } => *waited + room_own,
-            };
-            let (glossy_g, sampled) = (glossy_flux[g], sampled_flux[g]);
-            let target = targets[g];
+            }
+        }
+        Reception {
+            glossy_flux,
+            sampled_flux: vec![Spectrum::zero(); n],
+            far_adds,
+            scales: vec![(Spectrum::splat(1.0), Spectrum::splat(1.0)); n],
+        }
+    }
+
+    /// One batch of a shot's groups (whole receiving faces) after its
+    /// stage 2: its node links' flux, then each group's scales
+    /// (`glossy::group_scale`) towards its target, so that j never
+    /// reflects more than arrived.
+    pub(crate) fn reflect_batch(
+        &mut self,
+        groups: &Groups<N>,
+        (glossy, incidences): (&Glossy<N>, &[Option<Incidence<N>>]),
+        node_links: &NodeLinks<N>,
+        batch: &[u32],
+        reception: &mut Reception<N>,
+    ) {
+        self.add_node_fluxes(glossy, node_links, reception);
+        let late = self.past_deadline();
+        let targets: Vec<Option<Spectrum<N>>> = batch
+            .par_iter()
+            .map(|&g| {
+                let g = g as usize;
+                let (l, scale) = (&glossy.links[g], glossy.scales[g]);
+                let arrived = l.unshot * scale * (PI * l.t);
+                let flux = reception.glossy_flux[g];
+                self.glossy_target(l, incidences[g].as_ref(), arrived, (flux, late))
+            })
+            .collect();
+        for (&g, target) in batch.iter().zip(targets) {
+            let g = g as usize;
+            let room = self.group_room(groups, g).now;
             self.state.stats.late_groups += u64::from(late && target.is_some());
             self.state.stats.coarse_groups +=
                 u64::from(target.is_some() && incidences[g].as_ref().is_some_and(|i| i.coarse));
-            let scale = crate::glossy::group_scale(target, glossy_g, sampled, room);
-            group_scale[g] = scale;
-            let reflected_glossy = glossy_g * scale.0 + sampled * scale.1;
-            let absorbed_g = room - reflected_glossy;
+            let (glossy_g, sampled) = (reception.glossy_flux[g], reception.sampled_flux[g]);
+            reception.scales[g] = crate::glossy::group_scale(target, glossy_g, sampled, room);
+        }
+    }
+
+    /// Phase 5: what every pair link (a group) delivers to its receiving
+    /// element j. The flux π T_ij δL arrives; its Lambertian share ρ_d goes
+    /// straight into j's two-point radiance; the glossy share is what the
+    /// group's node links gathered, renormalised (`reflect_batch`); the
+    /// rest is absorbed. A glossy share that waits (`deferred`) is neither
+    /// reflected nor absorbed yet; a released sum is reflected and
+    /// absorbed now. Books absorbed and escaped flux in the ledger, what
+    /// was reflected in the interreflection estimate (`share` of the
+    /// shot's flux `phi` being reflected light), and the far fields'
+    /// increments.
+    pub(crate) fn receive(
+        &mut self,
+        groups: &Groups<N>,
+        reception: Reception<N>,
+        (phi, share): (Spectrum<N>, Spectrum<N>),
+    ) {
+        let mut total_arrived = Spectrum::<N>::zero();
+        let mut absorbed = Spectrum::<N>::zero();
+        for (g, l) in groups.links.iter().enumerate() {
+            let room = self.group_room(groups, g);
+            self.receive_lambertian(l, groups.scale);
+            if let GlossyIn::Wait { from } = &groups.plan[g] {
+                self.state.deferred.book_waiting(l.face, *from, room.own);
+                self.state.queue.touch(Source::Deferred(l.face));
+            }
+            let scale = reception.scales[g];
+            let reflected_glossy =
+                reception.glossy_flux[g] * scale.0 + reception.sampled_flux[g] * scale.1;
+            let absorbed_g = room.now - reflected_glossy;
             // (A share that waits has absorbed nothing yet.)
             if !matches!(groups.plan[g], GlossyIn::Wait { .. }) {
-                let base = (arrived + room).max_value().max(1e-300);
+                let base = (room.arrived + room.now).max_value().max(1e-300);
                 self.state.ledger.min_element_absorbed = self
                     .state
                     .ledger
                     .min_element_absorbed
                     .min(absorbed_g.min_value() / base);
             }
-            total_arrived += arrived;
+            total_arrived += room.arrived;
             absorbed += absorbed_g;
             let ir = &mut self.state.interreflection;
             match &groups.plan[g] {
                 GlossyIn::Flush {
                     share: released, ..
                 } => {
-                    ir.book_group(l.face, arrived, diffuse, share);
+                    ir.book_group(l.face, room.arrived, room.diffuse, share);
                     ir.book_group(l.face, Spectrum::zero(), reflected_glossy, *released);
                 }
-                _ => ir.book_group(l.face, arrived, diffuse + reflected_glossy, share),
+                _ => ir.book_group(l.face, room.arrived, room.diffuse + reflected_glossy, share),
             }
             self.state.used[l.i.index()] = true;
             self.state.used[l.j.index()] = true;
         }
-        self.add_far_reflection(&groups.links, far_adds, &group_scale);
+        self.add_far_reflection(&groups.links, reception.far_adds, &reception.scales);
         self.state.ledger.book_shot(phi, total_arrived, absorbed);
-        group_scale
+    }
+
+    /// What arrives through group `g` and what its glossy share may
+    /// reflect (what arrived less the Lambertian share). Light spreads
+    /// over j's exposed area. (No transfer reaches an element that is
+    /// wholly buried, whose segments all count as blocked; if one did,
+    /// its light would be absorbed.)
+    fn group_room(&self, groups: &Groups<N>, g: usize) -> GroupRoom<N> {
+        let l = &groups.links[g];
+        let arrived = l.unshot * groups.scale * (PI * l.t);
+        let aj = self.setup.exposed_area[l.face.side()][l.j.index()];
+        let diffuse = if aj > 0.0 {
+            arrived * self.lambertian_rho(l)
+        } else {
+            Spectrum::zero()
+        };
+        let own = (arrived - diffuse).max(Spectrum::zero());
+        // What an element reflects may not exceed what arrived there (of
+        // a released sum: all that waited).
+        let now = match &groups.plan[g] {
+            GlossyIn::Now => own,
+            GlossyIn::Wait { .. } => Spectrum::zero(),
+            GlossyIn::Flush { waited, .. } => *waited + own,
+        };
+        GroupRoom {
+            arrived,
+            diffuse,
+            own,
+            now,
+        }
     }
 
     /// Traces the far fields of the faces that this shot's glossy light
@@ -130,51 +220,30 @@ impl<const N: usize> Solver<N> {
         }
     }
 
-    /// Per group, the glossy flux its node links carry (midpoint-rule
-    /// links, renormalised, and sampled ones, already conserving:
-    /// docs/solver.md, "Narrow lobes"), with what it reflects into its
-    /// face's far field (per far block, before the renormalisation).
-    #[allow(clippy::type_complexity)]
-    fn glossy_fluxes(
+    /// Adds, per group, the flux of a batch's node links: midpoint-rule
+    /// links (renormalised later) and sampled ones (already conserving:
+    /// docs/solver.md, "Narrow lobes").
+    fn add_node_fluxes(
         &self,
         glossy: &Glossy<N>,
-        incidences: &[Option<Incidence<N>>],
-        node_links: &[NodeLink<N>],
-    ) -> (
-        Vec<Spectrum<N>>,
-        Vec<Spectrum<N>>,
-        Vec<Option<Vec<Spectrum<N>>>>,
+        node_links: &NodeLinks<N>,
+        reception: &mut Reception<N>,
     ) {
-        let n = glossy.links.len();
-        let mut glossy_flux = vec![Spectrum::<N>::zero(); n];
-        let mut sampled_flux = vec![Spectrum::<N>::zero(); n];
-        for nl in node_links {
-            if let Some(h) = &self.state.hierarchies[nl.hierarchy as usize] {
+        for (h, links) in node_links {
+            let Some(h) = &self.state.hierarchies[*h as usize] else {
+                continue;
+            };
+            for nl in links {
                 let t = h.nodes[nl.node as usize].t;
                 let g = nl.group as usize;
                 let flux = nl.gathered * glossy.scales[g] * (PI * t);
                 if nl.sampled {
-                    sampled_flux[g] += flux;
+                    reception.sampled_flux[g] += flux;
                 } else {
-                    glossy_flux[g] += flux;
+                    reception.glossy_flux[g] += flux;
                 }
             }
         }
-        let far_adds: Vec<Option<Vec<Spectrum<N>>>> = glossy
-            .links
-            .par_iter()
-            .zip(&glossy.scales)
-            .zip(incidences)
-            .map(|((l, &scale), inc)| self.far_reflection(l, inc.as_ref(), scale))
-            .collect();
-        for (g, adds) in far_adds.iter().enumerate() {
-            if let (Some(adds), Some(field)) = (adds, &self.state.far[glossy.links[g].face]) {
-                for (b, dl) in field.blocks.iter().zip(adds) {
-                    glossy_flux[g] += *dl * (PI * b.t);
-                }
-            }
-        }
-        (glossy_flux, sampled_flux, far_adds)
     }
 
     /// Each group's far-field increments, renormalised with its group.
@@ -236,39 +305,10 @@ impl<const N: usize> Solver<N> {
         )
     }
 
-    /// Each group's glossy target (`glossy::glossy_target`), in parallel:
-    /// its hemisphere coverage traces rays.
-    fn glossy_targets(
-        &self,
-        glossy: &Glossy<N>,
-        incidences: &[Option<Incidence<N>>],
-        (glossy_flux, late): (&[Spectrum<N>], bool),
-    ) -> Vec<Option<Spectrum<N>>> {
-        glossy
-            .links
-            .par_iter()
-            .zip(&glossy.scales)
-            .zip(incidences)
-            .zip(glossy_flux)
-            .map(|(((l, &scale), inc), &flux)| {
-                let arrived = l.unshot * scale * (PI * l.t);
-                self.glossy_target(l, inc.as_ref(), arrived, (flux, late))
-            })
-            .collect()
-    }
-
     /// The Lambertian share of a pair link: ρ_d (T_ij / A_j) δL into j's
-    /// gathered radiance and its flux into the face's key. On
-    /// smooth-shaded meshes the BSDF takes the cosine about the shading
-    /// normal (as Mitsuba does), which changes the irradiance it reflects
-    /// (never beyond what arrived). Returns the ρ_d used.
-    fn receive_lambertian(&mut self, l: &PairLink<N>, shot_scale: Spectrum<N>) -> Spectrum<N> {
-        let face = &self.setup.faces[l.face];
-        let rho = match &self.setup.textures {
-            Some(t) => t.rho(l.face, l.j).unwrap_or(face.rho_d),
-            None => face.rho_d,
-        };
-        let rho_d = (rho * self.shading_factor(l.i, l.j)).min(Spectrum::splat(1.0));
+    /// gathered radiance and its flux into the face's key.
+    fn receive_lambertian(&mut self, l: &PairLink<N>, shot_scale: Spectrum<N>) {
+        let rho_d = self.lambertian_rho(l);
         let side = l.face.side();
         let aj = self.setup.exposed_area[side][l.j.index()];
         if !rho_d.is_black() && aj > 0.0 {
@@ -277,7 +317,19 @@ impl<const N: usize> Solver<N> {
             self.state.face_flux[l.face] += dl * (PI * aj);
             self.state.queue.touch(Source::Radiosity(l.face));
         }
-        rho_d
+    }
+
+    /// The ρ_d that j reflects light from i with. On smooth-shaded meshes
+    /// the BSDF takes the cosine about the shading normal (as Mitsuba
+    /// does), which changes the irradiance it reflects (never beyond what
+    /// arrived).
+    fn lambertian_rho(&self, l: &PairLink<N>) -> Spectrum<N> {
+        let face = &self.setup.faces[l.face];
+        let rho = match &self.setup.textures {
+            Some(t) => t.rho(l.face, l.j).unwrap_or(face.rho_d),
+            None => face.rho_d,
+        };
+        (rho * self.shading_factor(l.i, l.j)).min(Spectrum::splat(1.0))
     }
 
     /// The irradiance about j's shading normals over the one about its

@@ -24,10 +24,11 @@ use rayon::prelude::*;
 use trilux_color::Spectrum;
 use trilux_geometry::{ElementId, FaceId, PerFace};
 
+use crate::batch::batches;
 use crate::cluster_transport::{FarField, far_links};
 use crate::deferred::GlossyIn;
 use crate::interaction::Hierarchy;
-use crate::link::{NodeLink, PairLink, PairShot, Sender, Sent};
+use crate::link::{NodeLink, NodeLinks, PairLink, PairShot, Sender, Sent};
 use crate::refine::{Incidence, IncidenceMemo, Lateness, RefineContext, TripleTask};
 use crate::solver::{Solver, Source};
 use crate::state::RootThroughputs;
@@ -208,6 +209,35 @@ fn shot_sender<'a, const N: usize>(
     }
 }
 
+/// A shot's sending (`None` for a release of waiting light), its groups
+/// and, per group, the uniform sender of a released sum.
+type ShotGroups<'a, const N: usize> = (
+    Option<&'a Sending<N>>,
+    &'a Groups<N>,
+    &'a [Option<Sender<'static, N>>],
+);
+
+/// Each group's sender and sending face: the shot's own (`sender`), or a
+/// released sum's uniform sender from its own face.
+fn group_senders<'s, const N: usize>(
+    (sending, groups, uniform): ShotGroups<'s, N>,
+    sender: &'s Sender<'s, N>,
+) -> Vec<(&'s Sender<'s, N>, FaceId)> {
+    let shot_face = sending.map(Sending::face);
+    groups
+        .plan
+        .iter()
+        .zip(uniform)
+        .zip(&groups.links)
+        .map(|((p, u), l)| {
+            (
+                u.as_ref().unwrap_or(sender),
+                p.send_face(shot_face.unwrap_or(l.face)),
+            )
+        })
+        .collect()
+}
+
 impl<const N: usize> Solver<N> {
     /// One shot from `source` (module docs); returns the number of links it
     /// made.
@@ -361,41 +391,60 @@ impl<const N: usize> Solver<N> {
                 _ => None,
             })
             .collect();
-        let shot_face = sending.map(Sending::face);
-        let (incidences, stage_two, late) = {
+        let shot = (sending, groups, uniform.as_slice());
+        let incidences = {
+            let (ctx, _, _) = self.split_for_shot();
+            let sender = shot_sender(sending, ctx.field);
+            let senders = group_senders(shot, &sender);
+            incidences(&ctx.refine, ctx.stored_from, &senders, &glossy.links)
+        };
+        let mut reception = self.begin_reception(&glossy, &incidences);
+        let (mut most, mut made) = (0, 0);
+        let limit = self.batch_hierarchies;
+        for batch in batches(limit, &self.setup.stored_from, &glossy.links, &incidences) {
+            let stage_two = self.stage_two_batch(shot, (&glossy.links, &incidences), &batch);
+            let node_links = self.book_lost(stage_two);
+            let n = node_links.iter().map(|(_, l)| l.len()).sum::<usize>();
+            (most, made) = (most.max(n), made + n);
+            self.reflect_batch(
+                groups,
+                (&glossy, &incidences),
+                &node_links,
+                &batch,
+                &mut reception,
+            );
+            self.apply_node_links(&node_links, &glossy.scales, &reception.scales);
+        }
+        self.receive(groups, reception, (phi, share));
+        let live = groups.links.len() + most;
+        self.state.stats.links_peak = self.state.stats.links_peak.max(live);
+        self.state.stats.links_total += (groups.links.len() + made) as u64;
+        live
+    }
+
+    /// Phase 4 for one batch of groups (`batches`), with what its
+    /// refinement cut short at the deadline booked.
+    fn stage_two_batch(
+        &mut self,
+        shot: ShotGroups<'_, N>,
+        (links, incidences): (&[PairLink<N>], &[Option<Incidence<N>>]),
+        batch: &[u32],
+    ) -> StageTwo<N> {
+        let (stage_two, late) = {
             let (mut ctx, hierarchies, _) = self.split_for_shot();
-            let shot = shot_sender(sending, ctx.field);
-            let senders: Vec<(&Sender<'_, N>, FaceId)> = groups
-                .plan
-                .iter()
-                .zip(&uniform)
-                .zip(&groups.links)
-                .map(|((p, u), l)| {
-                    (
-                        u.as_ref().unwrap_or(&shot),
-                        p.send_face(shot_face.unwrap_or(l.face)),
-                    )
-                })
-                .collect();
-            let incidences = incidences(&ctx.refine, ctx.stored_from, &senders, &glossy.links);
-            let stage_two = stage_two(
+            let sender = shot_sender(shot.0, ctx.field);
+            let senders = group_senders(shot, &sender);
+            let made = stage_two(
                 &ctx.refine,
                 &senders,
                 (hierarchies, ctx.stored_from),
-                &glossy.links,
-                &incidences,
+                (links, incidences),
+                batch,
             );
-            let late = std::mem::take(&mut ctx.refine.late);
-            (incidences, stage_two, late)
+            (made, std::mem::take(&mut ctx.refine.late))
         };
         self.book_late(late);
-        let node_links = self.book_lost(stage_two);
-        let group_scale = self.receive(groups, &glossy, &incidences, &node_links, (phi, share));
-        self.apply_node_links(&node_links, &glossy.scales, &group_scale);
-        let live = groups.links.len() + node_links.len();
-        self.state.stats.links_peak = self.state.stats.links_peak.max(live);
-        self.state.stats.links_total += live as u64;
-        live
+        stage_two
     }
 
     /// Phase 1: the source's unshot flux leaves the residual, the source is
@@ -497,8 +546,8 @@ impl<const N: usize> Solver<N> {
 
     /// Flux that a split could not keep leaves the residual (it is booked
     /// as escaped); the node links of every hierarchy, in order.
-    fn book_lost(&mut self, stage_two: StageTwo<N>) -> Vec<NodeLink<N>> {
-        let mut node_links = Vec::new();
+    fn book_lost(&mut self, stage_two: StageTwo<N>) -> NodeLinks<N> {
+        let mut node_links = Vec::with_capacity(stage_two.len());
         for (links, h, lost) in stage_two {
             if let Some(hier) = self.state.hierarchies[h as usize].as_mut() {
                 hier.unshot_flux = (hier.unshot_flux - lost).max(Spectrum::zero());
@@ -507,7 +556,9 @@ impl<const N: usize> Solver<N> {
             for b in 0..N {
                 self.state.ledger.escaped[b] += lost[b];
             }
-            node_links.extend(links);
+            if !links.is_empty() {
+                node_links.push((h, links));
+            }
         }
         node_links
     }
@@ -517,23 +568,25 @@ impl<const N: usize> Solver<N> {
     /// key (the renormalisation applies to both alike).
     fn apply_node_links(
         &mut self,
-        node_links: &[NodeLink<N>],
+        node_links: &NodeLinks<N>,
         scales: &[Spectrum<N>],
         group_scale: &[(Spectrum<N>, Spectrum<N>)],
     ) {
-        for nl in node_links {
-            let Some(hier) = self.state.hierarchies[nl.hierarchy as usize].as_mut() else {
+        for (h, links) in node_links {
+            let Some(hier) = self.state.hierarchies[*h as usize].as_mut() else {
                 continue;
             };
-            let node = &mut hier.nodes[nl.node as usize];
-            let (midpoint, sampled) = group_scale[nl.group as usize];
-            let dl = nl.gathered
-                * scales[nl.group as usize]
-                * if nl.sampled { sampled } else { midpoint };
-            node.gathered += dl;
-            let t = node.t;
-            hier.unshot_flux += dl * (PI * t);
-            self.state.queue.touch(Source::Stored(nl.hierarchy));
+            for nl in links {
+                let node = &mut hier.nodes[nl.node as usize];
+                let (midpoint, sampled) = group_scale[nl.group as usize];
+                let dl = nl.gathered
+                    * scales[nl.group as usize]
+                    * if nl.sampled { sampled } else { midpoint };
+                node.gathered += dl;
+                let t = node.t;
+                hier.unshot_flux += dl * (PI * t);
+            }
+            self.state.queue.touch(Source::Stored(*h));
         }
     }
 
@@ -645,13 +698,14 @@ fn stage_two<const N: usize>(
     ctx: &RefineContext<'_, N>,
     senders: &[(&Sender<'_, N>, FaceId)],
     (hierarchies, stored_from): (&mut [Option<Hierarchy<N>>], &PerFace<Range<usize>>),
-    pair_links: &[PairLink<N>],
-    incidences: &[Option<Incidence<N>>],
+    (pair_links, incidences): (&[PairLink<N>], &[Option<Incidence<N>>]),
+    batch: &[u32],
 ) -> StageTwo<N> {
     let mut groups_of_face: HashMap<FaceId, Vec<u32>> = HashMap::new();
-    for (g, (l, inc)) in pair_links.iter().zip(incidences).enumerate() {
-        if inc.is_some() {
-            groups_of_face.entry(l.face).or_default().push(g as u32);
+    for &g in batch {
+        if incidences[g as usize].is_some() {
+            let face = pair_links[g as usize].face;
+            groups_of_face.entry(face).or_default().push(g);
         }
     }
     let memo = IncidenceMemo::new();
@@ -678,7 +732,6 @@ fn stage_two<const N: usize>(
                 sender,
                 si,
                 h: hier,
-                h_index: h as u32,
                 group: 0,
                 lost: Spectrum::zero(),
                 out: Vec::new(),
@@ -701,6 +754,9 @@ fn stage_two<const N: usize>(
                     ctx.refine_triple(&mut task, l.i, j, n, Some(incidence));
                 }
             }
+            // A batch's links live until it is received: without the
+            // growth's spare capacity (0.5 GB of the staircase's peak).
+            task.out.shrink_to_fit();
             (task.out, h as u32, task.lost)
         })
         .collect()
@@ -719,153 +775,4 @@ fn receiving<T>(hierarchies: &mut [T], mut ranges: Vec<Range<usize>>) -> Vec<(us
         (rest, base) = (tail, r.end);
     }
     out
-}
-
-#[cfg(test)]
-mod tests {
-    //! A shot that starts after the solve's deadline (a budget of zero,
-    //! shot by hand: the loop itself would not start it) still carries
-    //! its source's light, coarser.
-    #![allow(clippy::unwrap_used, clippy::expect_used)] // tests may panic
-
-    use std::f64::consts::PI;
-
-    use glam::DVec3;
-    use trilux_brdf::BsdfParams;
-    use trilux_color::ColorParam;
-
-    use crate::prepared::SceneDescription;
-    use crate::solver::Solver;
-    use crate::test_scenes as ts;
-
-    /// The first shot of a scene of unit squares: an emitter (Le = 1)
-    /// facing down at height 1 over `receivers` (centre, facing down,
-    /// material), with time budget `budget`.
-    fn first_shot(budget: Option<f64>, receivers: &[(DVec3, bool, BsdfParams)]) -> Solver<3> {
-        let mut shapes = vec![ts::square(DVec3::new(0.0, 0.0, 1.0), 1.0, true)];
-        let mut bsdfs = vec![ts::diffuse(0.0)];
-        let mut emission = vec![Some(ColorParam::Float(1.0))];
-        for (centre, down, bsdf) in receivers {
-            shapes.push(ts::square(*centre, 1.0, *down));
-            bsdfs.push(bsdf.clone());
-            emission.push(None);
-        }
-        let desc = SceneDescription {
-            shapes: &shapes,
-            bsdfs: &bsdfs,
-            emission: &emission,
-        };
-        let mut settings = ts::settings(3);
-        settings.time_budget_seconds = budget;
-        let mut solver = Solver::from_description(&desc, settings).unwrap();
-        let source = solver.next_source().unwrap();
-        solver.shoot(source);
-        solver
-    }
-
-    /// Energy is booked whole and no term is negative (docs/solver.md,
-    /// "Energy ledger"); what is unshot is finite and non-negative.
-    fn assert_ledger(s: &Solver<3>) {
-        let (ledger, residual) = (&s.state.ledger, s.residual());
-        for b in 0..3 {
-            let sum = ledger.absorbed[b] + ledger.escaped[b] + residual[b];
-            assert!((sum - ledger.emitted[b]).abs() <= 1e-9 * ledger.emitted[b]);
-        }
-        assert!(residual.is_finite() && residual.is_non_negative());
-        assert!(
-            ledger.min_shot_escaped >= -1e-9,
-            "{}",
-            ledger.min_shot_escaped
-        );
-        assert!(ledger.min_element_absorbed >= -1e-9);
-    }
-
-    /// A grey plate (ρ = 0.5) under the emitter, both unit squares at
-    /// distance 1 (A F = 0.199825, docs/validation.md, closed form (a)):
-    /// the first shot leaves ρ π A F Le = 0.3139 W per band to shoot on,
-    /// however fine its links, since the T of a pair is the sum of its
-    /// sub-pairs' (within the form factors' cubature error: 1 % at the
-    /// root, 2 % summed over leaves, `refine::pair::tests`). After the
-    /// deadline the shot makes one root link and counts it late; without
-    /// a budget it refines and counts nothing.
-    #[test]
-    fn a_shot_after_the_deadline_carries_the_same_light_coarser() {
-        let plate = [(DVec3::ZERO, false, ts::diffuse(0.5))];
-        let expected = 0.5 * PI * 0.199825;
-        let free = first_shot(None, &plate);
-        let late = first_shot(Some(0.0), &plate);
-        assert_eq!(free.state.stats.late_links, 0);
-        assert!(free.state.stats.links_total > 1);
-        assert!(late.state.stats.late_links > 0);
-        assert_eq!(late.state.stats.links_total, 1, "one root link");
-        for s in [&free, &late] {
-            assert_ledger(s);
-            let r = s.residual();
-            for b in 0..3 {
-                assert!((r[b] - expected).abs() < 0.02 * expected, "{}", r[b]);
-            }
-        }
-    }
-
-    /// A glossy floor (GGX α 0.3) under the emitter and a grey plate over
-    /// it beside the emitter: after the deadline stage 2 links the
-    /// floor's hierarchy where it stands, and the light the floor reflects
-    /// towards the plate is still carried (positive, finite, within what
-    /// arrived).
-    #[test]
-    fn a_glossy_receiver_after_the_deadline_still_reflects() {
-        let scene = [
-            (DVec3::new(0.5, 0.0, 0.0), false, ts::glossy(0.3)),
-            (DVec3::new(1.5, 0.0, 1.0), true, ts::diffuse(0.5)),
-        ];
-        for budget in [None, Some(0.0)] {
-            let s = first_shot(budget, &scene);
-            assert_eq!(s.state.stats.late_links > 0, budget.is_some());
-            assert_eq!(s.state.stats.late_groups > 0, budget.is_some());
-            assert_ledger(&s);
-            let glossy: f64 = s
-                .state
-                .hierarchies
-                .iter()
-                .flatten()
-                .map(|h| h.unshot_flux.sum())
-                .sum();
-            assert!(glossy > 0.0 && glossy.is_finite(), "{glossy}");
-            // At most the emitter's flux arrives on the floor.
-            assert!(glossy <= 3.0 * PI, "{glossy}");
-        }
-    }
-
-    /// Past the deadline a glossy face's hemisphere coverage is its
-    /// root's, summed from the root throughputs its hierarchies hold, for
-    /// any element j: the same form factors as the root coverage made
-    /// afresh, the visibility from other shadow rays (hundreds per root
-    /// pair, nearly all unblocked here: within 1 %).
-    #[test]
-    fn the_late_coverage_is_the_roots_from_the_stored_throughputs() {
-        let scene = [
-            (DVec3::new(0.5, 0.0, 0.0), false, ts::glossy(0.3)),
-            (DVec3::new(1.5, 0.0, 1.0), true, ts::diffuse(0.5)),
-        ];
-        let s = first_shot(None, &scene);
-        let floor = ts::front(1);
-        let root = s.setup.forest().root(floor.surface());
-        let leaf = *ts::leaves(s.setup.forest(), root).last().unwrap();
-        assert!(
-            s.state
-                .hierarchies
-                .iter()
-                .flatten()
-                .any(|h| h.from == floor && !h.pending)
-        );
-        let fresh = s.hemisphere_coverage(floor, root, false);
-        s.state.coverage.lock().unwrap().clear();
-        let late = s.hemisphere_coverage(floor, leaf, true);
-        assert!(fresh > 0.0 && fresh < 1.0, "{fresh}");
-        assert!((late - fresh).abs() <= 0.01 * fresh, "{late} {fresh}");
-        // Not j's own: the leaf's coverage made afresh differs.
-        s.state.coverage.lock().unwrap().clear();
-        let own = s.hemisphere_coverage(floor, leaf, false);
-        assert!((own - fresh).abs() > 0.05 * fresh, "{own} {fresh}");
-    }
 }

@@ -90,6 +90,9 @@ pub struct Solver<const N: usize> {
     /// (`release_all_deferred`): root throughputs are then made with the
     /// base rays.
     pub(crate) final_release: bool,
+    /// The most stored hierarchies one batch of a shot's stage 2 reaches
+    /// (`batch::BATCH_HIERARCHIES`; smaller in tests).
+    pub(crate) batch_hierarchies: usize,
 }
 
 impl<const N: usize> Solver<N> {
@@ -112,6 +115,7 @@ impl<const N: usize> Solver<N> {
             time_budget: budget.map(Duration::from_secs_f64),
             stop: None,
             final_release: false,
+            batch_hierarchies: crate::batch::BATCH_HIERARCHIES,
         })
     }
 

@@ -58,7 +58,6 @@ fn stage_two(
         sender: &sender,
         si: e,
         h: &mut h,
-        h_index: h_index as u32,
         group: 0,
         lost: Spectrum::zero(),
         out: Vec::new(),

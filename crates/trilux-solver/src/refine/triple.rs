@@ -102,8 +102,6 @@ pub(crate) struct TripleTask<'t, const N: usize> {
     pub si: FaceId,
     /// The receiving hierarchy (this task owns it for the shot).
     pub h: &'t mut Hierarchy<N>,
-    /// Its index among the solver's hierarchies.
-    pub h_index: u32,
     /// The pair link being refined.
     pub group: u32,
     /// Flux that splits could not keep.
@@ -399,7 +397,6 @@ impl<const N: usize> RefineContext<'_, N> {
         };
         let gathered = known.unshot * fr * (PI * known.tij.t / aj);
         let link = NodeLink {
-            hierarchy: task.h_index,
             node: n,
             group: task.group,
             gathered,
@@ -463,7 +460,6 @@ impl<const N: usize> RefineContext<'_, N> {
         let reflected = Spectrum::from_fn(|b| (share[b] * ratio).min(MAX_SAMPLED_GAIN));
         let gathered = known.unshot * reflected * g;
         let link = NodeLink {
-            hierarchy: task.h_index,
             node: n,
             group: task.group,
             gathered,

@@ -84,7 +84,6 @@ fn with_task(
         sender: &sender,
         si: e,
         h: &mut h,
-        h_index: h_index as u32,
         group: 0,
         lost: Spectrum::zero(),
         out: Vec::new(),
@@ -197,7 +196,6 @@ fn a_link_splits_the_element_its_errors_point_to() {
             driver,
         };
         let link = NodeLink {
-            hierarchy: 0,
             node: 0,
             group: 0,
             gathered: Spectrum::splat(1.0),
