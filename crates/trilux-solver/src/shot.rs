@@ -400,9 +400,16 @@ impl<const N: usize> Solver<N> {
         };
         let mut reception = self.begin_reception(&glossy, &incidences);
         let (mut most, mut made) = (0, 0);
-        let limit = self.batch_hierarchies;
-        for batch in batches(limit, &self.setup.stored_from, &glossy.links, &incidences) {
-            let stage_two = self.stage_two_batch(shot, (&glossy.links, &incidences), &batch);
+        let batches = batches(
+            self.batch_hierarchies,
+            &self.setup.stored_from,
+            &glossy.links,
+            &incidences,
+        );
+        let trim = batches.len() > 1;
+        for batch in batches {
+            let stage_two =
+                self.stage_two_batch(shot, (&glossy.links, &incidences), (&batch, trim));
             let node_links = self.book_lost(stage_two);
             let n = node_links.iter().map(|(_, l)| l.len()).sum::<usize>();
             (most, made) = (most.max(n), made + n);
@@ -423,12 +430,13 @@ impl<const N: usize> Solver<N> {
     }
 
     /// Phase 4 for one batch of groups (`batches`), with what its
-    /// refinement cut short at the deadline booked.
+    /// refinement cut short at the deadline booked; `trim` when the shot
+    /// has several batches.
     fn stage_two_batch(
         &mut self,
         shot: ShotGroups<'_, N>,
         (links, incidences): (&[PairLink<N>], &[Option<Incidence<N>>]),
-        batch: &[u32],
+        batch: (&[u32], bool),
     ) -> StageTwo<N> {
         let (stage_two, late) = {
             let (mut ctx, hierarchies, _) = self.split_for_shot();
@@ -699,7 +707,7 @@ fn stage_two<const N: usize>(
     senders: &[(&Sender<'_, N>, FaceId)],
     (hierarchies, stored_from): (&mut [Option<Hierarchy<N>>], &PerFace<Range<usize>>),
     (pair_links, incidences): (&[PairLink<N>], &[Option<Incidence<N>>]),
-    batch: &[u32],
+    (batch, trim): (&[u32], bool),
 ) -> StageTwo<N> {
     let mut groups_of_face: HashMap<FaceId, Vec<u32>> = HashMap::new();
     for &g in batch {
@@ -754,9 +762,13 @@ fn stage_two<const N: usize>(
                     ctx.refine_triple(&mut task, l.i, j, n, Some(incidence));
                 }
             }
-            // A batch's links live until it is received: without the
-            // growth's spare capacity (0.5 GB of the staircase's peak).
-            task.out.shrink_to_fit();
+            // A large shot's links live until their batch is received:
+            // without the growth's spare capacity (0.5 GB of the
+            // staircase's peak; a reallocation per hierarchy, so only
+            // there).
+            if trim {
+                task.out.shrink_to_fit();
+            }
             (task.out, h as u32, task.lost)
         })
         .collect()
