@@ -26,6 +26,8 @@ pub(crate) struct Reception<const N: usize> {
     sampled_flux: Vec<Spectrum<N>>,
     /// The far-field increments, before the renormalisation.
     far_adds: Vec<Option<Vec<Spectrum<N>>>>,
+    /// What arrives through each group and what it may reflect.
+    rooms: Vec<GroupRoom<N>>,
     /// Each group's scales of its midpoint-rule and sampled links.
     pub scales: Vec<(Spectrum<N>, Spectrum<N>)>,
 }
@@ -34,6 +36,8 @@ pub(crate) struct Reception<const N: usize> {
 struct GroupRoom<const N: usize> {
     /// π T_ij δL, the flux that arrives at j.
     arrived: Spectrum<N>,
+    /// The ρ_d that j reflects it with (`lambertian_rho`).
+    rho_d: Spectrum<N>,
     /// Its Lambertian share.
     diffuse: Spectrum<N>,
     /// What the glossy share may reflect of its own light.
@@ -44,14 +48,18 @@ struct GroupRoom<const N: usize> {
 }
 
 impl<const N: usize> Solver<N> {
-    /// Before a shot's batches: the far fields its glossy light reaches
-    /// are traced and what each group adds to them is its first glossy
-    /// flux.
+    /// Before a shot's batches: what arrives through each group, the far
+    /// fields its glossy light reaches traced, and what each group adds to
+    /// them as its first glossy flux.
     pub(crate) fn begin_reception(
         &mut self,
+        groups: &Groups<N>,
         glossy: &Glossy<N>,
         incidences: &[Option<Incidence<N>>],
     ) -> Reception<N> {
+        let rooms = (0..groups.links.len())
+            .map(|g| self.group_room(groups, g))
+            .collect();
         self.trace_far_fields(glossy);
         let n = glossy.links.len();
         let far_adds: Vec<Option<Vec<Spectrum<N>>>> = glossy
@@ -73,6 +81,7 @@ impl<const N: usize> Solver<N> {
             glossy_flux,
             sampled_flux: vec![Spectrum::zero(); n],
             far_adds,
+            rooms,
             scales: vec![(Spectrum::splat(1.0), Spectrum::splat(1.0)); n],
         }
     }
@@ -83,7 +92,6 @@ impl<const N: usize> Solver<N> {
     /// reflects more than arrived.
     pub(crate) fn reflect_batch(
         &mut self,
-        groups: &Groups<N>,
         (glossy, incidences): (&Glossy<N>, &[Option<Incidence<N>>]),
         node_links: &NodeLinks<N>,
         batch: &[u32],
@@ -103,7 +111,7 @@ impl<const N: usize> Solver<N> {
             .collect();
         for (&g, target) in batch.iter().zip(targets) {
             let g = g as usize;
-            let room = self.group_room(groups, g).now;
+            let room = reception.rooms[g].now;
             self.state.stats.late_groups += u64::from(late && target.is_some());
             self.state.stats.coarse_groups +=
                 u64::from(target.is_some() && incidences[g].as_ref().is_some_and(|i| i.coarse));
@@ -131,8 +139,8 @@ impl<const N: usize> Solver<N> {
         let mut total_arrived = Spectrum::<N>::zero();
         let mut absorbed = Spectrum::<N>::zero();
         for (g, l) in groups.links.iter().enumerate() {
-            let room = self.group_room(groups, g);
-            self.receive_lambertian(l, groups.scale);
+            let room = &reception.rooms[g];
+            self.receive_lambertian(l, room.rho_d, groups.scale);
             if let GlossyIn::Wait { from } = &groups.plan[g] {
                 self.state.deferred.book_waiting(l.face, *from, room.own);
                 self.state.queue.touch(Source::Deferred(l.face));
@@ -178,8 +186,9 @@ impl<const N: usize> Solver<N> {
         let l = &groups.links[g];
         let arrived = l.unshot * groups.scale * (PI * l.t);
         let aj = self.setup.exposed_area[l.face.side()][l.j.index()];
+        let rho_d = self.lambertian_rho(l);
         let diffuse = if aj > 0.0 {
-            arrived * self.lambertian_rho(l)
+            arrived * rho_d
         } else {
             Spectrum::zero()
         };
@@ -193,6 +202,7 @@ impl<const N: usize> Solver<N> {
         };
         GroupRoom {
             arrived,
+            rho_d,
             diffuse,
             own,
             now,
@@ -307,8 +317,7 @@ impl<const N: usize> Solver<N> {
 
     /// The Lambertian share of a pair link: ρ_d (T_ij / A_j) δL into j's
     /// gathered radiance and its flux into the face's key.
-    fn receive_lambertian(&mut self, l: &PairLink<N>, shot_scale: Spectrum<N>) {
-        let rho_d = self.lambertian_rho(l);
+    fn receive_lambertian(&mut self, l: &PairLink<N>, rho_d: Spectrum<N>, shot_scale: Spectrum<N>) {
         let side = l.face.side();
         let aj = self.setup.exposed_area[side][l.j.index()];
         if !rho_d.is_black() && aj > 0.0 {

@@ -398,7 +398,7 @@ impl<const N: usize> Solver<N> {
             let senders = group_senders(shot, &sender);
             incidences(&ctx.refine, ctx.stored_from, &senders, &glossy.links)
         };
-        let mut reception = self.begin_reception(&glossy, &incidences);
+        let mut reception = self.begin_reception(groups, &glossy, &incidences);
         let (mut most, mut made) = (0, 0);
         let batches = batches(
             self.batch_hierarchies,
@@ -413,13 +413,7 @@ impl<const N: usize> Solver<N> {
             let node_links = self.book_lost(stage_two);
             let n = node_links.iter().map(|(_, l)| l.len()).sum::<usize>();
             (most, made) = (most.max(n), made + n);
-            self.reflect_batch(
-                groups,
-                (&glossy, &incidences),
-                &node_links,
-                &batch,
-                &mut reception,
-            );
+            self.reflect_batch((&glossy, &incidences), &node_links, &batch, &mut reception);
             self.apply_node_links(&node_links, &glossy.scales, &reception.scales);
         }
         self.receive(groups, reception, (phi, share));

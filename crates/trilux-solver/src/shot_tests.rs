@@ -14,10 +14,13 @@ use crate::prepared::SceneDescription;
 use crate::solver::Solver;
 use crate::test_scenes as ts;
 
-/// The first shot of a scene of unit squares: an emitter (Le = 1)
-/// facing down at height 1 over `receivers` (centre, facing down,
-/// material), with time budget `budget`.
-fn first_shot(budget: Option<f64>, receivers: &[(DVec3, bool, BsdfParams)]) -> Solver<3> {
+/// A scene of unit squares: an emitter (Le = 1) facing down at height 1
+/// over `receivers` (centre, facing down, material), prepared with
+/// `settings`.
+fn under_emitter(
+    receivers: &[(DVec3, bool, BsdfParams)],
+    settings: crate::settings::SolverSettings,
+) -> Solver<3> {
     let mut shapes = vec![ts::square(DVec3::new(0.0, 0.0, 1.0), 1.0, true)];
     let mut bsdfs = vec![ts::diffuse(0.0)];
     let mut emission = vec![Some(ColorParam::Float(1.0))];
@@ -31,9 +34,15 @@ fn first_shot(budget: Option<f64>, receivers: &[(DVec3, bool, BsdfParams)]) -> S
         bsdfs: &bsdfs,
         emission: &emission,
     };
+    Solver::from_description(&desc, settings).unwrap()
+}
+
+/// The first shot of [`under_emitter`]'s scene, with time budget
+/// `budget`.
+fn first_shot(budget: Option<f64>, receivers: &[(DVec3, bool, BsdfParams)]) -> Solver<3> {
     let mut settings = ts::settings(3);
     settings.time_budget_seconds = budget;
-    let mut solver = Solver::from_description(&desc, settings).unwrap();
+    let mut solver = under_emitter(receivers, settings);
     let source = solver.next_source().unwrap();
     solver.shoot(source);
     solver
@@ -50,25 +59,10 @@ fn first_shot(budget: Option<f64>, receivers: &[(DVec3, bool, BsdfParams)]) -> S
 #[test]
 fn a_shot_in_batches_delivers_what_one_batch_does() {
     let run = |limit: usize| {
-        let mut shapes = vec![ts::square(DVec3::new(0.0, 0.0, 1.0), 1.0, true)];
-        let mut bsdfs = vec![ts::diffuse(0.0)];
-        let mut emission = vec![Some(ColorParam::Float(1.0))];
-        for x in [-1.5, 1.5] {
-            shapes.push(ts::square(DVec3::new(x, 0.0, 1.0), 1.0, true));
-            bsdfs.push(ts::diffuse(0.5));
-            emission.push(None);
-        }
-        for x in [-1.0, 0.0, 1.0] {
-            shapes.push(ts::square(DVec3::new(x, 0.0, 0.0), 1.0, false));
-            bsdfs.push(ts::glossy(0.3));
-            emission.push(None);
-        }
-        let desc = SceneDescription {
-            shapes: &shapes,
-            bsdfs: &bsdfs,
-            emission: &emission,
-        };
-        let mut solver = Solver::<3>::from_description(&desc, ts::settings(2)).unwrap();
+        let plates = [-1.5, 1.5].map(|x| (DVec3::new(x, 0.0, 1.0), true, ts::diffuse(0.5)));
+        let tiles = [-1.0, 0.0, 1.0].map(|x| (DVec3::new(x, 0.0, 0.0), false, ts::glossy(0.3)));
+        let receivers: Vec<_> = plates.into_iter().chain(tiles).collect();
+        let mut solver = under_emitter(&receivers, ts::settings(2));
         solver.batch_hierarchies = limit;
         for s in 3..6 {
             assert!(!solver.setup.stored_from[ts::front(s)].is_empty());

@@ -31,7 +31,7 @@ use crate::throughput::Throughput;
 /// metal-box's mirrors lost 0.14 % of its image, to 2 0.06 %, to 4 0.02 %.
 /// 4 still bounds surfaces in contact, where T_jk came out 800 times too
 /// low.
-const MAX_SAMPLED_GAIN: f64 = 4.0;
+pub(super) const MAX_SAMPLED_GAIN: f64 = 4.0;
 
 /// What a three-point link (i j) → (j k) takes from its pair (i, j), the
 /// same for every receiver node k: computed once per pair link and handed

@@ -13,7 +13,7 @@ use trilux_geometry::ElementId;
 
 use super::RefineContext;
 use super::incidences::IncidenceMemo;
-use super::triple::{Incidence, TripleErrors, TripleTask};
+use super::triple::{Incidence, MAX_SAMPLED_GAIN, TripleErrors, TripleTask};
 use crate::interaction::{Hierarchy, Split};
 use crate::link::Sent;
 use crate::link::{NodeLink, Sender};
@@ -248,7 +248,7 @@ fn a_sampled_link_is_bounded_by_the_light_that_arrives() {
     for b in 0..3 {
         let got = links[0].gathered[b];
         assert!(
-            got > 0.0 && got <= 4.0 * unshot[b] * (1.0 + 1e-12),
+            got > 0.0 && got <= MAX_SAMPLED_GAIN * unshot[b] * (1.0 + 1e-12),
             "band {b}: {got} against δL {}",
             unshot[b]
         );
